@@ -1,0 +1,51 @@
+// The render target: every buffer the passes and the reconstruction need, accumulated in double.
+// Pixel (x, y) has y = 0 at the BOTTOM row (Blender's convention). Gradients are forward
+// differences in those rows: dx(x, y) ~ I(x+1, y) - I(x, y), dy(x, y) ~ I(x, y+1) - I(x, y).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "integrator/math/vec.h"
+
+namespace gdpt {
+
+class Film {
+ public:
+  Film() = default;
+  Film(int width, int height);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  size_t pixel_count() const { return size_t(width_) * size_t(height_); }
+
+  // Float32 images for passes, interleaved, row 0 at the bottom. Means over the samples done.
+  void primal_rgb(float* out) const;      // 3 per pixel, without camera-visible emission
+  void gradient_x_rgb(float* out) const;  // 3 per pixel
+  void gradient_y_rgb(float* out) const;  // 3 per pixel
+  void emission_rgb(float* out) const;    // 3 per pixel: camera-visible emission (never shifted)
+  // 3 per pixel: variance of the pixel mean of luminance(primal), luminance(dx), luminance(dy).
+  void variance3(float* out) const;
+  void shift_failures(float* out) const;  // 1 per pixel: fraction of failed shifts
+  uint32_t samples(int x, int y) const { return samples_[size_t(y) * width_ + x]; }
+  uint32_t min_samples() const;
+
+  // --- Accumulation (called by the integrators; each pixel is written by one thread at a time) ---
+  struct Accumulator {
+    double primal[3] = {0, 0, 0}, primal2 = 0;  // sum, sum of squared luminance
+    double dx[3] = {0, 0, 0}, dx2 = 0;
+    double dy[3] = {0, 0, 0}, dy2 = 0;
+    double emission[3] = {0, 0, 0};
+    double shift_attempts = 0, shift_failures = 0;
+  };
+  Accumulator& pixel(int x, int y) { return acc_[size_t(y) * width_ + x]; }
+  const Accumulator& pixel(int x, int y) const { return acc_[size_t(y) * width_ + x]; }
+  void add_sample_count(int x, int y, uint32_t n = 1) { samples_[size_t(y) * width_ + x] += n; }
+
+ private:
+  int width_ = 0, height_ = 0;
+  std::vector<Accumulator> acc_;
+  std::vector<uint32_t> samples_;
+};
+
+}  // namespace gdpt

@@ -1,0 +1,21 @@
+// Render settings shared by the add-on (scene.gdpt), the tests and the benchmarks.
+#pragma once
+
+#include <cstdint>
+
+namespace gdpt {
+
+struct RenderSettings {
+  enum class Mode : uint8_t { PT, GPT } mode = Mode::GPT;
+  int samples = 64;         // samples per pixel
+  double time_limit = 0.0;  // seconds, 0 = none
+  int max_bounces = 8;      // path segments after the camera ray
+  uint32_t seed = 0;
+  int threads = 0;                           // 0 = all cores
+  float clamp = 0.0f;                        // max sample value, 0 = off
+  int rr_depth = 5;                          // Russian roulette from this depth on
+  float shift_roughness_threshold = 0.001f;  // G-PT: GGX alpha below this = specular vertex
+  int samples_per_pass = 1;  // progressive granularity (a pass = this many spp over the image)
+};
+
+}  // namespace gdpt

@@ -1,0 +1,84 @@
+// Plain-data scene description: everything the integrator needs, with no Blender or Python
+// types. The add-on fills it from the depsgraph with flat arrays; tests build it directly.
+// Conventions follow Blender/Cycles so a .blend renders as bright as in Cycles.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "integrator/math/transform.h"
+#include "integrator/math/vec.h"
+#include "shaders/material_desc.h"
+
+namespace gdpt {
+
+// Triangle mesh in object space. Attributes are per triangle corner (Blender loop triangles).
+struct Mesh {
+  std::vector<Vec3f> positions;        // vertices
+  std::vector<uint32_t> indices;       // 3 per triangle, into positions
+  std::vector<Vec3f> corner_normals;   // 3 per triangle (split normals); empty = flat shading
+  std::vector<Vec2f> corner_uvs;       // 3 per triangle; empty = no UVs (uv = 0)
+  std::vector<int32_t> material_slot;  // per triangle; empty = slot 0
+  size_t triangle_count() const { return indices.size() / 3; }
+};
+
+// A placement of a mesh. Many instances share one Mesh (Embree two-level instancing).
+struct Instance {
+  uint32_t mesh = 0;
+  Transform object_to_world;
+  std::vector<int32_t> slot_material;  // slot -> index in Scene::materials (-1 = default)
+};
+
+// Blender camera. Looks down its local -Z with +Y up, like Blender.
+struct Camera {
+  enum class Projection : uint8_t {
+    Perspective,
+    Orthographic
+  } projection = Projection::Perspective;
+  enum class SensorFit : uint8_t { Auto, Horizontal, Vertical } sensor_fit = SensorFit::Auto;
+  Transform camera_to_world;
+  float focal_length_mm = 50.0f;
+  float sensor_width_mm = 36.0f;
+  float sensor_height_mm = 24.0f;
+  float shift_x = 0.0f, shift_y = 0.0f;  // in units of the larger sensor dimension, as Blender
+  float ortho_scale = 6.0f;
+  float clip_start = 0.1f, clip_end = 1000.0f;
+  float aperture_radius = 0.0f;   // metres; 0 = pinhole (Blender: focal_length / (2 f-stop))
+  float focus_distance = 10.0f;   // metres along -Z
+  int width = 640, height = 480;  // pixels after resolution percentage
+  float pixel_aspect = 1.0f;      // pixel_aspect_x / pixel_aspect_y
+};
+
+// Blender light object. Emission direction is the light's local -Z (spot, sun, area).
+struct Light {
+  enum class Type : uint8_t { Point, Spot, Sun, Area } type = Type::Point;
+  enum class Shape : uint8_t { Square, Rectangle, Disk, Ellipse } shape = Shape::Square;
+  Transform light_to_world;
+  Spectrum color{1.0f, 1.0f, 1.0f};
+  float power = 10.0f;       // W for point/spot/area, W/m^2 irradiance for sun
+  float radius = 0.0f;       // point/spot soft size (sphere radius), metres
+  float spot_size = 0.785f;  // full cone angle, radians
+  float spot_blend = 0.15f;
+  float sun_angle = 0.0f;              // angular diameter, radians
+  float size_x = 1.0f, size_y = 1.0f;  // area light extent, metres (before object scale)
+};
+
+struct World {
+  Spectrum color{0.05f, 0.05f, 0.05f};  // Blender's default world grey
+  float strength = 1.0f;
+  int32_t image = -1;  // equirectangular environment in Scene::images; -1 = constant colour
+  Transform rotation;  // world direction -> environment lookup direction (Mapping node rotation)
+};
+
+struct Scene {
+  std::vector<Mesh> meshes;
+  std::vector<Instance> instances;
+  std::vector<MaterialDesc> materials;
+  std::vector<ImageDesc> images;
+  std::vector<Light> lights;
+  Camera camera;
+  World world;
+};
+
+}  // namespace gdpt

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package GDPT needs (compilers aside). Idempotent:
+# runs `apt-get update` and `apt-get install` only when something is missing.
+set -euo pipefail
+
+PACKAGES=(
+  cmake make g++ pkg-config clang-format
+  libembree-dev libtbb-dev
+  libopenimageio-dev openimageio-tools libopenexr-dev
+  libopencolorio-dev
+  libfftw3-dev
+  pybind11-dev python3-dev python3-numpy
+  libgtest-dev libgmock-dev libbenchmark-dev
+  blender
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+echo "setup-deps: installing ${missing[*]}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

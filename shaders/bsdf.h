@@ -1,0 +1,100 @@
+// The BSDF interface shared by PT and G-PT: a shading point's material evaluates to a ClosureSet,
+// a weighted sum of BSDF lobes (like Cycles' closures), sampled and evaluated in the local shading
+// frame (normal = +z).
+//
+// Conventions (Mitsuba-style):
+//  - wi points from the surface towards the previous path vertex, wo towards the next one.
+//  - eval() returns f(wi, wo) * |cos theta_o| (the cosine-weighted BSDF value).
+//  - pdf() is the solid-angle density of sample() producing wo, including lobe selection.
+//  - Delta lobes (smooth glass, mirror, transparent) are never returned by eval()/pdf(); sample()
+//    reports them with is_delta = true, value = weight of the discrete choice, pdf = its
+//    probability.
+//  - roughness() is what the gradient-domain shift uses to classify a vertex: the minimum GGX alpha
+//    (or 1 for diffuse lobes) over the non-delta lobes; a sampled delta lobe counts as 0.
+#pragma once
+
+#include <cstdint>
+
+#include "integrator/math/frame.h"
+#include "integrator/math/vec.h"
+
+namespace gdpt {
+
+enum class ClosureType : uint8_t {
+  Lambert,            // color / pi
+  OrenNayar,          // Cycles' Oren-Nayar with sigma = roughness
+  PrincipledDiffuse,  // Disney/Burley diffuse as in Cycles' Principled v1
+  GGXReflection,  // GGX with Fresnel mode below (Glossy: none; Principled specular: Schlick mix)
+  GGXDielectric,  // GGX glass: reflection + refraction by dielectric Fresnel; alpha 0 = smooth
+  Transparent,    // straight through, delta
+};
+
+enum class FresnelMode : uint8_t {
+  None,          // Glossy BSDF: colour only
+  Dielectric,    // exact dielectric Fresnel with ior
+  PrincipledV1,  // Cycles principled v1: mix(F0 tinted, base colour by metallic) via Schlick weight
+};
+
+struct Closure {
+  ClosureType type = ClosureType::Lambert;
+  FresnelMode fresnel = FresnelMode::None;
+  Spectrum weight{1.0f, 1.0f, 1.0f};  // colour * mix weight
+  float alpha = 0.0f;                 // GGX alpha (= Blender roughness^2); diffuse roughness
+  float ior = 1.45f;                  // relative IOR (outside -> inside)
+  Spectrum f0{0.04f, 0.04f, 0.04f};   // PrincipledV1 specular colour at normal incidence
+  Vec3f normal{0.0f, 0.0f, 1.0f};     // local-frame normal of the lobe (reserved; +z today)
+};
+
+enum LobeFlags : uint8_t {
+  kLobeReflection = 1 << 0,
+  kLobeTransmission = 1 << 1,
+  kLobeDiffuse = 1 << 2,
+  kLobeGlossy = 1 << 3,
+  kLobeDelta = 1 << 4,
+};
+
+struct BsdfSample {
+  Vec3f wo;                // local frame
+  Spectrum value;          // eval(wi, wo) (or the delta weight * pdf for delta lobes)
+  float pdf = 0.0f;        // solid angle (or discrete probability for delta lobes)
+  float eta = 1.0f;        // relative IOR crossed (1 for reflection)
+  float roughness = 1.0f;  // roughness of the sampled lobe (0 for delta)
+  uint8_t lobe = 0;        // LobeFlags of the sampled lobe
+  bool valid = false;
+  bool is_delta() const { return (lobe & kLobeDelta) != 0; }
+  Spectrum weight() const { return pdf > 0.0f ? value / pdf : Spectrum(0.0f); }
+};
+
+// At most kMaxClosures lobes per shading point: fixed storage, no allocation in the hot loop.
+inline constexpr int kMaxClosures = 8;
+
+class ClosureSet {
+ public:
+  void clear() {
+    count_ = 0;
+    emission_ = Spectrum(0.0f);
+  }
+  // Adds a lobe; weights that are zero are dropped; a full set drops the lobe of least weight.
+  void add(const Closure& c);
+  void add_emission(Spectrum e) { emission_ += e; }
+
+  int count() const { return count_; }
+  const Closure& operator[](int i) const { return closures_[i]; }
+  Spectrum emission() const { return emission_; }
+  bool has_bsdf() const { return count_ > 0; }
+
+  Spectrum eval(Vec3f wi, Vec3f wo) const;
+  float pdf(Vec3f wi, Vec3f wo) const;
+  // u_lobe picks the lobe (by weight luminance), u the direction within it.
+  BsdfSample sample(Vec3f wi, float u_lobe, Vec2f u) const;
+  // Minimum roughness over non-delta lobes (1 for pure diffuse); 0 if only delta lobes.
+  float roughness() const;
+  bool has_delta() const;
+
+ private:
+  Closure closures_[kMaxClosures];
+  int count_ = 0;
+  Spectrum emission_{0.0f, 0.0f, 0.0f};
+};
+
+}  // namespace gdpt

@@ -1,0 +1,46 @@
+// A compiled material: evaluates a MaterialDesc node tree at a hit point into closures.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "shaders/bsdf.h"
+#include "shaders/material_desc.h"
+#include "shaders/shading_context.h"
+#include "shaders/texture.h"
+
+namespace gdpt {
+
+// What a material uses; the integrator ORs these over the scene to pick a specialised kernel.
+enum MaterialFeature : uint32_t {
+  kFeatureTextures = 1u << 0,
+  kFeatureTransmission = 1u << 1,  // glass / principled transmission (refraction)
+  kFeatureGlossy = 1u << 2,        // GGX lobes
+  kFeatureDelta = 1u << 3,         // smooth glass / transparent
+  kFeatureEmission = 1u << 4,
+  kFeatureTransparent = 1u << 5,  // transparent BSDF or principled alpha < 1
+};
+
+class Material {
+ public:
+  Material(const MaterialDesc& desc, std::span<const Texture> textures);
+  // Default grey diffuse (Blender's default material, colour 0.8).
+  Material();
+
+  void evaluate(const ShadingContext& ctx, ClosureSet& out) const;  // BSDF lobes + emission
+  Spectrum emission(const ShadingContext& ctx) const;               // emission only, cheaper
+  bool is_emissive() const { return (features_ & kFeatureEmission) != 0; }
+  // Emission averaged over textures (for sampling emissive triangles by power).
+  Spectrum average_emission() const { return average_emission_; }
+  uint32_t features() const { return features_; }
+
+ private:
+  std::vector<ShaderNode> nodes_;
+  int32_t root_ = -1;
+  std::span<const Texture> textures_;
+  uint32_t features_ = 0;
+  Spectrum average_emission_{0.0f, 0.0f, 0.0f};
+};
+
+}  // namespace gdpt

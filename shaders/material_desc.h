@@ -1,0 +1,83 @@
+// Plain-data description of a material, translated from a Blender node tree by the add-on
+// (or built directly by tests). A material is a small expression tree of shader nodes; inputs are
+// constants or image-texture lookups. shaders/ compiles it into closures at each hit point.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "integrator/math/transform.h"
+#include "integrator/math/vec.h"
+
+namespace gdpt {
+
+// Texture lookup: Scene::images[image] sampled at the mesh UV, through an optional Mapping node.
+struct TextureLookup {
+  int32_t image = -1;    // -1: no texture, use the constant
+  Transform uv_mapping;  // applied to (u, v, 0): Blender Mapping node (Point type)
+  enum class Interpolation : uint8_t { Linear, Closest } interpolation = Interpolation::Linear;
+  enum class Extension : uint8_t { Repeat, Extend, Clip } extension = Extension::Repeat;
+};
+
+struct ColorInput {
+  ColorInput() = default;
+  explicit ColorInput(Spectrum v) : value(v) {}
+  Spectrum value{0.8f, 0.8f, 0.8f};
+  TextureLookup texture;  // when texture.image >= 0, the texture's RGB replaces value
+};
+
+struct FloatInput {
+  FloatInput() = default;
+  explicit FloatInput(float v) : value(v) {}
+  float value = 0.0f;
+  TextureLookup texture;  // when texture.image >= 0: the texture's channel below replaces value
+  enum class Channel : uint8_t { Luminance, Red, Alpha } channel = Channel::Luminance;
+};
+
+enum class ShaderNodeKind : uint8_t {
+  Diffuse,      // Blender Diffuse BSDF: Lambert (roughness 0) or Oren-Nayar (roughness > 0)
+  Glossy,       // Blender Glossy BSDF, GGX (no Fresnel; colour scales), roughness -> alpha = r^2
+  Glass,        // Blender Glass BSDF, GGX dielectric; roughness 0 = smooth (delta)
+  Principled,   // Blender 3.4 Principled BSDF v1
+  Emission,     // colour * strength (radiance, W/m^2/sr per unit strength as in Cycles)
+  Transparent,  // straight-through transmission, colour scales
+  Mix,          // (1 - fac) * a + fac * b
+  Add,          // a + b
+};
+
+struct ShaderNode {
+  ShaderNodeKind kind = ShaderNodeKind::Diffuse;
+  ColorInput color;           // base colour for every BSDF, emission colour for Emission
+  FloatInput roughness;       // Diffuse, Glossy, Glass, Principled
+  FloatInput ior{1.45f};      // Glass, Principled
+  FloatInput strength{1.0f};  // Emission
+  FloatInput fac{0.5f};       // Mix
+  int32_t a = -1, b = -1;     // Mix / Add children (indices into Material::nodes)
+
+  // Principled BSDF v1 inputs beyond colour / roughness / ior (subsurface is ignored with a
+  // warning).
+  FloatInput metallic{0.0f};
+  FloatInput specular{0.5f};
+  FloatInput specular_tint{0.0f};
+  FloatInput transmission{0.0f};
+  FloatInput alpha{1.0f};
+  ColorInput emission{Spectrum(0.0f)};
+  FloatInput emission_strength{1.0f};
+};
+
+struct MaterialDesc {
+  std::string name;
+  std::vector<ShaderNode> nodes;
+  int32_t root = -1;  // -1: Blender's default grey diffuse (0.8)
+};
+
+// Image pixels in scene-linear RGBA float (the loader converts from the file's colour space via
+// OCIO).
+struct ImageDesc {
+  std::string name;
+  int width = 0, height = 0;
+  std::vector<float> rgba;  // width * height * 4, row 0 at the bottom (Blender's convention)
+};
+
+}  // namespace gdpt
