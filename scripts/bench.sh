@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# `make bench`: runs every benchmark executable (bench_*) of the build, one after the other,
+# and every bench/*/*.sh script (e.g. the Blender-vs-Cycles comparison). Output goes to stdout
+# and to out/bench/<name>.txt.
+set -euo pipefail
+build=${1:-build}
+root=$(cd "$(dirname "$0")/.." && pwd)
+mkdir -p "$root/out/bench"
+status=0
+while IFS= read -r exe; do
+  name=$(basename "$exe")
+  echo "=== $name"
+  "$exe" 2>&1 | tee "$root/out/bench/$name.txt" || status=1
+done < <(find "$build/bench" -type f -name 'bench_*' -perm -u+x | sort)
+while IFS= read -r script; do
+  name=$(basename "$script" .sh)
+  echo "=== $name"
+  bash "$script" "$build" 2>&1 | tee "$root/out/bench/$name.txt" || status=1
+done < <(find "$root/bench" -mindepth 2 -name '*.sh' | sort)
+exit $status
