@@ -42,10 +42,23 @@ class Film {
   const Accumulator& pixel(int x, int y) const { return acc_[size_t(y) * width_ + x]; }
   void add_sample_count(int x, int y, uint32_t n = 1) { samples_[size_t(y) * width_ + x] += n; }
 
+  // --- Bookkeeping (RenderSession) ---
+  // PT mode: the integrator does not estimate gradients; gradient_x/y_rgb() then return forward
+  // differences of the primal pixel means (0 at the last column / row, the Neumann rows of the
+  // reconstruction) and variance3() the matching sum of the two pixels' variances, so that
+  // reconstructing PT passes returns the PT image.
+  void set_gradients_from_primal(bool on) { gradients_from_primal_ = on; }
+  bool gradients_from_primal() const { return gradients_from_primal_; }
+  void clear();  // zero every accumulator and sample count
+  // Adds rows [y0, y1) of `pass` (same size) into this film and zeroes them in `pass`: how a
+  // completed pass is committed.
+  void take_rows(Film& pass, int y0, int y1);
+
  private:
   int width_ = 0, height_ = 0;
   std::vector<Accumulator> acc_;
   std::vector<uint32_t> samples_;
+  bool gradients_from_primal_ = false;
 };
 
 }  // namespace gdpt

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -37,6 +38,8 @@ class RenderSession {
   std::string features_summary() const;
   // Non-fatal problems found while preparing the scene (e.g. degenerate lights).
   const std::vector<std::string>& warnings() const;
+  // Rays traced so far (camera, extension and shadow rays), for the benchmarks.
+  uint64_t rays_traced() const;
 
  private:
   struct Impl;

@@ -16,6 +16,9 @@ struct RenderSettings {
   int rr_depth = 5;                          // Russian roulette from this depth on
   float shift_roughness_threshold = 0.001f;  // G-PT: GGX alpha below this = specular vertex
   int samples_per_pass = 1;  // progressive granularity (a pass = this many spp over the image)
+  // Debug / benchmark: run the kernel with every feature path on (same image, slower), to measure
+  // what the per-scene specialisation buys.
+  bool force_all_features = false;
 };
 
 }  // namespace gdpt

@@ -1,0 +1,70 @@
+// Camera rays with Blender/Cycles projection: sensor fit (Auto / Horizontal / Vertical), focal
+// length against the fitted sensor size, shift in units of the fitted dimension, pixel aspect,
+// orthographic (ortho_scale across the fitted dimension), thin-lens depth of field (uniform disk of
+// aperture_radius focused at focus_distance) and clip_start / clip_end measured along the view
+// axis as Cycles does.
+//
+// Raster coordinates: (0, 0) is the bottom-left corner of the image, (width, height) the top
+// right; pixel (x, y) covers [x, x+1) x [y, y+1). y = 0 is the BOTTOM row (Blender's convention).
+//
+// Pixel filter: Cycles importance-samples a Blackman-Harris filter of width 1.5 px; we use a box
+// filter over the pixel (jitter uniform in [0,1)^2), which G-PT needs for its +-1 pixel shifts.
+// Cross-engine comparisons therefore set Cycles' filter_width small (e.g. 0.01).
+#pragma once
+
+#include "integrator/math/transform.h"
+#include "integrator/math/vec.h"
+#include "integrator/scene.h"
+
+namespace gdpt {
+
+struct Ray {
+  Vec3f origin;
+  Vec3f direction;  // unit
+  float t_min = 0.0f;
+  float t_max = 1e30f;
+};
+
+class CameraModel {
+ public:
+  CameraModel() = default;
+  explicit CameraModel(const Camera& camera);
+
+  // Ray through raster position `raster` (pixel units, y up) and lens sample `lens` in [0,1)^2
+  // (ignored without depth of field). Shifting `raster` by +-1 with the same `lens` is how G-PT
+  // builds its offset paths.
+  Ray generate_ray(Vec2f raster, Vec2f lens) const;
+
+  // World point -> raster position (pinhole); returns false behind the camera. For tests.
+  bool project(Vec3f world, Vec2f& raster) const;
+
+  bool has_dof() const { return aperture_radius_ > 0.0f; }
+  bool orthographic() const { return ortho_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  Vec3f position() const { return camera_to_world_.translation(); }
+
+ private:
+  // Raster -> screen (viewplane) coordinates.
+  Vec2f raster_to_screen(Vec2f raster) const {
+    return {left_ + (right_ - left_) * raster.x * inv_width_,
+            bottom_ + (top_ - bottom_) * raster.y * inv_height_};
+  }
+
+  Transform camera_to_world_, world_to_camera_;
+  bool ortho_ = false;
+  int width_ = 1, height_ = 1;
+  float inv_width_ = 1.0f, inv_height_ = 1.0f;
+  // Viewplane in screen units, after shift.
+  float left_ = -1.0f, right_ = 1.0f, bottom_ = -1.0f, top_ = 1.0f;
+  // Perspective: camera-space direction = (sx * tan_half_, sy * tan_half_, -1).
+  // Orthographic: camera-space origin = (sx, sy, 0) (screen units are metres).
+  float tan_half_ = 1.0f;
+  float aperture_radius_ = 0.0f, focus_distance_ = 10.0f;
+  float clip_start_ = 0.1f, clip_end_ = 1000.0f;
+};
+
+// Concentric (Shirley-Chiu) map of [0,1)^2 to the unit disk.
+Vec2f sample_concentric_disk(Vec2f u);
+
+}  // namespace gdpt

@@ -1,0 +1,204 @@
+#include "integrator/embree_scene.h"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace gdpt {
+
+namespace {
+
+// Integer-ULP offset scale and the absolute fallback near the origin (positions whose magnitude is
+// below kOriginRegion have too few ULPs to step by integers meaningfully).
+constexpr float kOriginRegion = 1.0f / 32.0f;
+constexpr float kFloatScale = 1.0f / 65536.0f;
+constexpr float kIntScale = 256.0f;
+
+float nudge(float p, float n) {
+  const int32_t of = int32_t(kIntScale * n);
+  const int32_t bits = std::bit_cast<int32_t>(p);
+  const float stepped = std::bit_cast<float>(bits + (p < 0.0f ? -of : of));
+  return std::fabs(p) < kOriginRegion ? p + kFloatScale * n : stepped;
+}
+
+Vec3f safe_normalize(Vec3f v, Vec3f fallback) {
+  const float l2 = length_squared(v);
+  if (!(l2 > 0.0f) || !std::isfinite(l2)) return fallback;
+  return v / std::sqrt(l2);
+}
+
+}  // namespace
+
+Vec3f offset_ray_origin(Vec3f p, Vec3f n) {
+  return {nudge(p.x, n.x), nudge(p.y, n.y), nudge(p.z, n.z)};
+}
+
+EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
+    : default_material_(default_material) {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
+
+  // --- Bottom level: one scene with one triangle geometry per mesh ---
+  mesh_scenes_.assign(scene.meshes.size(), nullptr);
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    const size_t tris = mesh.triangle_count();
+    if (tris == 0 || mesh.positions.empty()) continue;
+    for (uint32_t idx : mesh.indices)
+      if (idx >= mesh.positions.size())
+        throw std::invalid_argument("mesh " + std::to_string(m) + ": vertex index " +
+                                    std::to_string(idx) + " out of range");
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    // Copies into Embree-owned buffers: they carry the padding Embree's SIMD loads need.
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                           RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                           mesh.positions.size()));
+    std::memcpy(vb, mesh.positions.data(), mesh.positions.size() * sizeof(Vec3f));
+    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), tris));
+    std::memcpy(ib, mesh.indices.data(), tris * 3 * sizeof(uint32_t));
+    rtcCommitGeometry(geom);
+    RTCScene s = rtcNewScene(device_);
+    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
+    rtcAttachGeometryByID(s, geom, 0);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(s);
+    mesh_scenes_[m] = s;
+    triangles_ += tris;
+  }
+
+  // --- Top level: one instance per placement ---
+  top_ = rtcNewScene(device_);
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    if (inst.mesh >= scene.meshes.size() || !mesh_scenes_[inst.mesh]) continue;
+    const Transform& T = inst.object_to_world;
+    const float det = T.m[0][0] * (T.m[1][1] * T.m[2][2] - T.m[1][2] * T.m[2][1]) -
+                      T.m[0][1] * (T.m[1][0] * T.m[2][2] - T.m[1][2] * T.m[2][0]) +
+                      T.m[0][2] * (T.m[1][0] * T.m[2][1] - T.m[1][1] * T.m[2][0]);
+    if (!(std::fabs(det) > 0.0f) || !std::isfinite(det)) continue;  // flattened: invisible
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(geom, mesh_scenes_[inst.mesh]);
+    // Embree's RTC_FORMAT_FLOAT3X4_ROW_MAJOR matches our row-major 3x4 layout.
+    rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &T.m[0][0]);
+    rtcCommitGeometry(geom);
+    const unsigned id = rtcAttachGeometry(top_, geom);
+    rtcReleaseGeometry(geom);
+    if (id >= instances_.size()) instances_.resize(id + 1);
+    InstanceData& d = instances_[id];
+    d.mesh = &scene.meshes[inst.mesh];
+    d.instance = &inst;
+    d.to_world = T;
+    const Transform inv = T.inverse();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) d.normal_matrix[r][c] = inv.m[c][r];
+    instanced_triangles_ += d.mesh->triangle_count();
+  }
+  rtcSetSceneBuildQuality(top_, RTC_BUILD_QUALITY_MEDIUM);
+  rtcCommitScene(top_);
+  // Errors here are programming errors (bad buffers); surface them instead of rendering garbage.
+  const RTCError err = rtcGetDeviceError(device_);
+  if (err != RTC_ERROR_NONE)
+    throw std::runtime_error("Embree: scene build failed with error " + std::to_string(int(err)));
+}
+
+EmbreeScene::~EmbreeScene() {
+  if (top_) rtcReleaseScene(top_);
+  for (RTCScene s : mesh_scenes_)
+    if (s) rtcReleaseScene(s);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+bool EmbreeScene::intersect(const Ray& ray, SurfaceHit& hit) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh;
+  rh.ray.org_x = ray.origin.x;
+  rh.ray.org_y = ray.origin.y;
+  rh.ray.org_z = ray.origin.z;
+  rh.ray.dir_x = ray.direction.x;
+  rh.ray.dir_y = ray.direction.y;
+  rh.ray.dir_z = ray.direction.z;
+  rh.ray.tnear = ray.t_min;
+  rh.ray.tfar = ray.t_max;
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(top_, &ctx, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  hit.t = rh.ray.tfar;
+  complete_hit(rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v, ray.direction, hit);
+  return true;
+}
+
+bool EmbreeScene::occluded(const Ray& ray) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRay r;
+  r.org_x = ray.origin.x;
+  r.org_y = ray.origin.y;
+  r.org_z = ray.origin.z;
+  r.dir_x = ray.direction.x;
+  r.dir_y = ray.direction.y;
+  r.dir_z = ray.direction.z;
+  r.tnear = ray.t_min;
+  r.tfar = ray.t_max;
+  r.time = 0.0f;
+  r.mask = 0xffffffffu;
+  r.id = 0;
+  r.flags = 0;
+  rtcOccluded1(top_, &ctx, &r);
+  return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
+}
+
+void EmbreeScene::complete_hit(uint32_t instance, uint32_t primitive, float u, float v, Vec3f dir,
+                               SurfaceHit& hit) const {
+  const InstanceData& d = instances_[instance];
+  const Mesh& mesh = *d.mesh;
+  const uint32_t* idx = &mesh.indices[size_t(primitive) * 3];
+  const Vec3f p0 = mesh.positions[idx[0]], p1 = mesh.positions[idx[1]], p2 = mesh.positions[idx[2]];
+  const float w = 1.0f - u - v;
+  hit.instance = instance;
+  hit.primitive = primitive;
+  hit.position = d.to_world.point(p0 * w + p1 * u + p2 * v);
+
+  auto to_world_normal = [&](Vec3f n) {
+    const auto& M = d.normal_matrix;
+    return Vec3f(M[0][0] * n.x + M[0][1] * n.y + M[0][2] * n.z,
+                 M[1][0] * n.x + M[1][1] * n.y + M[1][2] * n.z,
+                 M[2][0] * n.x + M[2][1] * n.y + M[2][2] * n.z);
+  };
+  // Degenerate triangles have no normal: face the ray so shading stays finite.
+  const Vec3f ng = safe_normalize(to_world_normal(cross(p1 - p0, p2 - p0)), -dir);
+  hit.geometric_normal = ng;
+  hit.front_facing = dot(dir, ng) < 0.0f;
+
+  const size_t corner = size_t(primitive) * 3;
+  if (!mesh.corner_normals.empty() && mesh.corner_normals.size() >= corner + 3) {
+    const Vec3f n = mesh.corner_normals[corner] * w + mesh.corner_normals[corner + 1] * u +
+                    mesh.corner_normals[corner + 2] * v;
+    hit.shading_normal = safe_normalize(to_world_normal(n), ng);
+  } else {
+    hit.shading_normal = ng;
+  }
+  if (!mesh.corner_uvs.empty() && mesh.corner_uvs.size() >= corner + 3) {
+    hit.uv = mesh.corner_uvs[corner] * w + mesh.corner_uvs[corner + 1] * u +
+             mesh.corner_uvs[corner + 2] * v;
+  } else {
+    hit.uv = Vec2f(0.0f, 0.0f);
+  }
+
+  int32_t slot = 0;
+  if (primitive < mesh.material_slot.size()) slot = mesh.material_slot[primitive];
+  int32_t mat = -1;
+  const auto& slots = d.instance->slot_material;
+  if (slot >= 0 && size_t(slot) < slots.size()) mat = slots[size_t(slot)];
+  hit.material = (mat >= 0 && mat < default_material_) ? mat : default_material_;
+}
+
+}  // namespace gdpt

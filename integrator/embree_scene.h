@@ -1,0 +1,72 @@
+// Two-level Embree 3 BVH: one triangle geometry (in its own RTCScene) per Mesh, placed by one
+// RTC_GEOMETRY_TYPE_INSTANCE per Instance, so memory does not grow with the instance count.
+// Vertex and index buffers are shared with the Scene (no copies): the Scene must outlive this.
+//
+// Hit records are rebuilt from the mesh data (barycentrics, instance transform), not from
+// origin + t * direction, for precision; spawned rays are offset along the geometric normal by a
+// few ULPs of the position (offset_ray), so self-intersection is avoided at any scene scale.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "integrator/camera.h"
+#include "integrator/math/transform.h"
+#include "integrator/math/vec.h"
+#include "integrator/scene.h"
+
+namespace gdpt {
+
+struct SurfaceHit {
+  float t = 0.0f;
+  Vec3f position;          // world
+  Vec3f geometric_normal;  // unit, world, as the triangle winding gives it (not flipped)
+  Vec3f shading_normal;    // unit, world, interpolated corner normal (= geometric if flat)
+  Vec2f uv;
+  uint32_t instance = 0, primitive = 0;
+  int32_t material = -1;     // index into SceneContext::materials() (always valid after hit())
+  bool front_facing = true;  // the ray came from the side geometric_normal points to
+};
+
+// Moves p off the surface along n (the side the new ray leaves to) by an amount proportional to
+// the floating-point spacing at p, in the spirit of Wächter & Binder (Ray Tracing Gems, ch. 6):
+// integer ULP steps away from the origin, a small absolute step near it.
+Vec3f offset_ray_origin(Vec3f p, Vec3f n);
+
+class EmbreeScene {
+ public:
+  // `default_material`: material index used for slot -1 / out-of-range slots.
+  EmbreeScene(const Scene& scene, int32_t default_material);
+  ~EmbreeScene();
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+  // Closest hit in (t_min, t_max). Fills `hit` when true.
+  bool intersect(const Ray& ray, SurfaceHit& hit) const;
+  // True when something blocks the segment (t_min, t_max).
+  bool occluded(const Ray& ray) const;
+
+  size_t triangle_count() const { return triangles_; }  // unique (per mesh)
+  size_t instanced_triangle_count() const { return instanced_triangles_; }
+  // Fills the rest of a hit from (instance, primitive, barycentrics).
+  void complete_hit(uint32_t instance, uint32_t primitive, float u, float v, Vec3f dir,
+                    SurfaceHit& hit) const;
+
+ private:
+  struct InstanceData {
+    const Mesh* mesh = nullptr;
+    const Instance* instance = nullptr;
+    Transform to_world;
+    float normal_matrix[3][3];  // inverse transpose of the linear part
+  };
+  RTCDevice device_ = nullptr;
+  RTCScene top_ = nullptr;
+  std::vector<RTCScene> mesh_scenes_;
+  std::vector<InstanceData> instances_;  // indexed by Embree instance geometry id
+  int32_t default_material_ = -1;
+  size_t triangles_ = 0, instanced_triangles_ = 0;
+};
+
+}  // namespace gdpt

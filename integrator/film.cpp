@@ -1,0 +1,152 @@
+#include "integrator/film.h"
+
+#include <algorithm>
+
+namespace gdpt {
+
+namespace {
+
+double lum(const double c[3]) {
+  return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+}
+
+// Variance of the mean of n samples from their sum and sum of squares (unbiased sample variance
+// divided by n); 0 with fewer than two samples.
+double variance_of_mean(double sum, double sum2, uint32_t n) {
+  if (n < 2) return 0.0;
+  const double mean = sum / n;
+  const double var = std::max(0.0, (sum2 - mean * sum) / (n - 1));
+  return var / n;
+}
+
+}  // namespace
+
+Film::Film(int width, int height)
+    : width_(std::max(width, 0)),
+      height_(std::max(height, 0)),
+      acc_(size_t(width_) * size_t(height_)),
+      samples_(size_t(width_) * size_t(height_), 0u) {}
+
+void Film::clear() {
+  std::fill(acc_.begin(), acc_.end(), Accumulator{});
+  std::fill(samples_.begin(), samples_.end(), 0u);
+}
+
+void Film::take_rows(Film& pass, int y0, int y1) {
+  for (size_t i = size_t(y0) * width_, end = size_t(y1) * width_; i < end; ++i) {
+    Accumulator& a = acc_[i];
+    Accumulator& b = pass.acc_[i];
+    for (int c = 0; c < 3; ++c) {
+      a.primal[c] += b.primal[c];
+      a.dx[c] += b.dx[c];
+      a.dy[c] += b.dy[c];
+      a.emission[c] += b.emission[c];
+    }
+    a.primal2 += b.primal2;
+    a.dx2 += b.dx2;
+    a.dy2 += b.dy2;
+    a.shift_attempts += b.shift_attempts;
+    a.shift_failures += b.shift_failures;
+    samples_[i] += pass.samples_[i];
+    b = Accumulator{};
+    pass.samples_[i] = 0;
+  }
+}
+
+uint32_t Film::min_samples() const {
+  if (samples_.empty()) return 0;
+  return *std::min_element(samples_.begin(), samples_.end());
+}
+
+void Film::primal_rgb(float* out) const {
+  for (size_t i = 0; i < acc_.size(); ++i) {
+    const double inv = samples_[i] ? 1.0 / samples_[i] : 0.0;
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = float(acc_[i].primal[c] * inv);
+  }
+}
+
+void Film::emission_rgb(float* out) const {
+  for (size_t i = 0; i < acc_.size(); ++i) {
+    const double inv = samples_[i] ? 1.0 / samples_[i] : 0.0;
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = float(acc_[i].emission[c] * inv);
+  }
+}
+
+void Film::gradient_x_rgb(float* out) const {
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      const size_t i = size_t(y) * width_ + x;
+      const double inv = samples_[i] ? 1.0 / samples_[i] : 0.0;
+      for (int c = 0; c < 3; ++c) {
+        double v;
+        if (gradients_from_primal_) {
+          if (x + 1 < width_) {
+            const size_t j = i + 1;
+            const double invj = samples_[j] ? 1.0 / samples_[j] : 0.0;
+            v = acc_[j].primal[c] * invj - acc_[i].primal[c] * inv;
+          } else {
+            v = 0.0;
+          }
+        } else {
+          v = acc_[i].dx[c] * inv;
+        }
+        out[3 * i + c] = float(v);
+      }
+    }
+}
+
+void Film::gradient_y_rgb(float* out) const {
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      const size_t i = size_t(y) * width_ + x;
+      const double inv = samples_[i] ? 1.0 / samples_[i] : 0.0;
+      for (int c = 0; c < 3; ++c) {
+        double v;
+        if (gradients_from_primal_) {
+          if (y + 1 < height_) {
+            const size_t j = i + width_;
+            const double invj = samples_[j] ? 1.0 / samples_[j] : 0.0;
+            v = acc_[j].primal[c] * invj - acc_[i].primal[c] * inv;
+          } else {
+            v = 0.0;
+          }
+        } else {
+          v = acc_[i].dy[c] * inv;
+        }
+        out[3 * i + c] = float(v);
+      }
+    }
+}
+
+void Film::variance3(float* out) const {
+  auto primal_var = [&](size_t i) {
+    return variance_of_mean(lum(acc_[i].primal), acc_[i].primal2, samples_[i]);
+  };
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      const size_t i = size_t(y) * width_ + x;
+      const Accumulator& a = acc_[i];
+      const double vp = primal_var(i);
+      double vdx, vdy;
+      if (gradients_from_primal_) {
+        // Independent pixel means: the variance of a difference is the sum of the variances.
+        vdx = x + 1 < width_ ? vp + primal_var(i + 1) : 0.0;
+        vdy = y + 1 < height_ ? vp + primal_var(i + width_) : 0.0;
+      } else {
+        vdx = variance_of_mean(lum(a.dx), a.dx2, samples_[i]);
+        vdy = variance_of_mean(lum(a.dy), a.dy2, samples_[i]);
+      }
+      out[3 * i + 0] = float(vp);
+      out[3 * i + 1] = float(vdx);
+      out[3 * i + 2] = float(vdy);
+    }
+}
+
+void Film::shift_failures(float* out) const {
+  for (size_t i = 0; i < acc_.size(); ++i) {
+    const Accumulator& a = acc_[i];
+    out[i] = a.shift_attempts > 0.0 ? float(a.shift_failures / a.shift_attempts) : 0.0f;
+  }
+}
+
+}  // namespace gdpt

@@ -1,0 +1,254 @@
+#include "integrator/path_tracer.h"
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "integrator/features.h"
+#include "integrator/math/frame.h"
+#include "integrator/sampler.h"
+#include "integrator/scene_context.h"
+#include "shaders/shading_context.h"
+
+namespace gdpt {
+
+namespace {
+
+constexpr uint32_t kSpecialised =
+    kSceneDoF | kSceneWorld | kSceneAnalyticLights | kSceneEmissiveTriangles;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Radiance of one camera sample, split as the film stores it.
+struct PathResult {
+  Spectrum primal{0.0f};
+  Spectrum emission{0.0f};  // camera-visible emission
+  uint32_t rays = 0;
+};
+
+template <uint32_t kFeatures>
+class PathTracer final : public Integrator {
+  static constexpr bool kDoF = (kFeatures & kSceneDoF) != 0;
+  static constexpr bool kWorld = (kFeatures & kSceneWorld) != 0;
+  static constexpr bool kAnalytic = (kFeatures & kSceneAnalyticLights) != 0;
+  static constexpr bool kEmissive = (kFeatures & kSceneEmissiveTriangles) != 0;
+
+ public:
+  PathTracer(const SceneContext& ctx, const RenderSettings& settings)
+      : ctx_(ctx), settings_(settings) {}
+
+  void render_tile(const Tile& tile, uint32_t first_sample, uint32_t sample_count,
+                   Film& film) const override {
+    uint64_t rays = 0;
+    Sampler sampler;
+    const float clamp = settings_.clamp;
+    for (int y = tile.y0; y < tile.y1; ++y)
+      for (int x = tile.x0; x < tile.x1; ++x) {
+        Film::Accumulator& acc = film.pixel(x, y);
+        for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
+          sampler.start(settings_.seed, x, y, s);
+          PathResult r = trace(sampler, x, y);
+          rays += r.rays;
+          // A non-finite sample would poison the pixel forever: drop it (counted as black).
+          if (!is_finite(r.primal)) r.primal = Spectrum(0.0f);
+          if (!is_finite(r.emission)) r.emission = Spectrum(0.0f);
+          if (clamp > 0.0f) {
+            const float m = max_component(r.primal);
+            if (m > clamp) r.primal *= clamp / m;
+          }
+          const double lum = luminance(r.primal);
+          for (int c = 0; c < 3; ++c) {
+            acc.primal[c] += r.primal[c];
+            acc.emission[c] += r.emission[c];
+          }
+          acc.primal2 += lum * lum;
+        }
+        film.add_sample_count(x, y, sample_count);
+      }
+    count_rays(rays);
+  }
+
+ private:
+  PathResult trace(const Sampler& sampler, int px, int py) const {
+    const EmbreeScene& bvh = ctx_.bvh();
+    const LightSampler& lights = ctx_.lights();
+    const auto& materials = ctx_.materials();
+    const int max_bounces = settings_.max_bounces;
+    const bool has_lights = !lights.empty();
+
+    PathResult out;
+    // --- Camera ray ---
+    const Vec2f jitter = sampler.get2d(Sampler::kDimCamera);
+    const Vec2f lens = kDoF ? sampler.get2d(Sampler::kDimLens) : Vec2f(0.5f, 0.5f);
+    Ray ray = ctx_.camera().generate_ray({float(px) + jitter.x, float(py) + jitter.y}, lens);
+
+    Spectrum beta(1.0f);     // path throughput f / p
+    float prev_pdf = 0.0f;   // solid-angle pdf of the BSDF sample that spawned `ray`
+    bool prev_delta = true;  // no MIS for camera rays and delta lobes
+    Vec3f prev_position = ray.origin;
+    ClosureSet closures;
+    SurfaceHit hit;
+
+    for (int bounce = 0;; ++bounce) {
+      const bool found = bvh.intersect(ray, hit);
+      ++out.rays;
+      const float t_hit = found ? hit.t : ray.t_max;
+
+      // --- Analytic lights in front of the surface (BSDF-sampled; lamps are camera-invisible) ---
+      if constexpr (kAnalytic) {
+        LightHit lh;
+        if (bounce > 0 && lights.intersect(ray.origin, ray.direction, t_hit, lh)) {
+          const float w = prev_delta ? 1.0f : power_heuristic(prev_pdf, lh.pdf);
+          out.primal += beta * lh.radiance * w;
+        }
+      }
+
+      // --- Escape: the world ---
+      if (!found) {
+        if constexpr (kWorld) {
+          const Spectrum le = lights.environment(ray.direction);
+          if (bounce == 0) {
+            out.emission += le;
+          } else if (!is_black(le)) {
+            const float w = prev_delta
+                                ? 1.0f
+                                : power_heuristic(prev_pdf, lights.pdf_environment(ray.direction));
+            out.primal += beta * le * w;
+          }
+        }
+        break;
+      }
+
+      // --- Shading point ---
+      const ShadingContext sc{hit.uv, hit.front_facing};
+      const Material& material = materials[size_t(hit.material)];
+      if constexpr (kEmissive) {
+        if (material.is_emissive()) {
+          const Spectrum le = material.emission(sc);
+          if (bounce == 0) {
+            out.emission += le;
+          } else if (!is_black(le)) {
+            float w = 1.0f;
+            if (!prev_delta)
+              w = power_heuristic(prev_pdf,
+                                  lights.pdf_triangle(hit.instance, hit.primitive, prev_position,
+                                                      hit.position, hit.geometric_normal));
+            out.primal += beta * le * w;
+          }
+        }
+      }
+      if (bounce > max_bounces) break;
+      closures.clear();
+      material.evaluate(sc, closures);
+      if (!closures.has_bsdf()) break;
+
+      // Frame facing the incoming ray (Cycles flips N and Ng for back faces; materials learn the
+      // side from ShadingContext::front_facing). A shading normal that puts the incoming direction
+      // below its horizon would leak light: fall back to the geometric normal there.
+      const Vec3f wi_world = -ray.direction;
+      const Vec3f ng = hit.front_facing ? hit.geometric_normal : -hit.geometric_normal;
+      Vec3f ns = hit.front_facing ? hit.shading_normal : -hit.shading_normal;
+      if (dot(ns, wi_world) <= 1e-4f) ns = ng;
+      const Frame frame(ns);
+      const Vec3f wi = frame.to_local(wi_world);
+
+      // --- Next-event estimation ---
+      if (has_lights) {
+        const float u_select = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kLightSelect));
+        const Vec2f u_light = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kLightPoint));
+        const LightSample ls = lights.sample(hit.position, u_select, u_light);
+        if (ls.valid && ls.pdf > 0.0f && !is_black(ls.radiance)) {
+          const Vec3f wo = frame.to_local(ls.direction);
+          const float cos_ng = dot(ls.direction, ng);
+          // The geometric and shading hemispheres must agree, or light leaks through the surface.
+          if ((cos_ng > 0.0f) == (wo.z > 0.0f) && cos_ng != 0.0f) {
+            const Spectrum f = closures.eval(wi, wo);
+            if (!is_black(f)) {
+              Ray shadow;
+              shadow.origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);
+              shadow.direction = ls.direction;
+              shadow.t_min = 0.0f;
+              // Stop short of the light's own surface (emissive triangles are geometry too).
+              shadow.t_max = ls.is_infinite ? kInf : ls.distance * (1.0f - 1e-4f);
+              ++out.rays;
+              if (!bvh.occluded(shadow)) {
+                const float w = ls.is_delta ? 1.0f : power_heuristic(ls.pdf, closures.pdf(wi, wo));
+                out.primal += beta * f * ls.radiance * (w / ls.pdf);
+              }
+            }
+          }
+        }
+      }
+
+      // --- BSDF sampling: continue the path ---
+      const float u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
+      const Vec2f u_dir = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kBsdfDir));
+      const BsdfSample bs = closures.sample(wi, u_lobe, u_dir);
+      if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;
+      const Vec3f wo_world = frame.to_world(bs.wo);
+      const float cos_ng = dot(wo_world, ng);
+      if ((cos_ng > 0.0f) != (bs.wo.z > 0.0f) || cos_ng == 0.0f) break;
+      beta *= bs.value / bs.pdf;
+      prev_delta = bs.is_delta();
+      prev_pdf = bs.pdf;
+      prev_position = hit.position;
+
+      // --- Russian roulette ---
+      if (bounce >= settings_.rr_depth) {
+        const float q = std::min(max_component(beta), 0.95f);
+        if (!(sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kRoulette)) < q)) break;
+        beta /= q;
+      }
+
+      ray.origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);
+      ray.direction = normalize(wo_world);
+      ray.t_min = 0.0f;
+      ray.t_max = kInf;
+    }
+    return out;
+  }
+
+  const SceneContext& ctx_;
+  RenderSettings settings_;
+};
+
+// --- Dispatch: one instantiation per subset of kSpecialised, picked once per session ---
+
+template <uint32_t kMask>
+std::unique_ptr<Integrator> make_kernel(const SceneContext& ctx, const RenderSettings& s) {
+  return std::make_unique<PathTracer<kMask>>(ctx, s);
+}
+
+constexpr std::array<uint32_t, 4> kBits = {kSceneDoF, kSceneWorld, kSceneAnalyticLights,
+                                           kSceneEmissiveTriangles};
+
+constexpr uint32_t mask_of_index(size_t i) {
+  uint32_t m = 0;
+  for (size_t b = 0; b < kBits.size(); ++b)
+    if (i & (size_t(1) << b)) m |= kBits[b];
+  return m;
+}
+
+template <size_t... I>
+auto make_table(std::index_sequence<I...>) {
+  using Factory = std::unique_ptr<Integrator> (*)(const SceneContext&, const RenderSettings&);
+  return std::array<Factory, sizeof...(I)>{&make_kernel<mask_of_index(I)>...};
+}
+
+}  // namespace
+
+uint32_t path_tracer_specialised_features(uint32_t scene_features) {
+  return scene_features & kSpecialised;
+}
+
+std::unique_ptr<Integrator> make_path_tracer(const SceneContext& ctx,
+                                             const RenderSettings& settings) {
+  static const auto table = make_table(std::make_index_sequence<size_t(1) << kBits.size()>{});
+  const uint32_t f = ctx.features();
+  size_t index = 0;
+  for (size_t b = 0; b < kBits.size(); ++b)
+    if (f & kBits[b]) index |= size_t(1) << b;
+  return table[index](ctx, settings);
+}
+
+}  // namespace gdpt

@@ -1,0 +1,141 @@
+#include "integrator/render_session.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+#include <stdexcept>
+
+#include "integrator/features.h"
+#include "integrator/integrator.h"
+#include "integrator/path_tracer.h"
+#include "integrator/scene_context.h"
+
+namespace gdpt {
+
+namespace {
+// 16x16 tiles: a tile at one sample per pixel takes well under a millisecond in typical scenes,
+// so the cancel flag (polled between tiles) is seen almost immediately.
+constexpr int kTileSize = 16;
+}  // namespace
+
+struct RenderSession::Impl {
+  Scene scene;
+  RenderSettings settings;
+  std::unique_ptr<SceneContext> context;
+  std::unique_ptr<Integrator> integrator;
+  Film film, pass_film;
+  std::vector<Tile> tiles;
+  std::vector<std::string> warnings;
+};
+
+RenderSession::RenderSession(Scene scene, RenderSettings settings)
+    : impl_(std::make_unique<Impl>()) {
+  if (settings.samples < 0) throw std::invalid_argument("render settings: samples must be >= 0");
+  if (settings.max_bounces < 0)
+    throw std::invalid_argument("render settings: max_bounces must be >= 0");
+  if (settings.threads < 0) throw std::invalid_argument("render settings: threads must be >= 0");
+  if (settings.samples_per_pass < 1) settings.samples_per_pass = 1;
+  Impl& d = *impl_;
+  d.scene = std::move(scene);  // owned: the context and the BVH refer to it
+  d.settings = settings;
+  d.context = std::make_unique<SceneContext>(d.scene, d.settings);
+  d.warnings = d.context->warnings();
+  // G-PT dispatch: until integrator/gradient_path_tracer.h provides the G-PT integrator, GPT mode
+  // renders with the path tracer (gradients then come from the primal, see Film).
+  d.integrator = make_path_tracer(*d.context, d.settings);
+  const int w = d.scene.camera.width, h = d.scene.camera.height;
+  d.film = Film(w, h);
+  d.pass_film = Film(w, h);
+  d.film.set_gradients_from_primal(!d.integrator->estimates_gradients());
+  for (int y = 0; y < h; y += kTileSize)
+    for (int x = 0; x < w; x += kTileSize)
+      d.tiles.push_back({x, y, std::min(x + kTileSize, w), std::min(y + kTileSize, h)});
+}
+
+RenderSession::~RenderSession() = default;
+
+void RenderSession::render(const std::function<void(const RenderProgress&)>& on_pass,
+                           const std::atomic<bool>& cancel) {
+  Impl& d = *impl_;
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  tbb::task_arena arena(d.settings.threads > 0 ? d.settings.threads : tbb::task_arena::automatic);
+  const int total = d.settings.samples;
+  int done = int(d.film.min_samples());
+  const int height = d.film.height();
+  while (done < total) {
+    if (cancel.load(std::memory_order_relaxed)) break;
+    if (d.settings.time_limit > 0.0 && elapsed() >= d.settings.time_limit) break;
+    const uint32_t first = uint32_t(done);
+    const uint32_t count = uint32_t(std::min(d.settings.samples_per_pass, total - done));
+
+    // --- One pass over every tile; a pass interrupted by cancel is discarded, so every pixel
+    // always has the same sample count ---
+    std::atomic<bool> aborted{false};
+    arena.execute([&] {
+      tbb::parallel_for(
+          tbb::blocked_range<size_t>(0, d.tiles.size(), 1),
+          [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t t = r.begin(); t != r.end(); ++t) {
+              if (cancel.load(std::memory_order_relaxed)) {
+                aborted.store(true, std::memory_order_relaxed);
+                return;
+              }
+              d.integrator->render_tile(d.tiles[t], first, count, d.pass_film);
+            }
+          },
+          tbb::simple_partitioner());
+    });
+    if (aborted.load()) {
+      d.pass_film.clear();
+      break;
+    }
+    // --- Commit the pass ---
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<int>(0, height, 8),
+                        [&](const tbb::blocked_range<int>& r) {
+                          d.film.take_rows(d.pass_film, r.begin(), r.end());
+                        });
+    });
+    done += int(count);
+    if (on_pass) on_pass(RenderProgress{done, total, elapsed()});
+  }
+}
+
+const Film& RenderSession::film() const {
+  return impl_->film;
+}
+
+const RenderSettings& RenderSession::settings() const {
+  return impl_->settings;
+}
+
+const std::vector<std::string>& RenderSession::warnings() const {
+  return impl_->warnings;
+}
+
+uint64_t RenderSession::rays_traced() const {
+  return impl_->integrator->rays_traced();
+}
+
+std::string RenderSession::features_summary() const {
+  const Impl& d = *impl_;
+  const SceneContext& c = *d.context;
+  std::ostringstream s;
+  s << "scene features: " << features_to_string(c.scene_features());
+  s << "; kernel: " << features_to_string(path_tracer_specialised_features(c.features()));
+  if (d.settings.force_all_features) s << " (forced)";
+  s << "; " << c.bvh().triangle_count() << " unique / " << c.bvh().instanced_triangle_count()
+    << " instanced triangles, " << d.scene.instances.size() << " instances, "
+    << d.scene.lights.size() << " lights";
+  return s.str();
+}
+
+}  // namespace gdpt

@@ -1,0 +1,122 @@
+// Per-pixel deterministic low-discrepancy sampler: Owen-scrambled Sobol (0,2)-sequence pairs with
+// per-pixel, per-dimension hash scrambling (Burley 2020, "Practical Hash-based Owen Scrambling").
+//
+// Every 2D dimension pair uses the first two Sobol dimensions (a (0,2)-sequence, stratified in
+// every elementary interval), with the sample index shuffled by a nested uniform scramble and each
+// coordinate Owen-scrambled, all seeded by hash(seed, pixel, dimension). Pairs are therefore
+// decorrelated from each other ("padding") while each stays well stratified over a pixel's
+// samples. A value is a pure function of (seed, pixel, sample index, dimension): the image does not
+// depend on thread count or tile order.
+//
+// Dimension layout (Sampler::Dim): camera jitter 2D, lens 2D, then per bounce kDimsPerBounce
+// dimensions: light select 1D, light position 2D, BSDF lobe 1D, BSDF direction 2D, Russian
+// roulette 1D. G-PT uses the same layout for its base path.
+#pragma once
+
+#include <cstdint>
+
+#include "integrator/math/vec.h"
+
+namespace gdpt {
+
+namespace sampler_detail {
+
+inline uint32_t reverse_bits(uint32_t x) {
+  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+  return (x >> 16) | (x << 16);
+}
+
+// 32-bit integer hash (a "lowbias32"-style finaliser): good avalanche, cheap.
+inline uint32_t hash_u32(uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x21f0aaadu;
+  x ^= x >> 15;
+  x *= 0x735a2d97u;
+  x ^= x >> 15;
+  return x;
+}
+inline uint32_t hash_combine(uint32_t seed, uint32_t v) {
+  return hash_u32(seed ^ (v + 0x9e3779b9u + (seed << 6) + (seed >> 2)));
+}
+
+// Laine-Karras style permutation in reversed-bit order: each bit is flipped depending only on the
+// bits below it, which after the reversal below is exactly an Owen scramble (Burley 2020).
+inline uint32_t lk_permutation(uint32_t x, uint32_t seed) {
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return x;
+}
+inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
+  return reverse_bits(lk_permutation(reverse_bits(x), seed));
+}
+
+// Sobol dimension 1 (the second): generator matrix with v_k = v_{k-1} ^ (v_{k-1} >> 1).
+inline uint32_t sobol_dim1(uint32_t i) {
+  uint32_t r = 0;
+  for (uint32_t v = 1u << 31; i != 0; i >>= 1, v ^= v >> 1)
+    if (i & 1u) r ^= v;
+  return r;
+}
+
+inline float to_unit_float(uint32_t x) {
+  return float(x >> 8) * 0x1p-24f;  // in [0, 1), exactly representable
+}
+
+}  // namespace sampler_detail
+
+class Sampler {
+ public:
+  // Dimension layout shared by all integrators.
+  enum Dim : uint32_t {
+    kDimCamera = 0,      // 2D raster jitter
+    kDimLens = 1,        // 2D lens position
+    kDimFirstBounce = 2  // bounce b starts at kDimFirstBounce + b * kDimsPerBounce
+  };
+  enum BounceDim : uint32_t {
+    kLightSelect = 0,  // 1D
+    kLightPoint = 1,   // 2D
+    kBsdfLobe = 2,     // 1D
+    kBsdfDir = 3,      // 2D
+    kRoulette = 4,     // 1D
+    kDimsPerBounce = 5
+  };
+
+  // Starts sample `index` of pixel (x, y) for a render with `seed`.
+  void start(uint32_t seed, int x, int y, uint32_t index) {
+    using namespace sampler_detail;
+    pixel_hash_ = hash_combine(hash_combine(hash_u32(seed), uint32_t(x)), uint32_t(y));
+    index_ = index;
+  }
+
+  static uint32_t bounce_dim(int bounce, BounceDim d) {
+    return kDimFirstBounce + uint32_t(bounce) * kDimsPerBounce + d;
+  }
+
+  float get1d(uint32_t dim) const {
+    using namespace sampler_detail;
+    const uint32_t h = hash_combine(pixel_hash_, dim);
+    const uint32_t i = nested_uniform_scramble(index_, h);
+    return to_unit_float(nested_uniform_scramble(reverse_bits(i), hash_u32(h ^ 0x5bd1e995u)));
+  }
+
+  Vec2f get2d(uint32_t dim) const {
+    using namespace sampler_detail;
+    const uint32_t h = hash_combine(pixel_hash_, dim);
+    const uint32_t i = nested_uniform_scramble(index_, h);
+    const uint32_t x = nested_uniform_scramble(reverse_bits(i), hash_u32(h ^ 0x5bd1e995u));
+    const uint32_t y = nested_uniform_scramble(sobol_dim1(i), hash_u32(h ^ 0x1b873593u));
+    return {to_unit_float(x), to_unit_float(y)};
+  }
+
+ private:
+  uint32_t pixel_hash_ = 0;
+  uint32_t index_ = 0;
+};
+
+}  // namespace gdpt

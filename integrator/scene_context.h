@@ -1,0 +1,51 @@
+// Everything an integrator needs about a scene, built once per render session: the Embree BVH,
+// the camera model, textures, compiled materials, the light sampler and the feature mask. PT and
+// G-PT both receive a const SceneContext; nothing in it changes while rendering.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "integrator/camera.h"
+#include "integrator/embree_scene.h"
+#include "integrator/light_sampler.h"
+#include "integrator/render_settings.h"
+#include "integrator/scene.h"
+#include "shaders/material.h"
+#include "shaders/texture.h"
+
+namespace gdpt {
+
+class SceneContext {
+ public:
+  // Validates and prepares `scene` (which must outlive the context). Throws std::invalid_argument
+  // with a clear message for an unusable scene (zero resolution, out-of-range mesh indices, ...).
+  SceneContext(const Scene& scene, const RenderSettings& settings);
+  ~SceneContext();
+
+  const Scene& scene() const { return scene_; }
+  const EmbreeScene& bvh() const { return *bvh_; }
+  const CameraModel& camera() const { return camera_; }
+  const LightSampler& lights() const { return *lights_; }
+  // Scene::materials followed by Blender's default grey material (index default_material()).
+  const std::vector<Material>& materials() const { return materials_; }
+  int32_t default_material() const { return int32_t(materials_.size()) - 1; }
+  const std::vector<Texture>& textures() const { return textures_; }
+  // Feature mask (features.h); with force_all_features every bit is set.
+  uint32_t features() const { return features_; }
+  uint32_t scene_features() const { return scene_features_; }  // what the scene really uses
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  const Scene& scene_;
+  std::vector<Texture> textures_;
+  std::vector<Material> materials_;
+  std::unique_ptr<EmbreeScene> bvh_;
+  std::unique_ptr<LightSampler> lights_;
+  CameraModel camera_;
+  uint32_t features_ = 0, scene_features_ = 0;
+  std::vector<std::string> warnings_;
+};
+
+}  // namespace gdpt
