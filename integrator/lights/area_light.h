@@ -1,0 +1,115 @@
+// Blender area light (Cycles 3.4 units): a one-sided rectangle or ellipse emitting towards the
+// light's local -Z.
+//
+// Parameters (from gdpt::Light):
+//   size_x, size_y [m]   extents along local X and Y; the object transform scales them (Cycles
+//                        takes the axes from the object matrix columns, scale included)
+//   shape                Square (size_x both ways), Rectangle, Disk (diameter size_x), Ellipse
+//   power P [W], color c radiance L = c P / (4 A): Cycles 3.4 evaluates area lights with
+//                        eval_fac = 0.25 / area and strength = colour * power, and no 1/pi
+//                        anywhere, so a 1 W area light emits pi/4 W in total
+// Area A: |u x v| for rectangles, pi/4 |u x v| for ellipses (u, v the scaled full extents).
+// Sampled uniformly by area; the pdf is converted to solid angle.
+#pragma once
+
+#include <cmath>
+
+#include "integrator/light_sampler.h"
+#include "integrator/lights/warp.h"
+
+namespace gdpt::lights {
+
+struct AreaLight {
+  Vec3f center;
+  Vec3f axis_u, axis_v;  // full extents (world)
+  Vec3f normal;          // emission side (world, unit)
+  float area = 0.0f;
+  bool ellipse = false;
+  Spectrum radiance;
+  float select_pmf = 0.0f;  // filled by LightSampler
+  // Dual basis of (axis_u, axis_v): local coordinates of a point in the plane are dot products.
+  Vec3f dual_u, dual_v;
+
+  static AreaLight from_light(const Light& l) {
+    AreaLight a;
+    const Transform& m = l.light_to_world;
+    const bool square = l.shape == Light::Shape::Square || l.shape == Light::Shape::Disk;
+    const float sx = std::max(0.0f, l.size_x);
+    const float sy = square ? sx : std::max(0.0f, l.size_y);
+    a.center = m.translation();
+    a.axis_u = m.column(0) * sx;
+    a.axis_v = m.column(1) * sy;
+    a.ellipse = l.shape == Light::Shape::Disk || l.shape == Light::Shape::Ellipse;
+    const Vec3f n = cross(a.axis_u, a.axis_v);
+    const float parallelogram = length(n);
+    a.area = a.ellipse ? 0.25f * kPi * parallelogram : parallelogram;
+    if (!(a.area > 0.0f) || !std::isfinite(a.area)) {
+      a.area = 0.0f;
+      return a;
+    }
+    a.normal = n / parallelogram;
+    if (dot(a.normal, m.column(2)) > 0.0f) a.normal = -a.normal;  // emits along local -Z
+    a.radiance = l.color * (std::max(0.0f, l.power) * 0.25f / a.area);
+    // Dual basis from the Gram matrix, so sheared axes work too.
+    const float uu = dot(a.axis_u, a.axis_u), uv = dot(a.axis_u, a.axis_v);
+    const float vv = dot(a.axis_v, a.axis_v);
+    const float det = uu * vv - uv * uv;
+    a.dual_u = (a.axis_u * vv - a.axis_v * uv) / det;
+    a.dual_v = (a.axis_v * uu - a.axis_u * uv) / det;
+    return a;
+  }
+
+  // Emitted power (one-sided Lambertian emitter): pi L A.
+  float power() const { return area > 0.0f ? kPi * luminance(radiance) * area : 0.0f; }
+
+  bool sample(Vec3f ref, Vec2f u, LightSample& s) const {
+    if (dot(ref - center, normal) <= 0.0f) return false;  // behind: one-sided
+    Vec2f local;
+    if (ellipse) {
+      local = square_to_disk(u) * 0.5f;
+    } else {
+      local = {u.x - 0.5f, u.y - 0.5f};
+    }
+    const Vec3f p = center + axis_u * local.x + axis_v * local.y;
+    const Vec3f to = p - ref;
+    const float d2 = length_squared(to);
+    const float d = std::sqrt(d2);
+    if (!(d > 0.0f)) return false;
+    const Vec3f dir = to / d;
+    const float cos_l = -dot(dir, normal);
+    if (cos_l <= 0.0f) return false;
+    s.radiance = radiance;
+    s.position = p;
+    s.normal = normal;
+    s.direction = dir;
+    s.distance = d;
+    s.pdf = d2 / (area * cos_l);
+    s.is_delta = false;
+    s.is_infinite = false;
+    s.valid = std::isfinite(s.pdf);
+    return s.valid;
+  }
+
+  float intersect_t(Vec3f o, Vec3f d, float t_max) const {
+    if (area <= 0.0f) return -1.0f;
+    const float denom = dot(d, normal);
+    if (denom >= 0.0f) return -1.0f;  // one-sided: only rays travelling against the emission
+    const float t = dot(center - o, normal) / denom;
+    if (!(t > 0.0f && t < t_max)) return -1.0f;
+    const Vec3f q = o + d * t - center;
+    const float a = dot(q, dual_u), b = dot(q, dual_v);
+    const bool inside =
+        ellipse ? (4.0f * (a * a + b * b) <= 1.0f) : (std::fabs(a) <= 0.5f && std::fabs(b) <= 0.5f);
+    return inside ? t : -1.0f;
+  }
+
+  void fill_hit(Vec3f o, Vec3f d, float t, LightHit& hit) const {
+    hit.distance = t;
+    hit.position = o + d * t;
+    hit.normal = normal;
+    hit.radiance = radiance;
+    hit.pdf = t * t / (area * -dot(d, normal));
+  }
+};
+
+}  // namespace gdpt::lights

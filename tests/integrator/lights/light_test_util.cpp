@@ -1,0 +1,96 @@
+#include "light_test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "integrator/math/frame.h"
+
+namespace gdpt::test {
+
+Transform light_frame(Vec3f position, Vec3f emit_direction, float scale_x, float scale_y) {
+  const Frame f(-normalize(emit_direction));  // local +Z = -emit
+  const Vec3f x = f.s * scale_x, y = f.t * scale_y, z = f.n;
+  const float rows[12] = {x.x, y.x,        z.x, position.x, x.y, y.y,
+                          z.y, position.y, x.z, y.z,        z.z, position.z};
+  return Transform::from_rows(rows);
+}
+
+Scene black_scene() {
+  Scene s;
+  s.world.color = Spectrum(0.0f);
+  return s;
+}
+
+Estimate estimate(const LightSampler& lights, Vec3f ref, Vec3f normal, size_t n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> U(0.0f, 1.0f);
+  // Stratify the 2-D light sample on a sqrt(n) x sqrt(n) grid; u_select stays random.
+  const size_t side = size_t(std::sqrt(double(n)));
+  Estimate e;
+  double sum_omega = 0, sum_e = 0;
+  for (size_t i = 0; i < side * side; ++i) {
+    const Vec2f u((float(i % side) + U(rng)) / float(side),
+                  (float(i / side) + U(rng)) / float(side));
+    const LightSample s = lights.sample(ref, U(rng), u);
+    if (!s.valid) continue;
+    ++e.valid;
+    EXPECT_TRUE(std::isfinite(s.pdf) && s.pdf > 0.0f);
+    EXPECT_TRUE(is_finite(s.radiance));
+    EXPECT_NEAR(length(s.direction), 1.0f, 1e-4f);
+    sum_omega += 1.0 / double(s.pdf);
+    sum_e += double(s.radiance.x) * std::max(0.0, double(dot(normal, s.direction))) / double(s.pdf);
+  }
+  e.solid_angle = sum_omega / double(side * side);
+  e.irradiance = sum_e / double(side * side);
+  return e;
+}
+
+// Regularised upper incomplete gamma Q(a, x): series for x < a + 1, continued fraction otherwise.
+static double gamma_q(double a, double x) {
+  if (x <= 0) return 1.0;
+  const double log_prefix = -x + a * std::log(x) - std::lgamma(a);
+  if (x < a + 1.0) {
+    double term = 1.0 / a, sum = term;
+    for (int k = 1; k < 1000; ++k) {
+      term *= x / (a + k);
+      sum += term;
+      if (std::fabs(term) < std::fabs(sum) * 1e-15) break;
+    }
+    return 1.0 - sum * std::exp(log_prefix);
+  }
+  // Lentz's method for the continued fraction of Q.
+  const double tiny = 1e-300;
+  double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
+  for (int i = 1; i < 1000; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::fabs(d) < tiny) d = tiny;
+    c = b + an / c;
+    if (std::fabs(c) < tiny) c = tiny;
+    d = 1.0 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::fabs(delta - 1.0) < 1e-15) break;
+  }
+  return std::exp(log_prefix) * h;
+}
+
+double chi2_p_value(double chi2, double dof) {
+  return gamma_q(0.5 * dof, 0.5 * chi2);
+}
+
+MaterialDesc emission_material(Spectrum color, float strength) {
+  MaterialDesc d;
+  d.name = "emission";
+  ShaderNode n;
+  n.kind = ShaderNodeKind::Emission;
+  n.color = ColorInput(color);
+  n.strength = FloatInput(strength);
+  d.nodes.push_back(n);
+  d.root = 0;
+  return d;
+}
+
+}  // namespace gdpt::test

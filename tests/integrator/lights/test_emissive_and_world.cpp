@@ -1,0 +1,161 @@
+// Emissive triangles and the constant world: sampled solid angle and irradiance against closed
+// forms (Van Oosterom-Strackee solid angle, Lambert's polygon irradiance, E = pi L).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "integrator/light_sampler.h"
+#include "light_test_util.h"
+
+namespace gdpt {
+namespace {
+
+constexpr double kPiD = 3.14159265358979323846;
+
+struct TriangleScene {
+  Scene scene = test::black_scene();
+  std::vector<Material> materials;
+};
+
+// One emissive triangle (v0, v1, v2) in world space, reached through an instance transform.
+TriangleScene triangle_scene(Vec3f v0, Vec3f v1, Vec3f v2, float strength) {
+  TriangleScene t;
+  t.scene.materials.push_back(test::emission_material({1.0f, 1.0f, 1.0f}, strength));
+  Mesh mesh;
+  // Object space shifted by -1 in x; the instance moves it back.
+  const Vec3f off(1, 0, 0);
+  mesh.positions = {v0 - off, v1 - off, v2 - off};
+  mesh.indices = {0, 1, 2};
+  t.scene.meshes.push_back(mesh);
+  Instance inst;
+  inst.mesh = 0;
+  const float rows[12] = {1, 0, 0, 1, 0, 1, 0, 0, 0, 0, 1, 0};
+  inst.object_to_world = Transform::from_rows(rows);
+  inst.slot_material = {0};
+  t.scene.instances.push_back(inst);
+  for (const MaterialDesc& d : t.scene.materials)
+    t.materials.emplace_back(d, std::span<const Texture>{});
+  return t;
+}
+
+double triangle_solid_angle(Vec3f a, Vec3f b, Vec3f c) {
+  const double la = length(a), lb = length(b), lc = length(c);
+  const double num = std::fabs(dot(a, cross(b, c)));
+  const double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+  return 2.0 * std::atan2(num, den);
+}
+
+// Lambert: E = L/2 sum_i angle(v_i, v_i+1) (n . unit(v_i x v_i+1)), polygon above the plane.
+double triangle_irradiance(double L, Vec3f a, Vec3f b, Vec3f c, Vec3f n) {
+  const Vec3f v[3] = {normalize(a), normalize(b), normalize(c)};
+  double sum = 0;
+  for (int i = 0; i < 3; ++i) {
+    const Vec3f p = v[i], q = v[(i + 1) % 3];
+    const double angle = std::acos(std::clamp(double(dot(p, q)), -1.0, 1.0));
+    sum += angle * dot(n, normalize(cross(p, q)));
+  }
+  return std::fabs(L / 2.0 * sum);
+}
+
+TEST(EmissiveTriangle, SolidAngleAndIrradianceBothSides) {
+  const Vec3f v0(-0.5f, -0.3f, 1.5f), v1(0.8f, -0.2f, 1.7f), v2(0.1f, 0.9f, 1.2f);
+  TriangleScene t = triangle_scene(v0, v1, v2, 3.0f);
+  const LightSampler lights(t.scene, t.materials, {});
+  ASSERT_FALSE(lights.empty());
+  // Receiver below the triangle, then above it (two-sided emission).
+  for (const float z : {0.0f, 3.0f}) {
+    const Vec3f ref(0.1f, 0.05f, z);
+    const Vec3f n = z == 0.0f ? Vec3f(0, 0.2f, 1) : Vec3f(0, -0.1f, -1);
+    const Vec3f nn = normalize(n);
+    const test::Estimate e = test::estimate(lights, ref, nn, 250000);
+    const double omega = triangle_solid_angle(v0 - ref, v1 - ref, v2 - ref);
+    EXPECT_NEAR(e.solid_angle, omega, 5e-3 * omega) << z;
+    const double E = triangle_irradiance(3.0, v0 - ref, v1 - ref, v2 - ref, nn);
+    EXPECT_NEAR(e.irradiance, E, 3e-3 * E) << z;
+  }
+}
+
+TEST(EmissiveTriangle, PdfTriangleMatchesSample) {
+  const Vec3f v0(-0.5f, -0.3f, 1.5f), v1(0.8f, -0.2f, 1.7f), v2(0.1f, 0.9f, 1.2f);
+  TriangleScene t = triangle_scene(v0, v1, v2, 2.0f);
+  // A second light so that the selection probability is not 1.
+  Light p;
+  p.light_to_world = test::light_frame({5, 5, 5}, {0, 0, -1});
+  p.power = 300.0f;
+  t.scene.lights.push_back(p);
+  const LightSampler lights(t.scene, t.materials, {});
+  const Vec3f ref(0.2f, 0.1f, -0.5f);
+  int checked = 0;
+  for (int i = 0; i < 400; ++i) {
+    const LightSample s =
+        lights.sample(ref, (i + 0.5f) / 400.0f, {(i % 20 + 0.5f) / 20.0f, (i / 20 + 0.5f) / 20.0f});
+    if (!s.valid || s.is_delta) continue;
+    ++checked;
+    const float pdf = lights.pdf_triangle(0, 0, ref, s.position, s.normal);
+    EXPECT_NEAR(pdf, s.pdf, 1e-4f * s.pdf);
+    EXPECT_NEAR(s.radiance.x, 2.0f, 1e-6f);
+  }
+  EXPECT_GT(checked, 10);
+  // Unknown primitive / instance: zero.
+  EXPECT_EQ(lights.pdf_triangle(0, 1, ref, v0, {0, 0, 1}), 0.0f);
+  EXPECT_EQ(lights.pdf_triangle(3, 0, ref, v0, {0, 0, 1}), 0.0f);
+}
+
+TEST(EmissiveTriangle, SelectedProportionallyToPower) {
+  // Two instances of one mesh with two triangles: areas 1/2 and 2, emission 1 and 3 (slots).
+  Scene scene = test::black_scene();
+  scene.materials.push_back(test::emission_material({1, 1, 1}, 1.0f));
+  scene.materials.push_back(test::emission_material({1, 1, 1}, 3.0f));
+  Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 1}, {0, 2, 1}};
+  mesh.indices = {0, 1, 2, 3, 4, 5};
+  mesh.material_slot = {0, 1};
+  scene.meshes.push_back(mesh);
+  for (int k = 0; k < 2; ++k) {
+    Instance inst;
+    inst.object_to_world.m[0][3] = float(k * 10);
+    inst.slot_material = {0, 1};
+    scene.instances.push_back(inst);
+  }
+  std::vector<Material> materials;
+  for (const MaterialDesc& d : scene.materials)
+    materials.emplace_back(d, std::span<const Texture>{});
+  const LightSampler lights(scene, materials, {});
+  // Power ratio per instance: 0.5 * 1 : 2 * 3 = 1 : 12; selection pmf = power / total.
+  const Vec3f ref(0.2f, 0.2f, -1.0f);
+  const double total = 2.0 * (0.5 * 1.0 + 2.0 * 3.0);
+  const double pmf_small = 0.5 / total, pmf_big = 6.0 / total;
+  const LightSample s = lights.sample(ref, 0.0f, {0.3f, 0.3f});  // first entry: small, inst 0
+  ASSERT_TRUE(s.valid);
+  const Vec3f to = s.position - ref;
+  const double area_pdf =
+      double(length_squared(to)) / (0.5 * std::fabs(dot(normalize(to), Vec3f(0, 0, 1))));
+  EXPECT_NEAR(s.pdf, pmf_small * area_pdf, 1e-4 * s.pdf);
+  // Count selections with stratified u_select.
+  int counts[2] = {0, 0};
+  const int n = 13000;
+  for (int i = 0; i < n; ++i) {
+    const LightSample t = lights.sample(ref, (i + 0.5f) / n, {0.3f, 0.3f});
+    ASSERT_TRUE(t.valid);
+    counts[t.position.z > 0.5f ? 1 : 0]++;
+  }
+  EXPECT_NEAR(counts[0] / double(n), 2 * pmf_small, 1e-3);
+  EXPECT_NEAR(counts[1] / double(n), 2 * pmf_big, 1e-3);
+}
+
+TEST(ConstantWorld, IrradianceIsPiL) {
+  Scene scene = test::black_scene();
+  scene.world.color = {0.2f, 0.4f, 0.6f};
+  scene.world.strength = 2.5f;
+  const LightSampler lights(scene, {}, {});
+  ASSERT_TRUE(lights.has_environment());
+  const test::Estimate e = test::estimate(lights, {1, 2, 3}, normalize(Vec3f(1, 1, 0)), 250000);
+  EXPECT_NEAR(e.solid_angle, 4.0 * kPiD, 1e-4);
+  EXPECT_NEAR(e.irradiance, kPiD * 0.5, 3e-3 * kPiD * 0.5);
+  EXPECT_FLOAT_EQ(lights.environment({0, 0, 1}).y, 1.0f);
+  EXPECT_NEAR(lights.pdf_environment({0, 1, 0}), 1.0 / (4.0 * kPiD), 1e-7);
+}
+
+}  // namespace
+}  // namespace gdpt
