@@ -1,0 +1,535 @@
+// End-to-end path tracer tests against analytic oracles (white furnace, sun and point light on a
+// Lambert plane), plus determinism, robustness (never NaN/Inf), cancel, instancing, the Emission
+// pass split and the feature specialisation. Images are tiny; sample counts are what the 1%
+// tolerances need with the stratified sampler.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "integrator/integrator.h"
+#include "integrator/render_session.h"
+#include "integrator/scene_context.h"
+
+namespace gdpt {
+namespace {
+
+// --- Scene helpers ---
+
+MaterialDesc diffuse(Spectrum color, float roughness = 0.0f) {
+  MaterialDesc m;
+  ShaderNode n;
+  n.kind = ShaderNodeKind::Diffuse;
+  n.color = ColorInput(color);
+  n.roughness = FloatInput(roughness);
+  m.nodes.push_back(n);
+  m.root = 0;
+  return m;
+}
+
+MaterialDesc glossy(Spectrum color, float roughness) {
+  MaterialDesc m = diffuse(color, roughness);
+  m.nodes[0].kind = ShaderNodeKind::Glossy;
+  return m;
+}
+
+MaterialDesc emission(Spectrum color, float strength) {
+  MaterialDesc m;
+  ShaderNode n;
+  n.kind = ShaderNodeKind::Emission;
+  n.color = ColorInput(color);
+  n.strength = FloatInput(strength);
+  m.nodes.push_back(n);
+  m.root = 0;
+  return m;
+}
+
+Transform translation(Vec3f t) {
+  Transform T;
+  T.m[0][3] = t.x;
+  T.m[1][3] = t.y;
+  T.m[2][3] = t.z;
+  return T;
+}
+
+Transform rotation_x(float a, Vec3f t = Vec3f(0.0f)) {
+  Transform T = translation(t);
+  T.m[1][1] = std::cos(a);
+  T.m[1][2] = -std::sin(a);
+  T.m[2][1] = std::sin(a);
+  T.m[2][2] = std::cos(a);
+  return T;
+}
+
+// Square in z = 0 of half-size h, normal +z.
+Mesh quad(float h) {
+  Mesh m;
+  m.positions = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+// Flat-shaded UV sphere (a convex polyhedron, so the furnace identity holds exactly).
+Mesh sphere(float r, int seg, int rings, Vec3f c = Vec3f(0.0f)) {
+  Mesh m;
+  for (int i = 0; i <= rings; ++i) {
+    const float th = kPi * float(i) / float(rings);
+    for (int j = 0; j < seg; ++j) {
+      const float ph = 2.0f * kPi * float(j) / float(seg);
+      m.positions.push_back(
+          c + Vec3f(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)) * r);
+    }
+  }
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < seg; ++j) {
+      const uint32_t a = uint32_t(i * seg + j), b = uint32_t(i * seg + (j + 1) % seg);
+      const uint32_t c2 = a + uint32_t(seg), d = b + uint32_t(seg);
+      if (i > 0) m.indices.insert(m.indices.end(), {a, c2, b});
+      if (i < rings - 1) m.indices.insert(m.indices.end(), {b, c2, d});
+    }
+  return m;
+}
+
+Instance place(uint32_t mesh, int32_t material, Transform t = Transform()) {
+  Instance i;
+  i.mesh = mesh;
+  i.object_to_world = t;
+  i.slot_material = {material};
+  return i;
+}
+
+// Orthographic camera at `height` looking straight down, `scale` metres across.
+Camera top_camera(int res, float scale, float height = 10.0f) {
+  Camera c;
+  c.projection = Camera::Projection::Orthographic;
+  c.ortho_scale = scale;
+  c.camera_to_world = translation({0, 0, height});
+  c.width = c.height = res;
+  return c;
+}
+
+struct Image {
+  int w = 0, h = 0;
+  std::vector<float> primal, emission;
+  uint32_t min_samples = 0;
+  float at(int x, int y, int c = 0) const { return primal[size_t(y * w + x) * 3 + c]; }
+};
+
+Image render(const Scene& scene, RenderSettings s, std::string* summary = nullptr) {
+  RenderSession session(scene, s);
+  std::atomic<bool> cancel{false};
+  session.render(nullptr, cancel);
+  Image img;
+  img.w = session.film().width();
+  img.h = session.film().height();
+  img.primal.resize(session.film().pixel_count() * 3);
+  img.emission.resize(session.film().pixel_count() * 3);
+  session.film().primal_rgb(img.primal.data());
+  session.film().emission_rgb(img.emission.data());
+  img.min_samples = session.film().min_samples();
+  if (summary) *summary = session.features_summary();
+  return img;
+}
+
+RenderSettings pt(int spp, uint32_t seed = 1) {
+  RenderSettings s;
+  s.mode = RenderSettings::Mode::PT;
+  s.samples = spp;
+  s.seed = seed;
+  s.threads = 2;
+  return s;
+}
+
+// --- Analytic oracles ---
+
+TEST(Render, WhiteFurnace) {
+  Scene scene;
+  scene.meshes.push_back(sphere(1.0f, 48, 24));
+  scene.materials.push_back(diffuse(Spectrum(1.0f)));
+  scene.instances.push_back(place(0, 0));
+  scene.world.color = Spectrum(1.0f);
+  scene.world.strength = 1.0f;
+  scene.camera = top_camera(16, 1.2f);  // only the sphere's cap is in view
+  const Image img = render(scene, pt(64));
+  double sum = 0.0;
+  for (int y = 0; y < img.h; ++y)
+    for (int x = 0; x < img.w; ++x) {
+      sum += img.at(x, y, 1);
+      EXPECT_NEAR(img.at(x, y, 1), 1.0f, 0.05f) << x << "," << y;
+    }
+  EXPECT_NEAR(sum / (img.w * img.h), 1.0, 0.01);
+}
+
+// Plane of albedo 0.5 under a sun of irradiance E at angle theta: L = albedo E cos(theta) / pi.
+void sun_test(float theta, float sun_angle) {
+  Scene scene;
+  scene.meshes.push_back(quad(50.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  scene.instances.push_back(place(0, 0));
+  scene.world.color = Spectrum(0.0f);
+  Light sun;
+  sun.type = Light::Type::Sun;
+  sun.power = 3.0f;
+  sun.sun_angle = sun_angle;
+  sun.light_to_world = rotation_x(theta, {0, 0, 20});
+  scene.lights.push_back(sun);
+  scene.camera = top_camera(8, 2.0f);
+  const Image img = render(scene, pt(16));
+  const double expect = 0.5 * 3.0 * std::cos(theta) / kPi;
+  double sum = 0.0;
+  for (float v : img.primal) sum += v;
+  EXPECT_NEAR(sum / img.primal.size(), expect, 0.01 * expect) << "theta " << theta;
+}
+
+TEST(Render, SunOnLambertPlane) {
+  for (float theta : {0.0f, 0.5f, 1.1f}) sun_test(theta, 0.0f);
+}
+
+TEST(Render, SoftSunOnLambertPlane) {
+  sun_test(0.6f, 0.02f);  // a 1.1-degree disc: cos varies by < 1e-4 over it
+}
+
+// Point light of power P at height h: E = P / (4 pi h^2) below it, L = albedo E / pi.
+double point_light_radiance(float h) {
+  Scene scene;
+  scene.meshes.push_back(quad(50.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.8f)));
+  scene.instances.push_back(place(0, 0));
+  scene.world.color = Spectrum(0.0f);
+  Light l;
+  l.type = Light::Type::Point;
+  l.power = 100.0f;
+  l.light_to_world = translation({0, 0, h});
+  scene.lights.push_back(l);
+  scene.camera = top_camera(4, 0.02f * h, 0.5f * h);
+  const Image img = render(scene, pt(8));
+  double sum = 0.0;
+  for (float v : img.primal) sum += v;
+  return sum / img.primal.size();
+}
+
+TEST(Render, PointLightInverseSquare) {
+  const double l1 = point_light_radiance(1.0f), l2 = point_light_radiance(2.0f),
+               l4 = point_light_radiance(4.0f);
+  const double expect1 = 0.8 * 100.0 / (4.0 * kPi) / kPi;
+  EXPECT_NEAR(l1, expect1, 0.01 * expect1);
+  EXPECT_NEAR(l1 / l2, 4.0, 0.04);
+  EXPECT_NEAR(l1 / l4, 16.0, 0.16);
+}
+
+// --- Light-path semantics ---
+
+TEST(Render, CameraVisibleEmissionGoesToTheEmissionPass) {
+  Scene scene;
+  scene.meshes.push_back(quad(10.0f));
+  scene.materials.push_back(emission(Spectrum(1.0f, 0.5f, 0.25f), 2.0f));
+  scene.instances.push_back(place(0, 0));
+  scene.world.color = Spectrum(0.0f);
+  scene.camera = top_camera(4, 1.0f);
+  const Image img = render(scene, pt(4));
+  for (size_t i = 0; i < img.primal.size(); i += 3) {
+    EXPECT_FLOAT_EQ(img.emission[i], 2.0f);
+    EXPECT_FLOAT_EQ(img.emission[i + 1], 1.0f);
+    EXPECT_FLOAT_EQ(img.emission[i + 2], 0.5f);
+    EXPECT_EQ(img.primal[i], 0.0f);
+  }
+}
+
+// An emissive ceiling lights a floor through BSDF sampling and NEE on emissive triangles (MIS).
+// Two parallel infinite-ish planes: irradiance from a uniform radiance-Le ceiling = pi Le, so the
+// floor's radiance is albedo Le at one bounce (max_bounces = 0: direct light only).
+TEST(Render, EmissiveCeilingDirectLight) {
+  Scene scene;
+  scene.meshes.push_back(quad(200.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  scene.materials.push_back(emission(Spectrum(1.0f), 1.5f));
+  scene.instances.push_back(place(0, 0));
+  // Ceiling at z = 1 facing down (rotated by pi about X).
+  scene.instances.push_back(place(0, 1, rotation_x(kPi, {0, 0, 1})));
+  scene.world.color = Spectrum(0.0f);
+  scene.camera = top_camera(4, 0.5f, 0.5f);
+  RenderSettings s = pt(64);
+  s.max_bounces = 0;
+  const Image img = render(scene, s);
+  double sum = 0.0;
+  for (float v : img.primal) sum += v;
+  // The 400 m plane at height 1 subtends all but ~1e-5 of the hemisphere's projected solid angle.
+  EXPECT_NEAR(sum / img.primal.size(), 0.5 * 1.5, 0.01 * 0.75);
+}
+
+// Floor of albedo a under a ceiling that emits Le and reflects with albedo b (Add shader). Paths
+// floor -> ceiling (-> floor -> ceiling)^k carry a Le (a b)^k and need 2k + 1 bounces after the
+// camera ray, with Cycles' meaning of max_bounces (0 = direct light only): 0, 1 -> a Le;
+// 2, 3 -> a Le (1 + a b); 4 -> a Le (1 + a b + (a b)^2).
+TEST(Render, MaxBouncesFollowsCycles) {
+  Scene scene;
+  scene.meshes.push_back(quad(400.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  MaterialDesc ceiling = emission(Spectrum(1.0f), 1.0f);
+  ShaderNode d;
+  d.kind = ShaderNodeKind::Diffuse;
+  d.color = ColorInput(Spectrum(0.5f));
+  ceiling.nodes.push_back(d);
+  ShaderNode add;
+  add.kind = ShaderNodeKind::Add;
+  add.a = 0;
+  add.b = 1;
+  ceiling.nodes.push_back(add);
+  ceiling.root = 2;
+  scene.materials.push_back(ceiling);
+  scene.instances.push_back(place(0, 0));
+  scene.instances.push_back(place(0, 1, rotation_x(kPi, {0, 0, 1})));
+  scene.world.color = Spectrum(0.0f);
+  scene.camera = top_camera(4, 0.5f, 0.5f);
+  RenderSettings s = pt(64);
+  const double ab = 0.25;
+  const std::pair<int, double> cases[] = {
+      {0, 0.5}, {1, 0.5}, {2, 0.5 * (1 + ab)}, {4, 0.5 * (1 + ab + ab * ab)}};
+  for (const auto& [bounces, expect] : cases) {
+    s.max_bounces = bounces;
+    const Image img = render(scene, s);
+    double sum = 0.0;
+    for (float v : img.primal) sum += v;
+    EXPECT_NEAR(sum / img.primal.size(), expect, 0.01 * expect) << "max_bounces " << bounces;
+  }
+}
+
+// --- Determinism, robustness, session behaviour ---
+
+Scene cornell_like() {
+  Scene scene;
+  scene.meshes.push_back(quad(1.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.8f)));
+  scene.materials.push_back(diffuse(Spectrum(0.8f, 0.1f, 0.1f)));
+  scene.materials.push_back(diffuse(Spectrum(0.1f, 0.8f, 0.1f)));
+  scene.materials.push_back(emission(Spectrum(1.0f), 8.0f));
+  scene.instances.push_back(place(0, 0, rotation_x(-kPi / 2, {0, 1, 0})));  // back wall
+  scene.instances.push_back(place(0, 0, translation({0, 0, -1})));          // floor
+  scene.instances.push_back(place(0, 0, rotation_x(kPi, {0, 0, 1})));       // ceiling
+  Transform left;                                                           // x = -1 facing +x
+  left.m[0][0] = 0;
+  left.m[0][2] = 1;
+  left.m[2][0] = -1;
+  left.m[2][2] = 0;
+  left.m[0][3] = -1;
+  scene.instances.push_back(place(0, 1, left));
+  Transform right = left;
+  right.m[0][2] = -1;
+  right.m[2][0] = 1;
+  right.m[0][3] = 1;
+  scene.instances.push_back(place(0, 2, right));
+  Transform lamp = rotation_x(kPi, {0, 0, 0.99f});
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 2; ++c) lamp.m[r][c] *= 0.25f;
+  scene.instances.push_back(place(0, 3, lamp));
+  Light point;
+  point.power = 20.0f;
+  point.light_to_world = translation({0.3f, -0.2f, 0.5f});
+  scene.lights.push_back(point);
+  scene.world.color = Spectrum(0.02f);
+  Camera cam;
+  cam.camera_to_world = rotation_x(kPi / 2, {0, -3.5f, 0});  // looks along +y
+  cam.focal_length_mm = 35.0f;
+  cam.width = 24;
+  cam.height = 20;
+  scene.camera = cam;
+  return scene;
+}
+
+TEST(Render, BitIdenticalAcrossThreadCountsAndTileOrder) {
+  const Scene scene = cornell_like();
+  RenderSettings s = pt(4, 42);
+  s.threads = 1;
+  const Image one = render(scene, s);
+  s.threads = 2;
+  s.samples_per_pass = 2;
+  const Image two = render(scene, s);
+  ASSERT_EQ(one.primal.size(), two.primal.size());
+  for (size_t i = 0; i < one.primal.size(); ++i) ASSERT_EQ(one.primal[i], two.primal[i]) << i;
+
+  // Tiles in reverse order, odd tile shapes, driving the integrator directly.
+  const SceneContext ctx(scene, s);
+  const auto pt_integrator = make_path_tracer(ctx, s);
+  Film film(scene.camera.width, scene.camera.height);
+  for (int y0 = scene.camera.height; y0 > 0; y0 -= 7)
+    for (int x0 = scene.camera.width; x0 > 0; x0 -= 5)
+      pt_integrator->render_tile({std::max(x0 - 5, 0), std::max(y0 - 7, 0), x0, y0}, 0, 4, film);
+  std::vector<float> p(film.pixel_count() * 3);
+  film.primal_rgb(p.data());
+  for (size_t i = 0; i < p.size(); ++i) ASSERT_EQ(p[i], one.primal[i]) << i;
+
+  double sum = 0.0;
+  for (float v : one.primal) sum += v;
+  EXPECT_GT(sum, 0.0);
+  s.seed = 43;
+  const Image other = render(scene, s);
+  EXPECT_NE(other.primal, one.primal);
+}
+
+TEST(Render, NeverNaNOrInf) {
+  Scene scene = cornell_like();
+  // Degenerate triangles, zero-length and inverted shading normals, zero-roughness glossy,
+  // zero-area area light, zero-radius point light touching a surface.
+  Mesh bad;
+  bad.positions = {{-0.5f, 0, -0.5f},    {0.5f, 0, -0.5f},    {0.5f, 0, -0.5f},  {0, 0.2f, 0.2f},
+                   {-0.5f, 0.3f, -0.9f}, {0.5f, 0.3f, -0.9f}, {0.0f, 0.5f, 0.3f}};
+  bad.indices = {0, 1, 2, 3, 3, 3, 4, 5, 6};
+  const Vec3f n = normalize(Vec3f(0, -1, 0));
+  bad.corner_normals = {Vec3f(0.0f), Vec3f(0.0f), Vec3f(0.0f), n, n, n, -n, n * -1.0f, -n};
+  scene.meshes.push_back(bad);
+  scene.materials.push_back(glossy(Spectrum(0.9f), 0.0f));
+  scene.instances.push_back(place(1, 4));
+  scene.instances.push_back(place(1, 0, translation({0.2f, -0.3f, 0.1f})));
+  Light area;
+  area.type = Light::Type::Area;
+  area.size_x = 0.0f;
+  area.size_y = 0.0f;
+  area.power = 50.0f;
+  area.light_to_world = translation({0, 0, 0.8f});
+  scene.lights.push_back(area);
+  Light touching;
+  touching.power = 10.0f;
+  touching.light_to_world = translation({0, 0, -1.0f});  // on the floor
+  scene.lights.push_back(touching);
+  const Image img = render(scene, pt(8));
+  for (float v : img.primal) ASSERT_TRUE(std::isfinite(v));
+  for (float v : img.emission) ASSERT_TRUE(std::isfinite(v));
+}
+
+TEST(Render, CancelKeepsFinishedPasses) {
+  const Scene scene = cornell_like();
+  RenderSession session(scene, pt(1000));
+  std::atomic<bool> cancel{false};
+  int calls = 0;
+  session.render(
+      [&](const RenderProgress& p) {
+        ++calls;
+        EXPECT_EQ(p.samples_done, calls);
+        EXPECT_EQ(p.samples_total, 1000);
+        if (calls == 3) cancel = true;
+      },
+      cancel);
+  EXPECT_EQ(calls, 3);
+  for (int y = 0; y < session.film().height(); ++y)
+    for (int x = 0; x < session.film().width(); ++x) ASSERT_EQ(session.film().samples(x, y), 3u);
+}
+
+TEST(Render, CancelFromAnotherThreadStopsQuickly) {
+  Scene scene = cornell_like();
+  scene.camera.width = 160;
+  scene.camera.height = 120;
+  RenderSettings s = pt(1 << 20);
+  s.samples_per_pass = 4;
+  RenderSession session(scene, s);
+  std::atomic<bool> cancel{false};
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    cancel = true;
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  session.render(nullptr, cancel);
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stopper.join();
+  EXPECT_LT(secs, 1.2);
+  const uint32_t n = session.film().samples(0, 0);
+  EXPECT_EQ(n % 4, 0u);
+  EXPECT_EQ(session.film().min_samples(), n);  // a cancelled pass is discarded everywhere
+}
+
+TEST(Render, TimeLimitStopsTheRender) {
+  RenderSettings s = pt(1 << 20);
+  s.time_limit = 0.2;
+  RenderSession session(cornell_like(), s);
+  std::atomic<bool> cancel{false};
+  const auto t0 = std::chrono::steady_clock::now();
+  session.render(nullptr, cancel);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+  EXPECT_GT(session.film().min_samples(), 0u);
+}
+
+TEST(Render, InstancesRenderLikeCopies) {
+  Scene inst, copies;
+  const Mesh ball = sphere(0.4f, 16, 8);
+  inst.meshes.push_back(ball);
+  for (Scene* s : {&inst, &copies}) {
+    s->meshes.push_back(quad(20.0f));
+    s->materials.push_back(diffuse(Spectrum(0.7f, 0.5f, 0.3f)));
+    s->world.color = Spectrum(0.5f);
+    s->camera = top_camera(24, 4.0f);
+  }
+  inst.instances.push_back(place(1, 0));
+  copies.instances.push_back(place(0, 0));
+  for (int i = 0; i < 4; ++i) {
+    const Vec3f c(-1.2f + 0.8f * float(i), 0.3f * float(i % 2), 0.5f);
+    inst.instances.push_back(place(0, 0, translation(c)));
+    copies.meshes.push_back(sphere(0.4f, 16, 8, c));
+    copies.instances.push_back(place(uint32_t(copies.meshes.size() - 1), 0));
+  }
+  const Image a = render(inst, pt(32)), b = render(copies, pt(32));
+  double diff = 0.0, sum = 0.0;
+  for (size_t i = 0; i < a.primal.size(); ++i) {
+    diff += std::fabs(a.primal[i] - b.primal[i]);
+    sum += a.primal[i];
+  }
+  // Same samples, geometry equal up to float rounding of the transform.
+  EXPECT_LT(diff / sum, 1e-3);
+}
+
+TEST(Render, ForcedFeaturesGiveTheSameImage) {
+  const Scene scene = cornell_like();
+  std::string lean, forced;
+  RenderSettings s = pt(4);
+  const Image a = render(scene, s, &lean);
+  s.force_all_features = true;
+  const Image b = render(scene, s, &forced);
+  EXPECT_EQ(lean.find("dof"), std::string::npos);
+  EXPECT_NE(forced.find("(forced)"), std::string::npos);
+  double diff = 0.0, sum = 0.0;
+  for (size_t i = 0; i < a.primal.size(); ++i) {
+    diff += std::fabs(a.primal[i] - b.primal[i]);
+    sum += a.primal[i];
+  }
+  EXPECT_LT(diff / sum, 1e-5);
+}
+
+TEST(Render, PtGradientsAreForwardDifferencesOfPrimal) {
+  RenderSession session(cornell_like(), pt(2));
+  std::atomic<bool> cancel{false};
+  session.render(nullptr, cancel);
+  const Film& f = session.film();
+  std::vector<float> p(f.pixel_count() * 3), dx(p.size()), dy(p.size());
+  f.primal_rgb(p.data());
+  f.gradient_x_rgb(dx.data());
+  f.gradient_y_rgb(dy.data());
+  const int w = f.width();
+  for (int y = 0; y + 1 < f.height(); ++y)
+    for (int x = 0; x + 1 < w; ++x) {
+      const size_t i = size_t(y * w + x) * 3;
+      EXPECT_NEAR(dx[i], p[i + 3] - p[i], 1e-5f);
+      EXPECT_NEAR(dy[i], p[i + size_t(w) * 3] - p[i], 1e-5f);
+    }
+}
+
+TEST(Render, InvalidScenesThrowEmptyScenesRender) {
+  Scene bad = cornell_like();
+  bad.camera.width = 0;
+  EXPECT_THROW(RenderSession(bad, pt(1)), std::invalid_argument);
+  Scene bad_mesh = cornell_like();
+  bad_mesh.instances[0].mesh = 99;
+  EXPECT_THROW(RenderSession(bad_mesh, pt(1)), std::invalid_argument);
+  Scene empty;
+  empty.world.color = Spectrum(0.0f);
+  empty.camera.width = 8;
+  empty.camera.height = 4;
+  const Image img = render(empty, pt(2));
+  for (float v : img.primal) EXPECT_EQ(v, 0.0f);
+  EXPECT_EQ(img.min_samples, 2u);
+}
+
+}  // namespace
+}  // namespace gdpt
