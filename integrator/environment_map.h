@@ -1,6 +1,6 @@
 // Equirectangular environment (Blender World > Environment Texture) with importance sampling.
 //
-// Mapping (Cycles' direction_to_equirectangular, kernel/geom or util/projection: range
+// Mapping (Cycles' direction_to_equirectangular, kernel/camera/projection.h: range
 // (-2 pi, pi, -pi, pi)), for a unit lookup direction d:
 //   u = 0.5 - atan2(d.y, d.x) / (2 pi)     (+X at the image centre, +Y at u = 0.25)
 //   v = 1 - acos(d.z) / pi                 (+Z at the top row; rows are stored bottom-up)

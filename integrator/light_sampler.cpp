@@ -341,8 +341,9 @@ bool LightSampler::intersect(Vec3f origin, Vec3f direction, float t_max, LightHi
     hit.pdf *= area->select_pmf;
     return true;
   }
-  // Sun discs sit at infinity: only rays that escape the scene reach them.
-  if (t_max == std::numeric_limits<float>::infinity()) {
+  // Sun discs sit at infinity: only rays that escape the scene reach them, i.e. rays whose
+  // t_max is still unbounded (Ray::t_max defaults to 1e30, or +inf).
+  if (t_max >= 1e30f) {
     for (const lights::SunLight& s : I.suns) {
       if (s.hit(direction)) {
         s.fill_hit(origin, direction, hit);

@@ -46,6 +46,8 @@ class LightSampler {
   float pdf_triangle(uint32_t instance, uint32_t primitive, Vec3f ref_position,
                      Vec3f light_position, Vec3f light_normal) const;
   // Closest analytic light (sphere, spot sphere, area, sun disc) along the ray with t < t_max.
+  // Sun discs are at infinity: reported only for unbounded rays (t_max >= 1e30, Ray's default,
+  // or +inf), i.e. rays that escaped the geometry. Emissive triangles are geometry, not here.
   bool intersect(Vec3f origin, Vec3f direction, float t_max, LightHit& hit) const;
   // Radiance of the world along an escaping ray (sun discs excluded: see intersect) and its pdf.
   Spectrum environment(Vec3f direction) const;

@@ -154,6 +154,7 @@ TEST(LightSampler, IntersectRespectsTMaxAndOneSidedness) {
   // Sun disc only for escaping rays.
   const Vec3f to_sun = -normalize(Vec3f(0.2f, -0.3f, -1));
   ASSERT_TRUE(lights.intersect({0, 0, 0}, to_sun, kInf, hit));
+  EXPECT_TRUE(lights.intersect({0, 0, 0}, to_sun, 1e30f, hit));  // Ray::t_max default
   EXPECT_FALSE(lights.intersect({0, 0, 0}, to_sun, 1e6f, hit));
   // The rectangle emits along (1,0,-1): seen from behind it is invisible.
   const Vec3f c(-3, 0, 2);
