@@ -42,7 +42,10 @@ struct Closure {
   float alpha = 0.0f;                 // GGX alpha (= Blender roughness^2); diffuse roughness
   float ior = 1.45f;                  // relative IOR (outside -> inside)
   Spectrum f0{0.04f, 0.04f, 0.04f};   // PrincipledV1 specular colour at normal incidence
-  Vec3f normal{0.0f, 0.0f, 1.0f};     // local-frame normal of the lobe (reserved; +z today)
+  // GGXDielectric: extra factor on the refracted part only (Principled transmission: base colour;
+  // the reflected part is weight * Fresnel colour). Glass BSDF: 1 (its colour is in weight).
+  Spectrum transmission_tint{1.0f, 1.0f, 1.0f};
+  Vec3f normal{0.0f, 0.0f, 1.0f};  // local-frame normal of the lobe (reserved; +z today)
 };
 
 enum LobeFlags : uint8_t {

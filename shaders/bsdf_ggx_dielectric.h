@@ -1,0 +1,168 @@
+// GGX dielectric (Blender Glass BSDF; Principled v1 transmission), as Cycles 3.4.
+//
+// Side: the frame normal is the geometric side; wi.z > 0 means the ray arrives from outside and
+// refracts into the object with eta = n_t / n_i = ior, wi.z < 0 means it leaves with eta = 1/ior.
+// The problem is mirrored so that wi.z > 0 internally.
+//
+// Cycles 3.4 builds the Glass BSDF from two closures split by the Fresnel term at the SHADING
+// normal, F = fresnel_dielectric(cos_i, eta) (not per microfacet), and so do we:
+//   reflection   (wo.z > 0):  R(h) F D(h) G1(wi) G1(wo) / (4 cos_i),   h = normalize(wi + wo)
+//   transmission (wo.z < 0):  T (1 - F) D(h) G1(wi) G1(wo) eta^2 |wi.h| |wo.h|
+//                                          / (cos_i (wi.h + eta wo.h)^2), h ~ -(wi + eta wo)
+// with R(h) = weight (Glass) or weight * PrincipledFresnel(ior, f0)(wo.h) (Principled), and
+// T = weight * transmission_tint.
+// Radiance scaling: the transmitted part carries eta^2 relative to Walter et al.'s radiance
+// BTDF, i.e. radiance is NOT scaled by 1/eta^2 when it crosses the interface. This is what Cycles
+// does (bsdf_microfacet_ggx_eval_transmit multiplies by m_eta^2; the sharp refraction closure
+// returns weight 1): a camera path entering glass keeps throughput (1 - F), not (1 - F) / eta^2.
+// Consequence: f(wi, wo) = eta^2 f(wo, wi) for the microfacet part (tested).
+// A refraction sampled through a microfacet that totally reflects internally is lost (invalid
+// sample), as in Cycles.
+// Smooth (alpha < kDeltaAlpha) or eta ~ 1: delta lobes; reflection is chosen with probability
+// P_R (Fresnel weighted by colour luminances), value = R F, transmission value = T (1 - F).
+#pragma once
+
+#include "shaders/bsdf.h"
+#include "shaders/fresnel.h"
+#include "shaders/lobe_util.h"
+#include "shaders/microfacet.h"
+
+namespace gdpt::ggx_dielectric {
+
+// Per-call set-up from wi (mirrored to wi.z > 0): relative IOR, Fresnel split, selection.
+struct Setup {
+  float eta;      // n_t / n_i
+  float fresnel;  // reflectance at the shading normal
+  float p_reflect;
+  bool smooth;        // delta reflection and refraction
+  bool pass_through;  // eta ~ 1: refraction is a straight delta pass-through
+};
+
+inline Spectrum reflection_colour(const Closure& c, float eta, float cos_h) {
+  if (c.fresnel != FresnelMode::PrincipledV1) return c.weight;
+  return c.weight * PrincipledFresnel(eta, c.f0)(cos_h);
+}
+
+inline Setup setup(const Closure& c, float cos_i, bool entering) {
+  Setup s;
+  const float ior = std::max(c.ior, 1e-5f);
+  s.eta = entering ? ior : 1.0f / ior;
+  s.fresnel = fresnel_dielectric(cos_i, s.eta);
+  s.smooth = is_delta_alpha(c.alpha);
+  s.pass_through = std::fabs(s.eta - 1.0f) < 1e-4f;
+  const float r = s.fresnel * selection_luminance(reflection_colour(c, s.eta, cos_i));
+  const float t = (1.0f - s.fresnel) * selection_luminance(c.weight * c.transmission_tint);
+  s.p_reflect = (r + t) > 0.0f ? r / (r + t) : s.fresnel;
+  return s;
+}
+
+// Non-delta part; wi, wo mirrored so that wi.z > 0. Returns eval, writes the pdf.
+inline Spectrum eval_pdf_upper(const Closure& c, const Setup& st, Vec3f wi, Vec3f wo, float& pdf) {
+  pdf = 0.0f;
+  if (st.smooth || !(wi.z > 0.0f) || wo.z == 0.0f) return Spectrum(0.0f);
+  const GGX ggx(c.alpha);
+  if (wo.z > 0.0f) {
+    const Vec3f sum = wi + wo;
+    const float len2 = length_squared(sum);
+    if (!(len2 > 0.0f) || st.fresnel <= 0.0f) return Spectrum(0.0f);
+    const Vec3f h = sum / std::sqrt(len2);
+    const float common = ggx.D(h) * ggx.G1(wi) / (4.0f * wi.z);
+    pdf = st.p_reflect * common;
+    return reflection_colour(c, st.eta, dot(wo, h)) * (st.fresnel * common * ggx.G1(wo));
+  }
+  if (st.pass_through || st.fresnel >= 1.0f) return Spectrum(0.0f);
+  // Generalised half vector of the refraction, oriented to the outside (+z).
+  Vec3f ht = wi + wo * st.eta;
+  const float len2 = length_squared(ht);
+  if (!(len2 > 0.0f)) return Spectrum(0.0f);
+  ht = ht / std::sqrt(len2);
+  if (ht.z < 0.0f) ht = -ht;
+  const float cos_ih = dot(wi, ht), cos_oh = dot(wo, ht);
+  // Only microfacets facing wi that refract towards wo contribute.
+  if (!(cos_ih > 0.0f && cos_oh < 0.0f)) return Spectrum(0.0f);
+  const float denom = cos_ih + st.eta * cos_oh;
+  const float jacobian = st.eta * st.eta * std::fabs(cos_oh) / (denom * denom);  // dwh / dwo
+  const float pdf_h = ggx.G1(wi) * cos_ih * ggx.D(ht) / wi.z;
+  pdf = (1.0f - st.p_reflect) * pdf_h * jacobian;
+  return c.weight * c.transmission_tint * ((1.0f - st.fresnel) * pdf_h * jacobian * ggx.G1(wo));
+}
+
+inline Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo) {
+  if (wi.z == 0.0f) return Spectrum(0.0f);
+  const MirroredPair p(wi, wo);
+  const Setup st = setup(c, p.wi.z, wi.z > 0.0f);
+  float pdf;
+  return eval_pdf_upper(c, st, p.wi, p.wo, pdf);
+}
+
+inline float pdf(const Closure& c, Vec3f wi, Vec3f wo) {
+  if (wi.z == 0.0f) return 0.0f;
+  const MirroredPair p(wi, wo);
+  const Setup st = setup(c, p.wi.z, wi.z > 0.0f);
+  float pdf;
+  eval_pdf_upper(c, st, p.wi, p.wo, pdf);
+  return pdf;
+}
+
+inline BsdfSample sample(const Closure& c, Vec3f wi_, float u_choice, Vec2f u) {
+  BsdfSample s;
+  if (wi_.z == 0.0f) return s;
+  const float sign = wi_.z < 0.0f ? -1.0f : 1.0f;
+  const Vec3f wi = flip_z(wi_, sign);
+  const Setup st = setup(c, wi.z, wi_.z > 0.0f);
+  const bool pick_reflection = u_choice < st.p_reflect;
+
+  // Delta cases: smooth glass, or the straight pass-through of an index-matched interface.
+  if (st.smooth || (!pick_reflection && st.pass_through)) {
+    if (pick_reflection) {
+      s.wo = flip_z(Vec3f(-wi.x, -wi.y, wi.z), sign);
+      s.value = reflection_colour(c, st.eta, wi.z) * st.fresnel;
+      s.pdf = st.p_reflect;
+      s.eta = 1.0f;
+      s.lobe = kLobeReflection | kLobeDelta;
+    } else {
+      Vec3f wt;
+      if (!refract(wi, Vec3f(0.0f, 0.0f, 1.0f), st.eta, wt)) return s;
+      s.wo = flip_z(wt, sign);
+      s.value = c.weight * c.transmission_tint * (1.0f - st.fresnel);
+      s.pdf = 1.0f - st.p_reflect;
+      s.eta = st.eta;
+      s.lobe = kLobeTransmission | kLobeDelta;
+    }
+    s.roughness = 0.0f;
+    s.valid = s.pdf > 0.0f;
+    return s;
+  }
+
+  const GGX ggx(c.alpha);
+  const Vec3f m = ggx.sample_visible(wi, u);
+  Vec3f wo;
+  if (pick_reflection) {
+    wo = reflect(wi, m);
+    if (wo.z <= 0.0f) return s;
+    s.eta = 1.0f;
+    s.lobe = kLobeReflection | kLobeGlossy;
+  } else {
+    if (!refract(wi, m, st.eta, wo) || wo.z >= 0.0f) return s;
+    s.eta = st.eta;
+    s.lobe = kLobeTransmission | kLobeGlossy;
+  }
+  s.value = eval_pdf_upper(c, st, wi, wo, s.pdf);
+  if (!(s.pdf > 0.0f)) return s;
+  s.wo = flip_z(wo, sign);
+  s.roughness = c.alpha;
+  s.valid = true;
+  return s;
+}
+
+inline float albedo_hint(const Closure& c, Vec3f wi) {
+  if (wi.z == 0.0f) return 0.0f;
+  const Setup st = setup(c, std::fabs(wi.z), wi.z > 0.0f);
+  const float lw = selection_luminance(c.weight);
+  if (!(lw > 0.0f)) return 1.0f;
+  const float r = st.fresnel * selection_luminance(reflection_colour(c, st.eta, std::fabs(wi.z)));
+  const float t = (1.0f - st.fresnel) * selection_luminance(c.weight * c.transmission_tint);
+  return (r + t) / lw;
+}
+
+}  // namespace gdpt::ggx_dielectric

@@ -1,0 +1,172 @@
+// ClosureSet: a weighted sum of lobes, evaluated and sampled as one BSDF.
+//
+// Sampling is one-sample MIS over lobes: a lobe k is chosen with probability s_k proportional
+// to luminance(weight_k) * albedo_hint_k(wi), it samples wo, and the returned value and pdf are
+// those of the whole mixture, sum_j eval_j and sum_j s_j pdf_j, so that value / pdf agrees with
+// eval() / pdf() (delta lobes excepted: they return their own value and s_k * probability).
+#include <algorithm>
+
+#include "shaders/bsdf.h"
+#include "shaders/bsdf_ggx_dielectric.h"
+#include "shaders/bsdf_ggx_reflection.h"
+#include "shaders/bsdf_lambert.h"
+#include "shaders/bsdf_oren_nayar.h"
+#include "shaders/bsdf_principled_diffuse.h"
+#include "shaders/bsdf_transparent.h"
+
+namespace gdpt {
+
+namespace {
+
+// Static dispatch on the closure type (a switch keeps everything inlined; no virtual calls).
+#define GDPT_DISPATCH(c, call)           \
+  switch ((c).type) {                    \
+    case ClosureType::Lambert:           \
+      return lambert::call;              \
+    case ClosureType::OrenNayar:         \
+      return oren_nayar::call;           \
+    case ClosureType::PrincipledDiffuse: \
+      return principled_diffuse::call;   \
+    case ClosureType::GGXReflection:     \
+      return ggx_reflection::call;       \
+    case ClosureType::GGXDielectric:     \
+      return ggx_dielectric::call;       \
+    case ClosureType::Transparent:       \
+      return transparent::call;          \
+  }                                      \
+  return {};
+
+Spectrum lobe_eval(const Closure& c, Vec3f wi, Vec3f wo) {
+  GDPT_DISPATCH(c, eval(c, wi, wo))
+}
+float lobe_pdf(const Closure& c, Vec3f wi, Vec3f wo){GDPT_DISPATCH(c, pdf(c, wi, wo))} BsdfSample
+    lobe_sample(const Closure& c, Vec3f wi, float u_choice, Vec2f u) {
+  GDPT_DISPATCH(c, sample(c, wi, u_choice, u))
+}
+float lobe_albedo_hint(const Closure& c, Vec3f wi) {
+  GDPT_DISPATCH(c, albedo_hint(c, wi))
+}
+#undef GDPT_DISPATCH
+
+bool lobe_is_delta(const Closure& c) {
+  switch (c.type) {
+    case ClosureType::Transparent:
+      return true;
+    case ClosureType::GGXReflection:
+      return is_delta_alpha(c.alpha);
+    case ClosureType::GGXDielectric:
+      // An index-matched rough interface still has a (zero-weight) glossy reflection; its
+      // transmission is a delta pass-through, so it counts as delta for classification.
+      return is_delta_alpha(c.alpha) || std::fabs(c.ior - 1.0f) < 1e-4f;
+    default:
+      return false;
+  }
+}
+
+bool lobe_is_diffuse(const Closure& c) {
+  return c.type == ClosureType::Lambert || c.type == ClosureType::OrenNayar ||
+         c.type == ClosureType::PrincipledDiffuse;
+}
+
+// Unnormalised selection weights; returns their sum.
+float selection_weights(const Closure* closures, int count, Vec3f wi, float* w) {
+  float total = 0.0f;
+  for (int i = 0; i < count; ++i) {
+    w[i] = selection_luminance(closures[i].weight) * lobe_albedo_hint(closures[i], wi);
+    total += w[i];
+  }
+  return total;
+}
+
+}  // namespace
+
+void ClosureSet::add(const Closure& c) {
+  if (is_black(c.weight)) return;
+  if (count_ < kMaxClosures) {
+    closures_[count_++] = c;
+    return;
+  }
+  // Full: keep the kMaxClosures strongest lobes.
+  int weakest = 0;
+  for (int i = 1; i < count_; ++i)
+    if (selection_luminance(closures_[i].weight) < selection_luminance(closures_[weakest].weight))
+      weakest = i;
+  if (selection_luminance(c.weight) > selection_luminance(closures_[weakest].weight))
+    closures_[weakest] = c;
+}
+
+Spectrum ClosureSet::eval(Vec3f wi, Vec3f wo) const {
+  Spectrum f(0.0f);
+  for (int i = 0; i < count_; ++i) f += lobe_eval(closures_[i], wi, wo);
+  return f;
+}
+
+float ClosureSet::pdf(Vec3f wi, Vec3f wo) const {
+  if (count_ == 1) return lobe_pdf(closures_[0], wi, wo);
+  float w[kMaxClosures];
+  const float total = selection_weights(closures_, count_, wi, w);
+  if (!(total > 0.0f)) return 0.0f;
+  float p = 0.0f;
+  for (int i = 0; i < count_; ++i)
+    if (w[i] > 0.0f) p += w[i] * lobe_pdf(closures_[i], wi, wo);
+  return p / total;
+}
+
+BsdfSample ClosureSet::sample(Vec3f wi, float u_lobe, Vec2f u) const {
+  if (count_ == 0) return {};
+  if (count_ == 1) return lobe_sample(closures_[0], wi, u_lobe, u);
+
+  // --- Pick a lobe; the leftover of u_lobe within its interval drives the lobe's own choice.
+  float w[kMaxClosures];
+  const float total = selection_weights(closures_, count_, wi, w);
+  if (!(total > 0.0f)) return {};
+  const float target = u_lobe * total;
+  int k = 0;
+  float cdf = 0.0f;
+  for (; k < count_ - 1; ++k) {
+    if (target < cdf + w[k]) break;
+    cdf += w[k];
+  }
+  while (w[k] <= 0.0f && k > 0) --k;  // rounding at the top end: fall back to a live lobe
+  const float u_choice = std::clamp((target - cdf) / w[k], 0.0f, 0.99999994f);
+  BsdfSample s = lobe_sample(closures_[k], wi, u_choice, u);
+  if (!s.valid) return s;
+
+  const float sel_k = w[k] / total;
+  if (s.is_delta()) {
+    s.pdf *= sel_k;
+    return s;
+  }
+
+  // --- One-sample MIS: the mixture's value and density at the sampled direction.
+  Spectrum value = s.value;
+  float pdf = w[k] * s.pdf;
+  for (int i = 0; i < count_; ++i) {
+    if (i == k) continue;
+    value += lobe_eval(closures_[i], wi, s.wo);
+    if (w[i] > 0.0f) pdf += w[i] * lobe_pdf(closures_[i], wi, s.wo);
+  }
+  s.value = value;
+  s.pdf = pdf / total;
+  s.valid = s.pdf > 0.0f;
+  return s;
+}
+
+float ClosureSet::roughness() const {
+  float r = 2.0f;
+  for (int i = 0; i < count_; ++i) {
+    const Closure& c = closures_[i];
+    if (lobe_is_delta(c) && !(c.type == ClosureType::GGXDielectric && !is_delta_alpha(c.alpha)))
+      continue;
+    r = std::min(r, lobe_is_diffuse(c) ? 1.0f : std::clamp(c.alpha, 0.0f, 1.0f));
+  }
+  return r > 1.0f ? (count_ > 0 && has_delta() ? 0.0f : 1.0f) : r;
+}
+
+bool ClosureSet::has_delta() const {
+  for (int i = 0; i < count_; ++i)
+    if (lobe_is_delta(closures_[i])) return true;
+  return false;
+}
+
+}  // namespace gdpt

@@ -1,0 +1,355 @@
+// Material: a MaterialDesc node tree evaluated at a hit point into a ClosureSet.
+//
+// The tree is walked depth-first with a fixed-size explicit stack of (node, weight) pairs; Mix
+// gives (1 - fac) w to its first child and fac w to its second (fac clamped to [0, 1], as
+// Cycles), Add gives w to both. Each BSDF node adds its lobes with weight w, Emission nodes and
+// Principled emission add colour * strength * w to the emission. Inputs are constants or image
+// lookups at mapping.point(u, v, 0).
+//
+// The same walk, with texture inputs replaced by the texture's mean, gives average_emission().
+#include "shaders/material.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "shaders/microfacet.h"
+#include "shaders/principled.h"
+
+namespace gdpt {
+
+namespace {
+
+// Deepest Mix/Add nesting accepted (the explicit stack holds at most depth + 1 entries).
+constexpr int kMaxTreeDepth = 32;
+
+struct StackEntry {
+  int32_t node;
+  float weight;
+};
+
+// Inputs at a hit point: texture lookups at the mapped UV.
+struct PointInputs {
+  std::span<const Texture> textures;
+  Vec2f uv;
+
+  Rgba fetch(const TextureLookup& t) const {
+    const Vec3f p = t.uv_mapping.point(Vec3f(uv.x, uv.y, 0.0f));
+    return textures[size_t(t.image)].lookup(Vec2f(p.x, p.y), t.interpolation, t.extension);
+  }
+  Spectrum color(const ColorInput& in) const {
+    return in.texture.image < 0 ? in.value : fetch(in.texture).rgb;
+  }
+  float scalar(const FloatInput& in) const {
+    if (in.texture.image < 0) return in.value;
+    const Rgba c = fetch(in.texture);
+    switch (in.channel) {
+      case FloatInput::Channel::Red:
+        return c.rgb.x;
+      case FloatInput::Channel::Alpha:
+        return c.a;
+      case FloatInput::Channel::Luminance:
+        break;
+    }
+    return luminance(c.rgb);
+  }
+};
+
+// Inputs averaged over the whole texture (for light power estimates).
+struct AverageInputs {
+  const std::vector<Rgba>* means;
+
+  Spectrum color(const ColorInput& in) const {
+    return in.texture.image < 0 ? in.value : (*means)[size_t(in.texture.image)].rgb;
+  }
+  float scalar(const FloatInput& in) const {
+    if (in.texture.image < 0) return in.value;
+    const Rgba& c = (*means)[size_t(in.texture.image)];
+    switch (in.channel) {
+      case FloatInput::Channel::Red:
+        return c.rgb.x;
+      case FloatInput::Channel::Alpha:
+        return c.a;
+      case FloatInput::Channel::Luminance:
+        break;
+    }
+    return luminance(c.rgb);
+  }
+};
+
+float clamp01(float x) {
+  return std::clamp(x, 0.0f, 1.0f);
+}
+
+// Adds the lobes of one BSDF node (weight w) to `out`.
+template <class Inputs>
+void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
+  Closure c;
+  switch (n.kind) {
+    case ShaderNodeKind::Diffuse: {
+      const float r = clamp01(in.scalar(n.roughness));
+      c.type = r > 0.0f ? ClosureType::OrenNayar : ClosureType::Lambert;
+      c.alpha = r;
+      c.weight = in.color(n.color) * w;
+      out.add(c);
+      return;
+    }
+    case ShaderNodeKind::Glossy: {
+      const float r = clamp01(in.scalar(n.roughness));
+      c.type = ClosureType::GGXReflection;
+      c.fresnel = FresnelMode::None;
+      c.alpha = r * r;
+      c.weight = in.color(n.color) * w;
+      out.add(c);
+      return;
+    }
+    case ShaderNodeKind::Glass: {
+      const float r = clamp01(in.scalar(n.roughness));
+      const float ior = std::max(in.scalar(n.ior), 1e-5f);
+      c.weight = in.color(n.color) * w;
+      if (std::fabs(ior - 1.0f) < 1e-4f) {
+        // Index-matched: no reflection (F = 0), refraction is a straight pass-through.
+        c.type = ClosureType::Transparent;
+      } else {
+        c.type = ClosureType::GGXDielectric;
+        c.fresnel = FresnelMode::Dielectric;
+        c.alpha = r * r;
+        c.ior = ior;
+      }
+      out.add(c);
+      return;
+    }
+    case ShaderNodeKind::Transparent:
+      c.type = ClosureType::Transparent;
+      c.weight = in.color(n.color) * w;
+      out.add(c);
+      return;
+    case ShaderNodeKind::Principled: {
+      PrincipledParams p;
+      p.base_color = in.color(n.color);
+      p.metallic = in.scalar(n.metallic);
+      p.specular = in.scalar(n.specular);
+      p.specular_tint = in.scalar(n.specular_tint);
+      p.roughness = in.scalar(n.roughness);
+      p.ior = in.scalar(n.ior);
+      p.transmission = in.scalar(n.transmission);
+      p.alpha = in.scalar(n.alpha);
+      p.emission = in.color(n.emission) * in.scalar(n.emission_strength);
+      add_principled_closures(p, w, out);
+      return;
+    }
+    default:
+      return;
+  }
+}
+
+// Emission of one node (weight w), without building BSDF lobes.
+template <class Inputs>
+Spectrum node_emission(const ShaderNode& n, float w, const Inputs& in) {
+  if (n.kind == ShaderNodeKind::Emission) return in.color(n.color) * (in.scalar(n.strength) * w);
+  if (n.kind == ShaderNodeKind::Principled)
+    return in.color(n.emission) *
+           (in.scalar(n.emission_strength) * clamp01(in.scalar(n.alpha)) * w);
+  return Spectrum(0.0f);
+}
+
+// The tree walk. With `out` null only emission is accumulated.
+template <class Inputs>
+Spectrum walk(const std::vector<ShaderNode>& nodes, int32_t root, const Inputs& in,
+              ClosureSet* out) {
+  Spectrum emission(0.0f);
+  StackEntry stack[kMaxTreeDepth + 2];
+  int top = 0;
+  stack[top++] = {root, 1.0f};
+  while (top > 0) {
+    const StackEntry e = stack[--top];
+    if (e.weight <= 0.0f) continue;
+    const ShaderNode& n = nodes[size_t(e.node)];
+    switch (n.kind) {
+      case ShaderNodeKind::Mix: {
+        const float fac = clamp01(in.scalar(n.fac));
+        // Second child pushed first so the first child's lobes come first.
+        stack[top++] = {n.b, e.weight * fac};
+        stack[top++] = {n.a, e.weight * (1.0f - fac)};
+        break;
+      }
+      case ShaderNodeKind::Add:
+        stack[top++] = {n.b, e.weight};
+        stack[top++] = {n.a, e.weight};
+        break;
+      case ShaderNodeKind::Emission:
+        emission += node_emission(n, e.weight, in);
+        break;
+      default:
+        if (out) {
+          add_bsdf(n, e.weight, in, *out);  // Principled emission goes through out
+        } else {
+          emission += node_emission(n, e.weight, in);
+        }
+        break;
+    }
+  }
+  return emission;
+}
+
+bool has_texture(const ColorInput& c) {
+  return c.texture.image >= 0;
+}
+bool has_texture(const FloatInput& f) {
+  return f.texture.image >= 0;
+}
+
+// Could a roughness input give a delta lobe (alpha = r^2 below kDeltaAlpha)?
+bool may_be_delta(const FloatInput& roughness) {
+  if (has_texture(roughness)) return true;
+  const float r = clamp01(roughness.value);
+  return is_delta_alpha(r * r);
+}
+
+}  // namespace
+
+Material::Material() {
+  ShaderNode diffuse;
+  diffuse.kind = ShaderNodeKind::Diffuse;
+  diffuse.color = ColorInput(Spectrum(0.8f));
+  diffuse.roughness = FloatInput(0.0f);
+  nodes_.push_back(diffuse);
+  root_ = 0;
+}
+
+Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
+    : textures_(textures) {
+  if (desc.root < 0) {
+    *this = Material();
+    textures_ = textures;
+    return;
+  }
+  nodes_ = desc.nodes;
+  root_ = desc.root;
+  const std::string where = "material '" + desc.name + "': ";
+  auto check_node = [&](int32_t i) {
+    if (i < 0 || size_t(i) >= nodes_.size())
+      throw std::invalid_argument(where + "node index " + std::to_string(i) + " out of range (" +
+                                  std::to_string(nodes_.size()) + " nodes)");
+  };
+  auto check_lookup = [&](const TextureLookup& t) {
+    if (t.image >= 0 && size_t(t.image) >= textures.size())
+      throw std::invalid_argument(where + "image index " + std::to_string(t.image) +
+                                  " out of range (" + std::to_string(textures.size()) +
+                                  " textures)");
+  };
+  check_node(root_);
+
+  // --- Validate the reachable tree (indices, depth, cycles) and collect features. Recursion is
+  // fine here: this runs once at scene load, the per-hit walk uses the explicit stack.
+  std::vector<bool> uses_image(textures.size(), false);
+  auto note = [&](const auto& input) {
+    check_lookup(input.texture);
+    if (has_texture(input)) {
+      features_ |= kFeatureTextures;
+      uses_image[size_t(input.texture.image)] = true;
+    }
+  };
+  auto visit = [&](auto&& self, int32_t i, int depth) -> void {
+    check_node(i);
+    if (depth > kMaxTreeDepth)
+      throw std::invalid_argument(where + "node tree deeper than " + std::to_string(kMaxTreeDepth) +
+                                  " (or cyclic)");
+    const ShaderNode& n = nodes_[size_t(i)];
+    switch (n.kind) {
+      case ShaderNodeKind::Mix:
+      case ShaderNodeKind::Add:
+        if (n.kind == ShaderNodeKind::Mix) note(n.fac);
+        self(self, n.a, depth + 1);
+        self(self, n.b, depth + 1);
+        return;
+      case ShaderNodeKind::Diffuse:
+        note(n.color);
+        note(n.roughness);
+        return;
+      case ShaderNodeKind::Glossy:
+        note(n.color);
+        note(n.roughness);
+        features_ |= kFeatureGlossy;
+        if (may_be_delta(n.roughness)) features_ |= kFeatureDelta;
+        return;
+      case ShaderNodeKind::Glass:
+        note(n.color);
+        note(n.roughness);
+        note(n.ior);
+        features_ |= kFeatureGlossy | kFeatureTransmission;
+        if (may_be_delta(n.roughness) || has_texture(n.ior) ||
+            std::fabs(n.ior.value - 1.0f) < 1e-4f)
+          features_ |= kFeatureDelta;
+        return;
+      case ShaderNodeKind::Transparent:
+        note(n.color);
+        features_ |= kFeatureTransparent | kFeatureDelta;
+        return;
+      case ShaderNodeKind::Emission:
+        note(n.color);
+        note(n.strength);
+        if ((has_texture(n.color) || !is_black(n.color.value)) &&
+            (has_texture(n.strength) || n.strength.value != 0.0f))
+          features_ |= kFeatureEmission;
+        return;
+      case ShaderNodeKind::Principled: {
+        note(n.color);
+        note(n.roughness);
+        note(n.ior);
+        note(n.metallic);
+        note(n.specular);
+        note(n.specular_tint);
+        note(n.transmission);
+        note(n.alpha);
+        note(n.emission);
+        note(n.emission_strength);
+        const bool specular = has_texture(n.specular) || has_texture(n.metallic) ||
+                              n.specular.value > 0.0f || n.metallic.value > 0.0f;
+        const bool transmission = (has_texture(n.transmission) || n.transmission.value > 0.0f) &&
+                                  (has_texture(n.metallic) || n.metallic.value < 1.0f);
+        if (specular || transmission) {
+          features_ |= kFeatureGlossy;
+          if (may_be_delta(n.roughness)) features_ |= kFeatureDelta;
+        }
+        if (transmission) features_ |= kFeatureTransmission;
+        if (has_texture(n.alpha) || n.alpha.value < 1.0f)
+          features_ |= kFeatureTransparent | kFeatureDelta;
+        if ((has_texture(n.emission) || !is_black(n.emission.value)) &&
+            (has_texture(n.emission_strength) || n.emission_strength.value != 0.0f))
+          features_ |= kFeatureEmission;
+        return;
+      }
+    }
+  };
+  visit(visit, root_, 0);
+
+  // --- Mean of every texture the tree uses, for average_emission().
+  std::vector<Rgba> means(textures.size());
+  for (size_t i = 0; i < textures.size(); ++i) {
+    if (!uses_image[i]) continue;
+    const Texture& t = textures[i];
+    const size_t count = size_t(t.width()) * size_t(t.height());
+    double sum[4] = {0, 0, 0, 0};
+    for (size_t p = 0; p < count; ++p)
+      for (int ch = 0; ch < 4; ++ch) sum[ch] += t.rgba()[p * 4 + size_t(ch)];
+    const double inv = count > 0 ? 1.0 / double(count) : 0.0;
+    means[i] = {Spectrum(float(sum[0] * inv), float(sum[1] * inv), float(sum[2] * inv)),
+                float(sum[3] * inv)};
+  }
+  if (features_ & kFeatureEmission)
+    average_emission_ = walk(nodes_, root_, AverageInputs{&means}, nullptr);
+}
+
+void Material::evaluate(const ShadingContext& ctx, ClosureSet& out) const {
+  out.clear();
+  const Spectrum e = walk(nodes_, root_, PointInputs{textures_, ctx.uv}, &out);
+  out.add_emission(e);
+}
+
+Spectrum Material::emission(const ShadingContext& ctx) const {
+  if (!(features_ & kFeatureEmission)) return Spectrum(0.0f);
+  return walk(nodes_, root_, PointInputs{textures_, ctx.uv}, nullptr);
+}
+
+}  // namespace gdpt

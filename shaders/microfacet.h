@@ -1,0 +1,74 @@
+// Isotropic GGX (Trowbridge-Reitz) microfacet distribution with the separable Smith masking term,
+// in the local frame (normal = +z), as Cycles 3.4's `microfacet_ggx`.
+//
+//  alpha: GGX width, Blender roughness^2, clamped to [0, 1] by the caller.
+//  D(m):       normal distribution, integrates to 1 over projected microfacet area.
+//  G1(w):      Smith masking for direction w (either hemisphere; uses |w.z|).
+//  sample_visible(wi, u): microfacet normal from the distribution of normals visible from wi
+//              (Heitz 2018, "Sampling the GGX Distribution of Visible Normals"), wi.z > 0;
+//              density pdf_visible(wi, m) = G1(wi) max(0, wi.m) D(m) / wi.z.
+//  Below kDeltaAlpha the lobe is treated as a perfect mirror / refractor, as Cycles does for
+//  alpha_x * alpha_y <= 1e-7.
+#pragma once
+
+#include <cmath>
+
+#include "integrator/math/vec.h"
+
+namespace gdpt {
+
+inline constexpr float kDeltaAlpha = 3.1623e-4f;  // sqrt(1e-7)
+
+inline bool is_delta_alpha(float alpha) {
+  return alpha < kDeltaAlpha;
+}
+
+struct GGX {
+  float alpha;
+  float alpha2;
+
+  explicit GGX(float a) : alpha(a), alpha2(a * a) {}
+
+  float D(Vec3f m) const {
+    if (m.z <= 0.0f) return 0.0f;
+    const float c2 = m.z * m.z;
+    // alpha^2 cos^2 + sin^2 = 1 + (alpha^2 - 1) cos^2
+    const float t = c2 * (alpha2 - 1.0f) + 1.0f;
+    return alpha2 / (kPi * t * t);
+  }
+
+  // 2 / (1 + sqrt(1 + alpha^2 tan^2)), rewritten without the tangent so that z -> 0 gives 0.
+  float G1(Vec3f w) const {
+    const float z = std::fabs(w.z);
+    if (z == 0.0f) return 0.0f;
+    return 2.0f * z / (z + std::sqrt(alpha2 + (1.0f - alpha2) * z * z));
+  }
+
+  float pdf_visible(Vec3f wi, Vec3f m) const {
+    const float cos_im = dot(wi, m);
+    if (cos_im <= 0.0f || wi.z <= 0.0f) return 0.0f;
+    return G1(wi) * cos_im * D(m) / wi.z;
+  }
+
+  Vec3f sample_visible(Vec3f wi, Vec2f u) const {
+    // Stretch the view direction to the hemisphere configuration (alpha = 1).
+    const Vec3f vh = normalize(Vec3f(alpha * wi.x, alpha * wi.y, wi.z));
+    // Orthonormal basis around vh (t1 horizontal).
+    const float len2 = vh.x * vh.x + vh.y * vh.y;
+    const Vec3f t1 =
+        len2 > 0.0f ? Vec3f(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : Vec3f(1.0f, 0.0f, 0.0f);
+    const Vec3f t2 = cross(vh, t1);
+    // Uniform point on the disk, then squash its lower half onto the projected hemisphere.
+    const float r = std::sqrt(u.x);
+    const float phi = 2.0f * kPi * u.y;
+    const float p1 = r * std::cos(phi);
+    float p2 = r * std::sin(phi);
+    const float s = 0.5f * (1.0f + vh.z);
+    p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
+    const Vec3f nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2));
+    // Unstretch back to the alpha configuration.
+    return normalize(Vec3f(alpha * nh.x, alpha * nh.y, std::max(1e-7f, nh.z)));
+  }
+};
+
+}  // namespace gdpt

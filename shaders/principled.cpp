@@ -1,0 +1,84 @@
+#include "shaders/principled.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace gdpt {
+
+namespace {
+// Cycles drops closures lighter than this (CLOSURE_WEIGHT_CUTOFF).
+constexpr float kWeightCutoff = 1e-5f;
+
+float saturate(float x) {
+  return std::clamp(x, 0.0f, 1.0f);
+}
+Spectrum saturate(Spectrum c) {
+  return {saturate(c.x), saturate(c.y), saturate(c.z)};
+}
+}  // namespace
+
+void add_principled_closures(const PrincipledParams& p, float mix_weight, ClosureSet& out) {
+  const float alpha = saturate(p.alpha);
+  if (alpha < 1.0f) {
+    Closure t;
+    t.type = ClosureType::Transparent;
+    t.weight = Spectrum(mix_weight * (1.0f - alpha));
+    out.add(t);
+  }
+  const float w = mix_weight * alpha;
+  if (w <= 0.0f) return;
+  out.add_emission(p.emission * w);
+
+  const Spectrum base = p.base_color;
+  const float metallic = saturate(p.metallic);
+  const float transmission = saturate(p.transmission);
+  const float specular = std::max(0.0f, p.specular);
+  const float specular_tint = p.specular_tint;
+  const float roughness = saturate(p.roughness);
+  const float ggx_alpha = roughness * roughness;
+  const float diffuse_weight = (1.0f - metallic) * (1.0f - transmission);
+  const float final_transmission = transmission * (1.0f - metallic);
+  const float specular_weight = 1.0f - final_transmission;
+
+  // --- Diffuse (Burley with retro-reflection).
+  if (diffuse_weight > kWeightCutoff) {
+    Closure d;
+    d.type = ClosureType::PrincipledDiffuse;
+    d.weight = base * (w * diffuse_weight);
+    d.alpha = roughness;
+    out.add(d);
+  }
+
+  // --- Specular reflection.
+  if (specular_weight > kWeightCutoff && (specular > kWeightCutoff || metallic > kWeightCutoff)) {
+    Closure s;
+    s.type = ClosureType::GGXReflection;
+    s.fresnel = FresnelMode::PrincipledV1;
+    s.weight = Spectrum(w * specular_weight);
+    s.alpha = ggx_alpha;
+    // F0 = 0.08 specular; keep the IOR finite for specular >= 12.5.
+    const float sqrt_f0 = std::min(std::sqrt(0.08f * specular), 0.999f);
+    s.ior = 2.0f / (1.0f - sqrt_f0) - 1.0f;
+    // Cycles' rough luminance (0.3, 0.6, 0.1) isolates hue and saturation for the tint.
+    const float lum = 0.3f * base.x + 0.6f * base.y + 0.1f * base.z;
+    const Spectrum hue = lum > 0.0f ? base / lum : Spectrum(1.0f);
+    const Spectrum tint = Spectrum(1.0f - specular_tint) + hue * specular_tint;
+    s.f0 = saturate(tint * (specular * 0.08f * (1.0f - metallic)) + base * metallic);
+    out.add(s);
+  }
+
+  // --- Transmission (GGX glass; reflection part Fresnel-blended, refraction tinted by base).
+  if (final_transmission > kWeightCutoff) {
+    Closure g;
+    g.type = ClosureType::GGXDielectric;
+    g.fresnel = FresnelMode::PrincipledV1;
+    g.weight = Spectrum(w * final_transmission);
+    g.alpha = ggx_alpha;
+    g.ior = std::max(p.ior, 1e-5f);
+    g.f0 = saturate(base * specular_tint + Spectrum(1.0f - specular_tint));
+    g.transmission_tint = base;
+    out.add(g);
+  }
+}
+
+}  // namespace gdpt

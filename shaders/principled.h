@@ -1,0 +1,36 @@
+// Blender 3.4 Principled BSDF v1 (GGX distribution) turned into closures, following the
+// CLOSURE_BSDF_PRINCIPLED_ID case of Cycles 3.4 (kernel/svm/closure.h) and the node's expansion
+// (emission added, alpha mixed with Transparent):
+//   diffuse      PrincipledDiffuse, weight base * (1 - metallic)(1 - transmission)
+//   specular     GGXReflection with FresnelMode::PrincipledV1, weight (1 - transmission'),
+//                ior_s = 2 / (1 - sqrt(0.08 specular)) - 1 (so F0 = 0.08 specular),
+//                cspec0 = 0.08 specular tint (1 - metallic) + base metallic, where
+//                tint = mix(1, base / lum_approx(base), specular_tint)
+//   transmission GGXDielectric, weight transmission' = transmission (1 - metallic); the reflected
+//                part blends mix(1, base, specular_tint) towards white, the refracted part is
+//                tinted by base
+//   emission     emission * emission_strength
+//   alpha        everything above times alpha, plus Transparent (white) times 1 - alpha
+// Subsurface, sheen, clearcoat, anisotropy and the multiscatter GGX variant are not modelled.
+// All weights are multiplied by `mix_weight` (the Mix/Add tree weight).
+#pragma once
+
+#include "shaders/bsdf.h"
+
+namespace gdpt {
+
+struct PrincipledParams {
+  Spectrum base_color{0.8f};
+  float metallic = 0.0f;
+  float specular = 0.5f;
+  float specular_tint = 0.0f;
+  float roughness = 0.5f;
+  float ior = 1.45f;
+  float transmission = 0.0f;
+  float alpha = 1.0f;
+  Spectrum emission{0.0f};  // colour * strength
+};
+
+void add_principled_closures(const PrincipledParams& p, float mix_weight, ClosureSet& out);
+
+}  // namespace gdpt

@@ -1,0 +1,96 @@
+// Image texture sampling with Blender/Cycles conventions:
+//  - uv in [0, 1]^2 covers the image once, v = 0 is the bottom row (row 0 of the storage);
+//  - pixel (i, j) has its centre at ((i + 0.5) / w, (j + 0.5) / h);
+//  - Closest takes the pixel containing uv; Linear blends the four nearest pixel centres;
+//  - Repeat wraps, Extend clamps to the border pixels, Clip returns transparent black outside
+//    [0, 1]^2 and blends towards it at the border (pixels outside count as zero), as Cycles.
+//  - An empty image returns Blender's "missing texture" magenta.
+#include "shaders/texture.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace gdpt {
+
+Texture::Texture(const ImageDesc& image) : width_(image.width), height_(image.height) {
+  const size_t expected = size_t(std::max(0, width_)) * size_t(std::max(0, height_)) * 4;
+  if (width_ < 0 || height_ < 0 || image.rgba.size() != expected)
+    throw std::invalid_argument("image '" + image.name + "': " + std::to_string(width_) + "x" +
+                                std::to_string(height_) + " needs " + std::to_string(expected) +
+                                " floats, has " + std::to_string(image.rgba.size()));
+  rgba_ = image.rgba;
+}
+
+namespace {
+
+// Pixel index along one axis for the extension mode; -1 means "outside" (Clip).
+inline int wrap_index(int i, int n, TextureLookup::Extension ext) {
+  switch (ext) {
+    case TextureLookup::Extension::Repeat: {
+      const int r = i % n;
+      return r < 0 ? r + n : r;
+    }
+    case TextureLookup::Extension::Extend:
+      return std::clamp(i, 0, n - 1);
+    case TextureLookup::Extension::Clip:
+      return (i < 0 || i >= n) ? -1 : i;
+  }
+  return -1;
+}
+
+}  // namespace
+
+Rgba Texture::lookup(Vec2f uv, TextureLookup::Interpolation interpolation,
+                     TextureLookup::Extension extension) const {
+  if (width_ == 0 || height_ == 0) return {Spectrum(1.0f, 0.0f, 1.0f), 1.0f};
+  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return {Spectrum(0.0f), 0.0f};
+
+  float u = uv.x, v = uv.y;
+  switch (extension) {
+    case TextureLookup::Extension::Repeat:
+      // Reduce first so that huge coordinates do not overflow the integer pixel index.
+      u -= std::floor(u);
+      v -= std::floor(v);
+      break;
+    case TextureLookup::Extension::Extend:
+      u = std::clamp(u, -1.0f, 2.0f);
+      v = std::clamp(v, -1.0f, 2.0f);
+      break;
+    case TextureLookup::Extension::Clip:
+      if (u < 0.0f || u > 1.0f || v < 0.0f || v > 1.0f) return {Spectrum(0.0f), 0.0f};
+      break;
+  }
+
+  auto texel = [&](int x, int y) -> Rgba {
+    if (x < 0 || y < 0) return {Spectrum(0.0f), 0.0f};
+    const float* p = rgba_.data() + (size_t(y) * size_t(width_) + size_t(x)) * 4;
+    return {Spectrum(p[0], p[1], p[2]), p[3]};
+  };
+
+  if (interpolation == TextureLookup::Interpolation::Closest) {
+    // u == 1 exactly belongs to the last pixel (Clip / Extend) or wraps to the first (Repeat).
+    int x = int(std::floor(u * float(width_)));
+    int y = int(std::floor(v * float(height_)));
+    if (extension == TextureLookup::Extension::Clip) {
+      x = std::min(x, width_ - 1);
+      y = std::min(y, height_ - 1);
+    }
+    return texel(wrap_index(x, width_, extension), wrap_index(y, height_, extension));
+  }
+
+  // Bilinear between the four pixel centres around (u, v).
+  const float fx = u * float(width_) - 0.5f, fy = v * float(height_) - 0.5f;
+  const float x0f = std::floor(fx), y0f = std::floor(fy);
+  const float tx = fx - x0f, ty = fy - y0f;
+  const int x0 = int(x0f), y0 = int(y0f);
+  const int xa = wrap_index(x0, width_, extension), xb = wrap_index(x0 + 1, width_, extension);
+  const int ya = wrap_index(y0, height_, extension), yb = wrap_index(y0 + 1, height_, extension);
+  const Rgba p00 = texel(xa, ya), p10 = texel(xb, ya), p01 = texel(xa, yb), p11 = texel(xb, yb);
+  const float w00 = (1.0f - tx) * (1.0f - ty), w10 = tx * (1.0f - ty);
+  const float w01 = (1.0f - tx) * ty, w11 = tx * ty;
+  return {p00.rgb * w00 + p10.rgb * w10 + p01.rgb * w01 + p11.rgb * w11,
+          p00.a * w00 + p10.a * w10 + p01.a * w01 + p11.a * w11};
+}
+
+}  // namespace gdpt

@@ -1,0 +1,75 @@
+// Closures used by the shader tests, built the way the material code builds them.
+#pragma once
+
+#include <cmath>
+#include <string>
+
+#include "integrator/math/vec.h"
+#include "shaders/bsdf.h"
+
+namespace gdpt::test {
+
+inline Closure lambert(Spectrum c = Spectrum(1.0f)) {
+  Closure k;
+  k.type = ClosureType::Lambert;
+  k.weight = c;
+  return k;
+}
+inline Closure oren_nayar(float sigma, Spectrum c = Spectrum(1.0f)) {
+  Closure k;
+  k.type = ClosureType::OrenNayar;
+  k.weight = c;
+  k.alpha = sigma;
+  return k;
+}
+inline Closure principled_diffuse(float roughness, Spectrum c = Spectrum(1.0f)) {
+  Closure k;
+  k.type = ClosureType::PrincipledDiffuse;
+  k.weight = c;
+  k.alpha = roughness;
+  return k;
+}
+inline Closure ggx(float alpha, Spectrum c = Spectrum(1.0f)) {
+  Closure k;
+  k.type = ClosureType::GGXReflection;
+  k.fresnel = FresnelMode::None;
+  k.weight = c;
+  k.alpha = alpha;
+  return k;
+}
+inline Closure ggx_principled(float alpha, float ior, Spectrum cspec0) {
+  Closure k = ggx(alpha);
+  k.fresnel = FresnelMode::PrincipledV1;
+  k.ior = ior;
+  k.f0 = cspec0;
+  return k;
+}
+inline Closure glass(float alpha, float ior, Spectrum c = Spectrum(1.0f)) {
+  Closure k;
+  k.type = ClosureType::GGXDielectric;
+  k.fresnel = FresnelMode::Dielectric;
+  k.weight = c;
+  k.alpha = alpha;
+  k.ior = ior;
+  return k;
+}
+inline Closure transparent(Spectrum c = Spectrum(1.0f)) {
+  Closure k;
+  k.type = ClosureType::Transparent;
+  k.weight = c;
+  return k;
+}
+
+inline ClosureSet set_of(std::initializer_list<Closure> cs) {
+  ClosureSet s;
+  for (const Closure& c : cs) s.add(c);
+  return s;
+}
+
+// Incident direction with the given cosine, slightly off the x-z plane.
+inline Vec3f incident(float cos_theta) {
+  const float sin_theta = std::sqrt(std::max(0.0f, 1.0f - cos_theta * cos_theta));
+  return Vec3f(sin_theta * std::cos(0.3f), sin_theta * std::sin(0.3f), cos_theta);
+}
+
+}  // namespace gdpt::test
