@@ -56,12 +56,25 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
   return reverse_bits(lk_permutation(reverse_bits(x), seed));
 }
 
-// Sobol dimension 1 (the second): generator matrix with v_k = v_{k-1} ^ (v_{k-1} >> 1).
-inline uint32_t sobol_dim1(uint32_t i) {
+// Sobol dimension 1 (the second): generator matrix with v_k = v_{k-1} ^ (v_{k-1} >> 1), i.e. the
+// Pascal matrix mod 2. The map is linear over GF(2), so it is the XOR of four per-byte tables.
+inline uint32_t sobol_dim1_slow(uint32_t i) {
   uint32_t r = 0;
   for (uint32_t v = 1u << 31; i != 0; i >>= 1, v ^= v >> 1)
     if (i & 1u) r ^= v;
   return r;
+}
+struct SobolDim1Tables {
+  uint32_t t[4][256];
+  SobolDim1Tables() {
+    for (uint32_t b = 0; b < 4; ++b)
+      for (uint32_t v = 0; v < 256; ++v) t[b][v] = sobol_dim1_slow(v << (8 * b));
+  }
+};
+inline const SobolDim1Tables kSobolDim1;
+inline uint32_t sobol_dim1(uint32_t i) {
+  const auto& t = kSobolDim1.t;
+  return t[0][i & 0xffu] ^ t[1][(i >> 8) & 0xffu] ^ t[2][(i >> 16) & 0xffu] ^ t[3][i >> 24];
 }
 
 inline float to_unit_float(uint32_t x) {
@@ -102,14 +115,16 @@ class Sampler {
     using namespace sampler_detail;
     const uint32_t h = hash_combine(pixel_hash_, dim);
     const uint32_t i = nested_uniform_scramble(index_, h);
-    return to_unit_float(nested_uniform_scramble(reverse_bits(i), hash_u32(h ^ 0x5bd1e995u)));
+    // Sobol dimension 0 is reverse_bits(i): nested_uniform_scramble(reverse_bits(i), s) folds to
+    // reverse_bits(lk_permutation(i, s)).
+    return to_unit_float(reverse_bits(lk_permutation(i, hash_u32(h ^ 0x5bd1e995u))));
   }
 
   Vec2f get2d(uint32_t dim) const {
     using namespace sampler_detail;
     const uint32_t h = hash_combine(pixel_hash_, dim);
     const uint32_t i = nested_uniform_scramble(index_, h);
-    const uint32_t x = nested_uniform_scramble(reverse_bits(i), hash_u32(h ^ 0x5bd1e995u));
+    const uint32_t x = reverse_bits(lk_permutation(i, hash_u32(h ^ 0x5bd1e995u)));
     const uint32_t y = nested_uniform_scramble(sobol_dim1(i), hash_u32(h ^ 0x1b873593u));
     return {to_unit_float(x), to_unit_float(y)};
   }

@@ -46,6 +46,11 @@ TEST(Sampler, TwoDimensionalPairsAreElementaryIntervalStratified) {
   }
 }
 
+TEST(Sampler, SobolTablesMatchTheGeneratorMatrix) {
+  for (uint32_t i : {0u, 1u, 2u, 3u, 255u, 256u, 0x12345678u, 0xdeadbeefu, 0xffffffffu})
+    EXPECT_EQ(sampler_detail::sobol_dim1(i), sampler_detail::sobol_dim1_slow(i)) << i;
+}
+
 TEST(Sampler, OneDimensionalValuesAreStratified) {
   const int n = 128;
   std::vector<int> bins(n, 0);
