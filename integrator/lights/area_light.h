@@ -9,12 +9,18 @@
 //                        eval_fac = 0.25 / area and strength = colour * power, and no 1/pi
 //                        anywhere, so a 1 W area light emits pi/4 W in total
 // Area A: |u x v| for rectangles, pi/4 |u x v| for ellipses (u, v the scaled full extents).
-// Sampled uniformly by area; the pdf is converted to solid angle.
+// Rectangles (orthogonal axes) are sampled uniformly in the solid angle they subtend, as Cycles;
+// ellipses, sheared rectangles and rectangles subtending under kMinSphericalSolidAngle (where
+// the spherical construction loses float precision and area sampling is as good) are sampled
+// uniformly by area with the pdf converted to solid angle. The choice depends only on the
+// reference point, so sample() and intersect() agree on the density.
 #pragma once
 
 #include <cmath>
+#include <optional>
 
 #include "integrator/light_sampler.h"
+#include "integrator/lights/spherical_rectangle.h"
 #include "integrator/lights/warp.h"
 
 namespace gdpt::lights {
@@ -29,6 +35,19 @@ struct AreaLight {
   float select_pmf = 0.0f;  // filled by LightSampler
   // Dual basis of (axis_u, axis_v): local coordinates of a point in the plane are dot products.
   Vec3f dual_u, dual_v;
+  bool orthogonal = false;  // rectangle with orthogonal axes: spherical sampling possible
+  Vec3f corner, unit_u, unit_v;
+  float len_u = 0.0f, len_v = 0.0f;
+
+  static constexpr float kMinSphericalSolidAngle = 1e-3f;
+
+  // The spherical rectangle seen from ref when it is used for sampling (see the header).
+  std::optional<SphericalRectangle> spherical(Vec3f ref) const {
+    if (!orthogonal) return std::nullopt;
+    const SphericalRectangle r(ref, corner, unit_u, unit_v, len_u, len_v);
+    if (!(r.solid_angle() >= kMinSphericalSolidAngle)) return std::nullopt;
+    return r;
+  }
 
   static AreaLight from_light(const Light& l) {
     AreaLight a;
@@ -56,6 +75,12 @@ struct AreaLight {
     const float det = uu * vv - uv * uv;
     a.dual_u = (a.axis_u * vv - a.axis_v * uv) / det;
     a.dual_v = (a.axis_v * uu - a.axis_u * uv) / det;
+    a.len_u = std::sqrt(uu);
+    a.len_v = std::sqrt(vv);
+    a.unit_u = a.axis_u / a.len_u;
+    a.unit_v = a.axis_v / a.len_v;
+    a.corner = a.center - (a.axis_u + a.axis_v) * 0.5f;
+    a.orthogonal = !a.ellipse && std::fabs(uv) <= 1e-5f * a.len_u * a.len_v;
     return a;
   }
 
@@ -64,13 +89,14 @@ struct AreaLight {
 
   bool sample(Vec3f ref, Vec2f u, LightSample& s) const {
     if (dot(ref - center, normal) <= 0.0f) return false;  // behind: one-sided
-    Vec2f local;
-    if (ellipse) {
-      local = square_to_disk(u) * 0.5f;
+    const std::optional<SphericalRectangle> sph = spherical(ref);
+    Vec3f p;
+    if (sph) {
+      p = sph->sample(u);
     } else {
-      local = {u.x - 0.5f, u.y - 0.5f};
+      const Vec2f local = ellipse ? square_to_disk(u) * 0.5f : Vec2f(u.x - 0.5f, u.y - 0.5f);
+      p = center + axis_u * local.x + axis_v * local.y;
     }
-    const Vec3f p = center + axis_u * local.x + axis_v * local.y;
     const Vec3f to = p - ref;
     const float d2 = length_squared(to);
     const float d = std::sqrt(d2);
@@ -83,7 +109,7 @@ struct AreaLight {
     s.normal = normal;
     s.direction = dir;
     s.distance = d;
-    s.pdf = d2 / (area * cos_l);
+    s.pdf = sph ? 1.0f / sph->solid_angle() : d2 / (area * cos_l);
     s.is_delta = false;
     s.is_infinite = false;
     s.valid = std::isfinite(s.pdf);
@@ -108,7 +134,8 @@ struct AreaLight {
     hit.position = o + d * t;
     hit.normal = normal;
     hit.radiance = radiance;
-    hit.pdf = t * t / (area * -dot(d, normal));
+    const std::optional<SphericalRectangle> sph = spherical(o);
+    hit.pdf = sph ? 1.0f / sph->solid_angle() : t * t / (area * -dot(d, normal));
   }
 };
 

@@ -221,5 +221,41 @@ TEST(AreaLight, TiltedEllipseOffAxisAgainstQuadrature) {
   EXPECT_NEAR(e.irradiance, E, 3e-3 * E);
 }
 
+// Rectangles: spherical-rectangle sampling near the light, area sampling far away (solid angle
+// under 1e-3 sr); both against a midpoint quadrature over the rectangle.
+TEST(AreaLight, TiltedRectangleNearAndFarAgainstQuadrature) {
+  const Vec3f emit = normalize(Vec3f(-0.2f, 0.3f, -1.0f));
+  for (const float dist : {1.5f, 60.0f}) {
+    Scene scene = black_scene();
+    const Vec3f center(0.5f, 0.3f, dist);
+    Light l = make_light(Light::Type::Area, center, emit, 30.0f);
+    l.shape = Light::Shape::Rectangle;
+    l.size_x = 1.0f;
+    l.size_y = 0.6f;
+    l.light_to_world = light_frame(center, emit, 1.3f, 1.0f);
+    scene.lights.push_back(l);
+    const LightSampler lights(scene, {}, {});
+    const Frame f(-emit);
+    const double a = 1.3, b = 0.6, L = 30.0 / (4.0 * a * b);
+    const Vec3f n_recv = normalize(Vec3f(0.1f, 0.0f, 1.0f));
+    double omega = 0, E = 0;
+    const int q = 600;
+    for (int i = 0; i < q; ++i)
+      for (int j = 0; j < q; ++j) {
+        const double x = a * ((i + 0.5) / q - 0.5), y = b * ((j + 0.5) / q - 0.5);
+        const Vec3f p = center + f.s * float(x) + f.t * float(y);
+        const double d2 = length_squared(p);
+        const Vec3f w = normalize(p);
+        const double dA = a * b / (double(q) * q);
+        const double g = -dot(w, emit) / d2 * dA;
+        omega += g;
+        E += L * std::max(0.0, double(dot(w, n_recv))) * g;
+      }
+    const test::Estimate e = estimate(lights, {0, 0, 0}, n_recv, 250000);
+    EXPECT_NEAR(e.solid_angle, omega, 5e-3 * omega) << dist;
+    EXPECT_NEAR(e.irradiance, E, 3e-3 * E) << dist;
+  }
+}
+
 }  // namespace
 }  // namespace gdpt

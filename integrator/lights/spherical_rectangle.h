@@ -1,0 +1,75 @@
+// Uniform sampling of the solid angle a rectangle subtends from a point (Urena, Fajardo, King
+// 2013, "An Area-Preserving Parametrization for Spherical Rectangles"), as Cycles does for
+// rectangular area lights. Density 1 / solid_angle over the rectangle's projection.
+//
+// Parameters: reference point o, rectangle corner s, unit orthogonal edge directions x and y,
+// edge lengths ex and ey (the rectangle is s + [0, ex] x + [0, ey] y).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "integrator/math/vec.h"
+
+namespace gdpt::lights {
+
+class SphericalRectangle {
+ public:
+  SphericalRectangle(Vec3f o, Vec3f s, Vec3f x, Vec3f y, float ex, float ey) : o_(o), x_(x), y_(y) {
+    z_ = cross(x, y);
+    const Vec3f d = s - o;
+    x0_ = dot(d, x);
+    y0_ = dot(d, y);
+    z0_ = dot(d, z_);
+    // Work on the side of the plane facing o: z0 < 0.
+    if (z0_ > 0.0f) {
+      z0_ = -z0_;
+      z_ = -z_;
+    }
+    x1_ = x0_ + ex;
+    y1_ = y0_ + ey;
+    // Corners in the local frame and the normals of the four planes through o and each edge.
+    const Vec3f v00(x0_, y0_, z0_), v01(x0_, y1_, z0_), v10(x1_, y0_, z0_), v11(x1_, y1_, z0_);
+    const Vec3f n0 = normalize(cross(v00, v10));
+    const Vec3f n1 = normalize(cross(v10, v11));
+    const Vec3f n2 = normalize(cross(v11, v01));
+    const Vec3f n3 = normalize(cross(v01, v00));
+    // Interior angles of the spherical quadrilateral; its area is their sum minus 2 pi.
+    const float g0 = safe_acos(-dot(n0, n1)), g1 = safe_acos(-dot(n1, n2));
+    const float g2 = safe_acos(-dot(n2, n3)), g3 = safe_acos(-dot(n3, n0));
+    b0_ = n0.z;
+    b1_ = n2.z;
+    k_ = 2.0f * kPi - g2 - g3;
+    solid_angle_ = g0 + g1 - k_;
+  }
+
+  float solid_angle() const { return solid_angle_; }
+
+  // Point on the rectangle (world space) for u in [0,1)^2.
+  Vec3f sample(Vec2f u) const {
+    // 1. Pick the x coordinate by inverting the partial solid angle of the strip [x0, xu].
+    const float au = u.x * solid_angle_ + k_;
+    const float fu = (std::cos(au) * b0_ - b1_) / std::sin(au);
+    float cu = std::copysign(1.0f, fu) / std::sqrt(fu * fu + b0_ * b0_);
+    cu = std::clamp(cu, -1.0f, 1.0f);
+    float xu = -(cu * z0_) / std::sqrt(std::max(1e-12f, 1.0f - cu * cu));
+    xu = std::clamp(xu, x0_, x1_);
+    // 2. Pick y uniformly in the projected height h = y / sqrt(d^2 + y^2) along that line.
+    const float dist = std::sqrt(xu * xu + z0_ * z0_);
+    const float h0 = y0_ / std::sqrt(dist * dist + y0_ * y0_);
+    const float h1 = y1_ / std::sqrt(dist * dist + y1_ * y1_);
+    const float hv = h0 + u.y * (h1 - h0);
+    const float hv2 = hv * hv;
+    const float yv = hv2 < 1.0f - 1e-6f ? (hv * dist) / std::sqrt(1.0f - hv2) : y1_;
+    return o_ + x_ * xu + y_ * std::clamp(yv, y0_, y1_) + z_ * z0_;
+  }
+
+ private:
+  static float safe_acos(float c) { return std::acos(std::clamp(c, -1.0f, 1.0f)); }
+
+  Vec3f o_, x_, y_, z_;
+  float x0_, y0_, z0_, x1_, y1_;
+  float b0_, b1_, k_, solid_angle_;
+};
+
+}  // namespace gdpt::lights
