@@ -1,0 +1,320 @@
+// BSDF properties with analytic or independent oracles: energy (albedo) against quadrature of
+// eval(), reciprocity, Fresnel limits, smooth-glass energy and Snell's law, closed-form values
+// of the diffuse models, ClosureSet bookkeeping, and no NaN/Inf in degenerate configurations.
+#include <gtest/gtest.h>
+
+#include "shaders/fresnel.h"
+#include "tests/shaders/chi2.h"
+#include "tests/shaders/lobe_factory.h"
+
+namespace gdpt::test {
+namespace {
+
+// Integral of eval(wi, .) over the sphere (the directional albedo), by adaptive quadrature.
+double albedo_quadrature(const ClosureSet& set, Vec3f wi, int channel = 1) {
+  Integrator2D integ([&](double theta, double phi) {
+    return double(set.eval(wi, direction(std::cos(theta), phi))[channel]) * std::sin(theta);
+  });
+  double sum = 0.0;
+  // Split at the equator and in a few phi wedges so lobes on either side are resolved.
+  for (int h = 0; h < 2; ++h)
+    for (int k = 0; k < 8; ++k)
+      sum += integ.integrate(h * M_PI / 2, (h + 1) * M_PI / 2, k * M_PI / 4, (k + 1) * M_PI / 4,
+                             1e-8, 3, 9);
+  return sum;
+}
+
+// Mean sample weight (including delta lobes): the MC estimate of the albedo.
+double albedo_mc(const ClosureSet& set, Vec3f wi, int n, int channel = 1) {
+  Pcg32 rng(7);
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const float ul = rng.uniform();
+    const Vec2f u(rng.uniform(), rng.uniform());
+    const BsdfSample s = set.sample(wi, ul, u);
+    if (s.valid) sum += s.weight()[channel];
+  }
+  return sum / n;
+}
+
+TEST(BsdfEnergy, WhiteLambertAlbedoIsOne) {
+  const ClosureSet set = set_of({lambert()});
+  for (float c : {1.0f, 0.5f, 0.05f, -0.7f}) {
+    const Vec3f wi = incident(c);
+    EXPECT_NEAR(albedo_quadrature(set, wi), 1.0, 1e-4) << c;
+    EXPECT_NEAR(albedo_mc(set, wi, 20000), 1.0, 1e-6) << c;
+  }
+}
+
+// The MC estimate from sample weights must equal the quadrature of eval for every lobe: this
+// ties sample() to eval() independently of pdf().
+TEST(BsdfEnergy, SampleWeightsIntegrateEval) {
+  const ClosureSet sets[] = {
+      set_of({oren_nayar(0.8f)}),
+      set_of({principled_diffuse(0.7f)}),
+      set_of({ggx(0.3f)}),
+      set_of({ggx(1.0f)}),
+      set_of({ggx_principled(0.25f, 1.5f, Spectrum(0.9f, 0.6f, 0.3f))}),
+      set_of({glass(0.3f, 1.5f)}),
+      set_of({principled_diffuse(0.5f, Spectrum(0.5f)), ggx(0.4f, Spectrum(0.5f))}),
+  };
+  for (size_t i = 0; i < std::size(sets); ++i) {
+    for (float c : {0.9f, 0.4f, -0.5f}) {
+      const Vec3f wi = incident(c);
+      const double q = albedo_quadrature(sets[i], wi);
+      const double mc = albedo_mc(sets[i], wi, 200000);
+      EXPECT_NEAR(mc, q, 0.01 * q + 1e-3) << "set " << i << " cos_i " << c;
+      // Burley's diffuse (set 1) is not energy conserving (retro-reflection); the others are.
+      if (i != 1) {
+        EXPECT_LE(q, 1.0 + 1e-3) << "set " << i << " gains energy";
+      }
+    }
+  }
+}
+
+TEST(BsdfEnergy, GgxWhiteFurnaceLossIsSmallForSmoothAndLargerForRough) {
+  // Single-scattering GGX loses energy with roughness (no multiple scattering, as Cycles' GGX).
+  const Vec3f wi = incident(0.8f);
+  const double smooth = albedo_quadrature(set_of({ggx(0.05f)}), wi);
+  const double rough = albedo_quadrature(set_of({ggx(1.0f)}), wi);
+  EXPECT_NEAR(smooth, 1.0, 0.01);
+  EXPECT_LT(rough, smooth - 0.2);
+}
+
+TEST(BsdfReciprocity, ReflectionLobesAreSymmetric) {
+  const Closure lobes[] = {lambert(), oren_nayar(0.6f), principled_diffuse(0.8f), ggx(0.3f),
+                           ggx_principled(0.15f, 1.6f, Spectrum(0.7f, 0.4f, 0.2f))};
+  Pcg32 rng(3);
+  for (const Closure& c : lobes) {
+    const ClosureSet set = set_of({c});
+    for (int i = 0; i < 200; ++i) {
+      const float side = i % 2 ? 1.0f : -1.0f;  // both sides of the surface
+      Vec3f a = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+      Vec3f b = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+      a.z *= side;
+      b.z *= side;
+      const Spectrum fab = set.eval(a, b) / std::fabs(b.z);
+      const Spectrum fba = set.eval(b, a) / std::fabs(a.z);
+      for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(fab[k], fba[k], 1e-4f * std::max(1.0f, fab[k])) << int(c.type);
+    }
+  }
+}
+
+TEST(BsdfReciprocity, GlassTransmissionCarriesEtaSquared) {
+  // Without the 1/eta^2 radiance scaling (Cycles' convention) the microfacet BTDF satisfies
+  // f(wi, wo) / (1 - F(wi)) = eta^2 f(wo, wi) / (1 - F(wo)), eta = n(wo side) / n(wi side).
+  const float ior = 1.5f;
+  const ClosureSet set = set_of({glass(0.3f, ior)});
+  Pcg32 rng(5);
+  int checked = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3f a = direction(0.1 + 0.9 * rng.uniform(), 2 * M_PI * rng.uniform());
+    const Vec3f b = direction(-0.1 - 0.9 * rng.uniform(), 2 * M_PI * rng.uniform());
+    const float fab = set.eval(a, b).y / std::fabs(b.z);
+    const float fba = set.eval(b, a).y / std::fabs(a.z);
+    // Cycles 3.4 splits by the Fresnel term at the shading normal: the reverse direction may be
+    // beyond the critical angle (F = 1), where the lobe is not reciprocal at all.
+    if (fab < 1e-6f || fresnel_dielectric(b.z, 1.0f / ior) >= 1.0f) continue;
+    const float lhs = fab / (1.0f - fresnel_dielectric(a.z, ior));
+    const float rhs = ior * ior * fba / (1.0f - fresnel_dielectric(b.z, 1.0f / ior));
+    EXPECT_NEAR(lhs, rhs, 1e-3f * lhs);
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
+}
+
+TEST(Fresnel, NormalIncidenceAndKnownAngle) {
+  for (float n : {1.33f, 1.5f, 2.4f}) {
+    const float f0 = ((n - 1) / (n + 1)) * ((n - 1) / (n + 1));
+    EXPECT_NEAR(fresnel_dielectric(1.0f, n), f0, 1e-6f);
+    EXPECT_NEAR(fresnel_dielectric(1.0f, 1.0f / n), f0, 1e-6f);  // same from inside
+  }
+  // n = 1.5 at 45 degrees: Rs = 0.0920, Rp = 0.0085 (textbook values), mean 0.0503.
+  EXPECT_NEAR(fresnel_dielectric(std::cos(float(M_PI) / 4), 1.5f), 0.0503f, 2e-4f);
+  EXPECT_NEAR(fresnel_dielectric(0.0f, 1.5f), 1.0f, 1e-6f);  // grazing
+  EXPECT_NEAR(fresnel_dielectric(0.3f, 1.0f), 0.0f, 1e-7f);  // index matched
+}
+
+TEST(Fresnel, TotalInternalReflectionBeyondCriticalAngle) {
+  const float eta = 1.0f / 1.5f;                                      // leaving glass
+  const float cos_critical = std::sqrt(1.0f - 1.0f / (1.5f * 1.5f));  // 0.745
+  EXPECT_EQ(fresnel_dielectric(cos_critical - 1e-3f, eta), 1.0f);
+  EXPECT_EQ(fresnel_dielectric(0.2f, eta), 1.0f);
+  EXPECT_LT(fresnel_dielectric(cos_critical + 0.02f, eta), 1.0f);
+  EXPECT_LT(fresnel_dielectric(0.9f, eta), 0.1f);
+}
+
+TEST(SmoothGlass, EnergyIsConservedAndDirectionsObeySnell) {
+  const float ior = 1.5f;
+  const ClosureSet set = set_of({glass(0.0f, ior)});
+  EXPECT_TRUE(set.has_delta());
+  EXPECT_EQ(set.roughness(), 0.0f);
+  for (float c : {1.0f, 0.8f, 0.3f, 0.01f, -0.95f, -0.8f, -0.5f}) {
+    const Vec3f wi = incident(c);
+    const bool entering = c > 0;
+    const float eta = entering ? ior : 1.0f / ior;
+    const float fr = fresnel_dielectric(c, eta);
+    double expected_weight = 0.0;  // sum over the two outcomes of probability * weight
+    uint8_t seen = 0;
+    for (float ul : {0.0f, 0.999f}) {
+      const BsdfSample s = set.sample(wi, ul, Vec2f(0.5f, 0.5f));
+      if (!s.valid || (s.lobe & seen)) continue;  // each outcome once
+      seen |= s.lobe & (kLobeReflection | kLobeTransmission);
+      ASSERT_TRUE(s.is_delta());
+      expected_weight += s.pdf * s.weight().y;
+      if (s.lobe & kLobeReflection) {
+        EXPECT_NEAR(s.wo.z, wi.z, 1e-6f);
+        EXPECT_NEAR(s.wo.x, -wi.x, 1e-6f);
+        EXPECT_NEAR(s.pdf, fr, 1e-5f);  // white glass: reflection chosen with probability F
+        EXPECT_EQ(s.eta, 1.0f);
+      } else {
+        const float sin_i = std::sqrt(1 - wi.z * wi.z), sin_o = std::sqrt(1 - s.wo.z * s.wo.z);
+        EXPECT_NEAR(sin_o * eta, sin_i, 1e-5f);  // Snell
+        EXPECT_LT(s.wo.z * wi.z, 0.0f);
+        EXPECT_NEAR(s.eta, eta, 1e-6f);
+        EXPECT_NEAR(s.weight().y, 1.0f, 1e-5f);  // no 1/eta^2: Cycles' convention
+      }
+    }
+    EXPECT_NEAR(expected_weight, 1.0, 1e-5) << c;  // R + T = 1 for white glass
+    if (c < 0 && std::fabs(c) < std::sqrt(1.0f - 1.0f / (ior * ior))) {
+      EXPECT_EQ(fr, 1.0f);
+    }
+  }
+}
+
+TEST(SmoothGlass, TotalInternalReflectionReflectsEverything) {
+  const ClosureSet set = set_of({glass(0.0f, 1.5f)});
+  const Vec3f wi = incident(-0.5f);  // inside, beyond the critical angle (cos 0.745)
+  for (float ul : {0.0f, 0.5f, 0.999f}) {
+    const BsdfSample s = set.sample(wi, ul, Vec2f(0.3f, 0.7f));
+    ASSERT_TRUE(s.valid);
+    EXPECT_TRUE(s.lobe & kLobeReflection);
+    EXPECT_NEAR(s.weight().x, 1.0f, 1e-6f);
+    EXPECT_LT(s.wo.z, 0.0f);
+  }
+}
+
+TEST(DiffuseModels, ClosedFormValues) {
+  const Vec3f n(0, 0, 1);
+  const Vec3f wo = direction(0.5, 0.0);
+  // Principled diffuse, roughness 1, wi = normal: F_v = 0, F_l = 0.5^5, RR = 1 + 0.5.
+  {
+    const ClosureSet s = set_of({principled_diffuse(1.0f)});
+    const double fl = std::pow(0.5, 5), rr = 1.5;
+    const double expected = 0.5 / M_PI * ((1 - 0.5 * fl) + rr * fl);
+    EXPECT_NEAR(s.eval(n, wo).x, expected, 1e-6);
+    EXPECT_NEAR(set_of({principled_diffuse(0.0f)}).eval(n, n).x, 1.0 / M_PI, 1e-6);
+  }
+  // Oren-Nayar (Cycles' form), sigma = 1.
+  {
+    const ClosureSet s = set_of({oren_nayar(1.0f)});
+    const double a = 1.0 / (M_PI + (3 * M_PI - 4) / 6), b = a;
+    EXPECT_NEAR(s.eval(n, wo).x, 0.5 * a, 1e-6);  // s = dot - cos cos = 0
+    const Vec3f w = direction(0.6, 1.0);
+    const double t = (1.0 - 0.36) / 0.6;  // wi = wo: s = 1 - cos^2, divided by max(cos)
+    EXPECT_NEAR(s.eval(w, w).x, 0.6 * (a + b * t), 1e-5);
+  }
+  // Two-sided: the same values from below the surface.
+  {
+    const ClosureSet s = set_of({oren_nayar(1.0f)});
+    const Vec3f nb(0, 0, -1), wob(wo.x, wo.y, -wo.z);
+    EXPECT_NEAR(s.eval(nb, wob).x, s.eval(n, wo).x, 1e-7);
+    EXPECT_EQ(s.eval(nb, wo).x, 0.0f);  // other side of wi: nothing
+  }
+}
+
+TEST(ClosureSet, AddDropsZeroAndWeakestLobes) {
+  ClosureSet s;
+  s.add(lambert(Spectrum(0.0f)));
+  EXPECT_EQ(s.count(), 0);
+  for (int i = 0; i < kMaxClosures; ++i) s.add(lambert(Spectrum(0.1f * (i + 1))));
+  EXPECT_EQ(s.count(), kMaxClosures);
+  s.add(lambert(Spectrum(0.05f)));  // weaker than all: dropped
+  s.add(lambert(Spectrum(2.0f)));   // replaces the weakest (0.1)
+  EXPECT_EQ(s.count(), kMaxClosures);
+  float min_w = 10.0f, max_w = 0.0f;
+  for (int i = 0; i < s.count(); ++i) {
+    min_w = std::min(min_w, s[i].weight.x);
+    max_w = std::max(max_w, s[i].weight.x);
+  }
+  EXPECT_FLOAT_EQ(min_w, 0.2f);
+  EXPECT_FLOAT_EQ(max_w, 2.0f);
+  s.add_emission(Spectrum(1, 2, 3));
+  EXPECT_EQ(s.emission(), Spectrum(1, 2, 3));
+  s.clear();
+  EXPECT_EQ(s.count(), 0);
+  EXPECT_TRUE(is_black(s.emission()));
+}
+
+TEST(ClosureSet, RoughnessClassification) {
+  EXPECT_EQ(set_of({lambert()}).roughness(), 1.0f);
+  EXPECT_FLOAT_EQ(set_of({lambert(), ggx(0.2f)}).roughness(), 0.2f);
+  EXPECT_FLOAT_EQ(set_of({glass(0.04f, 1.5f), lambert()}).roughness(), 0.04f);
+  EXPECT_EQ(set_of({glass(0.0f, 1.5f)}).roughness(), 0.0f);
+  EXPECT_EQ(set_of({transparent()}).roughness(), 0.0f);
+  EXPECT_EQ(set_of({transparent(), lambert()}).roughness(), 1.0f);
+  EXPECT_FALSE(set_of({lambert(), ggx(0.2f)}).has_delta());
+  EXPECT_TRUE(set_of({lambert(), ggx(0.0f)}).has_delta());
+}
+
+TEST(ClosureSet, SampleReportsLobeFlagsEtaAndRoughness) {
+  const ClosureSet g = set_of({glass(0.3f, 1.5f)});
+  Pcg32 rng(11);
+  int refracted_in = 0, refracted_out = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const float c = i % 2 ? 0.8f : -0.9f;
+    const BsdfSample s = g.sample(incident(c), rng.uniform(), Vec2f(rng.uniform(), rng.uniform()));
+    if (!s.valid || !(s.lobe & kLobeTransmission)) continue;
+    EXPECT_TRUE(s.lobe & kLobeGlossy);
+    EXPECT_FLOAT_EQ(s.roughness, 0.3f);
+    if (c > 0) {
+      EXPECT_FLOAT_EQ(s.eta, 1.5f);
+      ++refracted_in;
+    } else {
+      EXPECT_FLOAT_EQ(s.eta, 1.0f / 1.5f);
+      ++refracted_out;
+    }
+  }
+  EXPECT_GT(refracted_in, 100);
+  EXPECT_GT(refracted_out, 100);
+  const BsdfSample t = set_of({transparent(Spectrum(0.5f))}).sample(incident(0.4f), 0.5f, {});
+  EXPECT_TRUE(t.valid && t.is_delta());
+  EXPECT_EQ(t.wo, -incident(0.4f));
+  EXPECT_NEAR(t.weight().x, 0.5f, 1e-7f);
+}
+
+// Degenerate inputs: zero roughness, exactly grazing wi (z = 0), wo = -wi, wo = wi, poles.
+TEST(BsdfRobustness, NoNaNOrInfInDegenerateConfigurations) {
+  std::vector<Closure> lobes = {lambert(), oren_nayar(1.0f), principled_diffuse(1.0f),
+                                transparent()};
+  for (float a : {0.0f, 1e-6f, 1e-4f, 3.2e-4f, 1e-3f, 1.0f}) {
+    lobes.push_back(ggx(a));
+    lobes.push_back(ggx_principled(a, 1.5f, Spectrum(0.5f)));
+    lobes.push_back(glass(a, 1.5f));
+    lobes.push_back(glass(a, 1.00001f));
+  }
+  const Vec3f wis[] = {Vec3f(1, 0, 0),  Vec3f(0, 0, 1),   Vec3f(0, 0, -1),
+                       incident(1e-7f), incident(-1e-7f), normalize(Vec3f(1, 1, 0))};
+  for (const Closure& c : lobes) {
+    const ClosureSet set = set_of({c, lambert(Spectrum(0.1f))});
+    for (const Vec3f& wi : wis) {
+      const Vec3f wos[] = {
+          -wi, wi, Vec3f(0, 0, 1), Vec3f(0, 0, -1), Vec3f(1, 0, 0), Vec3f(-wi.x, -wi.y, wi.z)};
+      for (const Vec3f& wo : wos) {
+        EXPECT_TRUE(is_finite(set.eval(wi, wo))) << int(c.type) << " alpha " << c.alpha;
+        EXPECT_TRUE(std::isfinite(set.pdf(wi, wo))) << int(c.type) << " alpha " << c.alpha;
+      }
+      for (float u : {0.0f, 0.5f, 0.99999994f}) {
+        const BsdfSample s = set.sample(wi, u, Vec2f(u, 1.0f - u));
+        if (!s.valid) continue;
+        EXPECT_TRUE(is_finite(s.value) && std::isfinite(s.pdf) && is_finite(s.wo))
+            << int(c.type) << " alpha " << c.alpha;
+        EXPECT_TRUE(is_finite(s.weight()));
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace gdpt::test

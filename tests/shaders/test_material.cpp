@@ -1,0 +1,244 @@
+// Material trees: Mix / Add weights, node -> closure mapping (Diffuse, Glossy, Glass,
+// Principled v1, Emission, Transparent), texture inputs through the Mapping transform,
+// feature flags, average emission, and malformed trees.
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <vector>
+
+#include "shaders/fresnel.h"
+#include "shaders/material.h"
+
+namespace gdpt {
+namespace {
+
+ShaderNode node(ShaderNodeKind kind, Spectrum color = Spectrum(0.8f)) {
+  ShaderNode n;
+  n.kind = kind;
+  n.color = ColorInput(color);
+  n.roughness = FloatInput(0.0f);
+  return n;
+}
+
+ClosureSet eval(const Material& m, Vec2f uv = {0.25f, 0.25f}) {
+  ClosureSet s;
+  m.evaluate(ShadingContext{uv, true}, s);
+  return s;
+}
+
+void expect_spectrum(Spectrum got, Spectrum want, float tol = 1e-6f) {
+  EXPECT_NEAR(got.x, want.x, tol);
+  EXPECT_NEAR(got.y, want.y, tol);
+  EXPECT_NEAR(got.z, want.z, tol);
+}
+
+TEST(Material, DefaultIsCyclesGreyDiffuse) {
+  for (const Material& m : {Material(), Material(MaterialDesc{}, {})}) {
+    const ClosureSet s = eval(m);
+    ASSERT_EQ(s.count(), 1);
+    EXPECT_EQ(s[0].type, ClosureType::Lambert);
+    expect_spectrum(s[0].weight, Spectrum(0.8f));
+    EXPECT_EQ(m.features(), 0u);
+    EXPECT_FALSE(m.is_emissive());
+  }
+}
+
+TEST(Material, MixAndAddWeights) {
+  // Add(Mix(Diffuse red rough 0.5, Glossy r 0.5, fac 0.25), Emission (1,2,3) x 2)
+  MaterialDesc d;
+  d.name = "tree";
+  d.nodes.push_back(node(ShaderNodeKind::Add));  // 0
+  d.nodes[0].a = 1;
+  d.nodes[0].b = 4;
+  d.nodes.push_back(node(ShaderNodeKind::Mix));  // 1
+  d.nodes[1].fac = FloatInput(0.25f);
+  d.nodes[1].a = 2;
+  d.nodes[1].b = 3;
+  d.nodes.push_back(node(ShaderNodeKind::Diffuse, Spectrum(1, 0, 0)));  // 2
+  d.nodes[2].roughness = FloatInput(0.5f);
+  d.nodes.push_back(node(ShaderNodeKind::Glossy, Spectrum(1.0f)));  // 3
+  d.nodes[3].roughness = FloatInput(0.5f);
+  d.nodes.push_back(node(ShaderNodeKind::Emission, Spectrum(1, 2, 3)));  // 4
+  d.nodes[4].strength = FloatInput(2.0f);
+  d.root = 0;
+  const Material m(d, {});
+  const ClosureSet s = eval(m);
+  ASSERT_EQ(s.count(), 2);
+  EXPECT_EQ(s[0].type, ClosureType::OrenNayar);
+  EXPECT_FLOAT_EQ(s[0].alpha, 0.5f);
+  expect_spectrum(s[0].weight, Spectrum(0.75f, 0, 0));
+  EXPECT_EQ(s[1].type, ClosureType::GGXReflection);
+  EXPECT_EQ(s[1].fresnel, FresnelMode::None);
+  EXPECT_FLOAT_EQ(s[1].alpha, 0.25f);  // roughness^2
+  expect_spectrum(s[1].weight, Spectrum(0.25f));
+  expect_spectrum(s.emission(), Spectrum(2, 4, 6));
+  expect_spectrum(m.emission(ShadingContext{}), Spectrum(2, 4, 6));
+  expect_spectrum(m.average_emission(), Spectrum(2, 4, 6));
+  EXPECT_EQ(m.features(), uint32_t(kFeatureGlossy | kFeatureEmission));
+
+  // Mix factors outside [0, 1] clamp, as Cycles.
+  d.nodes[1].fac = FloatInput(1.5f);
+  const ClosureSet s2 = eval(Material(d, {}));
+  ASSERT_EQ(s2.count(), 1);
+  EXPECT_EQ(s2[0].type, ClosureType::GGXReflection);
+}
+
+TEST(Material, TexturedInputsGoThroughTheMapping) {
+  // 2x2 texture, bottom row red 0.2 / 0.6, top row 0.9 / 1.0.
+  ImageDesc img;
+  img.width = 2;
+  img.height = 2;
+  img.rgba = {0.2f, 0.1f, 0.0f, 1, 0.6f, 0.3f, 0.0f, 1, 0.9f, 0.0f, 0.0f, 1, 1.0f, 1.0f, 1.0f, 1};
+  const std::vector<Texture> textures{Texture(img)};
+
+  MaterialDesc d;
+  d.nodes.push_back(node(ShaderNodeKind::Mix));  // fac from the red channel
+  d.nodes[0].fac.texture.image = 0;
+  d.nodes[0].fac.texture.interpolation = TextureLookup::Interpolation::Closest;
+  d.nodes[0].fac.channel = FloatInput::Channel::Red;
+  // Mapping: uv -> (uv.x + 0.5, uv.y): the lookup at u = 0.25 reads pixel x = 1.
+  d.nodes[0].fac.texture.uv_mapping.m[0][3] = 0.5f;
+  d.nodes[0].a = 1;
+  d.nodes[0].b = 2;
+  d.nodes.push_back(node(ShaderNodeKind::Diffuse));
+  d.nodes[1].color.texture.image = 0;  // base colour from the texture, bilinear
+  d.nodes.push_back(node(ShaderNodeKind::Transparent, Spectrum(1.0f)));
+  d.root = 0;
+  const Material m(d, textures);
+  EXPECT_TRUE(m.features() & kFeatureTextures);
+  EXPECT_TRUE(m.features() & kFeatureTransparent);
+  const ClosureSet s = eval(m, {0.25f, 0.25f});
+  ASSERT_EQ(s.count(), 2);
+  // fac = red of pixel (1, 0) = 0.6; diffuse colour = pixel (0, 0) = (0.2, 0.1, 0).
+  expect_spectrum(s[0].weight, Spectrum(0.2f, 0.1f, 0.0f) * 0.4f);
+  expect_spectrum(s[1].weight, Spectrum(0.6f));
+}
+
+TEST(Material, PrincipledMetallicReflectsBaseColourAtNormalIncidence) {
+  const Spectrum base(0.9f, 0.5f, 0.2f);
+  auto principled = [](Spectrum c) {
+    MaterialDesc d;
+    ShaderNode n = node(ShaderNodeKind::Principled, c);
+    n.metallic = FloatInput(1.0f);
+    n.roughness = FloatInput(0.3f);
+    d.nodes.push_back(n);
+    d.root = 0;
+    return Material(d, {});
+  };
+  const ClosureSet s = eval(principled(base));
+  const ClosureSet white = eval(principled(Spectrum(1.0f)));
+  ASSERT_EQ(s.count(), 1);  // metallic: no diffuse, no transmission
+  EXPECT_EQ(s[0].fresnel, FresnelMode::PrincipledV1);
+  const Vec3f n(0, 0, 1);
+  const Spectrum ratio = s.eval(n, n) / white.eval(n, n);
+  expect_spectrum(ratio, base, 1e-5f);
+  // Towards grazing the Fresnel blend goes to white.
+  const Vec3f g = normalize(Vec3f(1, 0, 0.02f)), go = normalize(Vec3f(-1, 0, 0.02f));
+  const Spectrum r2 = s.eval(g, go) / white.eval(g, go);
+  EXPECT_GT(r2.z, 0.8f);
+}
+
+TEST(Material, PrincipledWeightsFollowCycles) {
+  MaterialDesc d;
+  ShaderNode n = node(ShaderNodeKind::Principled, Spectrum(0.5f, 0.4f, 0.3f));
+  n.roughness = FloatInput(0.5f);
+  n.metallic = FloatInput(0.2f);
+  n.transmission = FloatInput(0.5f);
+  n.specular = FloatInput(0.5f);
+  n.ior = FloatInput(1.5f);
+  n.alpha = FloatInput(0.8f);
+  n.emission = ColorInput(Spectrum(1, 1, 0));
+  n.emission_strength = FloatInput(3.0f);
+  d.nodes.push_back(n);
+  d.root = 0;
+  const Material m(d, {});
+  const ClosureSet s = eval(m);
+  ASSERT_EQ(s.count(), 4);  // transparent, diffuse, specular, glass
+  EXPECT_EQ(s[0].type, ClosureType::Transparent);
+  expect_spectrum(s[0].weight, Spectrum(0.2f));
+  EXPECT_EQ(s[1].type, ClosureType::PrincipledDiffuse);
+  // 0.8 alpha * (1 - 0.2) * (1 - 0.5) * base
+  expect_spectrum(s[1].weight, Spectrum(0.5f, 0.4f, 0.3f) * 0.32f);
+  EXPECT_FLOAT_EQ(s[1].alpha, 0.5f);
+  EXPECT_EQ(s[2].type, ClosureType::GGXReflection);
+  // specular weight 1 - transmission (1 - metallic) = 0.6
+  expect_spectrum(s[2].weight, Spectrum(0.8f * 0.6f));
+  EXPECT_FLOAT_EQ(s[2].alpha, 0.25f);
+  EXPECT_NEAR(fresnel_f0(s[2].ior), 0.04f, 1e-5f);  // F0 = 0.08 specular
+  // cspec0 = 0.08 * 0.5 * (1 - 0.2) + base * 0.2
+  expect_spectrum(s[2].f0, Spectrum(0.032f) + Spectrum(0.5f, 0.4f, 0.3f) * 0.2f, 1e-6f);
+  EXPECT_EQ(s[3].type, ClosureType::GGXDielectric);
+  expect_spectrum(s[3].weight, Spectrum(0.8f * 0.4f));
+  expect_spectrum(s[3].transmission_tint, Spectrum(0.5f, 0.4f, 0.3f));
+  EXPECT_FLOAT_EQ(s[3].ior, 1.5f);
+  expect_spectrum(s.emission(), Spectrum(2.4f, 2.4f, 0.0f), 1e-5f);  // inside the alpha mix
+  EXPECT_EQ(m.features(), uint32_t(kFeatureGlossy | kFeatureTransmission | kFeatureEmission |
+                                   kFeatureTransparent | kFeatureDelta));
+}
+
+TEST(Material, GlassNodes) {
+  MaterialDesc d;
+  ShaderNode g = node(ShaderNodeKind::Glass, Spectrum(0.9f));
+  g.ior = FloatInput(1.33f);
+  d.nodes.push_back(g);
+  d.root = 0;
+  const Material smooth(d, {});
+  EXPECT_EQ(smooth.features(), uint32_t(kFeatureGlossy | kFeatureTransmission | kFeatureDelta));
+  ClosureSet s = eval(smooth);
+  ASSERT_EQ(s.count(), 1);
+  EXPECT_EQ(s[0].type, ClosureType::GGXDielectric);
+  EXPECT_TRUE(s.has_delta());
+
+  d.nodes[0].roughness = FloatInput(0.3f);
+  const Material rough(d, {});
+  EXPECT_EQ(rough.features(), uint32_t(kFeatureGlossy | kFeatureTransmission));
+  s = eval(rough);
+  EXPECT_FLOAT_EQ(s[0].alpha, 0.09f);
+  EXPECT_FALSE(s.has_delta());
+
+  d.nodes[0].ior = FloatInput(1.0f);  // index matched: a pass-through
+  s = eval(Material(d, {}));
+  ASSERT_EQ(s.count(), 1);
+  EXPECT_EQ(s[0].type, ClosureType::Transparent);
+}
+
+TEST(Material, AverageEmissionUsesTextureMeans) {
+  ImageDesc img;
+  img.width = 2;
+  img.height = 1;
+  img.rgba = {1, 0, 0, 1, 0, 0, 1, 1};
+  const std::vector<Texture> textures{Texture(img)};
+  MaterialDesc d;
+  ShaderNode e = node(ShaderNodeKind::Emission, Spectrum(1.0f));
+  e.color.texture.image = 0;
+  e.strength = FloatInput(4.0f);
+  d.nodes.push_back(e);
+  d.root = 0;
+  const Material m(d, textures);
+  EXPECT_TRUE(m.is_emissive());
+  expect_spectrum(m.average_emission(), Spectrum(2, 0, 2));
+  expect_spectrum(m.emission(ShadingContext{{0.25f, 0.5f}, true}), Spectrum(4, 0, 0));
+  const ClosureSet s = eval(m, {0.75f, 0.5f});
+  EXPECT_EQ(s.count(), 0);
+  expect_spectrum(s.emission(), Spectrum(0, 0, 4));
+}
+
+TEST(Material, MalformedTreesThrow) {
+  MaterialDesc d;
+  d.name = "broken";
+  d.nodes.push_back(node(ShaderNodeKind::Mix));
+  d.nodes[0].a = 0;  // cycle
+  d.nodes[0].b = 0;
+  d.root = 0;
+  EXPECT_THROW(Material(d, {}), std::invalid_argument);
+  d.nodes[0].a = 5;  // out of range
+  EXPECT_THROW(Material(d, {}), std::invalid_argument);
+  MaterialDesc t;
+  t.nodes.push_back(node(ShaderNodeKind::Diffuse));
+  t.nodes[0].color.texture.image = 2;  // no such texture
+  t.root = 0;
+  EXPECT_THROW(Material(t, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace gdpt

@@ -1,0 +1,81 @@
+// Image texture lookups against hand-computed values: pixel centres at (i + 0.5) / w, v = 0 at
+// the bottom row, closest / bilinear, repeat / extend / clip.
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+#include "shaders/texture.h"
+
+namespace gdpt {
+namespace {
+
+// 2x2 image, row 0 at the bottom: A B (bottom), C D (top). Alpha = 0.1, 0.2, 0.3, 0.4.
+const Spectrum A(1, 0, 0), B(0, 1, 0), C(0, 0, 1), D(1, 1, 1);
+
+Texture make_texture() {
+  ImageDesc img;
+  img.name = "quad";
+  img.width = 2;
+  img.height = 2;
+  img.rgba = {1, 0, 0, 0.1f, 0, 1, 0, 0.2f, 0, 0, 1, 0.3f, 1, 1, 1, 0.4f};
+  return Texture(img);
+}
+
+using I = TextureLookup::Interpolation;
+using E = TextureLookup::Extension;
+
+void expect_rgba(const Rgba& got, Spectrum rgb, float a) {
+  EXPECT_NEAR(got.rgb.x, rgb.x, 1e-6f);
+  EXPECT_NEAR(got.rgb.y, rgb.y, 1e-6f);
+  EXPECT_NEAR(got.rgb.z, rgb.z, 1e-6f);
+  EXPECT_NEAR(got.a, a, 1e-6f);
+}
+
+TEST(Texture, ClosestPicksThePixelContainingUv) {
+  const Texture t = make_texture();
+  expect_rgba(t.lookup({0.25f, 0.25f}, I::Closest, E::Repeat), A, 0.1f);
+  expect_rgba(t.lookup({0.75f, 0.25f}, I::Closest, E::Repeat), B, 0.2f);
+  expect_rgba(t.lookup({0.25f, 0.75f}, I::Closest, E::Repeat), C, 0.3f);  // v up = top row
+  expect_rgba(t.lookup({0.99f, 0.99f}, I::Closest, E::Repeat), D, 0.4f);
+  expect_rgba(t.lookup({1.25f, -0.75f}, I::Closest, E::Repeat), A, 0.1f);  // wraps
+  expect_rgba(t.lookup({1.0f, 1.0f}, I::Closest, E::Clip), D, 0.4f);       // edge is inside
+  expect_rgba(t.lookup({1.5f, 0.25f}, I::Closest, E::Extend), B, 0.2f);
+}
+
+TEST(Texture, BilinearIsExactAtCentresAndBlendsBetween) {
+  const Texture t = make_texture();
+  expect_rgba(t.lookup({0.25f, 0.25f}, I::Linear, E::Repeat), A, 0.1f);
+  expect_rgba(t.lookup({0.75f, 0.75f}, I::Linear, E::Repeat), D, 0.4f);
+  expect_rgba(t.lookup({0.5f, 0.25f}, I::Linear, E::Repeat), (A + B) * 0.5f, 0.15f);
+  expect_rgba(t.lookup({0.5f, 0.5f}, I::Linear, E::Repeat), (A + B + C + D) * 0.25f, 0.25f);
+  // 1/4 of the way from A's centre to B's centre.
+  expect_rgba(t.lookup({0.375f, 0.25f}, I::Linear, E::Extend), A * 0.75f + B * 0.25f, 0.125f);
+}
+
+TEST(Texture, ExtensionModesAtTheBorder) {
+  const Texture t = make_texture();
+  // u = 0: halfway between pixel -1 and pixel 0.
+  expect_rgba(t.lookup({0.0f, 0.25f}, I::Linear, E::Repeat), (A + B) * 0.5f, 0.15f);  // -1 -> B
+  expect_rgba(t.lookup({0.0f, 0.25f}, I::Linear, E::Extend), A, 0.1f);
+  expect_rgba(t.lookup({0.0f, 0.25f}, I::Linear, E::Clip), A * 0.5f, 0.05f);  // blends to 0
+  expect_rgba(t.lookup({1.2f, 0.5f}, I::Linear, E::Clip), Spectrum(0.0f), 0.0f);
+  expect_rgba(t.lookup({-0.01f, 0.5f}, I::Closest, E::Clip), Spectrum(0.0f), 0.0f);
+  expect_rgba(t.lookup({1.25f, 0.25f}, I::Linear, E::Repeat), A, 0.1f);
+  expect_rgba(t.lookup({-0.75f, 0.25f}, I::Linear, E::Repeat), A, 0.1f);
+  expect_rgba(t.lookup({-3.0f, 5.0f}, I::Linear, E::Extend), C, 0.3f);  // left, top
+  expect_rgba(t.lookup({1e9f, 0.25f}, I::Linear, E::Repeat), (A + B) * 0.5f, 0.15f);
+}
+
+TEST(Texture, MissingImageIsMagentaAndBadSizesThrow) {
+  const Texture empty{ImageDesc{}};
+  expect_rgba(empty.lookup({0.3f, 0.3f}, I::Linear, E::Repeat), Spectrum(1, 0, 1), 1.0f);
+  ImageDesc bad;
+  bad.name = "bad";
+  bad.width = 2;
+  bad.height = 2;
+  bad.rgba.resize(12);
+  EXPECT_THROW(Texture{bad}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace gdpt
