@@ -113,7 +113,7 @@ TEST(SpotLight, SphereSpotMatchesPointWithinCone) {
   EXPECT_NEAR(e.irradiance, expected, 2e-3 * expected);
 }
 
-TEST(SunLight, IrradianceIsPowerTimesCosine) {
+TEST(SunLight, IrradianceAsCycles) {
   for (float angle_deg : {0.0f, 0.526f, 10.0f, 40.0f}) {
     Scene scene = black_scene();
     Light l = make_light(Light::Type::Sun, {5, 5, 5}, normalize(Vec3f(0, 1, -2)), 3.0f);
@@ -124,7 +124,11 @@ TEST(SunLight, IrradianceIsPowerTimesCosine) {
     // Receiver tilted 30 degrees away from the sun direction (the cone stays above it).
     const Vec3f n = Frame(to_sun).to_world({std::sin(0.5236f), 0.0f, std::cos(0.5236f)});
     const test::Estimate e = estimate(lights, {1, 2, 3}, n, 40000);
-    EXPECT_NEAR(e.irradiance, 3.0 * std::cos(0.5236), 2e-3 * 3.0) << angle_deg;
+    // Cycles' disc of radius R = tan(a) at distance 1: E = P cos(theta) (2/R^2)(sqrt(1+R^2)-1),
+    // the mean of 1/sqrt(1 + r^2) over the disc (1 for a delta sun).
+    const double R = std::tan(0.5 * angle_deg * kPiD / 180.0);
+    const double disc = R > 0 ? 2.0 / (R * R) * (std::sqrt(1.0 + R * R) - 1.0) : 1.0;
+    EXPECT_NEAR(e.irradiance, 3.0 * std::cos(0.5236) * disc, 1e-4 * 3.0) << angle_deg;
     if (angle_deg > 0.0f) {
       const double omega = 2.0 * kPiD * (1.0 - std::cos(0.5 * angle_deg * kPiD / 180.0));
       EXPECT_NEAR(e.solid_angle, omega, 1e-3 * omega) << angle_deg;

@@ -1,0 +1,61 @@
+# Reference numbers for test_cycles_reference.cpp: renders a small white Lambert plane at the
+# origin (normal +Z) under one light with Cycles, 0 bounces, Standard view transform, and prints
+# the mean radiance of the 8x8 image (albedo 1: radiance = E / pi).
+# Usage: blender -b --factory-startup --python cycles_reference.py -- KIND [SAMPLES]
+#   KIND: area, area_scaled, disk, point, spot, sun. Writes /tmp/lights_cycles/out_KIND.exr.
+import bpy, math, sys
+argv = sys.argv[sys.argv.index("--") + 1:]
+kind = argv[0]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+sc = bpy.context.scene
+sc.render.engine = 'CYCLES'
+sc.cycles.device = 'CPU'
+sc.cycles.samples = int(argv[1]) if len(argv) > 1 else 256
+sc.cycles.max_bounces = 0
+sc.cycles.use_denoising = False
+sc.render.resolution_x = sc.render.resolution_y = 8
+sc.render.film_transparent = False
+sc.view_settings.view_transform = 'Standard'
+sc.view_settings.look = 'None'
+sc.world = bpy.data.worlds.new("w")
+sc.world.use_nodes = True
+sc.world.node_tree.nodes["Background"].inputs[1].default_value = 0.0
+bpy.ops.mesh.primitive_plane_add(size=0.02, location=(0, 0, 0))
+mat = bpy.data.materials.new("white"); mat.use_nodes = True
+nt = mat.node_tree; nt.nodes.clear()
+d = nt.nodes.new("ShaderNodeBsdfDiffuse"); d.inputs[0].default_value = (1, 1, 1, 1)
+o = nt.nodes.new("ShaderNodeOutputMaterial"); nt.links.new(d.outputs[0], o.inputs[0])
+bpy.context.object.data.materials.append(mat)
+cam = bpy.data.cameras.new("c"); cam.type = 'ORTHO'; cam.ortho_scale = 0.01
+co = bpy.data.objects.new("c", cam); sc.collection.objects.link(co); sc.camera = co
+co.location = (0, 0, 0.5)   # looks down -Z
+if kind == "area":
+    l = bpy.data.lights.new("l", 'AREA'); l.shape = 'SQUARE'; l.size = 1.0; l.energy = 100.0
+    lo = bpy.data.objects.new("l", l); lo.location = (0, 0, 2)
+elif kind == "area_scaled":
+    l = bpy.data.lights.new("l", 'AREA'); l.shape = 'RECTANGLE'; l.size = 1.0; l.size_y = 0.5; l.energy = 100.0
+    lo = bpy.data.objects.new("l", l); lo.location = (0, 0, 2); lo.scale = (2, 1, 1)
+elif kind == "disk":
+    l = bpy.data.lights.new("l", 'AREA'); l.shape = 'DISK'; l.size = 2.0; l.energy = 100.0
+    lo = bpy.data.objects.new("l", l); lo.location = (0, 0, 1.5)
+elif kind == "point":
+    l = bpy.data.lights.new("l", 'POINT'); l.shadow_soft_size = 0.0; l.energy = 100.0
+    lo = bpy.data.objects.new("l", l); lo.location = (0, 0, 3)
+elif kind == "spot":
+    l = bpy.data.lights.new("l", 'SPOT'); l.shadow_soft_size = 0.0; l.energy = 100.0
+    l.spot_size = 1.0; l.spot_blend = 0.5
+    lo = bpy.data.objects.new("l", l); lo.location = (3 * math.tan(0.35), 0, 3)
+elif kind == "sun":
+    l = bpy.data.lights.new("l", 'SUN'); l.energy = 3.0; l.angle = math.radians(10)
+    lo = bpy.data.objects.new("l", l); lo.rotation_euler = (math.radians(30), 0, 0)
+sc.collection.objects.link(lo)
+sc.render.image_settings.file_format = 'OPEN_EXR'
+import os
+os.makedirs("/tmp/lights_cycles", exist_ok=True)
+sc.render.filepath = "/tmp/lights_cycles/out_" + kind + ".exr"
+bpy.ops.render.render(write_still=True)
+img = bpy.data.images.load(sc.render.filepath)
+px = list(img.pixels)
+w = img.size[0]; h = img.size[1]
+vals = [px[(y * w + x) * 4] for y in range(h) for x in range(w)]
+print("RESULT", kind, sum(vals) / len(vals))

@@ -1,0 +1,78 @@
+// Brightness against Cycles itself: irradiance at the origin (normal +Z) for the six light set-ups
+// of cycles_reference.py, compared with the radiance Blender 3.4.1 Cycles rendered on a white
+// Lambert plane there (256 spp, 0 bounces; radiance = E / pi). This pins the units (area
+// P / (4 A) with object scale, point P / (4 pi), spot cos * smoothstep, sun disc) to Cycles.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "integrator/light_sampler.h"
+#include "light_test_util.h"
+
+namespace gdpt {
+namespace {
+
+constexpr double kPiD = 3.14159265358979323846;
+
+// Blender's default light frame: rotation only where the script sets one (local -Z down).
+Transform frame(Vec3f position, float rot_x_deg = 0.0f, float scale_x = 1.0f) {
+  const float r = rot_x_deg * float(kPiD) / 180.0f, c = std::cos(r), s = std::sin(r);
+  // Rotation about X (Blender Euler XYZ with only X set), then scale on local X.
+  const float rows[12] = {scale_x, 0, 0, position.x, 0, c, -s, position.y, 0, s, c, position.z};
+  return Transform::from_rows(rows);
+}
+
+double plane_radiance(const Light& l) {
+  Scene scene = test::black_scene();
+  scene.lights.push_back(l);
+  const LightSampler lights(scene, {}, {});
+  return test::estimate(lights, {0, 0, 0}, {0, 0, 1}, 250000).irradiance / kPiD;
+}
+
+TEST(CyclesReference, RenderedRadianceOfALambertPlane) {
+  struct Case {
+    const char* name;
+    Light light;
+    double cycles;  // mean pixel value rendered by Blender 3.4.1 Cycles
+  };
+  Light area;
+  area.type = Light::Type::Area;
+  area.shape = Light::Shape::Square;
+  area.size_x = 1.0f;
+  area.power = 100.0f;
+  area.light_to_world = frame({0, 0, 2});
+  Light area_scaled = area;
+  area_scaled.shape = Light::Shape::Rectangle;
+  area_scaled.size_y = 0.5f;
+  area_scaled.light_to_world = frame({0, 0, 2}, 0.0f, 2.0f);
+  Light disk = area;
+  disk.shape = Light::Shape::Disk;
+  disk.size_x = 2.0f;
+  disk.light_to_world = frame({0, 0, 1.5f});
+  Light point;
+  point.type = Light::Type::Point;
+  point.radius = 0.0f;
+  point.power = 100.0f;
+  point.light_to_world = frame({0, 0, 3});
+  Light spot = point;
+  spot.type = Light::Type::Spot;
+  spot.spot_size = 1.0f;
+  spot.spot_blend = 0.5f;
+  spot.light_to_world = frame({3.0f * std::tan(0.35f), 0, 3});
+  Light sun;
+  sun.type = Light::Type::Sun;
+  sun.power = 3.0f;
+  sun.sun_angle = 10.0f * float(kPiD) / 180.0f;
+  sun.light_to_world = frame({0, 0, 0}, 30.0f);
+  const Case cases[] = {
+      {"area", area, 1.8372802380472422},  {"area_scaled", area_scaled, 1.7016874235123396},
+      {"disk", disk, 2.4488340467214584},  {"point", point, 0.2814468815922737},
+      {"spot", spot, 0.21915356907993555}, {"sun", sun, 0.825493011623621}};
+  for (const Case& c : cases) {
+    const double ours = plane_radiance(c.light);
+    EXPECT_NEAR(ours, c.cycles, 2e-3 * c.cycles) << c.name << ": ours " << ours;
+  }
+}
+
+}  // namespace
+}  // namespace gdpt
