@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "integrator/features.h"
+#include "integrator/gradient_path_tracer.h"
 #include "integrator/integrator.h"
 #include "integrator/path_tracer.h"
 #include "integrator/scene_context.h"
@@ -45,9 +46,10 @@ RenderSession::RenderSession(Scene scene, RenderSettings settings)
   d.settings = settings;
   d.context = std::make_unique<SceneContext>(d.scene, d.settings);
   d.warnings = d.context->warnings();
-  // G-PT dispatch: until integrator/gradient_path_tracer.h provides the G-PT integrator, GPT mode
-  // renders with the path tracer (gradients then come from the primal, see Film).
-  d.integrator = make_path_tracer(*d.context, d.settings);
+  // Mode dispatch: G-PT estimates the gradients itself; PT derives them from the primal (Film).
+  d.integrator = d.settings.mode == RenderSettings::Mode::GPT
+                     ? make_gradient_path_tracer(*d.context, d.settings)
+                     : make_path_tracer(*d.context, d.settings);
   const int w = d.scene.camera.width, h = d.scene.camera.height;
   d.film = Film(w, h);
   d.pass_film = Film(w, h);

@@ -1,0 +1,855 @@
+// Gradient-domain path tracer: see gradient_path_tracer.h for the estimator and the film layout,
+// shift_mapping.h for the shift mathematics.
+//
+// Parameters (RenderSettings): max_bounces, rr_depth (Russian roulette decided by the base path,
+// its probability multiplied into base and offset densities alike), shift_roughness_threshold
+// (vertex classification), seed, clamp (applied to the primal only, as in PT).
+//
+// Bookkeeping: each path keeps its throughput f (product of BSDF values, not divided by pdfs) and
+// its density p (product of solid-angle densities), both in double; offsets multiply their shift
+// Jacobians into both. An emission event of the base path (light sample, BSDF-sampled light hit,
+// world) with contribution C = f * segment, and the matching offset contribution C' (Jacobian
+// included), adds w (C' - C) to the gradient half of that offset, w = shift::mis_weight_over_pdf.
+#include "integrator/gradient_path_tracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "integrator/features.h"
+#include "integrator/math/frame.h"
+#include "integrator/path_tracer.h"
+#include "integrator/sampler.h"
+#include "integrator/scene_context.h"
+#include "integrator/shift_mapping.h"
+#include "shaders/shading_context.h"
+
+namespace gdpt {
+
+namespace {
+
+using shift::PathDensities;
+using shift::Vec3d;
+using shift::VertexType;
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kOffsets = 4;
+// Offset order: +x (right), +y (up), -x (left), -y (down).
+constexpr int kShiftX[kOffsets] = {1, 0, -1, 0};
+constexpr int kShiftY[kOffsets] = {0, 1, 0, -1};
+enum : int { kRight = 0, kUp = 1, kLeft = 2, kDown = 3 };
+
+inline Vec3d mul(Vec3d a, Vec3d b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+inline Vec3d mul(Vec3d a, Spectrum b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+inline bool is_zero(Vec3d a) {
+  return a.x == 0.0 && a.y == 0.0 && a.z == 0.0;
+}
+
+// A shading point of a path: the hit, the frame facing the incoming ray, the closures.
+struct Vertex {
+  SurfaceHit hit;
+  Frame frame;
+  Vec3f ng;  // geometric normal on the side of the incoming ray
+  Vec3f wi;  // local incoming direction
+  ClosureSet closures;
+  float roughness = 1.0f;  // ClosureSet::roughness(), 1 for a vertex without BSDF
+};
+
+// Sets up `v` at `hit` reached along `dir` (world, unit), as the path tracer does: Cycles-style
+// flipped normals for back faces, geometric-normal fallback for a shading normal that puts the
+// incoming direction below its horizon.
+void setup_vertex(const SceneContext& ctx, const SurfaceHit& hit, Vec3f dir, Vertex& v) {
+  v.hit = hit;
+  const ShadingContext sc{hit.uv, hit.front_facing};
+  v.closures.clear();
+  ctx.materials()[size_t(hit.material)].evaluate(sc, v.closures);
+  const Vec3f wi_world = -dir;
+  v.ng = hit.front_facing ? hit.geometric_normal : -hit.geometric_normal;
+  Vec3f ns = hit.front_facing ? hit.shading_normal : -hit.shading_normal;
+  if (dot(ns, wi_world) <= 1e-4f) ns = v.ng;
+  v.frame = Frame(ns);
+  v.wi = v.frame.to_local(wi_world);
+  v.roughness = v.closures.has_bsdf() ? v.closures.roughness() : 1.0f;
+}
+
+// Emitted radiance of an emissive triangle at `hit` towards the point `from`.
+Spectrum triangle_emission(const SceneContext& ctx, const SurfaceHit& hit, Vec3f from) {
+  const Material& m = ctx.materials()[size_t(hit.material)];
+  if (!m.is_emissive()) return Spectrum(0.0f);
+  const ShadingContext sc{hit.uv, dot(from - hit.position, hit.geometric_normal) > 0.0f};
+  return m.emission(sc);
+}
+
+enum class Link : uint8_t { NotConnected, Recent, Connected };
+
+// How the offset follows the base over one segment.
+enum class Shift : uint8_t { Follow, RecentEval, Reconnect, ReconnectEnv, HalfVector, Failed };
+
+struct Offset {
+  bool active = false;  // traced for this sample (target pixel inside the image, needed)
+  bool alive = false;
+  bool failed = false;  // died at some point (statistics)
+  Link link = Link::NotConnected;
+  Vertex v;            // own vertex while NotConnected
+  Vec3f wi_world;      // Recent: direction towards the previous offset vertex, world
+  Vec3f wi_shared;     // Recent: the same in the base vertex's local frame
+  Vec3d f;             // throughput up to the current vertex, Jacobians included
+  double p = 0.0;      // density up to the current vertex, Jacobians included
+  Vec3d grad;          // sum of w (C' - C)
+  bool nee_on = true;  // next-event estimation shifted for this pair at the current vertex
+  // Segment from the current vertex (set per bounce).
+  Shift shift = Shift::Failed;
+  Vec3d seg_value;
+  double seg_pdf = 0.0, seg_jacobian = 1.0;
+  bool seg_visible = true;
+  Vec3f seg_dir;  // world direction of the offset's segment
+  // HalfVector: the offset's own next vertex.
+  Ray ray;
+  bool next_found = false;
+  SurfaceHit next_hit;
+  bool killed = false;  // the continuing path is not invertible / mismatched
+};
+
+struct SampleResult {
+  Spectrum primal{0.0f};
+  Spectrum emission{0.0f};
+  Vec3d grad[kOffsets];
+  uint8_t attempts = 0, failures = 0;
+  uint32_t rays = 0;
+};
+
+struct Halves {
+  Vec3d grad[kOffsets];
+};
+
+class GradientPathTracer final : public Integrator {
+ public:
+  GradientPathTracer(const SceneContext& ctx, const RenderSettings& settings)
+      : ctx_(ctx),
+        settings_(settings),
+        has_world_(ctx.lights().has_environment()),
+        has_dof_(ctx.camera().has_dof()) {}
+
+  bool estimates_gradients() const override { return true; }
+
+  void render_tile(const Tile& tile, uint32_t first_sample, uint32_t sample_count,
+                   Film& film) const override {
+    const int W = film.width(), H = film.height();
+    // Region: the tile plus its right column and top row (halo) when they exist.
+    const int rx1 = std::min(tile.x1 + 1, W), ry1 = std::min(tile.y1 + 1, H);
+    const int rw = rx1 - tile.x0, rh = ry1 - tile.y0;
+    thread_local std::vector<Halves> halves;
+    if (halves.size() < size_t(rw) * size_t(rh)) halves.resize(size_t(rw) * size_t(rh));
+    auto half_at = [&](int x, int y) -> Halves& {
+      return halves[size_t(y - tile.y0) * size_t(rw) + size_t(x - tile.x0)];
+    };
+    uint64_t rays = 0;
+    Sampler sampler;
+    const float clamp = settings_.clamp;
+    for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
+      // --- Trace every base path of the region with the offsets this tile needs ---
+      for (int y = tile.y0; y < ry1; ++y)
+        for (int x = tile.x0; x < rx1; ++x) {
+          const bool in_x = x < tile.x1, in_y = y < tile.y1;
+          if (!in_x && !in_y) continue;  // the corner is never needed
+          bool mask[kOffsets];
+          if (in_x && in_y) {
+            mask[kRight] = x + 1 < W;
+            mask[kUp] = y + 1 < H;
+            mask[kLeft] = x - 1 >= tile.x0;  // dx(x0 - 1) belongs to the left tile
+            mask[kDown] = y - 1 >= tile.y0;
+          } else {
+            mask[kRight] = mask[kUp] = false;
+            mask[kLeft] = !in_x;  // halo column: G_left for dx(x1 - 1)
+            mask[kDown] = !in_y;  // halo row: G_down for dy(y1 - 1)
+          }
+          sampler.start(settings_.seed, x, y, s);
+          SampleResult r;
+          trace(sampler, x, y, mask, r);
+          rays += r.rays;
+          Halves& h = half_at(x, y);
+          for (int k = 0; k < kOffsets; ++k) {
+            const Vec3d g = r.grad[k];
+            h.grad[k] =
+                (std::isfinite(g.x) && std::isfinite(g.y) && std::isfinite(g.z)) ? g : Vec3d();
+          }
+          if (!(in_x && in_y)) continue;
+          // --- Primal, emission and statistics of the pixel's own base path ---
+          if (!is_finite(r.primal)) r.primal = Spectrum(0.0f);
+          if (!is_finite(r.emission)) r.emission = Spectrum(0.0f);
+          if (clamp > 0.0f) {
+            const float m = max_component(r.primal);
+            if (m > clamp) r.primal *= clamp / m;
+          }
+          Film::Accumulator& acc = film.pixel(x, y);
+          const double lum = luminance(r.primal);
+          for (int c = 0; c < 3; ++c) {
+            acc.primal[c] += r.primal[c];
+            acc.emission[c] += r.emission[c];
+          }
+          acc.primal2 += lum * lum;
+          acc.shift_attempts += r.attempts;
+          acc.shift_failures += r.failures;
+        }
+      // --- Combine the halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
+      for (int y = tile.y0; y < tile.y1; ++y)
+        for (int x = tile.x0; x < tile.x1; ++x) {
+          Film::Accumulator& acc = film.pixel(x, y);
+          const Halves& h = half_at(x, y);
+          if (x + 1 < W) {
+            const Vec3d d = h.grad[kRight] - half_at(x + 1, y).grad[kLeft];
+            acc.dx[0] += d.x;
+            acc.dx[1] += d.y;
+            acc.dx[2] += d.z;
+            const double l = 0.2126 * d.x + 0.7152 * d.y + 0.0722 * d.z;
+            acc.dx2 += l * l;
+          }
+          if (y + 1 < H) {
+            const Vec3d d = h.grad[kUp] - half_at(x, y + 1).grad[kDown];
+            acc.dy[0] += d.x;
+            acc.dy[1] += d.y;
+            acc.dy[2] += d.z;
+            const double l = 0.2126 * d.x + 0.7152 * d.y + 0.0722 * d.z;
+            acc.dy2 += l * l;
+          }
+        }
+    }
+    for (int y = tile.y0; y < tile.y1; ++y)
+      for (int x = tile.x0; x < tile.x1; ++x) film.add_sample_count(x, y, sample_count);
+    count_rays(rays);
+  }
+
+ private:
+  VertexType classify(float roughness) const {
+    return shift::classify_vertex(roughness, settings_.shift_roughness_threshold);
+  }
+
+  bool occluded(Vec3f from, Vec3f ng, Vec3f dir, float t_max, uint32_t& rays) const {
+    Ray shadow;
+    shadow.origin = offset_ray_origin(from, dot(dir, ng) > 0.0f ? ng : -ng);
+    shadow.direction = dir;
+    shadow.t_min = 0.0f;
+    shadow.t_max = t_max;
+    ++rays;
+    return ctx_.bvh().occluded(shadow);
+  }
+
+  // Local outgoing direction at `v` for world `dir`; false when the geometric and shading
+  // hemispheres disagree (the path tracer's leak test).
+  static bool local_dir(const Vertex& v, Vec3f dir, Vec3f& wo) {
+    wo = v.frame.to_local(dir);
+    const float cos_ng = dot(dir, v.ng);
+    return cos_ng != 0.0f && (cos_ng > 0.0f) == (wo.z > 0.0f);
+  }
+
+  // The offset's light sample for a not-connected pair: the same point on the light (same
+  // direction for infinite lights) as the base's sample `ls`, seen from y. Resampling with the
+  // same random numbers gives that point for area-sampled lights, the world and the sun;
+  // solid-angle-sampled spheres are evaluated by intersecting the light towards the point.
+  bool offset_light(Vec3f y, float u_select, Vec2f u_light, const LightSample& ls,
+                    LightSample& out) const {
+    const LightSampler& lights = ctx_.lights();
+    out = lights.sample(y, u_select, u_light);
+    if (ls.is_infinite) {
+      return out.valid && out.is_infinite && length_squared(out.direction - ls.direction) < 1e-10f;
+    }
+    const float scale = std::max(1.0f, max_component(abs(ls.position)));
+    if (out.valid && length_squared(out.position - ls.position) < 1e-8f * scale * scale)
+      return true;
+    if (ls.is_delta) return false;
+    // Sphere lights: intersect towards the base's point.
+    const Vec3f to = ls.position - y;
+    const float d = length(to);
+    if (!(d > 0.0f)) return false;
+    const Vec3f dir = to / d;
+    LightHit lh;
+    if (!lights.intersect(y, dir, d * (1.0f + 1e-3f), lh)) return false;
+    if (length_squared(lh.position - ls.position) > 1e-6f * scale * scale) return false;
+    out.radiance = lh.radiance;
+    out.position = ls.position;
+    out.normal = ls.normal;
+    out.direction = dir;
+    out.distance = d;
+    out.pdf = lh.pdf;
+    out.is_delta = false;
+    out.is_infinite = false;
+    out.valid = lh.pdf > 0.0f;
+    return out.valid;
+  }
+
+  void trace(const Sampler& sampler, int px, int py, const bool mask[kOffsets],
+             SampleResult& out) const {
+    const EmbreeScene& bvh = ctx_.bvh();
+    const LightSampler& lights = ctx_.lights();
+    const int max_bounces = settings_.max_bounces;
+    const bool has_lights = !lights.empty();
+
+    // --- Camera rays: same jitter and lens sample for the base and the offsets ---
+    const Vec2f jitter = sampler.get2d(Sampler::kDimCamera);
+    const Vec2f lens = has_dof_ ? sampler.get2d(Sampler::kDimLens) : Vec2f(0.5f, 0.5f);
+    const Vec2f raster{float(px) + jitter.x, float(py) + jitter.y};
+    Ray ray = ctx_.camera().generate_ray(raster, lens);
+    SurfaceHit hit;
+    ++out.rays;
+    if (!bvh.intersect(ray, hit)) {
+      // Very direct light: the world seen by the camera, never shifted.
+      if (has_world_) out.emission += lights.environment(ray.direction);
+      return;
+    }
+
+    Offset off[kOffsets];
+    for (int k = 0; k < kOffsets; ++k) {
+      Offset& o = off[k];
+      o.active = mask[k];
+      if (!o.active) continue;
+      ++out.attempts;
+      o.alive = true;
+      o.f = Vec3d(1.0, 1.0, 1.0);
+      o.p = 1.0;
+      o.grad = Vec3d();
+      const Vec2f r{raster.x + float(kShiftX[k]), raster.y + float(kShiftY[k])};
+      o.ray = ctx_.camera().generate_ray(r, lens);
+      SurfaceHit h;
+      ++out.rays;
+      if (!bvh.intersect(o.ray, h)) {
+        o.alive = false;  // base hits a surface, the offset the world: no shift
+        continue;
+      }
+      setup_vertex(ctx_, h, o.ray.direction, o.v);
+    }
+
+    Vertex base;
+    setup_vertex(ctx_, hit, ray.direction, base);
+    // Very direct light: emission seen by the camera, never shifted.
+    out.emission += triangle_emission(ctx_, hit, ray.origin);
+
+    Spectrum beta(1.0f);  // f / p of the base, for the primal (PT estimator)
+    Vec3d fb(1.0, 1.0, 1.0);
+    double pb = 1.0;
+
+    for (int bounce = 0;; ++bounce) {
+      if (bounce > max_bounces) break;
+      if (!base.closures.has_bsdf()) break;
+
+      // Offsets arriving at a shared vertex see it from their own direction.
+      for (Offset& o : off) {
+        if (!o.active || !o.alive) continue;
+        if (o.link == Link::Recent) {
+          o.wi_shared = base.frame.to_local(o.wi_world);
+        } else if (o.link == Link::NotConnected && !o.v.closures.has_bsdf()) {
+          o.alive = false;  // the offset ends on a surface without BSDF: it cannot follow
+        }
+      }
+      const VertexType base_type = classify(base.roughness);
+      const ClosureSet& bc = base.closures;
+
+      // ==================== Next-event estimation ====================
+      if (has_lights) {
+        const float u_select = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kLightSelect));
+        const Vec2f u_light = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kLightPoint));
+        const LightSample ls = lights.sample(base.hit.position, u_select, u_light);
+        // Per-pair rule for BSDF-sampled hits at the next vertex (delta lights cannot be hit).
+        for (Offset& o : off)
+          o.nee_on =
+              o.link != Link::NotConnected ||
+              (base_type == VertexType::Diffuse && classify(o.v.roughness) == VertexType::Diffuse);
+        if (ls.valid && ls.pdf > 0.0f) {
+          // --- Base ---
+          Vec3f wo;
+          Spectrum fs(0.0f);
+          bool visible = false;
+          if (local_dir(base, ls.direction, wo)) {
+            fs = bc.eval(base.wi, wo);
+            if (!is_black(fs) && !is_black(ls.radiance))
+              visible = !occluded(base.hit.position, base.ng, ls.direction,
+                                  ls.is_infinite ? kInf : ls.distance * (1.0f - 1e-4f), out.rays);
+          }
+          const float pdf_bsdf = (!ls.is_delta && visible) ? bc.pdf(base.wi, wo) : 0.0f;
+          if (visible) {
+            const float w = ls.is_delta ? 1.0f : power_heuristic(ls.pdf, pdf_bsdf);
+            out.primal += beta * fs * ls.radiance * (w / ls.pdf);
+          }
+          const Vec3d cb = visible ? mul(mul(fb, fs), ls.radiance) : Vec3d();
+          const PathDensities db{pb, ls.pdf, pdf_bsdf};
+
+          // --- Offsets ---
+          for (Offset& o : off) {
+            if (!o.active) continue;
+            Vec3d co;
+            PathDensities d_off{0.0, 0.0, 0.0};
+            if (o.alive) {
+              if (o.link == Link::Connected) {
+                co = mul(o.f, Vec3d(visible ? fs * ls.radiance : Spectrum(0.0f)));
+                d_off = shift::offset_densities(o.p, 1.0, ls.pdf, pdf_bsdf);
+              } else if (o.link == Link::Recent) {
+                Spectrum fo(0.0f);
+                float pdf_o = 0.0f;
+                if (wo.z != 0.0f && visible) {
+                  fo = bc.eval(o.wi_shared, wo);
+                  if (!ls.is_delta) pdf_o = bc.pdf(o.wi_shared, wo);
+                }
+                co = mul(mul(o.f, fo), ls.radiance);
+                d_off = shift::offset_densities(o.p, 1.0, ls.pdf, pdf_o);
+              } else {
+                if (!ls.is_delta && !o.nee_on) continue;  // not shifted: dropped on both sides
+                LightSample lo;
+                if (!offset_light(o.v.hit.position, u_select, u_light, ls, lo)) {
+                  // The light cannot be sampled from y (e.g. y is behind a one-sided area
+                  // light): the offset has density 0, the base keeps its full weight. The base
+                  // at y skips this light sample as well, so the pair stays consistent.
+                  const double w = shift::mis_weight_over_pdf(db, d_off, db.light);
+                  o.grad = o.grad - cb * w;
+                  continue;
+                }
+                const double J =
+                    ls.is_delta || ls.is_infinite
+                        ? 1.0
+                        : shift::light_reconnection_jacobian(base.hit.position, o.v.hit.position,
+                                                             ls.position, ls.normal, false);
+                Vec3f wo_o;
+                Spectrum fo(0.0f);
+                bool vis_o = false;
+                if (local_dir(o.v, lo.direction, wo_o)) {
+                  fo = o.v.closures.eval(o.v.wi, wo_o);
+                  if (!is_black(fo) && !is_black(lo.radiance))
+                    vis_o =
+                        !occluded(o.v.hit.position, o.v.ng, lo.direction,
+                                  lo.is_infinite ? kInf : lo.distance * (1.0f - 1e-4f), out.rays);
+                }
+                const float pdf_o = (!ls.is_delta && vis_o) ? o.v.closures.pdf(o.v.wi, wo_o) : 0.0f;
+                co = vis_o ? mul(mul(o.f, fo), lo.radiance) * J : Vec3d();
+                d_off = shift::offset_densities(o.p, J, lo.pdf, pdf_o);
+              }
+            }
+            const double w = shift::mis_weight_over_pdf(db, d_off, db.light);
+            o.grad = o.grad + (co - cb) * w;
+          }
+        }
+      }
+
+      // ==================== BSDF sampling: extend the base ====================
+      const float u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
+      const Vec2f u_dir = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kBsdfDir));
+      const BsdfSample bs = bc.sample(base.wi, u_lobe, u_dir);
+      if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;
+      const Vec3f wo_world = base.frame.to_world(bs.wo);
+      const float cos_ng = dot(wo_world, base.ng);
+      if ((cos_ng > 0.0f) != (bs.wo.z > 0.0f) || cos_ng == 0.0f) break;
+      const bool delta = bs.is_delta();
+      // Classification of x_d for the BSDF step: a sampled delta lobe makes it specular.
+      const VertexType xd_type = delta ? VertexType::Specular : base_type;
+
+      beta *= bs.value / bs.pdf;
+      // --- Russian roulette, decided by the base; q enters every density of the pair ---
+      if (bounce >= settings_.rr_depth) {
+        const float q = std::min(max_component(beta), 0.95f);
+        if (!(sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kRoulette)) < q)) break;
+        beta /= q;
+        pb *= q;
+        for (Offset& o : off) o.p *= q;
+      }
+
+      // --- Trace the base's next segment ---
+      ray.origin = offset_ray_origin(base.hit.position, cos_ng > 0.0f ? base.ng : -base.ng);
+      ray.direction = normalize(wo_world);
+      ray.t_min = 0.0f;
+      ray.t_max = kInf;
+      SurfaceHit next;
+      const bool found = bvh.intersect(ray, next);
+      ++out.rays;
+      const float t_hit = found ? next.t : kInf;
+      LightHit lh;
+      const bool light_hit = lights.intersect(ray.origin, ray.direction, t_hit, lh);
+      Vertex next_base;
+      if (found) setup_vertex(ctx_, next, ray.direction, next_base);
+      const VertexType next_type = found ? classify(next_base.roughness) : VertexType::Diffuse;
+
+      // --- Shift every offset over this segment ---
+      for (Offset& o : off) {
+        if (!o.active || !o.alive) continue;
+        shift_segment(o, base, bs, xd_type, wo_world, found, next, next_type, u_lobe, u_dir,
+                      out.rays);
+      }
+
+      const Vec3d seg_b = Vec3d(bs.value);
+      const float pdf_b = bs.pdf;
+
+      // ==================== Emission events at the end of the segment ====================
+      // Emission events are processed per pair whenever the base OR the offset finds emission:
+      // a half-vector offset has its own end vertex and can reach a light the base misses.
+
+      // (a) analytic lights crossed by the rays (before their surfaces).
+      {
+        const bool base_lit = light_hit && !is_black(lh.radiance);
+        const float pl = (base_lit && !delta) ? lh.pdf : 0.0f;
+        if (base_lit)
+          out.primal += beta * lh.radiance * (delta ? 1.0f : power_heuristic(pdf_b, pl));
+        const Vec3d cb = base_lit ? mul(mul(fb, seg_b), lh.radiance) : Vec3d();
+        for (Offset& o : off) {
+          if (!o.active) continue;
+          Vec3d co;
+          PathDensities d_off{0.0, 0.0, 0.0};
+          const float pl_pair = o.nee_on ? pl : 0.0f;
+          const bool reconnectable = o.link == Link::NotConnected && !delta &&
+                                     base_type == VertexType::Diffuse &&
+                                     classify(o.v.roughness) == VertexType::Diffuse;
+          if (o.alive) {
+            if (o.shift == Shift::Follow || o.shift == Shift::RecentEval) {
+              if (base_lit) {
+                co = mul(mul(o.f, o.seg_value), lh.radiance);
+                d_off = shift::offset_densities(o.p, 1.0, pl_pair, o.seg_pdf);
+              }
+            } else if (reconnectable) {
+              // The light point is a diffuse end vertex: reconnect y_d to it. (A light that only
+              // the offset's own direction finds belongs to the reverse reconnection: not here.)
+              if (base_lit)
+                reconnect_to_light(o, base, ray.direction, lh, pl_pair, co, d_off, out.rays);
+            } else if (o.shift == Shift::HalfVector) {
+              // The offset's own direction: does its ray cross a light before its surface?
+              LightHit lo;
+              const float t_o = o.next_found ? o.next_hit.t : kInf;
+              if (lights.intersect(o.ray.origin, o.ray.direction, t_o, lo))
+                co = mul(mul(o.f, o.seg_value), lo.radiance) * o.seg_jacobian;
+              d_off = shift::offset_densities(o.p, o.seg_jacobian, 0.0, o.seg_pdf);
+            }
+          }
+          if (is_zero(cb) && is_zero(co)) continue;
+          const double w =
+              shift::mis_weight_over_pdf(PathDensities{pb, pl_pair, pdf_b}, d_off, pdf_b);
+          o.grad = o.grad + (co - cb) * w;
+        }
+      }
+
+      // (b) the world, (c) an emissive triangle at the end of the segment.
+      {
+        Spectrum le(0.0f);
+        float pl = 0.0f;
+        if (!found) {
+          if (has_world_) {
+            le = lights.environment(ray.direction);
+            if (!delta && !is_black(le)) pl = lights.pdf_environment(ray.direction);
+          }
+        } else {
+          le = triangle_emission(ctx_, next, base.hit.position);
+          if (!delta && !is_black(le))
+            pl = lights.pdf_triangle(next.instance, next.primitive, base.hit.position,
+                                     next.position, next.geometric_normal);
+        }
+        if (!is_black(le)) out.primal += beta * le * (delta ? 1.0f : power_heuristic(pdf_b, pl));
+        const Vec3d cb = mul(mul(fb, seg_b), le);
+        for (Offset& o : off) {
+          if (!o.active) continue;
+          Vec3d co;
+          PathDensities d_off{0.0, 0.0, 0.0};
+          const float pl_pair = o.nee_on ? pl : 0.0f;
+          if (o.alive) end_event(o, found, next, le, pl_pair, !delta && o.nee_on, co, d_off);
+          if (is_zero(cb) && is_zero(co)) continue;
+          const double w =
+              shift::mis_weight_over_pdf(PathDensities{pb, pl_pair, pdf_b}, d_off, pdf_b);
+          o.grad = o.grad + (co - cb) * w;
+        }
+      }
+
+      // ==================== Advance ====================
+      fb = mul(fb, seg_b);
+      pb *= pdf_b;
+      for (Offset& o : off) {
+        if (!o.active || !o.alive) continue;
+        advance(o, next_base);
+      }
+      if (!found) break;
+      base = next_base;
+    }
+
+    for (int k = 0; k < kOffsets; ++k) {
+      out.grad[k] = off[k].grad;
+      if (off[k].active && (off[k].failed || !off[k].alive)) ++out.failures;
+    }
+  }
+
+  // Decides and evaluates the offset's version of the base segment x_d -> x_{d+1}.
+  void shift_segment(Offset& o, const Vertex& base, const BsdfSample& bs, VertexType xd_type,
+                     Vec3f wo_world, bool found, const SurfaceHit& next, VertexType next_type,
+                     float u_lobe, Vec2f u_dir, uint32_t& rays) const {
+    const EmbreeScene& bvh = ctx_.bvh();
+    o.seg_jacobian = 1.0;
+    o.seg_visible = true;
+    o.killed = false;
+    o.next_found = false;
+    switch (o.link) {
+      case Link::Connected:
+        o.shift = Shift::Follow;
+        o.seg_value = Vec3d(bs.value);
+        o.seg_pdf = bs.pdf;
+        return;
+      case Link::Recent: {
+        // The shared vertex seen from the offset's own incoming direction.
+        o.shift = Shift::RecentEval;
+        if (bs.is_delta()) {
+          o.shift = Shift::Failed;  // a delta lobe cannot map another wi onto the same wo
+          return;
+        }
+        o.seg_value = Vec3d(base.closures.eval(o.wi_shared, bs.wo));
+        o.seg_pdf = base.closures.pdf(o.wi_shared, bs.wo);
+        if (!(o.seg_pdf > 0.0)) o.shift = Shift::Failed;
+        return;
+      }
+      case Link::NotConnected:
+        break;
+    }
+
+    const Vertex& y = o.v;
+    const VertexType yd_type =
+        bs.is_delta() && y.closures.has_delta() ? VertexType::Specular : classify(y.roughness);
+
+    // --- Reconnection: x_d, y_d and x_{d+1} all diffuse ---
+    if (xd_type == VertexType::Diffuse && yd_type == VertexType::Diffuse &&
+        next_type == VertexType::Diffuse) {
+      if (found) {
+        const shift::Reconnection r = shift::reconnect(base.hit.position, y.hit.position,
+                                                       next.position, next.geometric_normal);
+        if (!r.valid) {
+          o.shift = Shift::Failed;
+          return;
+        }
+        const Vec3f dir = r.direction.to_float();
+        o.seg_dir = dir;
+        // The offset must arrive on the same side of x_{d+1} as the base (the closures there
+        // depend on the side).
+        const bool base_front = dot(base.hit.position - next.position, next.geometric_normal) > 0;
+        const bool off_front = dot(y.hit.position - next.position, next.geometric_normal) > 0;
+        Vec3f wo;
+        if (base_front != off_front || !local_dir(y, dir, wo)) {
+          o.shift = Shift::Failed;
+          return;
+        }
+        o.shift = Shift::Reconnect;
+        o.seg_jacobian = r.jacobian;
+        o.seg_value = Vec3d(y.closures.eval(y.wi, wo));
+        o.seg_pdf = y.closures.pdf(y.wi, wo);
+        o.seg_visible =
+            !occluded(y.hit.position, y.ng, dir, float(r.distance) * (1.0f - 1e-4f), rays);
+      } else {
+        // Reconnection at infinity: the same direction, J = 1, visibility from y_d.
+        Vec3f wo;
+        o.seg_dir = wo_world;
+        if (!local_dir(y, wo_world, wo)) {
+          o.shift = Shift::Failed;
+          return;
+        }
+        o.shift = Shift::ReconnectEnv;
+        o.seg_value = Vec3d(y.closures.eval(y.wi, wo));
+        o.seg_pdf = y.closures.pdf(y.wi, wo);
+        o.seg_visible = !occluded(y.hit.position, y.ng, wo_world, kInf, rays);
+      }
+      return;
+    }
+
+    // --- Half-vector copy in the local frames ---
+    Vec3f wo;
+    if (bs.is_delta()) {
+      // Delta lobe: the same discrete event (reflection / transmission) at y_d, J = 1. The
+      // offset samples its own closures; when its random choice differs, the choice is forced
+      // for a single-lobe closure set (the lobe's event is driven by u_lobe alone).
+      const uint8_t want = bs.lobe & (kLobeReflection | kLobeTransmission);
+      BsdfSample so = y.closures.sample(y.wi, u_lobe, u_dir);
+      if (so.valid && (!so.is_delta() || (so.lobe & want) == 0) && y.closures.count() == 1)
+        so = y.closures.sample(y.wi, (want & kLobeReflection) ? 0.0f : 0.99999994f, u_dir);
+      if (!so.valid || !so.is_delta() || (so.lobe & want) == 0 || !(so.pdf > 0.0f)) {
+        o.shift = Shift::Failed;
+        return;
+      }
+      wo = so.wo;
+      o.seg_value = Vec3d(so.value);
+      o.seg_pdf = so.pdf;
+      o.seg_jacobian = 1.0;
+    } else {
+      const shift::Vec3d wi_b(base.wi), wo_b(bs.wo), wi_o(y.wi);
+      const bool transmission = base.wi.z * bs.wo.z < 0.0f;
+      const double ior = transmission ? (base.wi.z >= 0.0f ? bs.eta : 1.0 / bs.eta) : 1.0;
+      const shift::HalfVectorShift hv = shift::half_vector_shift(wi_b, wo_b, wi_o, ior);
+      if (!hv.valid) {
+        o.shift = Shift::Failed;
+        return;
+      }
+      wo = hv.wo.to_float();
+      o.seg_value = Vec3d(y.closures.eval(y.wi, wo));
+      o.seg_pdf = y.closures.pdf(y.wi, wo);
+      o.seg_jacobian = hv.jacobian;
+      if (!(o.seg_pdf > 0.0)) {
+        o.shift = Shift::Failed;
+        return;
+      }
+    }
+    const Vec3f dir = normalize(y.frame.to_world(wo));
+    const float cos_ng = dot(dir, y.ng);
+    if ((cos_ng > 0.0f) != (wo.z > 0.0f) || cos_ng == 0.0f) {
+      o.shift = Shift::Failed;
+      return;
+    }
+    o.shift = Shift::HalfVector;
+    o.seg_dir = dir;
+    o.ray.origin = offset_ray_origin(y.hit.position, cos_ng > 0.0f ? y.ng : -y.ng);
+    o.ray.direction = dir;
+    o.ray.t_min = 0.0f;
+    o.ray.t_max = kInf;
+    ++rays;
+    o.next_found = bvh.intersect(o.ray, o.next_hit);
+    // Kill: one path reaches the world and the other does not.
+    if (o.next_found != found) {
+      o.killed = true;
+      return;
+    }
+    // Kill: the reverse shift (from the offset as base) would reconnect: x_d, y_d, y_{d+1} all
+    // diffuse. Without this the shift is not invertible and the estimator is biased.
+    if (xd_type == VertexType::Diffuse && yd_type == VertexType::Diffuse) {
+      const VertexType yn_type =
+          o.next_found ? classify(next_vertex_roughness(o.next_hit)) : VertexType::Diffuse;
+      if (yn_type == VertexType::Diffuse) o.killed = true;
+    }
+  }
+
+  float next_vertex_roughness(const SurfaceHit& h) const {
+    ClosureSet cs;
+    ctx_.materials()[size_t(h.material)].evaluate(ShadingContext{h.uv, h.front_facing}, cs);
+    return cs.has_bsdf() ? cs.roughness() : 1.0f;
+  }
+
+  // (a) for a not-connected pair with x_d, y_d diffuse: the offset reconnects to the point the
+  // base's ray found on an analytic light.
+  void reconnect_to_light(Offset& o, const Vertex& base, Vec3f base_dir, const LightHit& lh,
+                          float pl_pair, Vec3d& co, PathDensities& d_off, uint32_t& rays) const {
+    const Vertex& y = o.v;
+    if (!std::isfinite(lh.distance)) {
+      // A sun disc: reconnection at infinity, the same direction and radiance, J = 1.
+      Vec3f wo;
+      if (!local_dir(y, base_dir, wo)) return;
+      const Spectrum fo = y.closures.eval(y.wi, wo);
+      const float pdf_o = y.closures.pdf(y.wi, wo);
+      const bool vis = !occluded(y.hit.position, y.ng, base_dir, kInf, rays);
+      co = vis ? mul(mul(o.f, fo), lh.radiance) : Vec3d();
+      d_off = shift::offset_densities(o.p, 1.0, pl_pair, vis ? pdf_o : 0.0f);
+      return;
+    }
+    const shift::Reconnection r =
+        shift::reconnect(base.hit.position, y.hit.position, lh.position, lh.normal);
+    if (!r.valid) return;  // degenerate: density 0 (failed)
+    const Vec3f dir = r.direction.to_float();
+    Vec3f wo;
+    if (!local_dir(y, dir, wo)) return;
+    LightHit lo;
+    const float d = float(r.distance);
+    const bool reaches = ctx_.lights().intersect(y.hit.position, dir, d * (1.0f + 1e-3f), lo) &&
+                         std::fabs(lo.distance - d) < 1e-3f * d;
+    const Spectrum fo = y.closures.eval(y.wi, wo);
+    const float pdf_o = y.closures.pdf(y.wi, wo);
+    const bool vis = reaches && !occluded(y.hit.position, y.ng, dir, d * (1.0f - 1e-4f), rays);
+    co = vis ? mul(mul(o.f, fo), lo.radiance) * r.jacobian : Vec3d();
+    d_off = shift::offset_densities(o.p, r.jacobian, pl_pair > 0.0f && reaches ? lo.pdf : 0.0f,
+                                    vis ? pdf_o : 0.0f);
+  }
+
+  // (b)/(c): the offset's contribution and densities for the emission at the end of the segment
+  // (world when !found, emissive triangle `next` otherwise). `nee_on`: the pair shifts light
+  // sampling here, so the offset's own light density counts.
+  void end_event(const Offset& o, bool found, const SurfaceHit& next, Spectrum le, float pl_pair,
+                 bool nee_on, Vec3d& co, PathDensities& d_off) const {
+    const LightSampler& lights = ctx_.lights();
+    switch (o.shift) {
+      case Shift::Follow:
+      case Shift::RecentEval:
+        // Same end point reached from the same vertex x_d.
+        co = mul(mul(o.f, o.seg_value), le);
+        d_off = shift::offset_densities(o.p, 1.0, pl_pair, o.seg_pdf);
+        return;
+      case Shift::Reconnect: {
+        // Same end point, reached from y_d. Occlusion zeroes the contribution and the BSDF
+        // density, but light sampling from y_d could still have produced the path.
+        const Spectrum le_o = triangle_emission(ctx_, next, o.v.hit.position);
+        const float pl_o =
+            pl_pair > 0.0f ? lights.pdf_triangle(next.instance, next.primitive, o.v.hit.position,
+                                                 next.position, next.geometric_normal)
+                           : 0.0f;
+        co = o.seg_visible ? mul(mul(o.f, o.seg_value), le_o) * o.seg_jacobian : Vec3d();
+        d_off = shift::offset_densities(o.p, o.seg_jacobian, pl_o, o.seg_visible ? o.seg_pdf : 0.0);
+        return;
+      }
+      case Shift::ReconnectEnv: {
+        co = o.seg_visible ? mul(mul(o.f, o.seg_value), le) : Vec3d();
+        d_off = shift::offset_densities(o.p, 1.0, pl_pair, o.seg_visible ? o.seg_pdf : 0.0);
+        return;
+      }
+      case Shift::HalfVector: {
+        if (o.killed) return;  // density 0: failed
+        Spectrum le_o(0.0f);
+        float pl_o = 0.0f;
+        if (!found) {
+          if (has_world_) le_o = lights.environment(o.ray.direction);
+          if (nee_on && !is_black(le_o)) pl_o = lights.pdf_environment(o.ray.direction);
+        } else {
+          le_o = triangle_emission(ctx_, o.next_hit, o.v.hit.position);
+          if (nee_on && !is_black(le_o))
+            pl_o = lights.pdf_triangle(o.next_hit.instance, o.next_hit.primitive, o.v.hit.position,
+                                       o.next_hit.position, o.next_hit.geometric_normal);
+        }
+        co = mul(mul(o.f, o.seg_value), le_o) * o.seg_jacobian;
+        d_off = shift::offset_densities(o.p, o.seg_jacobian, pl_o, o.seg_pdf);
+        return;
+      }
+      case Shift::Failed:
+        return;
+    }
+  }
+
+  // Moves the offset to the end of the segment.
+  void advance(Offset& o, const Vertex& next_base) const {
+    auto kill = [&] {
+      o.alive = false;
+      o.failed = true;
+    };
+    switch (o.shift) {
+      case Shift::Follow:
+        break;
+      case Shift::RecentEval:
+        o.link = Link::Connected;
+        break;
+      case Shift::Reconnect:
+        if (!o.seg_visible || !(o.seg_pdf > 0.0)) return kill();
+        o.link = Link::Recent;
+        o.wi_world = -o.seg_dir;
+        break;
+      case Shift::ReconnectEnv:
+        if (!o.seg_visible || !(o.seg_pdf > 0.0)) return kill();
+        o.link = Link::Connected;
+        break;
+      case Shift::HalfVector:
+        if (o.killed) return kill();
+        if (o.next_found) setup_vertex(ctx_, o.next_hit, o.ray.direction, o.v);
+        break;
+      case Shift::Failed:
+        return kill();
+    }
+    (void)next_base;
+    o.f = mul(o.f, o.seg_value) * o.seg_jacobian;
+    o.p *= o.seg_pdf * o.seg_jacobian;
+  }
+
+  const SceneContext& ctx_;
+  RenderSettings settings_;
+  bool has_world_ = false;
+  bool has_dof_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_gradient_path_tracer(const SceneContext& ctx,
+                                                      const RenderSettings& settings) {
+  return std::make_unique<GradientPathTracer>(ctx, settings);
+}
+
+}  // namespace gdpt
