@@ -40,7 +40,29 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
 
-  // --- Bottom level: one scene with one triangle geometry per mesh ---
+  // How often each mesh is placed: a mesh placed once is flattened into the top level in world
+  // space (one BVH traversal instead of two); a mesh placed several times is built once in object
+  // space and instanced, so memory does not grow with the instance count.
+  std::vector<int> uses(scene.meshes.size(), 0);
+  for (const Instance& inst : scene.instances)
+    if (inst.mesh < scene.meshes.size()) ++uses[inst.mesh];
+
+  auto new_triangle_geometry = [&](const Mesh& mesh, const Transform* to_world) {
+    const size_t tris = mesh.triangle_count();
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    // Embree-owned buffers: they carry the padding Embree's SIMD loads need.
+    auto* vb = static_cast<Vec3f*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(Vec3f), mesh.positions.size()));
+    for (size_t v = 0; v < mesh.positions.size(); ++v)
+      vb[v] = to_world ? to_world->point(mesh.positions[v]) : mesh.positions[v];
+    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), tris));
+    std::memcpy(ib, mesh.indices.data(), tris * 3 * sizeof(uint32_t));
+    rtcCommitGeometry(geom);
+    return geom;
+  };
+
+  // --- Bottom level: one scene per instanced mesh ---
   mesh_scenes_.assign(scene.meshes.size(), nullptr);
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
@@ -50,51 +72,51 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
       if (idx >= mesh.positions.size())
         throw std::invalid_argument("mesh " + std::to_string(m) + ": vertex index " +
                                     std::to_string(idx) + " out of range");
-    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    // Copies into Embree-owned buffers: they carry the padding Embree's SIMD loads need.
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                           RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                           mesh.positions.size()));
-    std::memcpy(vb, mesh.positions.data(), mesh.positions.size() * sizeof(Vec3f));
-    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), tris));
-    std::memcpy(ib, mesh.indices.data(), tris * 3 * sizeof(uint32_t));
-    rtcCommitGeometry(geom);
+    triangles_ += tris;
+    if (uses[m] < 2) continue;
+    RTCGeometry geom = new_triangle_geometry(mesh, nullptr);
     RTCScene s = rtcNewScene(device_);
     rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
     rtcAttachGeometryByID(s, geom, 0);
     rtcReleaseGeometry(geom);
     rtcCommitScene(s);
     mesh_scenes_[m] = s;
-    triangles_ += tris;
   }
 
-  // --- Top level: one instance per placement ---
+  // --- Top level: instances of shared meshes, world-space copies of single-use meshes ---
   top_ = rtcNewScene(device_);
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& inst = scene.instances[i];
-    if (inst.mesh >= scene.meshes.size() || !mesh_scenes_[inst.mesh]) continue;
+    if (inst.mesh >= scene.meshes.size()) continue;
+    const Mesh& mesh = scene.meshes[inst.mesh];
+    if (mesh.triangle_count() == 0 || mesh.positions.empty()) continue;
     const Transform& T = inst.object_to_world;
     const float det = T.m[0][0] * (T.m[1][1] * T.m[2][2] - T.m[1][2] * T.m[2][1]) -
                       T.m[0][1] * (T.m[1][0] * T.m[2][2] - T.m[1][2] * T.m[2][0]) +
                       T.m[0][2] * (T.m[1][0] * T.m[2][1] - T.m[1][1] * T.m[2][0]);
     if (!(std::fabs(det) > 0.0f) || !std::isfinite(det)) continue;  // flattened: invisible
-    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
-    rtcSetGeometryInstancedScene(geom, mesh_scenes_[inst.mesh]);
-    // Embree's RTC_FORMAT_FLOAT3X4_ROW_MAJOR matches our row-major 3x4 layout.
-    rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &T.m[0][0]);
-    rtcCommitGeometry(geom);
+    RTCGeometry geom;
+    if (mesh_scenes_[inst.mesh]) {
+      geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(geom, mesh_scenes_[inst.mesh]);
+      // Embree's RTC_FORMAT_FLOAT3X4_ROW_MAJOR matches our row-major 3x4 layout.
+      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &T.m[0][0]);
+      rtcCommitGeometry(geom);
+    } else {
+      geom = new_triangle_geometry(mesh, &T);
+    }
     const unsigned id = rtcAttachGeometry(top_, geom);
     rtcReleaseGeometry(geom);
     if (id >= instances_.size()) instances_.resize(id + 1);
     InstanceData& d = instances_[id];
-    d.mesh = &scene.meshes[inst.mesh];
+    d.mesh = &mesh;
     d.instance = &inst;
+    d.index = uint32_t(i);
     d.to_world = T;
     const Transform inv = T.inverse();
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) d.normal_matrix[r][c] = inv.m[c][r];
-    instanced_triangles_ += d.mesh->triangle_count();
+    instanced_triangles_ += mesh.triangle_count();
   }
   rtcSetSceneBuildQuality(top_, RTC_BUILD_QUALITY_MEDIUM);
   rtcCommitScene(top_);
@@ -132,7 +154,10 @@ bool EmbreeScene::intersect(const Ray& ray, SurfaceHit& hit) const {
   rtcIntersect1(top_, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.t = rh.ray.tfar;
-  complete_hit(rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v, ray.direction, hit);
+  // Instanced meshes report the top-level id in instID[0], flattened ones in geomID.
+  const unsigned top_id =
+      rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
+  complete_hit(top_id, rh.hit.primID, rh.hit.u, rh.hit.v, ray.direction, hit);
   return true;
 }
 
@@ -156,14 +181,14 @@ bool EmbreeScene::occluded(const Ray& ray) const {
   return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
 
-void EmbreeScene::complete_hit(uint32_t instance, uint32_t primitive, float u, float v, Vec3f dir,
+void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v, Vec3f dir,
                                SurfaceHit& hit) const {
-  const InstanceData& d = instances_[instance];
+  const InstanceData& d = instances_[top_id];
   const Mesh& mesh = *d.mesh;
   const uint32_t* idx = &mesh.indices[size_t(primitive) * 3];
   const Vec3f p0 = mesh.positions[idx[0]], p1 = mesh.positions[idx[1]], p2 = mesh.positions[idx[2]];
   const float w = 1.0f - u - v;
-  hit.instance = instance;
+  hit.instance = d.index;
   hit.primitive = primitive;
   hit.position = d.to_world.point(p0 * w + p1 * u + p2 * v);
 

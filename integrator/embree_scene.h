@@ -1,6 +1,7 @@
-// Two-level Embree 3 BVH: one triangle geometry (in its own RTCScene) per Mesh, placed by one
-// RTC_GEOMETRY_TYPE_INSTANCE per Instance, so memory does not grow with the instance count.
-// Vertex and index buffers are shared with the Scene (no copies): the Scene must outlive this.
+// Two-level Embree 3 BVH: a Mesh placed by several Instances is built once (in its own RTCScene)
+// and placed by one RTC_GEOMETRY_TYPE_INSTANCE per Instance, so memory does not grow with the
+// instance count; a Mesh placed once is stored in world space directly in the top level (one BVH
+// traversal instead of two). Hit records refer to the Scene's meshes: the Scene must outlive this.
 //
 // Hit records are rebuilt from the mesh data (barycentrics, instance transform), not from
 // origin + t * direction, for precision; spawned rays are offset along the geometric normal by a
@@ -25,7 +26,7 @@ struct SurfaceHit {
   Vec3f geometric_normal;  // unit, world, as the triangle winding gives it (not flipped)
   Vec3f shading_normal;    // unit, world, interpolated corner normal (= geometric if flat)
   Vec2f uv;
-  uint32_t instance = 0, primitive = 0;
+  uint32_t instance = 0, primitive = 0;  // index in Scene::instances, triangle in its mesh
   int32_t material = -1;     // index into SceneContext::materials() (always valid after hit())
   bool front_facing = true;  // the ray came from the side geometric_normal points to
 };
@@ -50,21 +51,22 @@ class EmbreeScene {
 
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
   size_t instanced_triangle_count() const { return instanced_triangles_; }
-  // Fills the rest of a hit from (instance, primitive, barycentrics).
-  void complete_hit(uint32_t instance, uint32_t primitive, float u, float v, Vec3f dir,
+  // Fills the rest of a hit from (top-level geometry id, primitive, barycentrics).
+  void complete_hit(uint32_t top_id, uint32_t primitive, float u, float v, Vec3f dir,
                     SurfaceHit& hit) const;
 
  private:
   struct InstanceData {
     const Mesh* mesh = nullptr;
     const Instance* instance = nullptr;
+    uint32_t index = 0;  // in Scene::instances
     Transform to_world;
     float normal_matrix[3][3];  // inverse transpose of the linear part
   };
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;
   std::vector<RTCScene> mesh_scenes_;
-  std::vector<InstanceData> instances_;  // indexed by Embree instance geometry id
+  std::vector<InstanceData> instances_;  // indexed by top-level Embree geometry id
   int32_t default_material_ = -1;
   size_t triangles_ = 0, instanced_triangles_ = 0;
 };

@@ -94,7 +94,12 @@ Scene cornell_box(int res) {
   s.meshes = {quad(), cube()};
   s.materials = {diffuse({0.73f, 0.73f, 0.73f}), diffuse({0.65f, 0.05f, 0.05f}),
                  diffuse({0.12f, 0.45f, 0.15f})};
-  auto wall = [&](int mat, Transform t) { s.instances.push_back(place(0, mat, t)); };
+  // Each wall is its own mesh, as Blender exports separate objects (single-use meshes are stored in
+  // world space); the cube is shared by both boxes (Embree instances).
+  auto wall = [&](int mat, Transform t) {
+    s.meshes.push_back(quad());
+    s.instances.push_back(place(uint32_t(s.meshes.size() - 1), mat, t));
+  };
   Transform floor_t = affine(1, 1, 1, 0, {0, 0, -1});
   wall(0, floor_t);
   Transform ceil_t;  // z = 1 facing down

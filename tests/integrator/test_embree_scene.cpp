@@ -176,6 +176,38 @@ TEST(EmbreeScene, OffsetRaysDoNotSelfIntersectFarFromTheOrigin) {
   EXPECT_EQ(self_hits, 0);
 }
 
+TEST(EmbreeScene, HitsReportSceneInstanceIndices) {
+  // Instance 0 is flattened to zero volume (skipped), instance 1 places a single-use mesh (stored
+  // in world space), instances 2 and 3 share a mesh (Embree instances).
+  Scene scene;
+  scene.meshes = {quad(), quad()};
+  Instance flat;
+  flat.object_to_world = translate_scale({0, 0, 0}, {1, 1, 0});
+  scene.instances.push_back(flat);
+  Instance single;
+  single.mesh = 1;
+  single.object_to_world = translate_scale({0, 0, 1}, {1, 1, 1});
+  single.slot_material = {2, 2};
+  scene.instances.push_back(single);
+  for (float x : {5.0f, 10.0f}) {
+    Instance shared;
+    shared.object_to_world = translate_scale({x, 0, 0}, {1, 1, 1});
+    scene.instances.push_back(shared);
+  }
+  EmbreeScene bvh(scene, 3);
+  SurfaceHit hit;
+  ASSERT_TRUE(bvh.intersect(down(0.2f, -0.5f), hit));
+  EXPECT_EQ(hit.instance, 1u);
+  EXPECT_EQ(hit.material, 2);
+  EXPECT_NEAR(hit.position.z, 1.0f, 1e-6f);
+  ASSERT_TRUE(bvh.intersect(down(5.2f, -0.5f), hit));
+  EXPECT_EQ(hit.instance, 2u);
+  EXPECT_EQ(hit.material, 3);  // no slot map: default
+  ASSERT_TRUE(bvh.intersect(down(10.2f, -0.5f), hit));
+  EXPECT_EQ(hit.instance, 3u);
+  EXPECT_EQ(bvh.triangle_count(), 4u);
+}
+
 TEST(EmbreeScene, ManyInstancesShareOneMesh) {
   Scene scene;
   scene.meshes.push_back(quad());
