@@ -40,8 +40,11 @@ struct Closure {
   FresnelMode fresnel = FresnelMode::None;
   Spectrum weight{1.0f, 1.0f, 1.0f};  // colour * mix weight
   float alpha = 0.0f;                 // GGX alpha (= Blender roughness^2); diffuse roughness
-  float ior = 1.45f;                  // relative IOR (outside -> inside)
-  Spectrum f0{0.04f, 0.04f, 0.04f};   // PrincipledV1 specular colour at normal incidence
+  // Relative IOR: GGXDielectric: n(below the frame normal) / n(above), i.e. the IOR crossed by
+  // a ray arriving with wi.z > 0 (Material sets 1/ior for back-face hits, since the integrators
+  // orient the frame towards the ray); PrincipledV1 reflection: the IOR giving its F0.
+  float ior = 1.45f;
+  Spectrum f0{0.04f, 0.04f, 0.04f};  // PrincipledV1 specular colour at normal incidence
   // GGXDielectric: extra factor on the refracted part only (Principled transmission: base colour;
   // the reflected part is weight * Fresnel colour). Glass BSDF: 1 (its colour is in weight).
   Spectrum transmission_tint{1.0f, 1.0f, 1.0f};

@@ -1,8 +1,11 @@
 // GGX dielectric (Blender Glass BSDF; Principled v1 transmission), as Cycles 3.4.
 //
-// Side: the frame normal is the geometric side; wi.z > 0 means the ray arrives from outside and
-// refracts into the object with eta = n_t / n_i = ior, wi.z < 0 means it leaves with eta = 1/ior.
-// The problem is mirrored so that wi.z > 0 internally.
+// Side: Closure::ior is the IOR below the frame normal relative to above it. wi.z > 0: the ray
+// crosses with eta = n_t / n_i = ior; wi.z < 0: with eta = 1 / ior. The integrators orient the
+// frame towards the incoming ray (as Cycles flips N on back faces) and Material stores 1 / ior
+// for back-face hits, so entering and leaving an object both come out right; a frame left on
+// the geometric side with front_facing = true works as well. The problem is mirrored so that
+// wi.z > 0 internally.
 //
 // Cycles 3.4 builds the Glass BSDF from two closures split by the Fresnel term at the SHADING
 // normal, F = fresnel_dielectric(cos_i, eta) (not per microfacet), and so do we:

@@ -32,6 +32,7 @@ struct StackEntry {
 struct PointInputs {
   std::span<const Texture> textures;
   Vec2f uv;
+  bool front_facing;
 
   Rgba fetch(const TextureLookup& t) const {
     const Vec3f p = t.uv_mapping.point(Vec3f(uv.x, uv.y, 0.0f));
@@ -58,6 +59,7 @@ struct PointInputs {
 // Inputs averaged over the whole texture (for light power estimates).
 struct AverageInputs {
   const std::vector<Rgba>* means;
+  bool front_facing = true;
 
   Spectrum color(const ColorInput& in) const {
     return in.texture.image < 0 ? in.value : (*means)[size_t(in.texture.image)].rgb;
@@ -114,7 +116,9 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
         c.type = ClosureType::GGXDielectric;
         c.fresnel = FresnelMode::Dielectric;
         c.alpha = r * r;
-        c.ior = ior;
+        // The integrators orient the frame towards the incoming ray (as Cycles flips N for back
+        // faces), so the closure's IOR is that of the far side: 1 / ior when leaving the object.
+        c.ior = in.front_facing ? ior : 1.0f / ior;
       }
       out.add(c);
       return;
@@ -135,6 +139,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       p.transmission = in.scalar(n.transmission);
       p.alpha = in.scalar(n.alpha);
       p.emission = in.color(n.emission) * in.scalar(n.emission_strength);
+      p.front_facing = in.front_facing;
       add_principled_closures(p, w, out);
       return;
     }
@@ -338,18 +343,18 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
                 float(sum[3] * inv)};
   }
   if (features_ & kFeatureEmission)
-    average_emission_ = walk(nodes_, root_, AverageInputs{&means}, nullptr);
+    average_emission_ = walk(nodes_, root_, AverageInputs{&means, true}, nullptr);
 }
 
 void Material::evaluate(const ShadingContext& ctx, ClosureSet& out) const {
   out.clear();
-  const Spectrum e = walk(nodes_, root_, PointInputs{textures_, ctx.uv}, &out);
+  const Spectrum e = walk(nodes_, root_, PointInputs{textures_, ctx.uv, ctx.front_facing}, &out);
   out.add_emission(e);
 }
 
 Spectrum Material::emission(const ShadingContext& ctx) const {
   if (!(features_ & kFeatureEmission)) return Spectrum(0.0f);
-  return walk(nodes_, root_, PointInputs{textures_, ctx.uv}, nullptr);
+  return walk(nodes_, root_, PointInputs{textures_, ctx.uv, ctx.front_facing}, nullptr);
 }
 
 }  // namespace gdpt

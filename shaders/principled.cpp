@@ -74,7 +74,8 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
     g.fresnel = FresnelMode::PrincipledV1;
     g.weight = Spectrum(w * final_transmission);
     g.alpha = ggx_alpha;
-    g.ior = std::max(p.ior, 1e-5f);
+    const float ior = std::max(p.ior, 1e-5f);
+    g.ior = p.front_facing ? ior : 1.0f / ior;
     g.f0 = saturate(base * specular_tint + Spectrum(1.0f - specular_tint));
     g.transmission_tint = base;
     out.add(g);

@@ -28,7 +28,8 @@ struct PrincipledParams {
   float ior = 1.45f;
   float transmission = 0.0f;
   float alpha = 1.0f;
-  Spectrum emission{0.0f};  // colour * strength
+  Spectrum emission{0.0f};   // colour * strength
+  bool front_facing = true;  // false: the transmission closure gets 1 / ior (leaving the object)
 };
 
 void add_principled_closures(const PrincipledParams& p, float mix_weight, ClosureSet& out);

@@ -171,6 +171,10 @@ TEST(Material, PrincipledWeightsFollowCycles) {
   expect_spectrum(s[3].weight, Spectrum(0.8f * 0.4f));
   expect_spectrum(s[3].transmission_tint, Spectrum(0.5f, 0.4f, 0.3f));
   EXPECT_FLOAT_EQ(s[3].ior, 1.5f);
+  ClosureSet back;
+  m.evaluate(ShadingContext{{0.0f, 0.0f}, false}, back);
+  EXPECT_FLOAT_EQ(back[3].ior, 1.0f / 1.5f);  // leaving the object
+  EXPECT_FLOAT_EQ(back[2].ior, s[2].ior);     // the specular F0 does not depend on the side
   expect_spectrum(s.emission(), Spectrum(2.4f, 2.4f, 0.0f), 1e-5f);  // inside the alpha mix
   EXPECT_EQ(m.features(), uint32_t(kFeatureGlossy | kFeatureTransmission | kFeatureEmission |
                                    kFeatureTransparent | kFeatureDelta));
@@ -188,6 +192,13 @@ TEST(Material, GlassNodes) {
   ASSERT_EQ(s.count(), 1);
   EXPECT_EQ(s[0].type, ClosureType::GGXDielectric);
   EXPECT_TRUE(s.has_delta());
+
+  // Hit from the back (leaving the object): the integrators orient the frame towards the ray,
+  // so the closure carries the inverse IOR.
+  ClosureSet back;
+  smooth.evaluate(ShadingContext{{0.0f, 0.0f}, false}, back);
+  EXPECT_FLOAT_EQ(back[0].ior, 1.0f / 1.33f);
+  EXPECT_FLOAT_EQ(s[0].ior, 1.33f);
 
   d.nodes[0].roughness = FloatInput(0.3f);
   const Material rough(d, {});
