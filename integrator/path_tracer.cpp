@@ -94,12 +94,17 @@ class PathTracer final : public Integrator {
       ++out.rays;
       const float t_hit = found ? hit.t : ray.t_max;
 
-      // --- Analytic lights in front of the surface (BSDF-sampled; lamps are camera-invisible) ---
+      // --- Analytic lights in front of the surface (visible to camera rays, as in Cycles 3.x
+      // with the object's default camera visibility) ---
       if constexpr (kAnalytic) {
         LightHit lh;
-        if (bounce > 0 && lights.intersect(ray.origin, ray.direction, t_hit, lh)) {
-          const float w = prev_delta ? 1.0f : power_heuristic(prev_pdf, lh.pdf);
-          out.primal += beta * lh.radiance * w;
+        if (lights.intersect(ray.origin, ray.direction, t_hit, lh)) {
+          if (bounce == 0) {
+            out.emission += lh.radiance;
+          } else {
+            const float w = prev_delta ? 1.0f : power_heuristic(prev_pdf, lh.pdf);
+            out.primal += beta * lh.radiance * w;
+          }
         }
       }
 

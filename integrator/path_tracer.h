@@ -9,7 +9,8 @@
 //
 // Film outputs: emission seen by the camera ray (emissive surfaces and the world) goes to the
 // emission accumulator (the Emission pass, never shifted); everything else to primal.
-// Analytic lights (lamps) are not visible to camera rays, as in Cycles by default.
+// Analytic lights with a surface (sphere, area, sun disc) are visible to camera rays, as in Cycles
+// 3.x (lights_intersect runs for camera rays unless the object's camera visibility is off).
 //
 // Specialisation: the kernel is a template over the scene features that change per-sample work
 // (depth of field, world lookups, analytic-light intersection, emissive triangles); one of the 16

@@ -240,6 +240,31 @@ TEST(Render, CameraVisibleEmissionGoesToTheEmissionPass) {
   }
 }
 
+// An area light seen directly by the camera: its radiance in the Emission pass (camera-visible, as
+// Cycles 3.x), nothing in primal. Cycles 3.4's area radiance is P / (4 A) (docs/lights.md).
+TEST(Render, CameraSeesAreaLightsInTheEmissionPass) {
+  Scene scene;
+  scene.world.color = Spectrum(0.0f);
+  Light area;
+  area.type = Light::Type::Area;
+  area.shape = Light::Shape::Rectangle;
+  area.size_x = 2.0f;
+  area.size_y = 0.5f;
+  area.power = 10.0f;
+  area.color = Spectrum(1.0f, 0.5f, 0.25f);
+  area.light_to_world = translation({0, 0, 3});  // emits along -z
+  scene.lights.push_back(area);
+  scene.camera = top_camera(4, 0.4f, 0.0f);
+  scene.camera.camera_to_world = rotation_x(kPi, {0, 0, 0});  // looks up (+z)
+  const Image img = render(scene, pt(4));
+  const float expect = 10.0f / (4.0f * 1.0f);
+  for (size_t i = 0; i < img.primal.size(); i += 3) {
+    EXPECT_NEAR(img.emission[i], expect, 1e-4f * expect);
+    EXPECT_NEAR(img.emission[i + 1], 0.5f * expect, 1e-4f * expect);
+    EXPECT_EQ(img.primal[i], 0.0f);
+  }
+}
+
 // An emissive ceiling lights a floor through BSDF sampling and NEE on emissive triangles (MIS).
 // Two parallel infinite-ish planes: irradiance from a uniform radiance-Le ceiling = pi Le, so the
 // floor's radiance is albedo Le at one bounce (max_bounces = 0: direct light only).
