@@ -324,6 +324,52 @@ TEST(Render, MaxBouncesFollowsCycles) {
   }
 }
 
+// Thin lens: emissive stripes on the focus plane render as with a pinhole; moving the focus away
+// blurs them (the gradient energy of the stripes' edges drops; total variation would not).
+TEST(Render, DepthOfFieldFocusesOnTheFocusPlane) {
+  Scene scene;
+  scene.materials.push_back(emission(Spectrum(1.0f), 1.0f));
+  scene.materials.push_back(emission(Spectrum(0.0f), 0.0f));
+  for (int i = 0; i < 8; ++i) {
+    Mesh stripe;
+    const float x0 = -2.0f + 0.5f * float(i), x1 = x0 + 0.5f;
+    stripe.positions = {{x0, -2, 0}, {x1, -2, 0}, {x1, 2, 0}, {x0, 2, 0}};
+    stripe.indices = {0, 1, 2, 0, 2, 3};
+    scene.meshes.push_back(stripe);
+    scene.instances.push_back(place(uint32_t(i), i % 2));
+  }
+  scene.world.color = Spectrum(0.0f);
+  Camera cam;
+  cam.camera_to_world = translation({0, 0, 5});
+  cam.width = cam.height = 16;
+  cam.focal_length_mm = 100.0f;  // 1.8 m across at 5 m: stripes 4.4 px wide
+  scene.camera = cam;
+  auto contrast = [](const Image& img) {
+    double c = 0.0;
+    for (size_t i = 0; i + 3 < img.emission.size(); i += 3)
+      c += (img.emission[i + 3] - img.emission[i]) * (img.emission[i + 3] - img.emission[i]);
+    return c;
+  };
+  const Image pinhole = render(scene, pt(64));
+  scene.camera.aperture_radius = 0.1f;
+  scene.camera.focus_distance = 5.0f;
+  std::string summary;
+  const Image focused = render(scene, pt(64), &summary);
+  EXPECT_NE(summary.find("dof"), std::string::npos);
+  scene.camera.focus_distance = 2.0f;
+  const Image blurred = render(scene, pt(64));
+  double diff = 0.0, sum = 0.0;
+  for (size_t i = 0; i < pinhole.emission.size(); ++i) {
+    diff += std::fabs(pinhole.emission[i] - focused.emission[i]);
+    sum += pinhole.emission[i];
+  }
+  EXPECT_LT(diff / sum, 0.03);
+  EXPECT_NEAR(contrast(focused), contrast(pinhole), 0.03 * contrast(pinhole));
+  // Focused 3 m in front of the plane: a blur disc of radius 0.1 * 3 / 2 = 0.15 m on the plane,
+  // wider than a pixel's 0.11 m footprint, spreads each edge over about three pixels.
+  EXPECT_LT(contrast(blurred), 0.7 * contrast(pinhole));
+}
+
 // --- Determinism, robustness, session behaviour ---
 
 Scene cornell_like() {
