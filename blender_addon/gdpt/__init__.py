@@ -1,0 +1,40 @@
+# GDPT: gradient-domain path tracing render engine for Blender 3.4.
+#
+# The add-on only translates Blender data into flat arrays (export_*.py) and hands them to the
+# C++ core through the `_gdpt` pybind11 module, which scripts/install-addon.sh puts next to this
+# file.
+
+bl_info = {
+    "name": "Gradient PT",
+    "author": "GDPT developers",
+    "version": (0, 1, 0),
+    "blender": (3, 4, 0),
+    "location": "Render Properties > Render Engine > Gradient PT",
+    "description": "Gradient-domain path tracer (Kettunen et al. 2015) with screened Poisson "
+                   "reconstruction",
+    "category": "Render",
+}
+
+if "bpy" in locals():
+    import importlib
+
+    for _module in (properties, passes, export_images, export_materials, export_mesh,  # noqa: F821
+                    export_lights, export_camera, export_world, export_scene, engine, ui):
+        importlib.reload(_module)
+else:
+    from . import (properties, passes, export_images, export_materials, export_mesh,
+                   export_lights, export_camera, export_world, export_scene, engine, ui)
+
+import bpy  # noqa: E402
+
+
+def register():
+    properties.register()
+    bpy.utils.register_class(engine.GDPTRenderEngine)
+    ui.register()
+
+
+def unregister():
+    ui.unregister()
+    bpy.utils.unregister_class(engine.GDPTRenderEngine)
+    properties.unregister()

@@ -1,0 +1,180 @@
+# The Gradient PT render engine: sync, progressive render, reconstruction, passes.
+#
+# render() runs once per view layer (and frame). Timeline:
+#   export (depsgraph -> arrays) -> _gdpt.RenderJob (BVH, lights) -> job.render(poll)
+# poll() runs on Blender's thread about every 0.1 s while the core renders on its own threads: it
+# checks Esc (test_break), prints progress, and every `preview_interval` seconds asks for a film
+# snapshot, reconstructs it (L2, the fast exact solve) and shows it with update_result. At the end
+# the film is reconstructed with the chosen norm and every pass is written in one foreach_set.
+import time
+
+import bpy
+
+from . import export_camera, export_scene, passes, properties
+
+MARKER = "GDPT:"  # every console line of the engine starts with it (tests look for it)
+
+# Figures of the last finished render() in this process (samples, timings): read by the tests
+# and the benchmark to tell that Gradient PT really rendered and what the add-on cost.
+LAST_RENDER = {}
+LAST_ERROR = {}  # the last error reported (message), for the same readers
+
+
+def _load_module():
+    try:
+        from . import _gdpt  # built by blender_addon/CMakeLists.txt, copied by install-addon.sh
+    except ImportError as e:
+        return None, str(e)
+    return _gdpt, None
+
+
+def _clock(seconds):
+    seconds = max(0.0, seconds)
+    minutes = int(seconds // 60)
+    return f"{minutes:02d}:{seconds - 60 * minutes:05.2f}"
+
+
+class GDPTRenderEngine(bpy.types.RenderEngine):
+    bl_idname = "GDPT"
+    bl_label = "Gradient PT"
+    bl_use_postprocess = True
+    bl_use_preview = False
+    bl_use_shading_nodes_custom = False  # materials use Blender's (Cycles') shader nodes
+    bl_use_eevee_viewport = True  # Material Preview / Rendered viewport fall back to EEVEE
+
+    def update_render_passes(self, scene=None, renderlayer=None):
+        passes.register_passes(self, scene, renderlayer)
+
+    # --- helpers ------------------------------------------------------------------------------
+
+    def _warn(self, message):
+        if message in self._warned:
+            return
+        self._warned.add(message)
+        print(f"{MARKER} warning: {message}", flush=True)
+        self.report({'WARNING'}, f"Gradient PT: {message}")
+
+    def _error(self, message):
+        LAST_ERROR["message"] = message
+        print(f"{MARKER} error: {message}", flush=True)
+        self.report({'ERROR'}, f"Gradient PT: {message}")
+
+    def _combined(self, module, film, norm, settings):
+        if norm == 'NONE' or settings.mode == 'PT':
+            return film["primal"] + film["emission"]
+        return module.reconstruct(film["primal"], film["gradient_x"], film["gradient_y"],
+                                  film["variance"], film["emission"], norm, settings.alpha,
+                                  settings.threads)
+
+    def _write(self, result, layer, film, combined):
+        layer.passes.foreach_set("rect", passes.layer_buffer(layer, film, combined))
+        self.update_result(result)
+
+    # --- render -------------------------------------------------------------------------------
+
+    def render(self, depsgraph):
+        self._warned = set()
+        scene = depsgraph.scene
+        view_layer = depsgraph.view_layer
+        settings = scene.gdpt
+        t_start = time.perf_counter()
+
+        module, import_error = _load_module()
+        if module is None:
+            self._error(f"the _gdpt module could not be loaded ({import_error}); reinstall the "
+                        f"add-on with scripts/install-addon.sh")
+            return
+        if scene.camera is None:
+            self._error("the scene has no active camera: add a camera and set it as the scene "
+                        "camera (Scene Properties > Camera)")
+            return
+        camera = scene.camera.evaluated_get(depsgraph)
+        width, height = export_camera.render_resolution(scene.render)
+
+        self.update_stats("", "Synchronizing scene")
+        try:
+            builder, stats = export_scene.export_scene(module, depsgraph, camera, self._warn)
+        except Exception as e:  # a broken datablock must not take Blender down
+            self._error(f"scene export failed: {e}")
+            raise
+        print(f"{MARKER} view layer '{view_layer.name}' frame {scene.frame_current}: exported "
+              f"{stats.instances} instances of {stats.meshes} meshes ({stats.triangles} "
+              f"triangles), {stats.lights} lights, {stats.materials} materials in "
+              f"{stats.seconds:.3f} s", flush=True)
+
+        try:
+            job = module.RenderJob(builder, properties.settings_dict(scene))
+        except ValueError as e:
+            self._error(str(e))
+            return
+        for w in job.warnings():
+            self._warn(w)
+
+        result = self.begin_result(0, 0, width, height, layer=view_layer.name)
+        layer = result.layers[0]
+        for candidate in result.layers:
+            if candidate.name == view_layer.name:
+                layer = candidate
+
+        t_render = time.perf_counter()
+        interval = settings.preview_interval
+        state = {"next_preview": t_render + min(1.0, interval), "cancelled": False,
+                 "last_line": 0.0}
+
+        def poll(done, total, elapsed, snapshot_ready):
+            flags = 0
+            if self.test_break():
+                state["cancelled"] = True
+                return 1
+            now = time.perf_counter()
+            if snapshot_ready:
+                film = job.snapshot()
+                self._write(result, layer, film, self._combined(module, film, 'L2', settings))
+            if now >= state["next_preview"]:
+                state["next_preview"] = now + interval
+                flags |= 2
+            # ETA from the sample rate, or from the time limit when that ends first.
+            remaining = None
+            if done > 0:
+                remaining = elapsed / done * (total - done)
+            if settings.time_limit > 0:
+                left = settings.time_limit - elapsed
+                remaining = left if remaining is None else min(remaining, left)
+            info = f"Sample {done}/{total}"
+            if remaining is not None:
+                info += f" | Remaining:{_clock(remaining)}"
+            if now - state["last_line"] >= 0.5 or snapshot_ready:
+                state["last_line"] = now
+                self.update_stats("", info)
+                self.update_progress(done / max(total, 1))
+            return flags
+
+        try:
+            job.render(poll, 0.1)
+        except Exception as e:
+            self._error(f"render failed: {e}")
+            self.end_result(result, cancel=True)
+            return
+        t_done = time.perf_counter()
+
+        film = job.passes()
+        norm = settings.reconstruction
+        self.update_stats("", f"Sample {film['samples']}/{settings.samples} | Reconstructing "
+                              f"({norm})")
+        combined = self._combined(module, film, norm, settings)
+        t_reconstruct = time.perf_counter()
+        self._write(result, layer, film, combined)
+        self.end_result(result)
+        t_end = time.perf_counter()
+        status = "cancelled" if state["cancelled"] else "finished"
+        LAST_RENDER.clear()
+        LAST_RENDER.update(
+            view_layer=view_layer.name, status=status, samples=film["samples"], width=width,
+            height=height, export=stats.seconds, render=t_done - t_render,
+            reconstruct=t_reconstruct - t_done, write=t_end - t_reconstruct,
+            total=t_end - t_start, triangles=stats.triangles, warnings=sorted(self._warned))
+        print(f"{MARKER} view layer '{view_layer.name}' {status}: {film['samples']}/"
+              f"{settings.samples} samples, {width}x{height}, mode {settings.mode}, "
+              f"reconstruction {norm}; export {stats.seconds:.3f} s, render "
+              f"{t_done - t_render:.3f} s, reconstruction {t_reconstruct - t_done:.3f} s, "
+              f"write {t_end - t_reconstruct:.3f} s, total {t_end - t_start:.3f} s", flush=True)

@@ -1,0 +1,65 @@
+# The scene camera -> Scene::Camera dict (Blender conventions, as Cycles' blender/camera.cpp).
+import numpy as np
+from mathutils import Vector
+
+
+def render_resolution(render):
+    """Pixel size after the resolution percentage, as Blender computes it."""
+    scale = render.resolution_percentage / 100.0
+    return max(1, int(render.resolution_x * scale)), max(1, int(render.resolution_y * scale))
+
+
+def _rigid_matrix12(m):
+    # The camera's scale must not scale the image plane or the lens: keep rotation + position.
+    loc, rot, _scale = m.decompose()
+    r = rot.to_matrix()
+    rows = [[r[i][0], r[i][1], r[i][2], loc[i]] for i in range(3)]
+    return np.array(rows, dtype=np.float32).ravel()
+
+
+def _focus_distance(cam_obj, cam):
+    dof = cam.dof
+    if dof.focus_object is None:
+        return float(dof.focus_distance)
+    # Distance along the view axis to the focus object's origin (as Cycles).
+    m = cam_obj.matrix_world
+    view = (m.to_3x3() @ Vector((0.0, 0.0, 1.0))).normalized()
+    delta = m.translation - dof.focus_object.matrix_world.translation
+    return abs(view.dot(delta))
+
+
+def camera_dict(scene, cam_obj, warn):
+    cam = cam_obj.data
+    render = scene.render
+    width, height = render_resolution(render)
+    if cam.type == 'PANO':
+        warn("panoramic cameras are not supported by Gradient PT; rendering as perspective")
+    if render.use_border:
+        warn("render region (border) is ignored by Gradient PT; rendering the full frame")
+    d = {
+        "projection": 'ORTHO' if cam.type == 'ORTHO' else 'PERSP',
+        "sensor_fit": cam.sensor_fit,
+        "matrix": _rigid_matrix12(cam_obj.matrix_world),
+        "focal_length_mm": float(cam.lens),
+        "sensor_width_mm": float(cam.sensor_width),
+        "sensor_height_mm": float(cam.sensor_height),
+        "shift_x": float(cam.shift_x),
+        "shift_y": float(cam.shift_y),
+        "ortho_scale": float(cam.ortho_scale),
+        "clip_start": float(cam.clip_start),
+        "clip_end": float(cam.clip_end),
+        "width": width,
+        "height": height,
+        "pixel_aspect": float(render.pixel_aspect_x / render.pixel_aspect_y),
+        "aperture_radius": 0.0,
+        "focus_distance": _focus_distance(cam_obj, cam),
+    }
+    if cam.dof.use_dof:
+        fstop = max(float(cam.dof.aperture_fstop), 1e-5)
+        if cam.type == 'ORTHO':
+            d["aperture_radius"] = 1.0 / (2.0 * fstop)
+        else:
+            d["aperture_radius"] = float(cam.lens) * 1e-3 / (2.0 * fstop)
+        if cam.dof.aperture_blades >= 3:
+            warn("polygonal aperture blades are not supported by Gradient PT; using a disc")
+    return d

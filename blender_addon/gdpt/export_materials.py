@@ -1,0 +1,315 @@
+# Blender material node trees -> MaterialDesc dicts (see blender_addon/module/scene_convert.h).
+#
+# Walks from the active Material Output's Surface input. Supported shader nodes: Principled BSDF,
+# Diffuse, Glossy, Glass, Emission, Transparent, Mix Shader, Add Shader. Inputs may be constants,
+# RGB / Value nodes, or an Image Texture read at the active UV map, optionally through a Mapping
+# node (Point type) fed by a UV Map / Texture Coordinate UV output. Reroutes and muted nodes are
+# followed. Anything else is reported once per material (naming the node) and followed through its
+# mute pass-through link when it has one; otherwise a magenta diffuse (shaders) or the socket's
+# own value (inputs) stands in, so the render still completes.
+
+from mathutils import Euler, Matrix
+
+MAGENTA = (1.0, 0.0, 1.0)
+IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+
+_SHADERS = {
+    'BSDF_PRINCIPLED', 'BSDF_DIFFUSE', 'BSDF_GLOSSY', 'BSDF_GLASS', 'EMISSION',
+    'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER',
+}
+_GGX_LIKE = {'GGX', 'SHARP'}
+
+
+def _matrix12(m):
+    return [m[r][c] for r in range(3) for c in range(4)]
+
+
+class _Translator:
+    def __init__(self, material, images, warn):
+        self.material = material
+        self.images = images
+        self.warn_sink = warn
+        self.warned = set()
+        self.nodes = []
+
+    # --- reporting ---------------------------------------------------------------------------
+
+    def warn(self, node, what):
+        key = (node.name, what)
+        if key in self.warned:
+            return
+        self.warned.add(key)
+        self.warn_sink(f"material '{self.material.name}': {what} '{node.name}' "
+                       f"({node.bl_idname}) is not supported by Gradient PT")
+
+    # --- link following ----------------------------------------------------------------------
+
+    def _source(self, socket):
+        """The output socket feeding `socket`, through reroutes and muted nodes; None if
+        unlinked."""
+        seen = 0
+        while socket.is_linked and seen < 64:
+            seen += 1
+            link = socket.links[0]
+            if not link.is_valid or link.is_muted:
+                return None
+            out = link.from_socket
+            node = out.node
+            if node.type == 'REROUTE' or node.mute:
+                passthrough = self._passthrough_input(node, out)
+                if passthrough is None:
+                    return None
+                socket = passthrough
+                continue
+            return out
+        return None
+
+    @staticmethod
+    def _passthrough_input(node, output):
+        for link in node.internal_links:
+            if link.to_socket == output:
+                return link.from_socket
+        if node.type == 'REROUTE':
+            return node.inputs[0]
+        return None
+
+    # --- shaders -----------------------------------------------------------------------------
+
+    def shader(self, socket):
+        """Node index for the closure feeding `socket`, -1 for none (black/transparent)."""
+        out = self._source(socket)
+        if out is None:
+            return -1
+        node = out.node
+        if node.type not in _SHADERS:
+            self.warn(node, "shader node")
+            passthrough = self._passthrough_input(node, out)
+            if passthrough is not None:
+                return self.shader(passthrough)
+            return self._add({"kind": "DIFFUSE", "color": {"value": MAGENTA}})
+        return getattr(self, "_" + node.type.lower())(node)
+
+    def _add(self, d):
+        self.nodes.append(d)
+        return len(self.nodes) - 1
+
+    def _bsdf_principled(self, n):
+        i = n.inputs
+        if n.distribution not in _GGX_LIKE:
+            self.warn(n, f"distribution {n.distribution} of")
+        if i["Subsurface"].is_linked or i["Subsurface"].default_value > 0.0:
+            self.warn(n, "subsurface scattering of")
+        for name in ("Sheen", "Clearcoat"):
+            if i[name].is_linked or i[name].default_value > 0.0:
+                self.warn(n, f"{name.lower()} of")
+        for name in ("Normal", "Clearcoat Normal", "Tangent"):
+            if i[name].is_linked:
+                self.warn(self._source(i[name]).node if self._source(i[name]) else n,
+                          "normal / tangent input node")
+        return self._add({
+            "kind": "PRINCIPLED",
+            "color": self.color(i["Base Color"]),
+            "metallic": self.value(i["Metallic"]),
+            "specular": self.value(i["Specular"]),
+            "specular_tint": self.value(i["Specular Tint"]),
+            "roughness": self.value(i["Roughness"]),
+            "ior": self.value(i["IOR"]),
+            "transmission": self.value(i["Transmission"]),
+            "emission": self.color(i["Emission"]),
+            "emission_strength": self.value(i["Emission Strength"]),
+            "alpha": self.value(i["Alpha"]),
+        })
+
+    def _bsdf_diffuse(self, n):
+        return self._add({"kind": "DIFFUSE", "color": self.color(n.inputs["Color"]),
+                          "roughness": self.value(n.inputs["Roughness"])})
+
+    def _bsdf_glossy(self, n):
+        if n.distribution not in _GGX_LIKE:
+            self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
+        roughness = self.value(n.inputs["Roughness"])
+        if n.distribution == 'SHARP':
+            roughness = {"value": 0.0}
+        return self._add({"kind": "GLOSSY", "color": self.color(n.inputs["Color"]),
+                          "roughness": roughness})
+
+    def _bsdf_glass(self, n):
+        if n.distribution not in _GGX_LIKE:
+            self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
+        roughness = self.value(n.inputs["Roughness"])
+        if n.distribution == 'SHARP':
+            roughness = {"value": 0.0}
+        return self._add({"kind": "GLASS", "color": self.color(n.inputs["Color"]),
+                          "roughness": roughness, "ior": self.value(n.inputs["IOR"])})
+
+    def _emission(self, n):
+        return self._add({"kind": "EMISSION", "color": self.color(n.inputs["Color"]),
+                          "strength": self.value(n.inputs["Strength"])})
+
+    def _bsdf_transparent(self, n):
+        return self._add({"kind": "TRANSPARENT", "color": self.color(n.inputs["Color"])})
+
+    def _mix_shader(self, n):
+        fac = self.value(n.inputs[0])
+        a = self.shader(n.inputs[1])
+        b = self.shader(n.inputs[2])
+        return self._add({"kind": "MIX", "fac": fac, "a": a, "b": b})
+
+    def _add_shader(self, n):
+        a = self.shader(n.inputs[0])
+        b = self.shader(n.inputs[1])
+        return self._add({"kind": "ADD", "a": a, "b": b})
+
+    # --- inputs ------------------------------------------------------------------------------
+
+    def color(self, socket):
+        d = {"value": self._default_rgb(socket)}
+        out = self._source(socket)
+        if out is None:
+            return d
+        node = out.node
+        if node.type == 'RGB':
+            d["value"] = tuple(out.default_value)[:3]
+        elif node.type == 'VALUE':
+            v = out.default_value
+            d["value"] = (v, v, v)
+        elif node.type == 'TEX_IMAGE':
+            self._texture(node, d)
+        else:
+            self.warn(node, "input node")
+            passthrough = self._passthrough_input(node, out)
+            if passthrough is not None and passthrough.type in {'RGBA', 'VALUE', 'VECTOR'}:
+                return self.color(passthrough)
+            d["value"] = MAGENTA
+        return d
+
+    def value(self, socket):
+        d = {"value": float(socket.default_value)}
+        out = self._source(socket)
+        if out is None:
+            return d
+        node = out.node
+        if node.type == 'VALUE':
+            d["value"] = float(out.default_value)
+        elif node.type == 'RGB':
+            r, g, b = tuple(out.default_value)[:3]
+            d["value"] = 0.2126 * r + 0.7152 * g + 0.0722 * b
+        elif node.type == 'TEX_IMAGE':
+            self._texture(node, d)
+            d["channel"] = 'ALPHA' if out.name == "Alpha" else 'LUMINANCE'
+        else:
+            self.warn(node, "input node")
+            passthrough = self._passthrough_input(node, out)
+            if passthrough is not None and passthrough.type in {'RGBA', 'VALUE'}:
+                return self.value(passthrough)
+        return d
+
+    @staticmethod
+    def _default_rgb(socket):
+        v = socket.default_value
+        try:
+            return tuple(v)[:3]
+        except TypeError:
+            return (float(v),) * 3
+
+    def _texture(self, node, d):
+        image = node.image
+        index = self.images.get(image) if image is not None else -1
+        if index < 0:
+            self.warn(node, "image texture without pixels:")
+            d["value"] = MAGENTA if isinstance(d["value"], tuple) else d["value"]
+            return
+        if node.projection != 'FLAT':
+            self.warn(node, f"projection {node.projection} (rendered as flat) of")
+        d["image"] = index
+        d["interpolation"] = 'Closest' if node.interpolation == 'Closest' else 'Linear'
+        d["extension"] = node.extension if node.extension in {'REPEAT', 'EXTEND', 'CLIP'} \
+            else 'REPEAT'
+        d["mapping"] = self._uv_mapping(node.inputs["Vector"])
+
+    def _uv_mapping(self, socket):
+        """Row-major 3x4 transform applied to (u, v, 0) for a Vector input: identity for the
+        default UVs, a Mapping node's Point transform when it is fed by UVs."""
+        out = self._source(socket)
+        if out is None:
+            return IDENTITY12
+        node = out.node
+        if node.type == 'UVMAP' or (node.type == 'TEX_COORD' and out.name == "UV"):
+            if node.type == 'UVMAP' and node.uv_map:
+                self.warn(node, "UV map other than the active render UV map in")
+            return IDENTITY12
+        if node.type == 'MAPPING' and node.vector_type in {'POINT', 'TEXTURE'}:
+            inner = self._uv_mapping(node.inputs["Vector"])
+            loc = node.inputs["Location"].default_value
+            rot = node.inputs["Rotation"].default_value
+            scale = node.inputs["Scale"].default_value
+            for name in ("Location", "Rotation", "Scale"):
+                if node.inputs[name].is_linked:
+                    self.warn(node, f"linked {name} of")
+            m = (Matrix.Translation(loc) @ Euler(rot, 'XYZ').to_matrix().to_4x4()
+                 @ Matrix.Diagonal((scale[0], scale[1], scale[2], 1.0)))
+            if node.vector_type == 'TEXTURE':
+                m = m.inverted_safe()
+            inner_m = Matrix([inner[0:4], inner[4:8], inner[8:12], [0, 0, 0, 1]])
+            return _matrix12(m @ inner_m)
+        self.warn(node, "texture coordinate node")
+        return IDENTITY12
+
+
+def _output_node(tree):
+    outputs = [n for n in tree.nodes if n.type == 'OUTPUT_MATERIAL' and not n.mute]
+    for target in ('CYCLES', 'ALL'):
+        for n in outputs:
+            if n.is_active_output and n.target == target:
+                return n
+    for n in outputs:
+        if n.target in {'CYCLES', 'ALL'}:
+            return n
+    return None
+
+
+def translate_material(material, images, warn):
+    """MaterialDesc dict for a Blender material (root -1 = Blender's default grey)."""
+    if material is None:
+        return {"name": "", "nodes": [], "root": -1}
+    if not material.use_nodes or material.node_tree is None:
+        c = tuple(material.diffuse_color)[:3]
+        return {"name": material.name,
+                "nodes": [{"kind": "PRINCIPLED", "color": {"value": c},
+                           "metallic": {"value": material.metallic},
+                           "specular": {"value": material.specular_intensity},
+                           "roughness": {"value": material.roughness}}],
+                "root": 0}
+    t = _Translator(material, images, warn)
+    out = _output_node(material.node_tree)
+    if out is None:
+        warn(f"material '{material.name}' has no Material Output node; rendered black")
+        return {"name": material.name, "nodes": [], "root": -1}
+    if out.inputs["Volume"].is_linked:
+        warn(f"material '{material.name}': volumes are not supported by Gradient PT (ignored)")
+    if out.inputs["Displacement"].is_linked:
+        warn(f"material '{material.name}': displacement is not supported by Gradient PT (ignored)")
+    root = t.shader(out.inputs["Surface"])
+    if root < 0:
+        # Nothing connected: Cycles renders such a surface black. A black diffuse does the same.
+        root = t._add({"kind": "DIFFUSE", "color": {"value": (0.0, 0.0, 0.0)}})
+    return {"name": material.name, "nodes": t.nodes, "root": root}
+
+
+class MaterialCache:
+    def __init__(self, builder, images, warn):
+        self.builder = builder
+        self.images = images
+        self.warn = warn
+        self.index = {}
+
+    def get(self, material):
+        """Scene material index for a Blender material, -1 for an empty slot."""
+        if material is None:
+            return -1
+        key = material.original.as_pointer()
+        if key not in self.index:
+            desc = translate_material(material, self.images, self.warn)
+            self.index[key] = self.builder.add_material(desc)
+        return self.index[key]
+

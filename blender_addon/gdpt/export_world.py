@@ -1,0 +1,84 @@
+# The world -> Scene::World dict: a constant colour, or an equirectangular Environment Texture
+# (optionally rotated by a Mapping node), times the Background strength.
+import numpy as np
+from mathutils import Euler
+
+IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+
+
+def _source(socket):
+    while socket.is_linked:
+        link = socket.links[0]
+        if link.is_muted or not link.is_valid:
+            return None
+        node = link.from_node
+        if node.type == 'REROUTE' or node.mute:
+            if not node.inputs:
+                return None
+            socket = node.inputs[0]
+            continue
+        return link.from_socket
+    return None
+
+
+def world_dict(world, images, warn):
+    if world is None:
+        return {"color": (0.0, 0.0, 0.0), "strength": 0.0}
+    if not world.use_nodes or world.node_tree is None:
+        return {"color": tuple(world.color), "strength": 1.0}
+    outputs = [n for n in world.node_tree.nodes
+               if n.type == 'OUTPUT_WORLD' and n.is_active_output and not n.mute]
+    if not outputs:
+        return {"color": (0.0, 0.0, 0.0), "strength": 0.0}
+    out = _source(outputs[0].inputs["Surface"])
+    if out is None:
+        return {"color": (0.0, 0.0, 0.0), "strength": 0.0}
+    background = out.node
+    if background.type != 'BACKGROUND':
+        warn(f"world '{world.name}': node '{background.name}' ({background.bl_idname}) is not "
+             f"supported by Gradient PT; using the world colour")
+        return {"color": tuple(world.color), "strength": 1.0}
+    d = {
+        "color": tuple(background.inputs["Color"].default_value)[:3],
+        "strength": float(background.inputs["Strength"].default_value),
+        "rotation": np.array(IDENTITY12, dtype=np.float32),
+    }
+    if background.inputs["Strength"].is_linked:
+        warn(f"world '{world.name}': a linked Background strength is not supported; using "
+             f"its value")
+    color = _source(background.inputs["Color"])
+    if color is None:
+        return d
+    node = color.node
+    if node.type == 'RGB':
+        d["color"] = tuple(color.default_value)[:3]
+    elif node.type == 'TEX_ENVIRONMENT':
+        if node.projection != 'EQUIRECTANGULAR':
+            warn(f"world '{world.name}': {node.projection} environment projection is not "
+                 f"supported by Gradient PT; using equirectangular")
+        index = images.get(node.image)
+        if index < 0:
+            d["color"] = (1.0, 0.0, 1.0)
+        else:
+            d["image"] = index
+            d["color"] = (1.0, 1.0, 1.0)
+            d["rotation"] = _rotation(world, node, warn)
+    else:
+        warn(f"world '{world.name}': node '{node.name}' ({node.bl_idname}) is not supported by "
+             f"Gradient PT; using the Background colour")
+    return d
+
+
+def _rotation(world, env_node, warn):
+    vec = _source(env_node.inputs["Vector"])
+    if vec is None:
+        return np.array(IDENTITY12, dtype=np.float32)
+    node = vec.node
+    if node.type == 'MAPPING' and node.vector_type in {'POINT', 'VECTOR'}:
+        r = Euler(node.inputs["Rotation"].default_value, 'XYZ').to_matrix()
+        rows = [[r[i][0], r[i][1], r[i][2], 0.0] for i in range(3)]
+        return np.array(rows, dtype=np.float32).ravel()
+    if node.type != 'TEX_COORD':
+        warn(f"world '{world.name}': environment vector from '{node.name}' is not supported; "
+             f"using the view direction")
+    return np.array(IDENTITY12, dtype=np.float32)

@@ -1,0 +1,96 @@
+# Render settings (scene.gdpt) and per-view-layer pass toggles (view_layer.gdpt).
+# The names of scene.gdpt are part of the contract with tests and tools (see docs/blender.md).
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+
+
+def _update_passes(self, context):
+    # Re-registers the passes so the Render Layers node shows the change at once.
+    view_layer = context.view_layer if context else None
+    if view_layer is not None:
+        view_layer.update_render_passes()
+
+
+class GDPTRenderSettings(bpy.types.PropertyGroup):
+    samples: IntProperty(
+        name="Samples", description="Samples per pixel (each G-PT sample traces a base path and "
+        "four shifted paths)", default=64, min=1, max=1 << 24, soft_max=4096)
+    time_limit: FloatProperty(
+        name="Time Limit", description="Stop after this many seconds, keeping the samples done "
+        "(0 = no limit)", default=0.0, min=0.0, subtype='TIME_ABSOLUTE', unit='TIME_ABSOLUTE')
+    max_bounces: IntProperty(
+        name="Max Bounces", description="Path segments after the camera ray", default=8, min=0,
+        max=1024)
+    mode: EnumProperty(
+        name="Integrator",
+        items=[('GPT', "Gradient-Domain", "Gradient-domain path tracing: primal, gradients and a "
+                "screened Poisson reconstruction"),
+               ('PT', "Path Tracing", "Plain path tracing (no gradients; Combined = Primal + "
+                "Emission)")],
+        default='GPT')
+    reconstruction: EnumProperty(
+        name="Reconstruction",
+        items=[('L1', "L1", "Robust iteratively reweighted solve (fewer outliers, slightly biased)"),
+               ('L2', "L2", "Unbiased screened Poisson solve (exact DCT)"),
+               ('WEIGHTED', "Variance Weighted", "Each term weighted by its per-pixel variance"),
+               ('NONE', "None", "Combined = Primal + Emission")],
+        default='L1')
+    alpha: FloatProperty(
+        name="Alpha", description="Weight of the primal image against the gradients in the "
+        "reconstruction (higher keeps more of the noisy primal)", default=0.2, min=1e-4, max=100.0,
+        soft_max=2.0)
+    shift_threshold: FloatProperty(
+        name="Shift Roughness Threshold", description="GGX alpha below which a vertex is treated "
+        "as specular by the shift mapping (half-vector copy instead of reconnection)",
+        default=0.001, min=0.0, max=1.0, precision=4)
+    seed: IntProperty(name="Seed", description="Random seed (the image does not depend on the "
+                      "thread count)", default=0, min=0)
+    threads: IntProperty(name="Threads", description="Render threads (0 = all cores)", default=0,
+                         min=0, max=1024)
+    clamp: FloatProperty(name="Clamp", description="Maximum sample value (0 = off)", default=0.0,
+                         min=0.0)
+    preview_interval: FloatProperty(
+        name="Preview Interval", description="Seconds between reconstructed preview updates",
+        default=3.0, min=0.5, max=600.0)
+
+
+class GDPTViewLayerSettings(bpy.types.PropertyGroup):
+    use_pass_primal: BoolProperty(name="Primal", default=True, update=_update_passes)
+    use_pass_gradients: BoolProperty(name="Gradients", default=True, update=_update_passes)
+    use_pass_emission: BoolProperty(name="Emission", default=True, update=_update_passes)
+    use_pass_variance: BoolProperty(name="Variance", default=True, update=_update_passes)
+    use_pass_shift_failures: BoolProperty(name="Shift Failures", default=True,
+                                          update=_update_passes)
+
+
+_classes = (GDPTRenderSettings, GDPTViewLayerSettings)
+
+
+def register():
+    for cls in _classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.gdpt = PointerProperty(type=GDPTRenderSettings)
+    bpy.types.ViewLayer.gdpt = PointerProperty(type=GDPTViewLayerSettings)
+
+
+def unregister():
+    del bpy.types.ViewLayer.gdpt
+    del bpy.types.Scene.gdpt
+    for cls in reversed(_classes):
+        bpy.utils.unregister_class(cls)
+
+
+def settings_dict(scene):
+    """scene.gdpt as the plain dict the _gdpt module reads."""
+    s = scene.gdpt
+    return {
+        "mode": s.mode,
+        "samples": int(s.samples),
+        "time_limit": float(s.time_limit),
+        "max_bounces": int(s.max_bounces),
+        "seed": int(s.seed),
+        "threads": int(s.threads),
+        "clamp": float(s.clamp),
+        "shift_threshold": float(s.shift_threshold),
+    }

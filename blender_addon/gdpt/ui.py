@@ -1,0 +1,156 @@
+# Cycles-like panels for scene.gdpt and view_layer.gdpt, and GDPT in the COMPAT_ENGINES of the
+# Blender panels that apply to it (output, dimensions, camera, light, world, material, ...).
+import bpy
+from bpy.types import Panel
+
+ENGINE = "GDPT"
+
+
+class _RenderPanel:
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "render"
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+
+class GDPT_PT_sampling(_RenderPanel, Panel):
+    bl_label = "Sampling"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        s = context.scene.gdpt
+        col = layout.column(align=True)
+        col.prop(s, "samples")
+        col.prop(s, "time_limit")
+        col = layout.column()
+        col.prop(s, "seed")
+        col.prop(s, "clamp")
+
+
+class GDPT_PT_light_paths(_RenderPanel, Panel):
+    bl_label = "Light Paths"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(context.scene.gdpt, "max_bounces")
+
+
+class GDPT_PT_gradient_domain(_RenderPanel, Panel):
+    bl_label = "Gradient Domain"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        s = context.scene.gdpt
+        layout.prop(s, "mode")
+        col = layout.column()
+        col.active = s.mode == 'GPT'
+        col.prop(s, "shift_threshold")
+
+
+class GDPT_PT_reconstruction(_RenderPanel, Panel):
+    bl_label = "Reconstruction"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        s = context.scene.gdpt
+        col = layout.column()
+        col.active = s.mode == 'GPT'
+        col.prop(s, "reconstruction")
+        sub = col.column()
+        sub.active = s.reconstruction != 'NONE'
+        sub.prop(s, "alpha")
+
+
+class GDPT_PT_performance(_RenderPanel, Panel):
+    bl_label = "Performance"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        s = context.scene.gdpt
+        layout.prop(s, "threads")
+        layout.prop(s, "preview_interval")
+
+
+class GDPT_PT_passes(Panel):
+    bl_label = "Gradient PT Passes"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "view_layer"
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        s = context.view_layer.gdpt
+        col = layout.column(heading="Include", align=True)
+        col.prop(s, "use_pass_primal")
+        col.prop(s, "use_pass_gradients")
+        col.prop(s, "use_pass_emission")
+        col.prop(s, "use_pass_variance")
+        col.prop(s, "use_pass_shift_failures")
+
+
+_classes = (GDPT_PT_sampling, GDPT_PT_light_paths, GDPT_PT_gradient_domain,
+            GDPT_PT_reconstruction, GDPT_PT_performance, GDPT_PT_passes)
+
+# Blender's engine-agnostic panels carry 'BLENDER_RENDER' in COMPAT_ENGINES (the convention of
+# Blender's own "Custom Render Engine" template); EEVEE's light / material / world panels draw the
+# plain datablock settings and node surfaces GDPT reads, so they are listed by name.
+_EXCLUDE = {
+    "VIEWLAYER_PT_filter", "VIEWLAYER_PT_layer_passes", "RENDER_PT_freestyle",
+    "RENDER_PT_simplify",
+}
+_EXTRA = {
+    "DATA_PT_EEVEE_light", "DATA_PT_spot", "DATA_PT_EEVEE_shadow",
+    "EEVEE_MATERIAL_PT_context_material", "EEVEE_MATERIAL_PT_surface",
+    "EEVEE_WORLD_PT_surface", "DATA_PT_camera_dof", "DATA_PT_camera_dof_aperture",
+}
+
+_patched = []
+
+
+def _compat_panels():
+    for panel in bpy.types.Panel.__subclasses__():
+        engines = getattr(panel, "COMPAT_ENGINES", None)
+        if not isinstance(engines, set) or panel.__name__ in _EXCLUDE:
+            continue
+        if "BLENDER_RENDER" in engines or panel.__name__ in _EXTRA:
+            yield panel
+
+
+def register():
+    for cls in _classes:
+        bpy.utils.register_class(cls)
+    for panel in _compat_panels():
+        if ENGINE not in panel.COMPAT_ENGINES:
+            panel.COMPAT_ENGINES.add(ENGINE)
+            _patched.append(panel)
+
+
+def unregister():
+    while _patched:
+        panel = _patched.pop()
+        panel.COMPAT_ENGINES.discard(ENGINE)
+    for cls in reversed(_classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,79 @@
+// The `_gdpt` Python module: array conversion and the render call, nothing Blender-specific.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "blender_addon/module/render_job.h"
+#include "blender_addon/module/scene_convert.h"
+
+namespace py = pybind11;
+using namespace gdpt;
+using namespace gdpt::python;
+
+namespace {
+
+RenderSettings settings_from_dict(const py::dict& d) {
+  RenderSettings s;
+  if (d.contains("mode")) {
+    const auto mode = d["mode"].cast<std::string>();
+    if (mode == "GPT")
+      s.mode = RenderSettings::Mode::GPT;
+    else if (mode == "PT")
+      s.mode = RenderSettings::Mode::PT;
+    else
+      throw std::invalid_argument("unknown mode '" + mode + "'");
+  }
+  auto get = [&](const char* key, auto& out) {
+    if (d.contains(key)) out = d[key].cast<std::decay_t<decltype(out)>>();
+  };
+  get("samples", s.samples);
+  get("time_limit", s.time_limit);
+  get("max_bounces", s.max_bounces);
+  get("seed", s.seed);
+  get("threads", s.threads);
+  get("clamp", s.clamp);
+  get("rr_depth", s.rr_depth);
+  get("shift_threshold", s.shift_roughness_threshold);
+  get("samples_per_pass", s.samples_per_pass);
+  return s;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_gdpt, m) {
+  m.doc() = "GDPT core bindings: build a scene from flat arrays, render it, reconstruct passes.";
+
+  py::class_<SceneBuilder>(m, "SceneBuilder")
+      .def(py::init<>())
+      .def("add_mesh", &SceneBuilder::add_mesh, py::arg("positions").noconvert(),
+           py::arg("indices").noconvert(), py::arg("corner_normals").noconvert() = py::none(),
+           py::arg("corner_uvs").noconvert() = py::none(),
+           py::arg("material_slot").noconvert() = py::none())
+      .def("add_instance", &SceneBuilder::add_instance, py::arg("mesh"), py::arg("matrix"),
+           py::arg("slot_material"))
+      .def("add_material", &SceneBuilder::add_material)
+      .def("add_image", &SceneBuilder::add_image, py::arg("name"), py::arg("width"),
+           py::arg("height"), py::arg("rgba").noconvert(), py::arg("colorspace"))
+      .def("add_light", &SceneBuilder::add_light)
+      .def("set_camera", &SceneBuilder::set_camera)
+      .def("set_world", &SceneBuilder::set_world)
+      .def_property_readonly("mesh_count", &SceneBuilder::mesh_count)
+      .def_property_readonly("instance_count", &SceneBuilder::instance_count)
+      .def_property_readonly("triangle_count", &SceneBuilder::triangle_count);
+
+  py::class_<RenderJob>(m, "RenderJob")
+      .def(py::init([](SceneBuilder& builder, const py::dict& settings) {
+             return std::make_unique<RenderJob>(builder, settings_from_dict(settings));
+           }),
+           py::arg("builder"), py::arg("settings"))
+      .def("render", &RenderJob::render, py::arg("poll"), py::arg("poll_interval") = 0.1)
+      .def("snapshot", &RenderJob::snapshot)
+      .def("passes", &RenderJob::passes)
+      .def("features_summary", &RenderJob::features_summary)
+      .def("warnings", &RenderJob::warnings);
+
+  m.def("reconstruct", &reconstruct_arrays, py::arg("primal").noconvert(),
+        py::arg("gradient_x").noconvert(), py::arg("gradient_y").noconvert(),
+        py::arg("variance").noconvert() = py::none(), py::arg("emission").noconvert() = py::none(),
+        py::arg("norm") = "L1", py::arg("alpha") = 0.2f, py::arg("threads") = 0);
+}

@@ -1,0 +1,226 @@
+#include "blender_addon/module/render_job.h"
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include "reconstruct/reconstruct.h"
+
+namespace gdpt::python {
+
+namespace {
+
+// A numpy array that owns a moved-in vector (no second copy).
+py::array_t<float> to_numpy(std::vector<float>&& v, int height, int width, int channels) {
+  auto* owner = new std::vector<float>(std::move(v));
+  py::capsule free_owner(owner, [](void* p) { delete static_cast<std::vector<float>*>(p); });
+  std::vector<py::ssize_t> shape{height, width};
+  if (channels > 1) shape.push_back(channels);
+  return py::array_t<float>(shape, owner->data(), free_owner);
+}
+
+}  // namespace
+
+void FilmPasses::read(const Film& film, int samples) {
+  width = film.width();
+  height = film.height();
+  samples_done = samples;
+  const size_t n = film.pixel_count();
+  primal.resize(n * 3);
+  gradient_x.resize(n * 3);
+  gradient_y.resize(n * 3);
+  emission.resize(n * 3);
+  variance.resize(n * 3);
+  shift_failures.resize(n);
+  film.primal_rgb(primal.data());
+  film.gradient_x_rgb(gradient_x.data());
+  film.gradient_y_rgb(gradient_y.data());
+  film.emission_rgb(emission.data());
+  film.variance3(variance.data());
+  film.shift_failures(shift_failures.data());
+}
+
+py::dict FilmPasses::to_python() const {
+  FilmPasses copy = *this;  // the Python arrays own their data; this object may be reused
+  py::dict d;
+  d["width"] = width;
+  d["height"] = height;
+  d["samples"] = samples_done;
+  d["primal"] = to_numpy(std::move(copy.primal), height, width, 3);
+  d["gradient_x"] = to_numpy(std::move(copy.gradient_x), height, width, 3);
+  d["gradient_y"] = to_numpy(std::move(copy.gradient_y), height, width, 3);
+  d["emission"] = to_numpy(std::move(copy.emission), height, width, 3);
+  d["variance"] = to_numpy(std::move(copy.variance), height, width, 3);
+  d["shift_failures"] = to_numpy(std::move(copy.shift_failures), height, width, 1);
+  return d;
+}
+
+// Shared between the worker (on_pass) and the Python thread (poll loop).
+struct RenderJob::State {
+  std::mutex mutex;
+  std::condition_variable wake;
+  RenderProgress progress;
+  bool pass_finished = false;  // a pass ended since the last poll
+  bool finished = false;       // the worker returned
+  bool want_snapshot = false;
+  bool snapshot_ready = false;
+  FilmPasses snapshot;
+  std::atomic<bool> cancel{false};
+  std::exception_ptr error;
+};
+
+RenderJob::RenderJob(SceneBuilder& builder, const RenderSettings& settings)
+    : session_(std::make_unique<RenderSession>(builder.take(), settings)),
+      state_(std::make_unique<State>()) {}
+
+RenderJob::~RenderJob() = default;
+
+void RenderJob::render(const py::function& poll, double poll_interval) {
+  State& st = *state_;
+  st.progress.samples_total = session_->settings().samples;
+
+  auto on_pass = [this, &st](const RenderProgress& p) {
+    std::lock_guard lock(st.mutex);
+    st.progress = p;
+    st.pass_finished = true;
+    if (st.want_snapshot) {
+      // The film is only consistent between passes: copy it now (a few memcpy-sized loops).
+      st.snapshot.read(session_->film(), p.samples_done);
+      st.want_snapshot = false;
+      st.snapshot_ready = true;
+    }
+    st.wake.notify_all();
+  };
+
+  std::thread worker;
+  {
+    py::gil_scoped_release no_gil;
+    worker = std::thread([this, &st, on_pass] {
+      try {
+        session_->render(on_pass, st.cancel);
+      } catch (...) {
+        std::lock_guard lock(st.mutex);
+        st.error = std::current_exception();
+      }
+      std::lock_guard lock(st.mutex);
+      st.finished = true;
+      st.wake.notify_all();
+    });
+  }
+
+  const auto interval = std::chrono::duration<double>(std::max(poll_interval, 0.01));
+  std::exception_ptr poll_error;
+  for (;;) {
+    RenderProgress progress;
+    bool finished = false, ready = false;
+    {
+      py::gil_scoped_release no_gil;
+      std::unique_lock lock(st.mutex);
+      st.wake.wait_for(lock, interval, [&] { return st.finished || st.pass_finished; });
+      st.pass_finished = false;
+      progress = st.progress;
+      finished = st.finished;
+      ready = st.snapshot_ready;
+    }
+    if (finished) break;
+    if (st.cancel.load()) continue;  // already cancelled: just wait for the worker
+    int flags = 0;
+    try {
+      flags = poll(progress.samples_done, progress.samples_total, progress.elapsed_seconds, ready)
+                  .cast<int>();
+    } catch (...) {
+      poll_error = std::current_exception();
+      flags = 1;
+    }
+    if (flags & 1) st.cancel.store(true);
+    if (flags & 2) {
+      std::lock_guard lock(st.mutex);
+      st.want_snapshot = true;
+      st.snapshot_ready = false;
+    }
+  }
+  {
+    py::gil_scoped_release no_gil;
+    worker.join();
+  }
+  if (st.error) std::rethrow_exception(st.error);
+  if (poll_error) std::rethrow_exception(poll_error);
+}
+
+py::dict RenderJob::snapshot() {
+  std::lock_guard lock(state_->mutex);
+  if (!state_->snapshot_ready) throw std::runtime_error("no snapshot has been taken");
+  state_->snapshot_ready = false;
+  return state_->snapshot.to_python();
+}
+
+py::dict RenderJob::passes() {
+  FilmPasses p;
+  {
+    py::gil_scoped_release no_gil;
+    p.read(session_->film(), int(session_->film().min_samples()));
+  }
+  return p.to_python();
+}
+
+std::string RenderJob::features_summary() const {
+  return session_->features_summary();
+}
+
+py::list RenderJob::warnings() const {
+  py::list out;
+  for (const std::string& w : session_->warnings()) out.append(w);
+  return out;
+}
+
+py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray& gradient_x,
+                                      const FloatArray& gradient_y,
+                                      const std::optional<FloatArray>& variance,
+                                      const std::optional<FloatArray>& emission,
+                                      const std::string& norm, float alpha, int threads) {
+  if (primal.ndim() < 2) throw std::invalid_argument("primal: expected a (height, width, 3) array");
+  const int height = int(primal.shape(0)), width = int(primal.shape(1));
+  const size_t rgb = size_t(width) * size_t(height) * 3;
+  for (const FloatArray* a : {&primal, &gradient_x, &gradient_y})
+    if (size_t(a->size()) != rgb) throw std::invalid_argument("passes differ in size");
+  if (variance && size_t(variance->size()) != rgb)
+    throw std::invalid_argument("variance: expected 3 values per pixel");
+  if (emission && size_t(emission->size()) != rgb)
+    throw std::invalid_argument("emission: expected 3 values per pixel");
+
+  ReconstructionSettings settings;
+  if (norm == "L1")
+    settings.norm = ReconstructionNorm::L1;
+  else if (norm == "L2")
+    settings.norm = ReconstructionNorm::L2;
+  else if (norm == "WEIGHTED")
+    settings.norm = ReconstructionNorm::Weighted;
+  else if (norm == "NONE")
+    settings.norm = ReconstructionNorm::None;
+  else
+    throw std::invalid_argument("unknown reconstruction norm '" + norm + "'");
+  settings.alpha = alpha;
+  settings.threads = threads;
+
+  ReconstructionInput input;
+  input.width = width;
+  input.height = height;
+  input.primal = primal.data();
+  input.gradient_x = gradient_x.data();
+  input.gradient_y = gradient_y.data();
+  input.variance = variance ? variance->data() : nullptr;
+  input.emission = emission ? emission->data() : nullptr;
+
+  std::vector<float> image;
+  {
+    py::gil_scoped_release no_gil;
+    image = reconstruct(input, settings);
+  }
+  return to_numpy(std::move(image), height, width, 3);
+}
+
+}  // namespace gdpt::python

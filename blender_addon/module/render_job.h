@@ -1,0 +1,59 @@
+// A render session driven from Blender's Python thread.
+//
+// Blender's RenderEngine API (test_break, update_result, update_stats) must be called from the
+// thread that runs render(). The core's RenderSession::render() blocks, so it runs on a worker
+// thread while the calling thread waits with the GIL released and wakes every `poll_interval`
+// seconds (and after each finished pass) to call the Python `poll` callback with the GIL held.
+// That keeps Esc responsive (within poll_interval, not one pass) and keeps every Blender call on
+// Blender's thread.
+//
+// Snapshots: the film may only be read between passes, so the worker copies the passes into a
+// snapshot inside its on_pass callback when the Python side has asked for one.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <memory>
+
+#include "blender_addon/module/scene_convert.h"
+#include "integrator/render_session.h"
+
+namespace gdpt::python {
+
+// The film passes as float32 images, row 0 at the bottom, interleaved.
+struct FilmPasses {
+  int width = 0, height = 0, samples_done = 0;
+  std::vector<float> primal, gradient_x, gradient_y, emission, variance, shift_failures;
+  void read(const Film& film, int samples);
+  py::dict to_python() const;  // numpy views owning copies of the vectors
+};
+
+class RenderJob {
+ public:
+  RenderJob(SceneBuilder& builder, const RenderSettings& settings);
+  ~RenderJob();
+
+  // Runs the render. poll(samples_done, samples_total, elapsed_seconds, snapshot_ready) returns a
+  // bitmask: 1 = cancel, 2 = take a snapshot after the next pass. Exceptions from the core or from
+  // poll cancel the render and propagate.
+  void render(const py::function& poll, double poll_interval);
+  py::dict snapshot();  // last snapshot taken (after poll saw snapshot_ready)
+  py::dict passes();    // the film after render() returned
+  std::string features_summary() const;
+  py::list warnings() const;
+
+ private:
+  struct State;
+  std::unique_ptr<RenderSession> session_;
+  std::unique_ptr<State> state_;
+};
+
+// Screened Poisson reconstruction of numpy passes (the same code as the CLI and the engine).
+py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray& gradient_x,
+                                      const FloatArray& gradient_y,
+                                      const std::optional<FloatArray>& variance,
+                                      const std::optional<FloatArray>& emission,
+                                      const std::string& norm, float alpha, int threads);
+
+}  // namespace gdpt::python

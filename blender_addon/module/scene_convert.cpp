@@ -1,0 +1,326 @@
+// See scene_convert.h for the dict layouts.
+#include "blender_addon/module/scene_convert.h"
+
+#include <cstring>
+#include <stdexcept>
+#include <type_traits>
+
+#include "shaders/image_io.h"
+
+namespace gdpt::python {
+
+namespace {
+
+// --- Small typed accessors: a missing key keeps the Scene's default --------------------------
+
+template <typename T>
+void get(const py::dict& d, const char* key, T& out) {
+  if (d.contains(key)) out = d[key].cast<T>();
+}
+
+void get_vec3(const py::dict& d, const char* key, Vec3f& out) {
+  if (!d.contains(key)) return;
+  const auto seq = d[key].cast<py::sequence>();
+  if (py::len(seq) < 3) throw std::invalid_argument(std::string(key) + ": expected 3 values");
+  out = Vec3f(seq[0].cast<float>(), seq[1].cast<float>(), seq[2].cast<float>());
+}
+
+Transform to_transform(const py::handle& obj, const char* what) {
+  const auto a = py::cast<FloatArray>(obj);
+  if (a.size() != 12 && a.size() != 16)
+    throw std::invalid_argument(std::string(what) + ": matrix needs 12 (3x4) or 16 (4x4) floats");
+  return Transform::from_rows(a.data());  // the first three rows either way
+}
+
+void get_transform(const py::dict& d, const char* key, Transform& out) {
+  if (d.contains(key)) out = to_transform(d[key], key);
+}
+
+std::string get_str(const py::dict& d, const char* key, const std::string& fallback) {
+  return d.contains(key) ? d[key].cast<std::string>() : fallback;
+}
+
+[[noreturn]] void bad_enum(const char* what, const std::string& value) {
+  throw std::invalid_argument(std::string("unknown ") + what + " '" + value + "'");
+}
+
+// --- Material inputs ---------------------------------------------------------------------------
+
+void read_lookup(const py::dict& d, TextureLookup& t) {
+  get(d, "image", t.image);
+  get_transform(d, "mapping", t.uv_mapping);
+  const std::string interp = get_str(d, "interpolation", "Linear");
+  if (interp == "Closest")
+    t.interpolation = TextureLookup::Interpolation::Closest;
+  else
+    t.interpolation = TextureLookup::Interpolation::Linear;  // Cubic / Smart approximated
+  const std::string ext = get_str(d, "extension", "REPEAT");
+  if (ext == "REPEAT")
+    t.extension = TextureLookup::Extension::Repeat;
+  else if (ext == "EXTEND")
+    t.extension = TextureLookup::Extension::Extend;
+  else if (ext == "CLIP")
+    t.extension = TextureLookup::Extension::Clip;
+  else
+    bad_enum("texture extension", ext);
+}
+
+void read_color(const py::dict& node, const char* key, ColorInput& out) {
+  if (!node.contains(key)) return;
+  const auto d = node[key].cast<py::dict>();
+  get_vec3(d, "value", out.value);
+  read_lookup(d, out.texture);
+}
+
+void read_float(const py::dict& node, const char* key, FloatInput& out) {
+  if (!node.contains(key)) return;
+  const auto d = node[key].cast<py::dict>();
+  get(d, "value", out.value);
+  read_lookup(d, out.texture);
+  const std::string channel = get_str(d, "channel", "LUMINANCE");
+  if (channel == "LUMINANCE")
+    out.channel = FloatInput::Channel::Luminance;
+  else if (channel == "RED")
+    out.channel = FloatInput::Channel::Red;
+  else if (channel == "ALPHA")
+    out.channel = FloatInput::Channel::Alpha;
+  else
+    bad_enum("float channel", channel);
+}
+
+ShaderNodeKind to_kind(const std::string& kind) {
+  if (kind == "DIFFUSE") return ShaderNodeKind::Diffuse;
+  if (kind == "GLOSSY") return ShaderNodeKind::Glossy;
+  if (kind == "GLASS") return ShaderNodeKind::Glass;
+  if (kind == "PRINCIPLED") return ShaderNodeKind::Principled;
+  if (kind == "EMISSION") return ShaderNodeKind::Emission;
+  if (kind == "TRANSPARENT") return ShaderNodeKind::Transparent;
+  if (kind == "MIX") return ShaderNodeKind::Mix;
+  if (kind == "ADD") return ShaderNodeKind::Add;
+  bad_enum("shader node kind", kind);
+}
+
+template <typename T>
+const T* checked_data(const py::array_t<T, py::array::c_style>& a, size_t expected,
+                      const char* what) {
+  if (size_t(a.size()) != expected)
+    throw std::invalid_argument(std::string(what) + ": expected " + std::to_string(expected) +
+                                " values, got " + std::to_string(a.size()));
+  return a.data();
+}
+
+}  // namespace
+
+// --- Geometry ----------------------------------------------------------------------------------
+
+int SceneBuilder::add_mesh(const FloatArray& positions, const IntArray& indices,
+                           const std::optional<FloatArray>& corner_normals,
+                           const std::optional<FloatArray>& corner_uvs,
+                           const std::optional<IntArray>& material_slot) {
+  if (positions.size() % 3 != 0) throw std::invalid_argument("positions: size not a multiple of 3");
+  if (indices.size() % 3 != 0) throw std::invalid_argument("indices: size not a multiple of 3");
+  const size_t vertex_count = size_t(positions.size()) / 3;
+  const size_t triangle_count = size_t(indices.size()) / 3;
+
+  Mesh mesh;
+  // Vec3f / Vec2f are trivially copyable packed floats: the numpy buffers are copied as bytes.
+  static_assert(sizeof(Vec3f) == 3 * sizeof(float) && sizeof(Vec2f) == 2 * sizeof(float));
+  static_assert(std::is_trivially_copyable_v<Vec3f> && std::is_trivially_copyable_v<Vec2f>);
+  mesh.positions.resize(vertex_count);
+  std::memcpy(static_cast<void*>(mesh.positions.data()), positions.data(),
+              vertex_count * sizeof(Vec3f));
+
+  mesh.indices.resize(triangle_count * 3);
+  const int32_t* idx = indices.data();
+  for (size_t i = 0; i < triangle_count * 3; ++i) {
+    // Validated here once, so the BVH build and the shading code can trust the indices.
+    if (idx[i] < 0 || size_t(idx[i]) >= vertex_count)
+      throw std::invalid_argument("indices: vertex index out of range");
+    mesh.indices[i] = uint32_t(idx[i]);
+  }
+  if (corner_normals && corner_normals->size() > 0) {
+    const float* n = checked_data(*corner_normals, triangle_count * 9, "corner_normals");
+    mesh.corner_normals.resize(triangle_count * 3);
+    std::memcpy(static_cast<void*>(mesh.corner_normals.data()), n,
+                triangle_count * 9 * sizeof(float));
+  }
+  if (corner_uvs && corner_uvs->size() > 0) {
+    const float* uv = checked_data(*corner_uvs, triangle_count * 6, "corner_uvs");
+    mesh.corner_uvs.resize(triangle_count * 3);
+    std::memcpy(static_cast<void*>(mesh.corner_uvs.data()), uv, triangle_count * 6 * sizeof(float));
+  }
+  if (material_slot && material_slot->size() > 0) {
+    const int32_t* s = checked_data(*material_slot, triangle_count, "material_slot");
+    mesh.material_slot.assign(s, s + triangle_count);
+  }
+  scene_.meshes.push_back(std::move(mesh));
+  return int(scene_.meshes.size()) - 1;
+}
+
+void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material) {
+  if (mesh < 0 || size_t(mesh) >= scene_.meshes.size())
+    throw std::invalid_argument("add_instance: mesh index out of range");
+  Instance inst;
+  inst.mesh = uint32_t(mesh);
+  inst.object_to_world = to_transform(matrix, "instance");
+  inst.slot_material.reserve(py::len(slot_material));
+  for (const auto& m : slot_material) {
+    const int32_t index = m.cast<int32_t>();
+    if (index >= int32_t(scene_.materials.size()))
+      throw std::invalid_argument("add_instance: material index out of range");
+    inst.slot_material.push_back(index);
+  }
+  scene_.instances.push_back(std::move(inst));
+}
+
+size_t SceneBuilder::triangle_count() const {
+  size_t n = 0;
+  for (const Instance& inst : scene_.instances) n += scene_.meshes[inst.mesh].triangle_count();
+  return n;
+}
+
+// --- Materials and images ----------------------------------------------------------------------
+
+int SceneBuilder::add_material(const py::dict& material) {
+  MaterialDesc desc;
+  desc.name = get_str(material, "name", "");
+  get(material, "root", desc.root);
+  if (material.contains("nodes")) {
+    for (const auto& item : material["nodes"].cast<py::list>()) {
+      const auto d = item.cast<py::dict>();
+      ShaderNode node;
+      node.kind = to_kind(get_str(d, "kind", "DIFFUSE"));
+      read_color(d, "color", node.color);
+      read_float(d, "roughness", node.roughness);
+      read_float(d, "ior", node.ior);
+      read_float(d, "strength", node.strength);
+      read_float(d, "fac", node.fac);
+      get(d, "a", node.a);
+      get(d, "b", node.b);
+      read_float(d, "metallic", node.metallic);
+      read_float(d, "specular", node.specular);
+      read_float(d, "specular_tint", node.specular_tint);
+      read_float(d, "transmission", node.transmission);
+      read_float(d, "alpha", node.alpha);
+      read_color(d, "emission", node.emission);
+      read_float(d, "emission_strength", node.emission_strength);
+      desc.nodes.push_back(node);
+    }
+  }
+  // Child and image indices are checked here so a bad export fails with a message, not a crash.
+  const auto n = int32_t(desc.nodes.size());
+  if (desc.root < -1 || desc.root >= n) throw std::invalid_argument("material root out of range");
+  for (const ShaderNode& node : desc.nodes) {
+    if (node.a < -1 || node.a >= n || node.b < -1 || node.b >= n)
+      throw std::invalid_argument("material '" + desc.name + "': child index out of range");
+    for (const TextureLookup* t :
+         {&node.color.texture, &node.roughness.texture, &node.ior.texture, &node.strength.texture,
+          &node.fac.texture, &node.metallic.texture, &node.specular.texture,
+          &node.specular_tint.texture, &node.transmission.texture, &node.alpha.texture,
+          &node.emission.texture, &node.emission_strength.texture}) {
+      if (t->image >= int32_t(scene_.images.size()))
+        throw std::invalid_argument("material '" + desc.name + "': image index out of range");
+    }
+  }
+  scene_.materials.push_back(std::move(desc));
+  return int(scene_.materials.size()) - 1;
+}
+
+int SceneBuilder::add_image(const std::string& name, int width, int height, const FloatArray& rgba,
+                            const std::string& colorspace) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("image '" + name + "': empty");
+  ImageDesc image;
+  image.name = name;
+  image.width = width;
+  image.height = height;
+  const size_t count = size_t(width) * size_t(height) * 4;
+  const float* p = checked_data(rgba, count, "image pixels");
+  image.rgba.assign(p, p + count);
+  if (!colorspace.empty()) convert_to_scene_linear(image, colorspace);
+  scene_.images.push_back(std::move(image));
+  return int(scene_.images.size()) - 1;
+}
+
+// --- Lights, camera, world ---------------------------------------------------------------------
+
+void SceneBuilder::add_light(const py::dict& d) {
+  Light light;
+  const std::string type = get_str(d, "type", "POINT");
+  if (type == "POINT")
+    light.type = Light::Type::Point;
+  else if (type == "SPOT")
+    light.type = Light::Type::Spot;
+  else if (type == "SUN")
+    light.type = Light::Type::Sun;
+  else if (type == "AREA")
+    light.type = Light::Type::Area;
+  else
+    bad_enum("light type", type);
+  const std::string shape = get_str(d, "shape", "SQUARE");
+  if (shape == "SQUARE")
+    light.shape = Light::Shape::Square;
+  else if (shape == "RECTANGLE")
+    light.shape = Light::Shape::Rectangle;
+  else if (shape == "DISK")
+    light.shape = Light::Shape::Disk;
+  else if (shape == "ELLIPSE")
+    light.shape = Light::Shape::Ellipse;
+  else
+    bad_enum("area light shape", shape);
+  get_transform(d, "matrix", light.light_to_world);
+  get_vec3(d, "color", light.color);
+  get(d, "power", light.power);
+  get(d, "radius", light.radius);
+  get(d, "spot_size", light.spot_size);
+  get(d, "spot_blend", light.spot_blend);
+  get(d, "sun_angle", light.sun_angle);
+  get(d, "size_x", light.size_x);
+  get(d, "size_y", light.size_y);
+  scene_.lights.push_back(light);
+}
+
+void SceneBuilder::set_camera(const py::dict& d) {
+  Camera& c = scene_.camera;
+  const std::string projection = get_str(d, "projection", "PERSP");
+  if (projection == "PERSP")
+    c.projection = Camera::Projection::Perspective;
+  else if (projection == "ORTHO")
+    c.projection = Camera::Projection::Orthographic;
+  else
+    bad_enum("camera projection", projection);
+  const std::string fit = get_str(d, "sensor_fit", "AUTO");
+  if (fit == "AUTO")
+    c.sensor_fit = Camera::SensorFit::Auto;
+  else if (fit == "HORIZONTAL")
+    c.sensor_fit = Camera::SensorFit::Horizontal;
+  else if (fit == "VERTICAL")
+    c.sensor_fit = Camera::SensorFit::Vertical;
+  else
+    bad_enum("sensor fit", fit);
+  get_transform(d, "matrix", c.camera_to_world);
+  get(d, "focal_length_mm", c.focal_length_mm);
+  get(d, "sensor_width_mm", c.sensor_width_mm);
+  get(d, "sensor_height_mm", c.sensor_height_mm);
+  get(d, "shift_x", c.shift_x);
+  get(d, "shift_y", c.shift_y);
+  get(d, "ortho_scale", c.ortho_scale);
+  get(d, "clip_start", c.clip_start);
+  get(d, "clip_end", c.clip_end);
+  get(d, "aperture_radius", c.aperture_radius);
+  get(d, "focus_distance", c.focus_distance);
+  get(d, "width", c.width);
+  get(d, "height", c.height);
+  get(d, "pixel_aspect", c.pixel_aspect);
+}
+
+void SceneBuilder::set_world(const py::dict& d) {
+  World& w = scene_.world;
+  get_vec3(d, "color", w.color);
+  get(d, "strength", w.strength);
+  get(d, "image", w.image);
+  if (w.image >= int32_t(scene_.images.size()))
+    throw std::invalid_argument("world: image index out of range");
+  get_transform(d, "rotation", w.rotation);
+}
+
+}  // namespace gdpt::python

@@ -1,0 +1,67 @@
+// Conversion of the add-on's flat numpy arrays and small dicts into the plain-data gdpt::Scene.
+//
+// The Python side (blender_addon/gdpt/export_*.py) owns every Blender concept; this layer only
+// checks shapes and copies contiguous float32/int32 buffers into the Scene's vectors (one memcpy
+// per array: the arrays are taken with noconvert, so a wrong dtype is an error, not a silent copy).
+//
+// Dict layouts (keys are the Scene field names):
+//   camera:   projection 'PERSP'|'ORTHO', sensor_fit 'AUTO'|'HORIZONTAL'|'VERTICAL', matrix (12
+//             floats, row-major 3x4), focal_length_mm, sensor_width_mm, sensor_height_mm, shift_x,
+//             shift_y, ortho_scale, clip_start, clip_end, aperture_radius, focus_distance, width,
+//             height, pixel_aspect
+//   light:    type 'POINT'|'SPOT'|'SUN'|'AREA', shape 'SQUARE'|'RECTANGLE'|'DISK'|'ELLIPSE',
+//             matrix, color (3), power, radius, spot_size, spot_blend, sun_angle, size_x, size_y
+//   world:    color (3), strength, image (int), rotation (12 floats)
+//   material: name, root, nodes: list of dicts {kind: 'DIFFUSE'|'GLOSSY'|'GLASS'|'PRINCIPLED'|
+//             'EMISSION'|'TRANSPARENT'|'MIX'|'ADD', a, b, and inputs color, roughness, ior,
+//             strength, fac, metallic, specular, specular_tint, transmission, alpha, emission,
+//             emission_strength}; a colour input is {value: (3), image, mapping (12), interpolation
+//             'Linear'|'Closest', extension 'REPEAT'|'EXTEND'|'CLIP'}, a float input the same with
+//             a scalar value and channel 'LUMINANCE'|'RED'|'ALPHA'.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <optional>
+#include <string>
+
+#include "integrator/scene.h"
+
+namespace gdpt::python {
+
+namespace py = pybind11;
+
+using FloatArray = py::array_t<float, py::array::c_style>;
+using IntArray = py::array_t<int32_t, py::array::c_style>;
+
+// Incrementally filled scene; handed over (moved) to a render session.
+class SceneBuilder {
+ public:
+  // positions: (n, 3); indices: (m, 3) or flat 3m, int32 vertex indices; corner_normals: (m, 3, 3)
+  // or empty; corner_uvs: (m, 3, 2) or empty; material_slot: (m,) or empty. Returns the mesh index.
+  int add_mesh(const FloatArray& positions, const IntArray& indices,
+               const std::optional<FloatArray>& corner_normals,
+               const std::optional<FloatArray>& corner_uvs,
+               const std::optional<IntArray>& material_slot);
+  void add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material);
+  int add_material(const py::dict& material);
+  // rgba: (h, w, 4) or flat, row 0 at the bottom; converted to scene linear from `colorspace`
+  // unless it is empty (already scene linear).
+  int add_image(const std::string& name, int width, int height, const FloatArray& rgba,
+                const std::string& colorspace);
+  void add_light(const py::dict& light);
+  void set_camera(const py::dict& camera);
+  void set_world(const py::dict& world);
+
+  size_t mesh_count() const { return scene_.meshes.size(); }
+  size_t instance_count() const { return scene_.instances.size(); }
+  size_t triangle_count() const;
+  Scene take() { return std::move(scene_); }
+  const Scene& scene() const { return scene_; }
+
+ private:
+  Scene scene_;
+};
+
+}  // namespace gdpt::python

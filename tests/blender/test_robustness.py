@@ -1,0 +1,155 @@
+# Behaviour around the render rather than the image:
+#  - an unsupported node is reported as a warning naming the node, once per material, is followed
+#    through its mute pass-through link, and the render still finishes and writes its image;
+#  - a scene without a camera reports a clear error and renders nothing;
+#  - cancelling (test_break) stops within a second and keeps (and reconstructs) the samples done;
+#  - time_limit stops on time with the samples done.
+# (The "Sample k/N" console lines are checked by test_installed.sh on a plain command line.)
+import os
+import sys
+import time
+
+import bpy
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(__file__))
+import scenes as S  # noqa: E402
+
+
+def check(cond, message):
+    if not cond:
+        raise AssertionError(message)
+    print("ok:", message, flush=True)
+
+
+def basic_scene(scene):
+    S.room()
+    S.camera((0, -5.5, 2.0), (0, 0, 1.6), lens=30)
+    S.light('AREA', (0, 0, 3.95), 150.0, target=(0, 0, 0), size=1.0)
+
+
+def test_unsupported_node(out):
+    import gdpt.engine as engine
+    scene = S.clear()
+    basic_scene(scene)
+    # Toon BSDF: unsupported shader, no shader pass-through -> magenta stand-in.
+    toon = S.shader_material("toon", "ShaderNodeBsdfToon", Color=(0.2, 0.8, 0.2, 1))
+    S.uv_sphere("ball", 0.6, (-0.8, 0.3, 0.6), toon)
+    # Bright/Contrast between an RGB node and the Diffuse colour: followed through its pass-through.
+    m, nt, outn = S._material("bc")
+    rgb = nt.nodes.new("ShaderNodeRGB")
+    rgb.outputs[0].default_value = (0.1, 0.2, 0.9, 1)
+    bc = nt.nodes.new("ShaderNodeBrightContrast")
+    bc.name = "My Bright Contrast"
+    bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    nt.links.new(rgb.outputs[0], bc.inputs["Color"])
+    nt.links.new(bc.outputs[0], bsdf.inputs["Color"])
+    nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
+    S.uv_sphere("ball2", 0.6, (0.8, 0.3, 0.6), m)
+    S.setup_gdpt(scene, 8)
+    path = S.render(scene, os.path.join(out, "unsupported.exr"))
+    info = engine.LAST_RENDER
+    check(info.get("status") == "finished", f"render finished ({info.get('status')})")
+    warnings = info.get("warnings", [])
+    print("\n".join(warnings))
+    toon_w = [w for w in warnings if "Toon BSDF" in w and "'toon'" in w]
+    bc_w = [w for w in warnings if "My Bright Contrast" in w]
+    check(len(toon_w) == 1, "one warning names the Toon BSDF node of material 'toon'")
+    check(len(bc_w) == 1, "one warning names the Bright/Contrast node")
+    img = S.read_rgb(path)
+    check(img.mean() > 0.01, "the image was written")
+    # The pass-through keeps the RGB node's blue: the right sphere is bluer than it is red.
+    right = img[:, 40:56]
+    check(right[..., 2].mean() > right[..., 0].mean(), "pass-through kept the RGB colour")
+
+
+def test_no_camera(out):
+    import gdpt.engine as engine
+    scene = S.clear()
+    basic_scene(scene)
+    bpy.data.objects.remove(scene.camera)
+    scene.camera = None
+    S.setup_gdpt(scene, 4)
+    engine.LAST_RENDER.clear()
+    engine.LAST_ERROR.clear()
+    scene.render.filepath = os.path.join(out, "nocam.exr")
+    # Blender refuses before calling the engine ("Cannot render, no camera"); the engine's own
+    # check covers the cases that get past it. Either way: a clear error and no image.
+    message = ""
+    try:
+        bpy.ops.render.render(write_still=True)
+    except RuntimeError as e:
+        message = str(e)
+    message += " " + engine.LAST_ERROR.get("message", "")
+    check("no camera" in message or "no active camera" in message,
+          f"clear error reported: '{message.strip()}'")
+    check(not engine.LAST_RENDER, "nothing was rendered")
+    check(not os.path.exists(scene.render.filepath), "no image written")
+
+
+def test_cancel(out):
+    """Esc in a background render is SIGINT: Blender sets its break flag, which test_break()
+    reports. The render must stop within a second, keep and reconstruct the samples done; the
+    Render Result is then saved (Blender skips write_still after a break)."""
+    import signal
+    import threading
+    import gdpt.engine as engine
+    scene = S.clear()
+    basic_scene(scene)
+    S.uv_sphere("ball", 0.8, (0, 0.3, 0.8), S.diffuse("ball", (0.8, 0.8, 0.8)))
+    S.setup_gdpt(scene, 1000000, reconstruction='L1')
+    scene.gdpt.time_limit = 30.0  # backstop: a broken cancel fails the checks, it does not hang
+    pressed = {}
+
+    def press_esc():
+        pressed["t"] = time.perf_counter()
+        os.kill(os.getpid(), signal.SIGINT)
+
+    timer = threading.Timer(2.0, press_esc)
+    timer.start()
+    bpy.ops.render.render()
+    ended = time.perf_counter()
+    timer.join()
+    info = engine.LAST_RENDER
+    check(info.get("status") == "cancelled", f"the render was cancelled ({info.get('status')})")
+    check(0 < info["samples"] < 1000000, f"kept {info['samples']} samples")
+    latency = ended - pressed["t"] - info["reconstruct"] - info["write"]
+    check(latency < 1.0, f"stopped {latency:.3f} s after Esc (excluding reconstruction)")
+    path = os.path.join(out, "cancel.exr")
+    s = scene.render.image_settings
+    s.file_format, s.color_depth = 'OPEN_EXR', '32'
+    bpy.data.images["Render Result"].save_render(path, scene=scene)
+    img = S.read_rgb(path)
+    check(img.mean() > 0.01 and np.isfinite(img).all(), "the partial image is in the result")
+
+
+def test_time_limit(out):
+    import gdpt.engine as engine
+    scene = S.clear()
+    basic_scene(scene)
+    S.setup_gdpt(scene, 1000000)
+    scene.gdpt.time_limit = 1.0
+    t0 = time.perf_counter()
+    S.render(scene, os.path.join(out, "time_limit.exr"))
+    elapsed = time.perf_counter() - t0
+    info = engine.LAST_RENDER
+    check(info.get("status") == "finished" and 0 < info["samples"] < 1000000,
+          f"time limit kept {info.get('samples')} samples")
+    check(info["render"] < 2.0, f"render phase took {info['render']:.2f} s for a 1 s limit")
+    print(f"total {elapsed:.2f} s")
+
+
+def main():
+    out = S.args()["out"]
+    os.makedirs(out, exist_ok=True)
+    test_unsupported_node(out)
+    test_no_camera(out)
+    test_time_limit(out)
+    test_cancel(out)  # last: Blender's break flag stays set afterwards
+    print("ALL ROBUSTNESS CHECKS PASSED", flush=True)
+    # Blender turns the SIGINT break flag into a non-zero exit status at quit; every check has
+    # passed at this point, so leave with success explicitly.
+    sys.exit(0)
+
+
+main()
