@@ -3,9 +3,24 @@
 // with forward differences and zero (Neumann) rows at the last column / row, per RGB channel.
 // Images are interleaved RGB float, `width * height * 3`, in rows as stored (the gradient
 // convention dy(x, y) = I(x, y + 1) - I(x, y) refers to those rows).
+//
+// Norms (docs/reconstruct.md has the details and measured numbers):
+//   L2        exact direct solve by the 2-D DCT, in double precision.
+//   L1        IRLS from the L2 solution. The L1 term of a pixel is the Euclidean norm of its RGB
+//             residual (the reweighting weights are shared across RGB, so this is the objective
+//             they minimise): objective = sum_px alpha |I - primal|_RGB + |Dx I - dx|_RGB + |Dy I -
+//             dy|_RGB.
+//   Weighted  Rousselle et al. 2016: every squared term weighted by the inverse of its per-pixel
+//             variance (floored), the primal term also by alpha^2 (alpha = 1 is the maximum-
+//             likelihood weighting); Jacobi-preconditioned CG from the L2 solution to
+//             `weighted_tolerance`.
+//   None      primal (+ emission).
+// Non-finite inputs are missing data: a term (primal, dx or dy of a pixel) with any non-finite
+// channel gets zero weight. The output is always finite.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace gdpt {
@@ -16,6 +31,18 @@ struct ReconstructionSettings {
   ReconstructionNorm norm = ReconstructionNorm::L1;
   float alpha = 0.2f;  // must be > 0
   int threads = 0;     // 0 = all cores
+
+  // L1: reweightings, and Jacobi-PCG steps per reweighting (chosen by bench_reconstruct).
+  int l1_reweightings = 36;
+  int l1_cg_steps = 10;
+  // Weighted (and L2 with missing data): stop at |b - A I| <= tolerance |b| per channel.
+  double weighted_tolerance = 1e-4;
+  int max_cg_iterations = 2000;
+  // FFTW_MEASURE plans (kept as wisdom in ~/.cache/gdpt/fftw-wisdom): worth it when the same size
+  // is solved repeatedly in one process (the add-on); FFTW_ESTIMATE otherwise.
+  bool fft_measure = false;
+  // Called with the completed fraction in [0, 1] (from the calling thread).
+  std::function<void(float)> progress;
 };
 
 struct ReconstructionInput {
@@ -31,6 +58,8 @@ struct ReconstructionReport {
   int iterations = 0;      // total inner iterations
   double objective = 0.0;  // final value of the objective for the chosen norm
   double seconds = 0.0;
+  double relative_residual = 0.0;  // CG exit residual |b - A I| / |b| (0 for the direct solve)
+  int missing_values = 0;          // non-finite input terms treated as missing
 };
 
 // Returns RGB `width * height * 3`. Throws std::invalid_argument on bad input (alpha <= 0, sizes,
@@ -38,5 +67,10 @@ struct ReconstructionReport {
 std::vector<float> reconstruct(const ReconstructionInput& input,
                                const ReconstructionSettings& settings,
                                ReconstructionReport* report = nullptr);
+
+// The objective of `norm` (as documented above) for `image`, in double precision; missing terms
+// are skipped. For Weighted, `input.variance` is required.
+double reconstruction_objective(const ReconstructionInput& input, ReconstructionNorm norm,
+                                float alpha, const float* image);
 
 }  // namespace gdpt

@@ -1,0 +1,42 @@
+// Exact L2 screened Poisson solve by the 2-D DCT (Bhat et al. 2008, "Fourier analysis of the 2D
+// screened Poisson equation for gradient domain problems").
+//
+// With forward differences and Neumann rows at the last column / row, the normal-equation
+// operator  alpha^2 + Dx^T Dx + Dy^T Dy  has the DCT-II basis as eigenvectors, with eigenvalues
+//   alpha^2 + (2 - 2 cos(pi kx / W)) + (2 - 2 cos(pi ky / H)).
+// So  I = DCT-III( DCT-II(b) / eigenvalue ) / (4 W H)  with  b = alpha^2 primal + Dx^T dx + Dy^T
+// dy. The solve runs in double precision: with alpha -> 1e-4 the DC term is alpha^2 * sum(primal)
+// next to O(1) divergence values, which float cannot hold.
+//
+// FFTW plans (REDFT10 forward, REDFT01 inverse, 3 contiguous planes at once) are created once per
+// (size, threads, effort) and cached for the life of the process; FFTW_MEASURE plans also load and
+// save FFTW wisdom in $XDG_CACHE_HOME/gdpt/fftw-wisdom (or ~/.cache/gdpt/fftw-wisdom).
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+
+namespace gdpt::detail {
+
+// SIMD-aligned double buffer from fftw_malloc (FFTW requires the alignment of the planning buffer).
+struct FftwFree {
+  void operator()(double* p) const;
+};
+using DctBuffer = std::unique_ptr<double[], FftwFree>;
+DctBuffer dct_alloc(size_t count);
+
+// Inputs are interleaved RGB floats, all finite. `planes` holds 3 planes of width * height doubles
+// (from dct_alloc) and receives the solution per channel. `threads` >= 1 is the FFTW thread count;
+// the row passes run in the caller's TBB arena.
+void solve_l2_dct(int width, int height, double alpha, const float* primal, const float* gradient_x,
+                  const float* gradient_y, double* planes, int threads, bool measure);
+
+// One forward (REDFT10) and one inverse (REDFT01) transform of the 3 planes, unnormalised, through
+// the same cached plans as solve_l2_dct: the benchmark's reference cost.
+void dct_round_trip(int width, int height, double* planes, int threads, bool measure);
+
+// Path of the FFTW wisdom file used by FFTW_MEASURE plans.
+std::string fftw_wisdom_path();
+
+}  // namespace gdpt::detail

@@ -1,0 +1,224 @@
+// gdpt-reconstruct: screened Poisson reconstruction of a GDPT multilayer EXR.
+//
+//   gdpt-reconstruct IN.exr -o OUT.exr [--alpha A] [--norm l1|l2|weighted|none] [--layer NAME]
+//                    [--view V] [--threads N]
+//
+// Reads `<layer>.Primal`, `<layer>.Gradient X`, `<layer>.Gradient Y` (and `Variance` for
+// --norm weighted, `Emission` when present), writes Combined = solve(...) + Emission.
+// OUT.exr: single-part RGBA float EXR, scene linear. OUT.png / .jpg / .jpeg / .tif: 8-bit through
+// the OpenColorIO view transform.
+// Exit status: 0 success, 1 unreadable or invalid input (or unwritable output), 2 bad arguments.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "reconstruct/display.h"
+#include "reconstruct/exr_io.h"
+#include "reconstruct/reconstruct.h"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: gdpt-reconstruct IN.exr -o OUT.(exr|png|jpg|tif) [options]\n"
+    "\n"
+    "Reconstructs the final image from the Primal, Gradient X and Gradient Y passes of a\n"
+    "multilayer EXR (Blender naming: <ViewLayer>.<Pass>.R/G/B), adds the Emission pass when\n"
+    "present, and writes it: EXR as RGBA scene linear, PNG/JPEG/TIFF through OpenColorIO.\n"
+    "\n"
+    "options:\n"
+    "  -o, --output FILE     output image (required)\n"
+    "  --alpha A             weight of the primal term, > 0 (default 0.2)\n"
+    "  --norm NORM           l1 (default), l2, weighted (needs a Variance pass), none\n"
+    "  --layer NAME          view layer (default: the first layer with a Primal pass)\n"
+    "  --view V              OCIO view transform for PNG/JPEG, e.g. Filmic or Standard\n"
+    "                        (default: the config's default view; config from $OCIO or\n"
+    "                        Blender's bundled config)\n"
+    "  --threads N           worker threads (default 0 = all cores)\n"
+    "  -h, --help            this help\n"
+    "\n"
+    "exit status: 0 ok, 1 unreadable or invalid input, 2 bad arguments\n";
+
+struct Options {
+  std::string input, output, layer, view;
+  gdpt::ReconstructionSettings settings;
+  bool display = false;  // output through OCIO
+};
+
+[[noreturn]] void bad_arguments(const std::string& message) {
+  std::fprintf(stderr, "gdpt-reconstruct: %s (see --help)\n", message.c_str());
+  std::exit(2);
+}
+
+std::string lower_extension(const std::string& path) {
+  const size_t dot = path.rfind('.');
+  if (dot == std::string::npos || path.find('/', dot) != std::string::npos) return {};
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+double parse_number(const std::string& option, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0') bad_arguments(option + " expects a number, got '" + text + "'");
+  return v;
+}
+
+Options parse(int argc, char** argv) {
+  Options o;
+  o.settings.norm = gdpt::ReconstructionNorm::L1;
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) bad_arguments("no input file");
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) bad_arguments(a + " needs a value");
+      return args[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (a == "-o" || a == "--output") {
+      o.output = value();
+    } else if (a == "--alpha") {
+      const double alpha = parse_number(a, value());
+      if (!(alpha > 0) || alpha > 1e30) bad_arguments("--alpha must be > 0");
+      o.settings.alpha = float(alpha);
+    } else if (a == "--norm") {
+      const std::string n = value();
+      if (n == "l1")
+        o.settings.norm = gdpt::ReconstructionNorm::L1;
+      else if (n == "l2")
+        o.settings.norm = gdpt::ReconstructionNorm::L2;
+      else if (n == "weighted")
+        o.settings.norm = gdpt::ReconstructionNorm::Weighted;
+      else if (n == "none")
+        o.settings.norm = gdpt::ReconstructionNorm::None;
+      else
+        bad_arguments("--norm must be l1, l2, weighted or none, got '" + n + "'");
+    } else if (a == "--layer") {
+      o.layer = value();
+      if (o.layer.empty()) bad_arguments("--layer needs a name");
+    } else if (a == "--view") {
+      o.view = value();
+    } else if (a == "--threads") {
+      const double t = parse_number(a, value());
+      if (t < 0 || t > 4096 || t != int(t)) bad_arguments("--threads must be an integer >= 0");
+      o.settings.threads = int(t);
+    } else if (a.size() > 1 && a[0] == '-') {
+      bad_arguments("unknown option '" + a + "'");
+    } else if (o.input.empty()) {
+      o.input = a;
+    } else {
+      bad_arguments("more than one input file ('" + o.input + "', '" + a + "')");
+    }
+  }
+  if (o.input.empty()) bad_arguments("no input file");
+  if (o.output.empty()) bad_arguments("no output file (-o OUT.exr)");
+  const std::string ext = lower_extension(o.output);
+  if (ext == "exr") {
+    o.display = false;
+  } else if (ext == "png" || ext == "jpg" || ext == "jpeg" || ext == "tif" || ext == "tiff") {
+    o.display = true;
+  } else {
+    bad_arguments("output must end in .exr, .png, .jpg, .jpeg or .tif, got '" + o.output + "'");
+  }
+  return o;
+}
+
+// Progress on stderr, only once a run has taken more than a second, at most twice a second.
+class Progress {
+ public:
+  void stage(const char* name, float fraction) {
+    const double t = elapsed();
+    if (t < 1.0 || (t - last_ < 0.5 && fraction < 1.f)) return;
+    last_ = t;
+    std::fprintf(stderr, "gdpt-reconstruct: %s %3d%% (%.1f s)\n", name,
+                 int(fraction * 100.f + 0.5f), t);
+  }
+  double elapsed() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  double last_ = -1.0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options o = parse(argc, argv);
+  Progress progress;
+
+  // The view is an argument: check it before the (possibly long) solve.
+  std::optional<gdpt::DisplayTransform> display;
+  if (o.display || !o.view.empty()) {
+    try {
+      display = gdpt::resolve_display_transform(o.view);
+    } catch (const std::invalid_argument& e) {
+      bad_arguments(e.what());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "gdpt-reconstruct: %s\n", e.what());
+      return 1;
+    }
+  }
+
+  try {
+    const bool weighted = o.settings.norm == gdpt::ReconstructionNorm::Weighted;
+    std::vector<std::string> required = {"Primal"};
+    if (o.settings.norm != gdpt::ReconstructionNorm::None) {
+      required.push_back("Gradient X");
+      required.push_back("Gradient Y");
+    }
+    if (weighted) required.push_back("Variance");
+    const gdpt::ExrPasses in = gdpt::read_exr_passes(o.input, o.layer, required, {"Emission"});
+    progress.stage("read", 1.f);
+
+    gdpt::ReconstructionInput input;
+    input.width = in.width;
+    input.height = in.height;
+    input.primal = in.passes.at("Primal").data();
+    if (o.settings.norm != gdpt::ReconstructionNorm::None) {
+      input.gradient_x = in.passes.at("Gradient X").data();
+      input.gradient_y = in.passes.at("Gradient Y").data();
+    }
+    if (weighted) input.variance = in.passes.at("Variance").data();
+    if (auto it = in.passes.find("Emission"); it != in.passes.end())
+      input.emission = it->second.data();
+
+    gdpt::ReconstructionSettings settings = o.settings;
+    settings.progress = [&](float f) { progress.stage("solve", f); };
+    gdpt::ReconstructionReport report;
+    const std::vector<float> image = gdpt::reconstruct(input, settings, &report);
+
+    if (o.display)
+      gdpt::write_display_image(o.output, *display, in.width, in.height, image);
+    else
+      gdpt::write_rgba_exr(o.output, in.width, in.height, image);
+
+    static const char* kNames[] = {"l2", "l1", "weighted", "none"};
+    std::printf(
+        "gdpt-reconstruct: %s layer '%s' %dx%d norm %s alpha %g: %d iterations, "
+        "objective %.6g, %.2f s solve, %.2f s total%s%s\n",
+        o.output.c_str(), in.layer.c_str(), in.width, in.height, kNames[int(o.settings.norm)],
+        double(o.settings.alpha), report.iterations, report.objective, report.seconds,
+        progress.elapsed(), input.emission ? ", emission added" : "",
+        o.display ? (", view '" + display->view + "'").c_str() : "");
+    if (report.missing_values > 0)
+      std::fprintf(stderr,
+                   "gdpt-reconstruct: warning: %d non-finite input values treated as missing\n",
+                   report.missing_values);
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "gdpt-reconstruct: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gdpt-reconstruct: %s\n", e.what());
+    return 1;
+  }
+}

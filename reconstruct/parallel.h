@@ -1,0 +1,53 @@
+// Deterministic row-parallel loops for the reconstruction passes.
+//
+// Images are cut into fixed chunks of `kRowsPerChunk` rows whatever the thread count, and every
+// reduction is summed chunk by chunk in chunk order, so a solve gives bit-identical results on 1
+// or 32 threads. Loops run in the caller's TBB arena (reconstruct() sets one up from
+// ReconstructionSettings::threads).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace gdpt::detail {
+
+// 8 rows of a 1080p RGB float image are ~180 KB per array: big enough to amortise scheduling,
+// small enough that the five arrays a stencil pass touches stay in L2.
+inline constexpr int kRowsPerChunk = 8;
+
+inline int chunk_count(int height) {
+  return (height + kRowsPerChunk - 1) / kRowsPerChunk;
+}
+
+// body(y_begin, y_end) for every chunk, in parallel.
+template <class Body>
+void parallel_rows(int height, const Body& body) {
+  const int chunks = chunk_count(height);
+  tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& r) {
+    for (int c = r.begin(); c != r.end(); ++c)
+      body(c * kRowsPerChunk, std::min(height, (c + 1) * kRowsPerChunk));
+  });
+}
+
+// Deterministic reduction of N doubles: body(y_begin, y_end, std::array<double, N>& sums) adds
+// its chunk's contribution to `sums` (zeroed per chunk); the chunk sums are then added in order.
+template <int N, class Body>
+std::array<double, N> parallel_rows_sum(int height, const Body& body) {
+  const int chunks = chunk_count(height);
+  std::vector<std::array<double, N>> partial(chunks);
+  tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& r) {
+    for (int c = r.begin(); c != r.end(); ++c) {
+      partial[c].fill(0.0);
+      body(c * kRowsPerChunk, std::min(height, (c + 1) * kRowsPerChunk), partial[c]);
+    }
+  });
+  std::array<double, N> total{};
+  for (const auto& p : partial)
+    for (int i = 0; i < N; ++i) total[i] += p[i];
+  return total;
+}
+
+}  // namespace gdpt::detail

@@ -1,0 +1,367 @@
+#include "reconstruct/reconstruct.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+
+#include "reconstruct/dct_solver.h"
+#include "reconstruct/parallel.h"
+#include "reconstruct/weighted_cg.h"
+
+namespace gdpt {
+
+namespace {
+
+using detail::parallel_rows;
+using detail::parallel_rows_sum;
+
+// Parameters of the reweighting and weighting schemes (docs/reconstruct.md).
+// w = 1 / (|e| + reg); reg decays geometrically from 0.05 to the value the reference L1D scheme
+// ends at after its 20 halvings, whatever the number of reweightings: the final reg, not the
+// number of CG steps, decides how close IRLS gets to the L1 minimum (bench_reconstruct --sweep).
+constexpr double kL1InitialRegulariser = 0.05;
+constexpr double kL1FinalRegulariser = 0.05 / 524288.0;  // 0.05 / 2^19
+constexpr double kVarianceFloor = 1e-3;                  // variances floored at 1e-3 x their mean
+
+enum TermBits : uint8_t { kPrimal = 1, kDx = 2, kDy = 4, kAll = 7 };
+
+// Inputs with non-finite values replaced by 0, and which terms of each pixel take part.
+struct Prepared {
+  int width = 0, height = 0;
+  const float* primal = nullptr;
+  const float* gradient_x = nullptr;
+  const float* gradient_y = nullptr;
+  std::vector<float> primal_copy, gx_copy, gy_copy;  // only when something is missing
+  std::vector<uint8_t> terms;                        // per pixel TermBits; empty = all present
+  int missing = 0;
+
+  uint8_t terms_at(size_t i) const { return terms.empty() ? uint8_t(kAll) : terms[i]; }
+};
+
+bool finite3(const float* v) {
+  return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+Prepared prepare(const ReconstructionInput& in, bool need_gradients) {
+  Prepared p;
+  p.width = in.width;
+  p.height = in.height;
+  p.primal = in.primal;
+  p.gradient_x = in.gradient_x;
+  p.gradient_y = in.gradient_y;
+  const int W = in.width;
+  const auto count = parallel_rows_sum<1>(in.height, [&](int y0, int y1, std::array<double, 1>& s) {
+    for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
+      s[0] += !finite3(in.primal + 3 * i);
+      if (need_gradients) s[0] += !finite3(in.gradient_x + 3 * i) + !finite3(in.gradient_y + 3 * i);
+    }
+  });
+  p.missing = int(count[0]);
+  if (p.missing == 0) return p;
+
+  const size_t n = size_t(W) * in.height;
+  p.terms.assign(n, kAll);
+  auto sanitise = [&](const float* src, std::vector<float>& dst, uint8_t bit) {
+    dst.resize(3 * n);
+    parallel_rows(in.height, [&](int y0, int y1) {
+      for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
+        const bool ok = finite3(src + 3 * i);
+        for (int c = 0; c < 3; ++c) dst[3 * i + c] = ok ? src[3 * i + c] : 0.f;
+        if (!ok) p.terms[i] &= uint8_t(~bit);
+      }
+    });
+  };
+  sanitise(in.primal, p.primal_copy, kPrimal);
+  p.primal = p.primal_copy.data();
+  if (need_gradients) {
+    sanitise(in.gradient_x, p.gx_copy, kDx);
+    sanitise(in.gradient_y, p.gy_copy, kDy);
+    p.gradient_x = p.gx_copy.data();
+    p.gradient_y = p.gy_copy.data();
+  }
+  return p;
+}
+
+// Calls body(i, terms, e0, ex, ey, sums) per pixel with the term residuals
+//   e0 = I - primal,  ex = Dx I - dx,  ey = Dy I - dy   (RGB; ex / ey zero where absent),
+// where `terms` has the Neumann boundary bits cleared; returns the deterministic sum.
+template <class Body>
+double for_each_term(const Prepared& pr, const float* x, const Body& body) {
+  const int W = pr.width, H = pr.height;
+  return parallel_rows_sum<1>(H, [&](int y0, int y1, std::array<double, 1>& s) {
+    for (int y = y0; y < y1; ++y)
+      for (int xx = 0; xx < W; ++xx) {
+        const size_t i = size_t(y) * W + xx;
+        uint8_t t = pr.terms_at(i);
+        if (xx == W - 1) t &= uint8_t(~kDx);
+        if (y == H - 1) t &= uint8_t(~kDy);
+        float e0[3], ex[3] = {0, 0, 0}, ey[3] = {0, 0, 0};
+        for (int c = 0; c < 3; ++c) {
+          e0[c] = x[3 * i + c] - pr.primal[3 * i + c];
+          if (t & kDx) ex[c] = x[3 * (i + 1) + c] - x[3 * i + c] - pr.gradient_x[3 * i + c];
+          if (t & kDy) ey[c] = x[3 * (i + W) + c] - x[3 * i + c] - pr.gradient_y[3 * i + c];
+        }
+        s[0] += body(i, t, e0, ex, ey);
+      }
+  })[0];
+}
+
+double norm3(const float* e) {
+  return std::sqrt(double(e[0]) * e[0] + double(e[1]) * e[1] + double(e[2]) * e[2]);
+}
+double squared3(const float* e) {
+  return double(e[0]) * e[0] + double(e[1]) * e[1] + double(e[2]) * e[2];
+}
+
+// Per-pixel weights of a quadratic problem (alpha^2 folded into w0).
+struct Weights {
+  std::vector<float> w0, wx, wy;
+  explicit Weights(size_t n) : w0(n), wx(n), wy(n) {}
+};
+
+Weights uniform_weights(const Prepared& pr, double alpha) {
+  const int W = pr.width, H = pr.height;
+  Weights w(size_t(W) * H);
+  const float a2 = float(alpha * alpha);
+  parallel_rows(H, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < W; ++x) {
+        const size_t i = size_t(y) * W + x;
+        const uint8_t t = pr.terms_at(i);
+        w.w0[i] = (t & kPrimal) ? a2 : 0.f;
+        w.wx[i] = (t & kDx) && x < W - 1 ? 1.f : 0.f;
+        w.wy[i] = (t & kDy) && y < H - 1 ? 1.f : 0.f;
+      }
+  });
+  return w;
+}
+
+// Inverse-variance weights. Variances are floored at kVarianceFloor x their mean (a zero-variance
+// pixel must not get an infinite weight) and every weight is multiplied by that mean, so the
+// float weights stay O(1) whatever the image's scale (a common factor does not move the minimum).
+struct VarianceScale {
+  double mean = 1.0, floor = 1.0;
+};
+
+VarianceScale variance_scale(const Prepared& pr, const float* variance) {
+  const int W = pr.width;
+  const auto s = parallel_rows_sum<2>(pr.height, [&](int y0, int y1, std::array<double, 2>& a) {
+    for (size_t i = 3 * size_t(y0) * W; i < 3 * size_t(y1) * W; ++i)
+      if (std::isfinite(variance[i]) && variance[i] > 0) {
+        a[0] += variance[i];
+        a[1] += 1;
+      }
+  });
+  VarianceScale v;
+  if (s[1] > 0 && s[0] > 0) v.mean = s[0] / s[1];
+  v.floor = kVarianceFloor * v.mean;
+  return v;
+}
+
+Weights variance_weights(const Prepared& pr, const float* variance, double alpha,
+                         const VarianceScale& vs) {
+  const int W = pr.width, H = pr.height;
+  Weights w(size_t(W) * H);
+  auto inverse = [&](float v) {
+    return std::isfinite(v) ? float(vs.mean / std::max(double(v), vs.floor)) : 0.f;
+  };
+  parallel_rows(H, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < W; ++x) {
+        const size_t i = size_t(y) * W + x;
+        const uint8_t t = pr.terms_at(i);
+        w.w0[i] = (t & kPrimal) ? float(alpha * alpha) * inverse(variance[3 * i]) : 0.f;
+        w.wx[i] = (t & kDx) && x < W - 1 ? inverse(variance[3 * i + 1]) : 0.f;
+        w.wy[i] = (t & kDy) && y < H - 1 ? inverse(variance[3 * i + 2]) : 0.f;
+      }
+  });
+  return w;
+}
+
+detail::WeightedProblem make_problem(const Prepared& pr, const Weights& w) {
+  detail::WeightedProblem pb;
+  pb.width = pr.width;
+  pb.height = pr.height;
+  pb.primal = pr.primal;
+  pb.gradient_x = pr.gradient_x;
+  pb.gradient_y = pr.gradient_y;
+  pb.w0 = w.w0.data();
+  pb.wx = w.wx.data();
+  pb.wy = w.wy.data();
+  return pb;
+}
+
+double objective(const Prepared& pr, ReconstructionNorm norm, double alpha, const float* variance,
+                 const float* x) {
+  switch (norm) {
+    case ReconstructionNorm::L1:
+      return for_each_term(
+          pr, x, [&](size_t, uint8_t t, const float* e0, const float* ex, const float* ey) {
+            return ((t & kPrimal) ? alpha * norm3(e0) : 0.0) + norm3(ex) + norm3(ey);
+          });
+    case ReconstructionNorm::Weighted: {
+      const VarianceScale vs = variance_scale(pr, variance);
+      auto inverse = [&](float v) {
+        return std::isfinite(v) ? 1.0 / std::max(double(v), vs.floor) : 0.0;
+      };
+      return for_each_term(
+          pr, x, [&](size_t i, uint8_t t, const float* e0, const float* ex, const float* ey) {
+            return ((t & kPrimal) ? alpha * alpha * inverse(variance[3 * i]) * squared3(e0) : 0.0) +
+                   inverse(variance[3 * i + 1]) * squared3(ex) +
+                   inverse(variance[3 * i + 2]) * squared3(ey);
+          });
+    }
+    case ReconstructionNorm::L2:
+    case ReconstructionNorm::None:
+      return for_each_term(
+          pr, x, [&](size_t, uint8_t t, const float* e0, const float* ex, const float* ey) {
+            return ((t & kPrimal) ? alpha * alpha * squared3(e0) : 0.0) + squared3(ex) +
+                   squared3(ey);
+          });
+  }
+  return 0.0;
+}
+
+void validate(const ReconstructionInput& in, ReconstructionNorm norm, float alpha) {
+  if (in.width <= 0 || in.height <= 0)
+    throw std::invalid_argument("reconstruct: image size must be positive, got " +
+                                std::to_string(in.width) + "x" + std::to_string(in.height));
+  if (size_t(in.width) * size_t(in.height) > size_t(std::numeric_limits<int>::max()) / 3)
+    throw std::invalid_argument("reconstruct: image too large");
+  if (!in.primal) throw std::invalid_argument("reconstruct: primal is required");
+  if (norm == ReconstructionNorm::None) return;
+  if (!in.gradient_x || !in.gradient_y)
+    throw std::invalid_argument("reconstruct: gradient_x and gradient_y are required");
+  if (!(alpha > 0.f) || !std::isfinite(alpha))
+    throw std::invalid_argument("reconstruct: alpha must be > 0, got " + std::to_string(alpha));
+  if (norm == ReconstructionNorm::Weighted && !in.variance)
+    throw std::invalid_argument("reconstruct: the Weighted norm needs the variance buffer");
+}
+
+// The exact uniform L2 solution of the (sanitised) data, as interleaved float.
+std::vector<float> l2_solution(const Prepared& pr, double alpha, int threads, bool measure) {
+  const int W = pr.width, H = pr.height;
+  const size_t plane = size_t(W) * H;
+  detail::DctBuffer planes = detail::dct_alloc(3 * plane);
+  detail::solve_l2_dct(W, H, alpha, pr.primal, pr.gradient_x, pr.gradient_y, planes.get(), threads,
+                       measure);
+  std::vector<float> x(3 * plane);
+  parallel_rows(H, [&](int y0, int y1) {
+    for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i)
+      for (int c = 0; c < 3; ++c) x[3 * i + c] = float(planes[c * plane + i]);
+  });
+  return x;
+}
+
+}  // namespace
+
+double reconstruction_objective(const ReconstructionInput& input, ReconstructionNorm norm,
+                                float alpha, const float* image) {
+  validate(input, norm == ReconstructionNorm::None ? ReconstructionNorm::L2 : norm, alpha);
+  const Prepared pr = prepare(input, true);
+  return objective(pr, norm, alpha, input.variance, image);
+}
+
+std::vector<float> reconstruct(const ReconstructionInput& input,
+                               const ReconstructionSettings& settings,
+                               ReconstructionReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  validate(input, settings.norm, settings.alpha);
+  const int threads = settings.threads > 0 ? settings.threads : tbb::info::default_concurrency();
+  auto progress = [&](float f) {
+    if (settings.progress) settings.progress(f);
+  };
+
+  const int W = input.width, H = input.height;
+  const size_t n = size_t(W) * H;
+  const double alpha = settings.alpha;
+  ReconstructionReport rep;
+  std::vector<float> x;
+
+  tbb::task_arena arena(threads);
+  arena.execute([&] {
+    const bool gradients = settings.norm != ReconstructionNorm::None;
+    const Prepared pr = prepare(input, gradients);
+    rep.missing_values = pr.missing;
+    progress(0.f);
+
+    if (!gradients) {
+      x.assign(input.primal, input.primal + 3 * n);  // non-finite values become 0 below
+    } else {
+      x = l2_solution(pr, alpha, threads, settings.fft_measure);
+      detail::CgWorkspace ws;
+      if (settings.norm == ReconstructionNorm::L2 && pr.missing > 0) {
+        // Missing terms break the DCT's constant coefficients: finish with CG on the masked
+        // system from the DCT solution of the zero-filled data.
+        const Weights w = uniform_weights(pr, alpha);
+        auto pb = make_problem(pr, w);
+        const auto inv_diag = detail::jacobi_inverse_diagonal(pb);
+        pb.inv_diagonal = inv_diag.data();
+        const auto cg = detail::solve_weighted_cg(pb, x.data(), settings.max_cg_iterations,
+                                                  settings.weighted_tolerance, ws);
+        rep.iterations = cg.iterations;
+        rep.relative_residual = cg.relative_residual;
+      } else if (settings.norm == ReconstructionNorm::L1) {
+        // IRLS: each reweighting solves  min sum w e^2  with w = s^2 / (s |e| + reg) from the
+        // current iterate (s = alpha for the primal term, 1 for gradients), which majorises the
+        // L1 objective.
+        Weights w(n);
+        const int K = std::max(1, settings.l1_reweightings);
+        const double decay =
+            K > 1 ? std::pow(kL1FinalRegulariser / kL1InitialRegulariser, 1.0 / (K - 1)) : 1.0;
+        double reg = K > 1 ? kL1InitialRegulariser : kL1FinalRegulariser;
+        for (int k = 0; k < K; ++k, reg *= decay) {
+          for_each_term(
+              pr, x.data(),
+              [&](size_t i, uint8_t t, const float* e0, const float* ex, const float* ey) {
+                w.w0[i] = (t & kPrimal) ? float(alpha * alpha / (alpha * norm3(e0) + reg)) : 0.f;
+                w.wx[i] = (t & kDx) ? float(1.0 / (norm3(ex) + reg)) : 0.f;
+                w.wy[i] = (t & kDy) ? float(1.0 / (norm3(ey) + reg)) : 0.f;
+                return 0.0;
+              });
+          auto pb = make_problem(pr, w);
+          const auto inv_diag = detail::jacobi_inverse_diagonal(pb);
+          pb.inv_diagonal = inv_diag.data();
+          const auto cg = detail::solve_weighted_cg(pb, x.data(), settings.l1_cg_steps, 0.0, ws);
+          rep.iterations += cg.iterations;
+          rep.relative_residual = cg.relative_residual;
+          progress(float(k + 1) / float(K + 1));
+        }
+      } else if (settings.norm == ReconstructionNorm::Weighted) {
+        const VarianceScale vs = variance_scale(pr, input.variance);
+        const Weights w = variance_weights(pr, input.variance, alpha, vs);
+        auto pb = make_problem(pr, w);
+        const auto inv_diag = detail::jacobi_inverse_diagonal(pb);
+        pb.inv_diagonal = inv_diag.data();
+        const auto cg = detail::solve_weighted_cg(pb, x.data(), settings.max_cg_iterations,
+                                                  settings.weighted_tolerance, ws);
+        rep.iterations = cg.iterations;
+        rep.relative_residual = cg.relative_residual;
+      }
+    }
+    if (gradients) rep.objective = objective(pr, settings.norm, alpha, input.variance, x.data());
+
+    // Output = solution + very-direct emission; nothing non-finite leaves this function.
+    parallel_rows(H, [&](int y0, int y1) {
+      for (size_t i = 3 * size_t(y0) * W; i < 3 * size_t(y1) * W; ++i) {
+        float v = x[i];
+        if (input.emission && std::isfinite(input.emission[i])) v += input.emission[i];
+        x[i] = std::isfinite(v) ? v : 0.f;
+      }
+    });
+    progress(1.f);
+  });
+
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (report) *report = rep;
+  return x;
+}
+
+}  // namespace gdpt
