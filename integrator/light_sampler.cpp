@@ -18,7 +18,7 @@
 #include "integrator/environment_map.h"
 #include "integrator/light_distribution.h"
 #include "integrator/lights/area_light.h"
-#include "integrator/lights/sphere_light.h"
+#include "integrator/lights/point_light.h"
 #include "integrator/lights/sun_light.h"
 #include "integrator/lights/triangle_light.h"
 #include "integrator/lights/warp.h"
@@ -27,7 +27,7 @@ namespace gdpt {
 
 namespace {
 
-enum class Kind : uint8_t { Sphere, Area, Sun, Triangle, World };
+enum class Kind : uint8_t { Point, Area, Sun, Triangle, World };
 
 struct Entry {
   Kind kind;
@@ -70,7 +70,7 @@ float scene_radius(const Scene& scene) {
 
 struct LightSampler::Impl {
   std::span<const Material> materials;
-  std::vector<lights::SphereLight> spheres;
+  std::vector<lights::PointLight> points;
   std::vector<lights::AreaLight> areas;
   std::vector<lights::SunLight> suns;
   std::vector<lights::TriangleLight> triangles;
@@ -104,11 +104,11 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
     switch (l.type) {
       case Light::Type::Point:
       case Light::Type::Spot: {
-        const lights::SphereLight s = lights::SphereLight::from_light(l);
+        const lights::PointLight s = lights::PointLight::from_light(l);
         const float p = s.power();
         if (!(p > 0.0f) || !std::isfinite(p)) break;
-        I.entries.push_back({Kind::Sphere, uint32_t(I.spheres.size())});
-        I.spheres.push_back(s);
+        I.entries.push_back({Kind::Point, uint32_t(I.points.size())});
+        I.points.push_back(s);
         weights.push_back(p);
         break;
       }
@@ -215,8 +215,8 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
     const float pmf = I.selection.pmf(e);
     const Entry& en = I.entries[e];
     switch (en.kind) {
-      case Kind::Sphere:
-        I.spheres[en.index].select_pmf = pmf;
+      case Kind::Point:
+        I.points[en.index].select_pmf = pmf;
         break;
       case Kind::Area:
         I.areas[en.index].select_pmf = pmf;
@@ -253,8 +253,8 @@ LightSample LightSampler::sample(Vec3f ref, float u_select, Vec2f u) const {
   if (!(pmf > 0.0f)) return s;
   bool ok = false;
   switch (e.kind) {
-    case Kind::Sphere:
-      ok = I.spheres[e.index].sample(ref, u, s);
+    case Kind::Point:
+      ok = I.points[e.index].sample(ref, u, s);
       break;
     case Kind::Area:
       ok = I.areas[e.index].sample(ref, u, s);
@@ -313,13 +313,13 @@ float LightSampler::pdf_triangle(uint32_t instance, uint32_t primitive, Vec3f re
 bool LightSampler::intersect(Vec3f origin, Vec3f direction, float t_max, LightHit& hit) const {
   const Impl& I = *impl_;
   float best = t_max;
-  const lights::SphereLight* sphere = nullptr;
+  const lights::PointLight* point = nullptr;
   const lights::AreaLight* area = nullptr;
-  for (const lights::SphereLight& s : I.spheres) {
+  for (const lights::PointLight& s : I.points) {
     const float t = s.intersect_t(origin, direction, best);
     if (t > 0.0f) {
       best = t;
-      sphere = &s;
+      point = &s;
       area = nullptr;
     }
   }
@@ -328,12 +328,12 @@ bool LightSampler::intersect(Vec3f origin, Vec3f direction, float t_max, LightHi
     if (t > 0.0f) {
       best = t;
       area = &a;
-      sphere = nullptr;
+      point = nullptr;
     }
   }
-  if (sphere) {
-    sphere->fill_hit(origin, direction, best, hit);
-    hit.pdf *= sphere->select_pmf;
+  if (point) {
+    point->fill_hit(origin, direction, best, hit);
+    hit.pdf *= point->select_pmf;
     return true;
   }
   if (area) {

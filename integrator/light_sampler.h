@@ -1,4 +1,4 @@
-// All light sources of a scene behind one interface: point/sphere, spot, sun, area lights,
+// All light sources of a scene behind one interface: point (radius: disc), spot, sun, area lights,
 // emissive triangles (sampled by power) and the world (constant or importance-sampled image).
 // Units and looks as Cycles: area radiance = P / (pi A), point/spot intensity = P / (4 pi) per
 // steradian, sun = irradiance in W/m^2.
@@ -45,7 +45,7 @@ class LightSampler {
   // Density of sample() choosing the point hit on emissive triangle (instance, primitive).
   float pdf_triangle(uint32_t instance, uint32_t primitive, Vec3f ref_position,
                      Vec3f light_position, Vec3f light_normal) const;
-  // Closest analytic light (sphere, spot sphere, area, sun disc) along the ray with t < t_max.
+  // Closest analytic light (point/spot disc, area, sun disc) along the ray with t < t_max.
   // Sun discs are at infinity: reported only for unbounded rays (t_max >= 1e30, Ray's default,
   // or +inf), i.e. rays that escaped the geometry. Emissive triangles are geometry, not here.
   bool intersect(Vec3f origin, Vec3f direction, float t_max, LightHit& hit) const;

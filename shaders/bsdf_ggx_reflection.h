@@ -44,10 +44,13 @@ inline Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo) {
 
 inline float pdf(const Closure& c, Vec3f wi, Vec3f wo) {
   if (is_delta_alpha(c.alpha) || !(wi.z * wo.z > 0.0f)) return 0.0f;
+  // Density only: D(h) G1(wi) / (4 cos_i), without the Fresnel and G1(wo) of the value.
   const MirroredPair p(wi, wo);
-  float pdf;
-  eval_pdf_upper(c, p.wi, p.wo, pdf);
-  return pdf;
+  const Vec3f sum = p.wi + p.wo;
+  const float len2 = length_squared(sum);
+  if (!(len2 > 0.0f)) return 0.0f;
+  const GGX ggx(c.alpha);
+  return ggx.D(sum / std::sqrt(len2)) * ggx.G1(p.wi) / (4.0f * p.wi.z);
 }
 
 inline BsdfSample sample(const Closure& c, Vec3f wi_, float, Vec2f u) {

@@ -1,17 +1,19 @@
-// Blender point and spot lights (Cycles 3.4 units).
+// Blender point and spot lights, exactly as Cycles 3.4 (kernel/light/light.h, LIGHT_POINT and
+// LIGHT_SPOT; scene/light.cpp for the constants).
 //
 // Parameters (from gdpt::Light):
 //   power P [W], color c      radiant intensity I = c P / (4 pi) [W/sr] (Cycles: strength / 4 pi)
-//   radius r [m]              r = 0: a delta light; r > 0: a sphere of uniform radiance
-//                             L = I / (pi r^2), so that its far field is the same intensity I
+//   radius r [m]              r = 0: a delta light. r > 0: a disc of radius r through the light
+//                             centre, always facing the receiver, of radiance L = I / (pi r^2)
+//                             (Cycles 3.4's "sphere" light; 4.x made it a true sphere). A receiver
+//                             at distance d gets I / (d^2 + r^2) at normal incidence.
 //   spot_size (full angle)    spot only: cone half angle a = spot_size / 2
-//   spot_blend b              spot only: Cycles 3.4 attenuation of the intensity along a direction
-//                             at angle t from the axis: cos t * smoothstep((cos t - cos a) /
-//                             ((1 - cos a) b)), 0 outside the cone (yes, 3.4 keeps the cos t)
-// The spot attenuation is evaluated for the direction from the light centre to the receiver.
-// Spheres are sampled uniformly in the solid angle of the cone they subtend (Cycles 4 does the
-// same; Cycles 3.4 used a disc facing the receiver, which subtends slightly less solid angle).
-// A receiver inside the sphere gets no light from it, and rays starting inside do not hit it.
+//   spot_blend b              spot only: the emission along a direction at angle t from the axis
+//                             is scaled by cos t * smoothstep((cos t - cos a) / ((1 - cos a) b)),
+//                             0 outside the cone (3.4 keeps the leading cos t). The direction is
+//                             from the sampled disc point to the receiver, as Cycles.
+// The disc is sampled uniformly by area and the pdf converted to solid angle; since its
+// orientation depends only on the receiver (the ray origin), intersect() reports the same pdf.
 #pragma once
 
 #include <cmath>
@@ -22,7 +24,7 @@
 
 namespace gdpt::lights {
 
-struct SphereLight {
+struct PointLight {
   Vec3f center;
   float radius = 0.0f;
   Spectrum intensity;  // W/sr
@@ -32,10 +34,10 @@ struct SphereLight {
   float smooth = 0.0f;      // (1 - cos_half_angle) * blend
   float select_pmf = 0.0f;  // filled by LightSampler
 
-  static SphereLight from_light(const Light& l) {
-    SphereLight s;
+  static PointLight from_light(const Light& l) {
+    PointLight s;
     s.center = l.light_to_world.translation();
-    s.radius = std::max(0.0f, l.radius);
+    s.radius = std::isfinite(l.radius) ? std::max(0.0f, l.radius) : 0.0f;
     s.intensity = l.color * (std::max(0.0f, l.power) * kInv4Pi);
     if (l.type == Light::Type::Spot) {
       s.is_spot = true;
@@ -66,28 +68,19 @@ struct SphereLight {
     return c;
   }
 
-  Spectrum sphere_radiance(Vec3f receiver) const {
-    const Vec3f to = receiver - center;
-    const float d2 = length_squared(to);
-    return intensity * (attenuation(to / std::sqrt(d2)) / (kPi * radius * radius));
-  }
-
-  float cone_one_minus_cos(float d2) const { return one_minus_cos_from_sin2(radius * radius / d2); }
-
   // Fills s without the selection probability.
   bool sample(Vec3f ref, Vec2f u, LightSample& s) const {
-    const Vec3f to_center = center - ref;
-    const float d2 = length_squared(to_center);
-    if (!(d2 > radius * radius)) return false;  // inside (or at) the light
+    const Vec3f from_center = ref - center;
+    const float d2 = length_squared(from_center);
+    if (!(d2 > 0.0f)) return false;
     const float d = std::sqrt(d2);
-    const Vec3f w = to_center / d;
-    const float atten = attenuation(-w);
-    if (atten <= 0.0f) return false;
     if (radius == 0.0f) {
+      const float atten = attenuation(from_center / d);
+      if (!(atten > 0.0f)) return false;
       s.radiance = intensity * (atten / d2);
       s.position = center;
       s.normal = Vec3f(0.0f);
-      s.direction = w;
+      s.direction = -from_center / d;
       s.distance = d;
       s.pdf = 1.0f;
       s.is_delta = true;
@@ -95,47 +88,52 @@ struct SphereLight {
       s.valid = true;
       return true;
     }
-    const float omc = cone_one_minus_cos(d2);
-    const Vec3f local = square_to_cone(u, omc);
-    const Vec3f dir = Frame(w).to_world(local);
-    // Distance to the near intersection with the sphere along dir (law of cosines).
-    const float cos_t = local.z;
-    const float sin2_t = std::max(0.0f, 1.0f - cos_t * cos_t);
-    const float t = d * cos_t - std::sqrt(std::max(0.0f, radius * radius - d2 * sin2_t));
-    const Vec3f p = ref + dir * t;
+    const Vec3f disc_normal = from_center / d;  // faces the receiver
+    const Frame f(disc_normal);
+    const Vec2f q = square_to_disk(u) * radius;
+    const Vec3f p = center + f.s * q.x + f.t * q.y;
+    const Vec3f to = p - ref;
+    const float t2 = length_squared(to);
+    const float t = std::sqrt(t2);
+    const Vec3f dir = to / t;
+    const float atten = attenuation(-dir);
+    if (!(atten > 0.0f)) return false;
+    const float cos_l = -dot(dir, disc_normal);  // = d / t > 0
     s.radiance = intensity * (atten / (kPi * radius * radius));
     s.position = p;
-    s.normal = normalize(p - center);
+    s.normal = disc_normal;
     s.direction = dir;
     s.distance = t;
-    s.pdf = cone_pdf(omc);
+    s.pdf = t2 / (kPi * radius * radius * cos_l);
     s.is_delta = false;
     s.is_infinite = false;
     s.valid = s.pdf > 0.0f && std::isfinite(s.pdf);
     return s.valid;
   }
 
-  // Nearest hit with 0 < t < t_max; returns t or a negative value.
+  // Hit of the disc facing the ray origin with 0 < t < t_max; returns t or a negative value.
   float intersect_t(Vec3f o, Vec3f d, float t_max) const {
     if (radius <= 0.0f) return -1.0f;
-    const Vec3f oc = o - center;
-    const float c = length_squared(oc) - radius * radius;
-    if (c <= 0.0f) return -1.0f;  // origin inside: see the header comment
-    const float b = dot(oc, d);
-    if (b >= 0.0f) return -1.0f;  // pointing away
-    const float disc = b * b - c;
-    if (disc < 0.0f) return -1.0f;
-    // Stable near root: t = c / (-b + sqrt(disc)).
-    const float t = c / (-b + std::sqrt(disc));
-    return (t > 0.0f && t < t_max) ? t : -1.0f;
+    const Vec3f from_center = o - center;
+    const float dist2 = length_squared(from_center);
+    if (!(dist2 > 0.0f)) return -1.0f;
+    const float dist = std::sqrt(dist2);
+    const float cos_l = -dot(d, from_center) / dist;
+    if (!(cos_l > 0.0f)) return -1.0f;
+    const float t = dist / cos_l;
+    if (!(t < t_max)) return -1.0f;
+    const Vec3f q = o + d * t - center;
+    return length_squared(q) <= radius * radius ? t : -1.0f;
   }
 
   void fill_hit(Vec3f o, Vec3f d, float t, LightHit& hit) const {
+    const Vec3f disc_normal = normalize(o - center);
+    const float cos_l = -dot(d, disc_normal);
     hit.distance = t;
     hit.position = o + d * t;
-    hit.normal = normalize(hit.position - center);
-    hit.radiance = sphere_radiance(o);
-    hit.pdf = cone_pdf(cone_one_minus_cos(length_squared(center - o)));
+    hit.normal = disc_normal;
+    hit.radiance = intensity * (attenuation(-d) / (kPi * radius * radius));
+    hit.pdf = t * t / (kPi * radius * radius * cos_l);
   }
 };
 

@@ -2,7 +2,7 @@
 # origin (normal +Z) under one light with Cycles, 0 bounces, Standard view transform, and prints
 # the mean radiance of the 8x8 image (albedo 1: radiance = E / pi).
 # Usage: blender -b --factory-startup --python cycles_reference.py -- KIND [SAMPLES]
-#   KIND: area, area_scaled, disk, point, spot, sun. Writes /tmp/lights_cycles/out_KIND.exr.
+#   KIND: area, area_scaled, disk, point, point_radius, spot, spot_radius, sun. Writes /tmp/lights_cycles/out_KIND.exr.
 import bpy, math, sys
 argv = sys.argv[sys.argv.index("--") + 1:]
 kind = argv[0]
@@ -41,6 +41,13 @@ elif kind == "disk":
 elif kind == "point":
     l = bpy.data.lights.new("l", 'POINT'); l.shadow_soft_size = 0.0; l.energy = 100.0
     lo = bpy.data.objects.new("l", l); lo.location = (0, 0, 3)
+elif kind == "point_radius":
+    l = bpy.data.lights.new("l", 'POINT'); l.shadow_soft_size = 0.5; l.energy = 100.0
+    lo = bpy.data.objects.new("l", l); lo.location = (0, 0, 1.5)
+elif kind == "spot_radius":
+    l = bpy.data.lights.new("l", 'SPOT'); l.shadow_soft_size = 0.3; l.energy = 80.0
+    l.spot_size = 0.8; l.spot_blend = 0.6
+    lo = bpy.data.objects.new("l", l); lo.location = (0.4, 0, 1.5)
 elif kind == "spot":
     l = bpy.data.lights.new("l", 'SPOT'); l.shadow_soft_size = 0.0; l.energy = 100.0
     l.spot_size = 1.0; l.spot_blend = 0.5

@@ -41,29 +41,33 @@ TEST(PointLight, DeltaIrradianceIsInverseSquare) {
   EXPECT_NEAR(e.irradiance, 100.0 / (4.0 * kPiD * 25.0) * std::sqrt(0.5), 1e-6);
 }
 
-TEST(PointLight, SphereSolidAngleAndIrradiance) {
+TEST(PointLight, RadiusIsADiscFacingTheReceiver) {
   Scene scene = black_scene();
   Light l = make_light(Light::Type::Point, {0, 0, 2}, {0, 0, -1}, 50.0f);
   l.radius = 0.5f;
   scene.lights.push_back(l);
   const LightSampler lights(scene, {}, {});
-  const test::Estimate e = estimate(lights, {0, 0, 0}, {0, 0, 1}, 40000);
-  const double omega = 2.0 * kPiD * (1.0 - std::sqrt(1.0 - 0.25 / 4.0));
-  EXPECT_NEAR(e.solid_angle, omega, 1e-4 * omega);
-  // A fully visible sphere of radiance I / (pi r^2) gives exactly I / d^2 at normal incidence.
-  const double expected = 50.0 / (4.0 * kPiD) / 4.0;
-  EXPECT_NEAR(e.irradiance, expected, 2e-3 * expected);
+  const test::Estimate e = estimate(lights, {0, 0, 0}, {0, 0, 1}, 250000);
+  // Cycles 3.4: a disc of radius r facing the receiver, radiance I / (pi r^2).
+  const double omega = 2.0 * kPiD * (1.0 - 2.0 / std::sqrt(4.0 + 0.25));
+  EXPECT_NEAR(e.solid_angle, omega, 5e-3 * omega);
+  const double expected = 50.0 / (4.0 * kPiD) / (4.0 + 0.25);  // I / (d^2 + r^2)
+  EXPECT_NEAR(e.irradiance, expected, 3e-3 * expected);
 }
 
-TEST(PointLight, InsideSphereGivesNoLight) {
+TEST(PointLight, ReceiverAtTheCentreGivesNoLightAndNoNaN) {
   Scene scene = black_scene();
   Light l = make_light(Light::Type::Point, {0, 0, 0}, {0, 0, -1}, 50.0f);
   l.radius = 1.0f;
   scene.lights.push_back(l);
   const LightSampler lights(scene, {}, {});
-  EXPECT_FALSE(lights.sample({0.1f, 0, 0}, 0.3f, {0.2f, 0.7f}).valid);
+  EXPECT_FALSE(lights.sample({0, 0, 0}, 0.3f, {0.2f, 0.7f}).valid);
   LightHit hit;
-  EXPECT_FALSE(lights.intersect({0.1f, 0, 0}, {1, 0, 0}, 1e30f, hit));
+  EXPECT_FALSE(lights.intersect({0, 0, 0}, {1, 0, 0}, 1e30f, hit));
+  // Very close to the centre: still finite.
+  const LightSample s = lights.sample({1e-3f, 0, 0}, 0.3f, {0.2f, 0.7f});
+  ASSERT_TRUE(s.valid);
+  EXPECT_TRUE(std::isfinite(s.pdf) && is_finite(s.radiance));
 }
 
 // Cycles 3.4 spot attenuation, written out independently: cos * smoothstep over the blend band.
@@ -98,19 +102,38 @@ TEST(SpotLight, OnAxisAndBlendBand) {
   EXPECT_FALSE(lights.sample({4.0f, 0, 0}, 0.5f, {0.5f, 0.5f}).valid);
 }
 
-TEST(SpotLight, SphereSpotMatchesPointWithinCone) {
+TEST(SpotLight, DiscSpotAgainstQuadrature) {
   Scene scene = black_scene();
-  Light l = make_light(Light::Type::Spot, {0, 0, 3}, {0, 0, -1}, 80.0f);
+  const Vec3f c(0.4f, 0, 1.5f);
+  Light l = make_light(Light::Type::Spot, c, {0, 0, -1}, 80.0f);
   l.radius = 0.3f;
-  l.spot_size = 2.0f;
-  l.spot_blend = 0.0f;
+  l.spot_size = 0.8f;
+  l.spot_blend = 0.6f;
   scene.lights.push_back(l);
   const LightSampler lights(scene, {}, {});
-  const test::Estimate e = estimate(lights, {0, 0, 0}, {0, 0, 1}, 40000);
-  const double omega = 2.0 * kPiD * (1.0 - std::sqrt(1.0 - 0.09 / 9.0));
-  EXPECT_NEAR(e.solid_angle, omega, 1e-4 * omega);
-  const double expected = 80.0 / (4.0 * kPiD * 9.0);  // on axis: attenuation cos 0 = 1
-  EXPECT_NEAR(e.irradiance, expected, 2e-3 * expected);
+  // Quadrature over the disc facing the receiver at the origin; the attenuation uses the
+  // direction from each disc point to the receiver. The disc straddles the cone's edge.
+  const Vec3f dn = normalize(Vec3f(0, 0, 0) - c);
+  const Frame f(dn);
+  const double r = 0.3, L = 80.0 / (4.0 * kPiD) / (kPiD * r * r);
+  double omega = 0, E = 0;
+  const int nr = 400, np = 800;
+  for (int i = 0; i < nr; ++i)
+    for (int j = 0; j < np; ++j) {
+      const double rho = r * (i + 0.5) / nr, phi = 2 * kPiD * (j + 0.5) / np;
+      const double dA = rho * (r / nr) * (2 * kPiD / np);
+      const Vec3f p = c + f.s * float(rho * std::cos(phi)) + f.t * float(rho * std::sin(phi));
+      const double d2 = length_squared(p);
+      const Vec3f w = normalize(p);  // receiver -> disc point
+      const double cos_l = -dot(w, dn);
+      const double atten = cycles_spot(w.z, 0.8, 0.6);  // axis (0,0,-1) . (-w)
+      // Disc points outside the cone give no light sample: count only the lit part.
+      if (atten > 0.0) omega += cos_l / d2 * dA;
+      E += L * atten * std::max(0.0, double(w.z)) * cos_l / d2 * dA;
+    }
+  const test::Estimate e = estimate(lights, {0, 0, 0}, {0, 0, 1}, 250000);
+  EXPECT_NEAR(e.solid_angle, omega, 5e-3 * omega);
+  EXPECT_NEAR(e.irradiance, E, 3e-3 * E);
 }
 
 TEST(SunLight, IrradianceAsCycles) {

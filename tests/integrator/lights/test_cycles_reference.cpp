@@ -1,7 +1,8 @@
 // Brightness against Cycles itself: irradiance at the origin (normal +Z) for the six light set-ups
-// of cycles_reference.py, compared with the radiance Blender 3.4.1 Cycles rendered on a white
-// Lambert plane there (256 spp, 0 bounces; radiance = E / pi). This pins the units (area
-// P / (4 A) with object scale, point P / (4 pi), spot cos * smoothstep, sun disc) to Cycles.
+// of cycles_reference.py (eight of them), compared with the radiance Blender 3.4.1 Cycles rendered
+// on a white Lambert plane there (256 spp, 1024 for the two lights with a radius; 0 bounces;
+// radiance = E / pi). This pins the units (area P / (4 A) with object scale, point P / (4 pi),
+// radius as a facing disc, spot cos * smoothstep, sun disc) to Cycles.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -59,15 +60,28 @@ TEST(CyclesReference, RenderedRadianceOfALambertPlane) {
   spot.spot_size = 1.0f;
   spot.spot_blend = 0.5f;
   spot.light_to_world = frame({3.0f * std::tan(0.35f), 0, 3});
+  Light point_radius = point;
+  point_radius.radius = 0.5f;
+  point_radius.light_to_world = frame({0, 0, 1.5f});
+  Light spot_radius = spot;
+  spot_radius.radius = 0.3f;
+  spot_radius.power = 80.0f;
+  spot_radius.spot_size = 0.8f;
+  spot_radius.spot_blend = 0.6f;
+  spot_radius.light_to_world = frame({0.4f, 0, 1.5f});
   Light sun;
   sun.type = Light::Type::Sun;
   sun.power = 3.0f;
   sun.sun_angle = 10.0f * float(kPiD) / 180.0f;
   sun.light_to_world = frame({0, 0, 0}, 30.0f);
-  const Case cases[] = {
-      {"area", area, 1.8372802380472422},  {"area_scaled", area_scaled, 1.7016874235123396},
-      {"disk", disk, 2.4488340467214584},  {"point", point, 0.2814468815922737},
-      {"spot", spot, 0.21915356907993555}, {"sun", sun, 0.825493011623621}};
+  const Case cases[] = {{"area", area, 1.8372802380472422},
+                        {"area_scaled", area_scaled, 1.7016874235123396},
+                        {"disk", disk, 2.4488340467214584},
+                        {"point", point, 0.2814468815922737},
+                        {"point_radius", point_radius, 1.0131703354418278},
+                        {"spot", spot, 0.21915356907993555},
+                        {"spot_radius", spot_radius, 0.5208117729052901},
+                        {"sun", sun, 0.825493011623621}};
   for (const Case& c : cases) {
     const double ours = plane_radiance(c.light);
     EXPECT_NEAR(ours, c.cycles, 2e-3 * c.cycles) << c.name << ": ours " << ours;

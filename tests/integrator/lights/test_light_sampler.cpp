@@ -56,7 +56,7 @@ struct MixedScene {
   Scene scene = test::black_scene();
   std::vector<Material> materials;
   MixedScene() {
-    scene.lights.push_back(point({0, 0, 4}, 100.0f, 0.4f));  // sphere above
+    scene.lights.push_back(point({0, 0, 4}, 100.0f, 0.4f));  // disc above
     Light spot = point({3, 0, 3}, 500.0f, 0.2f);
     spot.type = Light::Type::Spot;
     spot.light_to_world = test::light_frame({3, 0, 3}, normalize(Vec3f(-1, 0, -1)));
@@ -119,7 +119,7 @@ TEST(LightSampler, IntersectAndPdfsAgreeWithSample) {
       }
       ++analytic;
       if (!hit_light || std::fabs(hit.distance - s.distance) > 1e-3f * s.distance) {
-        ++misses;  // grazing rays at a sphere's silhouette may miss in float
+        ++misses;  // rays grazing a disc's rim may miss in float
         continue;
       }
       EXPECT_NEAR(hit.pdf, s.pdf, 2e-3f * s.pdf);
@@ -147,10 +147,11 @@ TEST(LightSampler, IntersectRespectsTMaxAndOneSidedness) {
   MixedScene m;
   const LightSampler lights(m.scene, m.materials, {});
   LightHit hit;
-  // Sphere at (0,0,4) r 0.4 straight up: hit at 3.6 - 0.3 from (0.1,-0.2,0.3)... use the axis.
+  // Point light of radius 0.4 at (0,0,4): a disc facing the origin, hit at 4 straight up.
   ASSERT_TRUE(lights.intersect({0, 0, 0}, {0, 0, 1}, kInf, hit));
-  EXPECT_NEAR(hit.distance, 3.6f, 1e-5f);
-  EXPECT_FALSE(lights.intersect({0, 0, 0}, {0, 0, 1}, 3.5f, hit));
+  EXPECT_NEAR(hit.distance, 4.0f, 1e-5f);
+  EXPECT_FALSE(lights.intersect({0, 0, 0}, {0, 0, 1}, 3.9f, hit));
+  EXPECT_FALSE(lights.intersect({0, 0, 0}, normalize(Vec3f(0.11f, 0, 1)), kInf, hit));
   // Sun disc only for escaping rays.
   const Vec3f to_sun = -normalize(Vec3f(0.2f, -0.3f, -1));
   ASSERT_TRUE(lights.intersect({0, 0, 0}, to_sun, kInf, hit));
