@@ -41,13 +41,14 @@ class PathTracer final : public Integrator {
                    Film& film) const override {
     uint64_t rays = 0;
     Sampler sampler;
+    ClosureSet closures;  // ~0.5 KB: initialised once per tile, not per sample
     const float clamp = settings_.clamp;
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x) {
         Film::Accumulator& acc = film.pixel(x, y);
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
           sampler.start(settings_.seed, x, y, s);
-          PathResult r = trace(sampler, x, y);
+          PathResult r = trace(sampler, x, y, closures);
           rays += r.rays;
           // A non-finite sample would poison the pixel forever: drop it (counted as black).
           if (!is_finite(r.primal)) r.primal = Spectrum(0.0f);
@@ -69,7 +70,7 @@ class PathTracer final : public Integrator {
   }
 
  private:
-  PathResult trace(const Sampler& sampler, int px, int py) const {
+  PathResult trace(const Sampler& sampler, int px, int py, ClosureSet& closures) const {
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
     const auto& materials = ctx_.materials();
@@ -86,7 +87,6 @@ class PathTracer final : public Integrator {
     float prev_pdf = 0.0f;   // solid-angle pdf of the BSDF sample that spawned `ray`
     bool prev_delta = true;  // no MIS for camera rays and delta lobes
     Vec3f prev_position = ray.origin;
-    ClosureSet closures;
     SurfaceHit hit;
 
     for (int bounce = 0;; ++bounce) {
