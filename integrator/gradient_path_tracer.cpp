@@ -349,15 +349,17 @@ class GradientPathTracer final : public Integrator {
       const ClosureSet& bc = base.closures;
 
       // ==================== Next-event estimation ====================
+      // Per-pair rule, shared by light sampling here and BSDF-sampled light hits at the next
+      // vertex: a not-connected pair shifts light samples only when both vertices are diffuse.
+      // A dead offset leaves the base alone with both of its techniques: light sampling stays on.
+      for (Offset& o : off)
+        o.nee_on =
+            !o.alive || o.link != Link::NotConnected ||
+            (base_type == VertexType::Diffuse && classify(o.v.roughness) == VertexType::Diffuse);
       if (has_lights) {
         const float u_select = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kLightSelect));
         const Vec2f u_light = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kLightPoint));
         const LightSample ls = lights.sample(base.hit.position, u_select, u_light);
-        // Per-pair rule for BSDF-sampled hits at the next vertex (delta lights cannot be hit).
-        for (Offset& o : off)
-          o.nee_on =
-              o.link != Link::NotConnected ||
-              (base_type == VertexType::Diffuse && classify(o.v.roughness) == VertexType::Diffuse);
         if (ls.valid && ls.pdf > 0.0f) {
           // --- Base ---
           Vec3f wo;
