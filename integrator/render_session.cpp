@@ -22,6 +22,8 @@ namespace {
 // 16x16 tiles: a tile at one sample per pixel takes well under a millisecond in typical scenes,
 // so the cancel flag (polled between tiles) is seen almost immediately.
 constexpr int kTileSize = 16;
+// Pixel-samples per render_tile call (16 spp of a full tile): a few milliseconds of PT or G-PT.
+constexpr uint32_t kChunkSamples = 16 * kTileSize * kTileSize;
 }  // namespace
 
 struct RenderSession::Impl {
@@ -86,11 +88,20 @@ void RenderSession::render(const std::function<void(const RenderProgress&)>& on_
           tbb::blocked_range<size_t>(0, d.tiles.size(), 1),
           [&](const tbb::blocked_range<size_t>& r) {
             for (size_t t = r.begin(); t != r.end(); ++t) {
-              if (cancel.load(std::memory_order_relaxed)) {
-                aborted.store(true, std::memory_order_relaxed);
-                return;
+              // A tile's samples go in chunks of at most kChunkSamples pixel-samples, with the
+              // cancel flag polled between chunks, so a large samples_per_pass does not delay a
+              // cancel. Each pixel still receives its samples in index order: the sums, hence the
+              // image, do not depend on the chunking.
+              const Tile& tile = d.tiles[t];
+              const uint32_t pixels = uint32_t((tile.x1 - tile.x0) * (tile.y1 - tile.y0));
+              const uint32_t chunk = std::max<uint32_t>(1, kChunkSamples / std::max(pixels, 1u));
+              for (uint32_t s = 0; s < count; s += chunk) {
+                if (cancel.load(std::memory_order_relaxed)) {
+                  aborted.store(true, std::memory_order_relaxed);
+                  return;
+                }
+                d.integrator->render_tile(tile, first + s, std::min(chunk, count - s), d.pass_film);
               }
-              d.integrator->render_tile(d.tiles[t], first, count, d.pass_film);
             }
           },
           tbb::simple_partitioner());
