@@ -64,17 +64,22 @@ inline uint32_t sobol_dim1_slow(uint32_t i) {
     if (i & 1u) r ^= v;
   return r;
 }
+// The tables store reverse_bits(sobol_dim1(.)) (still linear over GF(2)): the Owen scramble that
+// follows works on reversed bits, so this saves two reversals per 2D sample.
 struct SobolDim1Tables {
   uint32_t t[4][256];
   SobolDim1Tables() {
     for (uint32_t b = 0; b < 4; ++b)
-      for (uint32_t v = 0; v < 256; ++v) t[b][v] = sobol_dim1_slow(v << (8 * b));
+      for (uint32_t v = 0; v < 256; ++v) t[b][v] = reverse_bits(sobol_dim1_slow(v << (8 * b)));
   }
 };
 inline const SobolDim1Tables kSobolDim1;
-inline uint32_t sobol_dim1(uint32_t i) {
+inline uint32_t reversed_sobol_dim1(uint32_t i) {
   const auto& t = kSobolDim1.t;
   return t[0][i & 0xffu] ^ t[1][(i >> 8) & 0xffu] ^ t[2][(i >> 16) & 0xffu] ^ t[3][i >> 24];
+}
+inline uint32_t sobol_dim1(uint32_t i) {
+  return reverse_bits(reversed_sobol_dim1(i));
 }
 
 inline float to_unit_float(uint32_t x) {
@@ -104,34 +109,36 @@ class Sampler {
   void start(uint32_t seed, int x, int y, uint32_t index) {
     using namespace sampler_detail;
     pixel_hash_ = hash_combine(hash_combine(hash_u32(seed), uint32_t(x)), uint32_t(y));
-    index_ = index;
+    reversed_index_ = reverse_bits(index);
   }
 
   static uint32_t bounce_dim(int bounce, BounceDim d) {
     return kDimFirstBounce + uint32_t(bounce) * kDimsPerBounce + d;
   }
 
+  // Written with the reversals folded: nested_uniform_scramble(v, s) =
+  // reverse_bits(lk_permutation(reverse_bits(v), s)), Sobol dimension 0 is reverse_bits(i) and
+  // the dimension-1 table already returns reversed bits.
   float get1d(uint32_t dim) const {
     using namespace sampler_detail;
     const uint32_t h = hash_combine(pixel_hash_, dim);
-    const uint32_t i = nested_uniform_scramble(index_, h);
-    // Sobol dimension 0 is reverse_bits(i): nested_uniform_scramble(reverse_bits(i), s) folds to
-    // reverse_bits(lk_permutation(i, s)).
+    const uint32_t i = reverse_bits(lk_permutation(reversed_index_, h));  // shuffled index
     return to_unit_float(reverse_bits(lk_permutation(i, hash_u32(h ^ 0x5bd1e995u))));
   }
 
   Vec2f get2d(uint32_t dim) const {
     using namespace sampler_detail;
     const uint32_t h = hash_combine(pixel_hash_, dim);
-    const uint32_t i = nested_uniform_scramble(index_, h);
+    const uint32_t i = reverse_bits(lk_permutation(reversed_index_, h));  // shuffled index
     const uint32_t x = reverse_bits(lk_permutation(i, hash_u32(h ^ 0x5bd1e995u)));
-    const uint32_t y = nested_uniform_scramble(sobol_dim1(i), hash_u32(h ^ 0x1b873593u));
+    const uint32_t y =
+        reverse_bits(lk_permutation(reversed_sobol_dim1(i), hash_u32(h ^ 0x1b873593u)));
     return {to_unit_float(x), to_unit_float(y)};
   }
 
  private:
   uint32_t pixel_hash_ = 0;
-  uint32_t index_ = 0;
+  uint32_t reversed_index_ = 0;
 };
 
 }  // namespace gdpt
