@@ -34,6 +34,8 @@ struct RenderSession::Impl {
   Film film, pass_film;
   std::vector<Tile> tiles;
   std::vector<std::string> warnings;
+  // settings.threads worker slots (0 = all cores): used for the BVH build and every pass.
+  std::unique_ptr<tbb::task_arena> arena;
 };
 
 RenderSession::RenderSession(Scene scene, RenderSettings settings)
@@ -46,7 +48,11 @@ RenderSession::RenderSession(Scene scene, RenderSettings settings)
   Impl& d = *impl_;
   d.scene = std::move(scene);  // owned: the context and the BVH refer to it
   d.settings = settings;
-  d.context = std::make_unique<SceneContext>(d.scene, d.settings);
+  const int arena_threads =
+      d.settings.threads > 0 ? d.settings.threads : int(tbb::task_arena::automatic);
+  d.arena = std::make_unique<tbb::task_arena>(arena_threads);
+  // Embree builds with TBB: inside the arena it uses no more threads than the user allowed.
+  d.arena->execute([&] { d.context = std::make_unique<SceneContext>(d.scene, d.settings); });
   d.warnings = d.context->warnings();
   // Mode dispatch: G-PT estimates the gradients itself; PT derives them from the primal (Film).
   d.integrator = d.settings.mode == RenderSettings::Mode::GPT
@@ -70,7 +76,7 @@ void RenderSession::render(const std::function<void(const RenderProgress&)>& on_
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  tbb::task_arena arena(d.settings.threads > 0 ? d.settings.threads : tbb::task_arena::automatic);
+  tbb::task_arena& arena = *d.arena;
   const int total = d.settings.samples;
   int done = int(d.film.min_samples());
   const int height = d.film.height();
