@@ -41,6 +41,18 @@ TEST(Camera, AutoFitLandscapeUsesSensorWidthAcrossWidth) {
   EXPECT_NEAR(q.y, 25.0f, 1e-3f);
 }
 
+TEST(Camera, PerspectiveRayDirectionsMatchTheSensor) {
+  // Right edge of a 200x100 image at 50 mm / 36 mm: direction (18/50, 0, -1); top edge (0, 9/50).
+  const CameraModel cam(base_camera(200, 100));
+  const Ray r = cam.generate_ray({200.0f, 50.0f}, {0.5f, 0.5f});
+  EXPECT_NEAR(r.direction.x / -r.direction.z, 0.36f, 1e-6f);
+  EXPECT_NEAR(r.direction.y, 0.0f, 1e-6f);
+  const Ray t = cam.generate_ray({100.0f, 100.0f}, {0.5f, 0.5f});
+  EXPECT_NEAR(t.direction.y / -t.direction.z, 0.18f, 1e-6f);
+  const Ray b = cam.generate_ray({100.0f, 0.0f}, {0.5f, 0.5f});
+  EXPECT_LT(b.direction.y, 0.0f);  // raster y = 0 is the bottom row
+}
+
 TEST(Camera, AutoFitPortraitUsesSensorWidthAcrossHeight) {
   const Camera c = base_camera(100, 200);
   const Vec2f top = project(c, {0.0f, 3.6f, -10.0f});
