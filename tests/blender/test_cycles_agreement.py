@@ -1,7 +1,9 @@
 # Cross-engine agreement: each supported feature rendered by Gradient PT (G-PT, L2 reconstruction,
 # which is unbiased) and by Cycles set up to model the same thing (GGX, equal bounces, no clamping,
 # no glossy blur, no light threshold, 1-pixel box filter, no denoising, same resolution) at high
-# sample counts. Pass: relMSE(GDPT, Cycles) < 1%.
+# sample counts. Pass: relMSE(GDPT, Cycles) < 1% and image means within 2% (an energy error
+# spread over the whole image can hide under the relMSE bound; the mean catches it).
+# Noise floor at the default counts (measured): relMSE 1e-4 .. 4e-3 for the agreeing cases.
 #   blender -b --factory-startup --addons gdpt --python-exit-code 1 --python this.py --
 #           --out DIR --cases diffuse,glossy,...
 import math
@@ -15,9 +17,14 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(__file__))
 import scenes as S  # noqa: E402
 
-GDPT_SAMPLES = int(os.environ.get("GDPT_TEST_SAMPLES", "256"))
-CYCLES_SAMPLES = int(os.environ.get("GDPT_TEST_CYCLES_SAMPLES", "1024"))
+GDPT_SAMPLES = int(os.environ.get("GDPT_TEST_SAMPLES", "128"))
+CYCLES_SAMPLES = int(os.environ.get("GDPT_TEST_CYCLES_SAMPLES", "256"))
 THRESHOLD = 0.01
+MEAN_TOLERANCE = 0.02
+# G-PT with the unbiased L2 reconstruction by default; GDPT_TEST_MODE=PT / GDPT_TEST_RECON=NONE
+# isolate the primal estimator when a case disagrees.
+MODE = os.environ.get("GDPT_TEST_MODE", "GPT")
+RECON = os.environ.get("GDPT_TEST_RECON", "L2")
 
 
 def lit_room(scene):
@@ -198,7 +205,7 @@ def run_case(name, out_dir):
     scene = S.clear()
     bounces = CASES[name](scene)
     import gdpt.engine as engine
-    S.setup_gdpt(scene, GDPT_SAMPLES, mode='GPT', reconstruction='L2', bounces=bounces)
+    S.setup_gdpt(scene, GDPT_SAMPLES, mode=MODE, reconstruction=RECON, bounces=bounces)
     engine.LAST_RENDER.clear()
     t0 = time.time()
     gdpt_path = S.render(scene, os.path.join(out_dir, f"{name}_gdpt.exr"))
@@ -226,7 +233,7 @@ def main():
     failures = []
     for name in names:
         err, ratio = run_case(name, out_dir)
-        if not (err < THRESHOLD):
+        if not (err < THRESHOLD and abs(ratio - 1.0) < MEAN_TOLERANCE):
             failures.append(f"{name} (relMSE {err:.4f}, mean ratio {ratio:.3f})")
     if failures:
         raise RuntimeError("FAILED: " + ", ".join(failures))

@@ -1,0 +1,116 @@
+# Driver of compare_cycles.sh (runs inside Blender). Prints BENCH lines.
+import os
+import sys
+import time
+
+import bpy
+import numpy as np
+
+here = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(here, "..", "..", "tests", "blender"))
+import scenes as S  # noqa: E402
+
+RES = tuple(int(v) for v in os.environ.get("GDPT_BENCH_RES", "96x72").split("x"))
+SAMPLES = int(os.environ.get("GDPT_BENCH_SAMPLES", "32"))
+REF_SAMPLES = int(os.environ.get("GDPT_BENCH_REF_SAMPLES", "512"))
+BOUNCES = int(os.environ.get("GDPT_BENCH_BOUNCES", "4"))
+
+
+def cornell(scene):
+    S.room()
+    S.camera((0, -5.5, 2.0), (0, 0, 1.7), lens=30)
+    S.light('AREA', (0, 0, 3.95), 150.0, target=(0, 0, 0), size=1.0)
+    S.uv_sphere("a", 0.7, (-0.8, 0.2, 0.7), S.diffuse("a", (0.8, 0.8, 0.8)))
+    S.uv_sphere("b", 0.7, (0.8, 0.6, 0.7), S.shader_material(
+        "b", "ShaderNodeBsdfGlossy", Color=(0.9, 0.9, 0.9, 1), Roughness=0.3,
+        distribution='GGX'))
+
+
+def textured(scene):
+    cornell(scene)
+    img = bpy.data.images.new("grid", 256, 256)
+    img.generated_type = 'COLOR_GRID'
+    back = bpy.data.objects["back"]
+    back.data.materials.clear()
+    back.data.materials.append(S.image_material("tex", img))
+    floor = bpy.data.objects["floor"]
+    floor.data.materials.clear()
+    floor.data.materials.append(S.image_material("tex2", img))
+
+
+def render(scene, engine, samples, path):
+    if engine == 'GDPT':
+        S.setup_gdpt(scene, samples, mode='PT', reconstruction='NONE', bounces=BOUNCES)
+    else:
+        S.setup_cycles(scene, samples, bounces=BOUNCES)
+    scene.render.resolution_x, scene.render.resolution_y = RES
+    t0 = time.perf_counter()
+    S.render(scene, path)
+    return time.perf_counter() - t0, S.read_rgb(path)
+
+
+def compare(name, build, out):
+    import gdpt.engine as engine
+    scene = S.clear()
+    build(scene)
+    row = {}
+    for eng in ('GDPT', 'CYCLES'):
+        t, img = render(scene, eng, SAMPLES, os.path.join(out, f"{name}_{eng}_{SAMPLES}.exr"))
+        render_only = engine.LAST_RENDER["render"] if eng == 'GDPT' else t
+        _, ref = render(scene, eng, REF_SAMPLES, os.path.join(out, f"{name}_{eng}_ref.exr"))
+        row[eng] = (t, render_only, S.rel_mse(img, ref), ref)
+    pixels = RES[0] * RES[1] * SAMPLES
+    g, c = row['GDPT'], row['CYCLES']
+    cross = S.rel_mse(g[3], c[3])
+    print(f"BENCH {name}: {RES[0]}x{RES[1]}, {SAMPLES} spp, {BOUNCES} bounces")
+    print(f"  GDPT PT : {g[0]:.2f} s wall ({g[1]:.2f} s render) = {pixels / g[0] / 1e6:.3f} "
+          f"Msamples/s wall; relMSE vs own {REF_SAMPLES} spp: {g[2]:.5f}")
+    print(f"  Cycles  : {c[0]:.2f} s wall = {pixels / c[0] / 1e6:.3f} Msamples/s; relMSE vs "
+          f"own {REF_SAMPLES} spp: {c[2]:.5f}")
+    print(f"  samples/s ratio GDPT/Cycles (wall): {c[0] / g[0]:.2f}x; relMSE ratio "
+          f"GDPT/Cycles: {g[2] / max(c[2], 1e-12):.2f}; references differ by relMSE {cross:.5f}")
+
+
+def export_and_overhead(out):
+    import gdpt.engine as engine
+    scene = S.clear()
+    S.camera((0, -3, 3), (0, 0, 0), lens=35)
+    S.light('SUN', (0, 0, 5), 3.0)
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=708, y_subdivisions=708, size=4)
+    grid = bpy.context.active_object
+    grid.data.polygons.foreach_set("use_smooth", [True] * len(grid.data.polygons))
+    grid.data.update()
+    S.setup_gdpt(scene, 1, mode='PT', reconstruction='NONE', bounces=1)
+    scene.render.resolution_x, scene.render.resolution_y = 64, 48
+    t0 = time.perf_counter()
+    S.render(scene, os.path.join(out, "million.exr"))
+    wall = time.perf_counter() - t0
+    info = engine.LAST_RENDER
+    print(f"BENCH export: {info['triangles']} triangles exported in {info['export']:.3f} s "
+          f"(target < 0.5 s)")
+    print(f"  render() total {info['total']:.3f} s: export {info['export']:.3f} s, core "
+          f"(BVH + 1 spp) {info['render']:.3f} s, reconstruct {info['reconstruct']:.3f} s, "
+          f"write {info['write']:.3f} s; operator wall {wall:.3f} s")
+    # Add-on overhead on an ordinary scene: everything in render() that is not the core render.
+    scene = S.clear()
+    cornell(scene)
+    S.setup_gdpt(scene, SAMPLES, mode='GPT', reconstruction='L1', bounces=BOUNCES)
+    scene.render.resolution_x, scene.render.resolution_y = RES
+    S.render(scene, os.path.join(out, "overhead.exr"))
+    info = engine.LAST_RENDER
+    overhead = info['total'] - info['render']
+    print(f"BENCH overhead (Cornell box G-PT {SAMPLES} spp {RES[0]}x{RES[1]}): render() "
+          f"{info['total']:.3f} s, core render {info['render']:.3f} s, add-on overhead "
+          f"{overhead:.3f} s ({100 * overhead / info['total']:.1f}%: export {info['export']:.3f},"
+          f" reconstruct L1 {info['reconstruct']:.3f}, write {info['write']:.3f})")
+
+
+def main():
+    out = S.args()["out"]
+    os.makedirs(out, exist_ok=True)
+    compare("cornell", cornell, out)
+    compare("textured", textured, out)
+    export_and_overhead(out)
+
+
+main()

@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# `make bench` (via scripts/bench.sh): Gradient PT (PT mode) against Cycles in one Blender run:
+# samples/s ratio and relMSE at equal samples against each engine's own converged image, on a
+# Cornell box and a textured scene; export time of a 1M-triangle mesh; add-on overhead.
+#   bash bench/blender/compare_cycles.sh <build-dir>
+# Knobs (environment): GDPT_BENCH_RES (default 96x72), GDPT_BENCH_SAMPLES (32),
+# GDPT_BENCH_REF_SAMPLES (512), GDPT_BENCH_BOUNCES (4).
+set -euo pipefail
+build=${1:-build}
+root=$(cd "$(dirname "$0")/../.." && pwd)
+case "$build" in /*) ;; *) build="$root/$build" ;; esac
+module=$(ls "$build"/blender_addon/_gdpt*.so 2>/dev/null | head -1)
+[ -n "$module" ] || { echo "compare_cycles: build the _gdpt module first" >&2; exit 1; }
+scripts=$(mktemp -d)
+trap 'rm -rf "$scripts"' EXIT
+bash "$root/tests/blender/stage_addon.sh" "$root" "$module" "$scripts" >/dev/null
+out="$root/out/bench/blender"
+mkdir -p "$out"
+BLENDER_USER_SCRIPTS="$scripts" blender -b --factory-startup --addons gdpt --python-exit-code 1 \
+  --python "$root/bench/blender/compare_cycles.py" -- --out "$out" 2>&1 | grep -E "^(BENCH|  )" 
