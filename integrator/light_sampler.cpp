@@ -175,6 +175,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
         t.uv2 = mesh.corner_uvs[size_t(tri) * 3 + 2];
       }
       t.material = uint32_t(mat);
+      t.finish();
       const float p = t.power(materials[size_t(mat)].average_emission());
       if (!(p > 0.0f) || !std::isfinite(p)) continue;
       I.entries.push_back({Kind::Triangle, uint32_t(I.triangles.size())});

@@ -63,10 +63,11 @@ TEST(EmissiveTriangle, SolidAngleAndIrradianceBothSides) {
   TriangleScene t = triangle_scene(v0, v1, v2, 3.0f);
   const LightSampler lights(t.scene, t.materials, {});
   ASSERT_FALSE(lights.empty());
-  // Receiver below the triangle, then above it (two-sided emission).
-  for (const float z : {0.0f, 3.0f}) {
+  // Receiver below the triangle, then above it (two-sided emission), then far below (area
+  // sampling instead of spherical-triangle sampling).
+  for (const float z : {0.0f, 3.0f, -25.0f}) {
     const Vec3f ref(0.1f, 0.05f, z);
-    const Vec3f n = z == 0.0f ? Vec3f(0, 0.2f, 1) : Vec3f(0, -0.1f, -1);
+    const Vec3f n = z <= 0.0f ? Vec3f(0, 0.2f, 1) : Vec3f(0, -0.1f, -1);
     const Vec3f nn = normalize(n);
     const test::Estimate e = test::estimate(lights, ref, nn, 250000);
     const double omega = triangle_solid_angle(v0 - ref, v1 - ref, v2 - ref);
@@ -128,10 +129,10 @@ TEST(EmissiveTriangle, SelectedProportionallyToPower) {
   const double pmf_small = 0.5 / total, pmf_big = 6.0 / total;
   const LightSample s = lights.sample(ref, 0.0f, {0.3f, 0.3f});  // first entry: small, inst 0
   ASSERT_TRUE(s.valid);
-  const Vec3f to = s.position - ref;
-  const double area_pdf =
-      double(length_squared(to)) / (0.5 * std::fabs(dot(normalize(to), Vec3f(0, 0, 1))));
-  EXPECT_NEAR(s.pdf, pmf_small * area_pdf, 1e-4 * s.pdf);
+  // Large and near: sampled by solid angle, density pmf / Omega.
+  const double omega =
+      triangle_solid_angle(Vec3f(0, 0, 0) - ref, Vec3f(1, 0, 0) - ref, Vec3f(0, 1, 0) - ref);
+  EXPECT_NEAR(s.pdf, pmf_small / omega, 1e-4 * s.pdf);
   // Count selections with stratified u_select.
   int counts[2] = {0, 0};
   const int n = 13000;
