@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "integrator/features.h"
@@ -123,6 +124,13 @@ struct SampleResult {
   uint32_t rays = 0;
 };
 
+// Per-thread working storage of trace(), reused across samples: no allocation or large
+// initialisation per sample (a ClosureSet holds kMaxClosures lobes).
+struct PathScratch {
+  Offset off[kOffsets];
+  Vertex verts[2];  // base vertex and the next one, swapped per bounce
+};
+
 struct Halves {
   Vec3d grad[kOffsets];
 };
@@ -150,6 +158,7 @@ class GradientPathTracer final : public Integrator {
     };
     uint64_t rays = 0;
     Sampler sampler;
+    thread_local PathScratch scratch;
     const float clamp = settings_.clamp;
     for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
       // --- Trace every base path of the region with the offsets this tile needs ---
@@ -170,7 +179,7 @@ class GradientPathTracer final : public Integrator {
           }
           sampler.start(settings_.seed, x, y, s);
           SampleResult r;
-          trace(sampler, x, y, mask, r);
+          trace(sampler, x, y, mask, scratch, r);
           rays += r.rays;
           Halves& h = half_at(x, y);
           for (int k = 0; k < kOffsets; ++k) {
@@ -254,36 +263,42 @@ class GradientPathTracer final : public Integrator {
   bool offset_light(Vec3f y, float u_select, Vec2f u_light, const LightSample& ls,
                     LightSample& out) const {
     const LightSampler& lights = ctx_.lights();
-    out = lights.sample(y, u_select, u_light);
     if (ls.is_infinite) {
+      // World and sun: sampled directions do not depend on the reference point.
+      out = lights.sample(y, u_select, u_light);
       return out.valid && out.is_infinite && length_squared(out.direction - ls.direction) < 1e-10f;
     }
     const float scale = std::max(1.0f, max_component(abs(ls.position)));
-    if (out.valid && length_squared(out.position - ls.position) < 1e-8f * scale * scale)
-      return true;
-    if (ls.is_delta) return false;
-    // Sphere lights: intersect towards the base's point.
-    const Vec3f to = ls.position - y;
-    const float d = length(to);
-    if (!(d > 0.0f)) return false;
-    const Vec3f dir = to / d;
-    LightHit lh;
-    if (!lights.intersect(y, dir, d * (1.0f + 1e-3f), lh)) return false;
-    if (length_squared(lh.position - ls.position) > 1e-6f * scale * scale) return false;
-    out.radiance = lh.radiance;
-    out.position = ls.position;
-    out.normal = ls.normal;
-    out.direction = dir;
-    out.distance = d;
-    out.pdf = lh.pdf;
-    out.is_delta = false;
-    out.is_infinite = false;
-    out.valid = lh.pdf > 0.0f;
-    return out.valid;
+    if (!ls.is_delta) {
+      // Analytic lights (area, sphere) are sampled in solid angle from the reference point:
+      // evaluate the base's point from y by intersecting the light instead.
+      const Vec3f to = ls.position - y;
+      const float d = length(to);
+      if (!(d > 0.0f)) return false;
+      const Vec3f dir = to / d;
+      LightHit lh;
+      if (lights.intersect(y, dir, d * (1.0f + 1e-3f), lh) &&
+          length_squared(lh.position - ls.position) <= 1e-6f * scale * scale) {
+        out.radiance = lh.radiance;
+        out.position = ls.position;
+        out.normal = ls.normal;
+        out.direction = dir;
+        out.distance = d;
+        out.pdf = lh.pdf;
+        out.is_delta = false;
+        out.is_infinite = false;
+        out.valid = lh.pdf > 0.0f;
+        return out.valid;
+      }
+    }
+    // Point lights and emissive triangles (sampled by area): the same random numbers give the
+    // same point.
+    out = lights.sample(y, u_select, u_light);
+    return out.valid && length_squared(out.position - ls.position) < 1e-8f * scale * scale;
   }
 
   void trace(const Sampler& sampler, int px, int py, const bool mask[kOffsets],
-             SampleResult& out) const {
+             PathScratch& scratch, SampleResult& out) const {
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
     const int max_bounces = settings_.max_bounces;
@@ -302,13 +317,17 @@ class GradientPathTracer final : public Integrator {
       return;
     }
 
-    Offset off[kOffsets];
+    Offset* off = scratch.off;
     for (int k = 0; k < kOffsets; ++k) {
       Offset& o = off[k];
       o.active = mask[k];
+      o.alive = false;
       if (!o.active) continue;
       ++out.attempts;
       o.alive = true;
+      o.failed = false;
+      o.link = Link::NotConnected;
+      o.nee_on = true;
       o.f = Vec3d(1.0, 1.0, 1.0);
       o.p = 1.0;
       o.grad = Vec3d();
@@ -323,8 +342,8 @@ class GradientPathTracer final : public Integrator {
       setup_vertex(ctx_, h, o.ray.direction, o.v);
     }
 
-    Vertex base;
-    setup_vertex(ctx_, hit, ray.direction, base);
+    int cur = 0;  // scratch.verts[cur] is the base vertex
+    setup_vertex(ctx_, hit, ray.direction, scratch.verts[cur]);
     // Very direct light: emission seen by the camera, never shifted.
     out.emission += triangle_emission(ctx_, hit, ray.origin);
 
@@ -334,10 +353,12 @@ class GradientPathTracer final : public Integrator {
 
     for (int bounce = 0;; ++bounce) {
       if (bounce > max_bounces) break;
+      const Vertex& base = scratch.verts[cur];
+      Vertex& next_base = scratch.verts[cur ^ 1];
       if (!base.closures.has_bsdf()) break;
 
       // Offsets arriving at a shared vertex see it from their own direction.
-      for (Offset& o : off) {
+      for (Offset& o : std::span(off, kOffsets)) {
         if (!o.active || !o.alive) continue;
         if (o.link == Link::Recent) {
           o.wi_shared = base.frame.to_local(o.wi_world);
@@ -352,7 +373,7 @@ class GradientPathTracer final : public Integrator {
       // Per-pair rule, shared by light sampling here and BSDF-sampled light hits at the next
       // vertex: a not-connected pair shifts light samples only when both vertices are diffuse.
       // A dead offset leaves the base alone with both of its techniques: light sampling stays on.
-      for (Offset& o : off)
+      for (Offset& o : std::span(off, kOffsets))
         o.nee_on =
             !o.alive || o.link != Link::NotConnected ||
             (base_type == VertexType::Diffuse && classify(o.v.roughness) == VertexType::Diffuse);
@@ -380,7 +401,7 @@ class GradientPathTracer final : public Integrator {
           const PathDensities db{pb, ls.pdf, pdf_bsdf};
 
           // --- Offsets ---
-          for (Offset& o : off) {
+          for (Offset& o : std::span(off, kOffsets)) {
             if (!o.active) continue;
             Vec3d co;
             PathDensities d_off{0.0, 0.0, 0.0};
@@ -453,7 +474,7 @@ class GradientPathTracer final : public Integrator {
         if (!(sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kRoulette)) < q)) break;
         beta /= q;
         pb *= q;
-        for (Offset& o : off) o.p *= q;
+        for (Offset& o : std::span(off, kOffsets)) o.p *= q;
       }
 
       // --- Trace the base's next segment ---
@@ -467,12 +488,11 @@ class GradientPathTracer final : public Integrator {
       const float t_hit = found ? next.t : kInf;
       LightHit lh;
       const bool light_hit = lights.intersect(ray.origin, ray.direction, t_hit, lh);
-      Vertex next_base;
       if (found) setup_vertex(ctx_, next, ray.direction, next_base);
       const VertexType next_type = found ? classify(next_base.roughness) : VertexType::Diffuse;
 
       // --- Shift every offset over this segment ---
-      for (Offset& o : off) {
+      for (Offset& o : std::span(off, kOffsets)) {
         if (!o.active || !o.alive) continue;
         shift_segment(o, base, bs, xd_type, wo_world, found, next, next_type, u_lobe, u_dir,
                       out.rays);
@@ -492,7 +512,7 @@ class GradientPathTracer final : public Integrator {
         if (base_lit)
           out.primal += beta * lh.radiance * (delta ? 1.0f : power_heuristic(pdf_b, pl));
         const Vec3d cb = base_lit ? mul(mul(fb, seg_b), lh.radiance) : Vec3d();
-        for (Offset& o : off) {
+        for (Offset& o : std::span(off, kOffsets)) {
           if (!o.active) continue;
           Vec3d co;
           PathDensities d_off{0.0, 0.0, 0.0};
@@ -544,7 +564,7 @@ class GradientPathTracer final : public Integrator {
         }
         if (!is_black(le)) out.primal += beta * le * (delta ? 1.0f : power_heuristic(pdf_b, pl));
         const Vec3d cb = mul(mul(fb, seg_b), le);
-        for (Offset& o : off) {
+        for (Offset& o : std::span(off, kOffsets)) {
           if (!o.active) continue;
           Vec3d co;
           PathDensities d_off{0.0, 0.0, 0.0};
@@ -560,12 +580,12 @@ class GradientPathTracer final : public Integrator {
       // ==================== Advance ====================
       fb = mul(fb, seg_b);
       pb *= pdf_b;
-      for (Offset& o : off) {
+      for (Offset& o : std::span(off, kOffsets)) {
         if (!o.active || !o.alive) continue;
         advance(o, next_base);
       }
       if (!found) break;
-      base = next_base;
+      cur ^= 1;
     }
 
     for (int k = 0; k < kOffsets; ++k) {
