@@ -3,7 +3,8 @@
 //  - pixel (i, j) has its centre at ((i + 0.5) / w, (j + 0.5) / h);
 //  - Closest takes the pixel containing uv; Linear blends the four nearest pixel centres;
 //  - Repeat wraps, Extend clamps to the border pixels, Clip returns transparent black outside
-//    [0, 1]^2 and blends towards it at the border (pixels outside count as zero), as Cycles.
+//    [0, 1]^2 for Closest; for Linear, pixels outside the image count as zero, so the border
+//    blends to zero over half a pixel on either side (as Cycles 3.4 renders it).
 //  - An empty image returns Blender's "missing texture" magenta.
 #include "shaders/texture.h"
 
@@ -58,7 +59,13 @@ Rgba Texture::lookup(Vec2f uv, TextureLookup::Interpolation interpolation,
       v = std::clamp(v, -1.0f, 2.0f);
       break;
     case TextureLookup::Extension::Clip:
-      if (u < 0.0f || u > 1.0f || v < 0.0f || v > 1.0f) return {Spectrum(0.0f), 0.0f};
+      // Closest: nothing outside [0, 1]^2. Linear: pixels outside count as zero, so the image
+      // fades out over half a pixel beyond its border (Cycles 3.4 does this; checked by render).
+      if (interpolation == TextureLookup::Interpolation::Closest &&
+          (u < 0.0f || u > 1.0f || v < 0.0f || v > 1.0f))
+        return {Spectrum(0.0f), 0.0f};
+      u = std::clamp(u, -1.0f, 2.0f);
+      v = std::clamp(v, -1.0f, 2.0f);
       break;
   }
 

@@ -57,8 +57,11 @@ TEST(Texture, ExtensionModesAtTheBorder) {
   // u = 0: halfway between pixel -1 and pixel 0.
   expect_rgba(t.lookup({0.0f, 0.25f}, I::Linear, E::Repeat), (A + B) * 0.5f, 0.15f);  // -1 -> B
   expect_rgba(t.lookup({0.0f, 0.25f}, I::Linear, E::Extend), A, 0.1f);
-  expect_rgba(t.lookup({0.0f, 0.25f}, I::Linear, E::Clip), A * 0.5f, 0.05f);  // blends to 0
-  expect_rgba(t.lookup({1.2f, 0.5f}, I::Linear, E::Clip), Spectrum(0.0f), 0.0f);
+  expect_rgba(t.lookup({0.0f, 0.25f}, I::Linear, E::Clip), A * 0.5f, 0.05f);        // blends to 0
+  expect_rgba(t.lookup({1.3f, 0.5f}, I::Linear, E::Clip), Spectrum(0.0f), 0.0f);    // > 0.5 px out
+  expect_rgba(t.lookup({1.2f, 0.5f}, I::Linear, E::Clip), (B + D) * 0.05f, 0.03f);  // 0.4 px out
+  // Half a pixel outside: still a quarter of the border pixel's centre away (Cycles 3.4).
+  expect_rgba(t.lookup({-0.125f, 0.25f}, I::Linear, E::Clip), A * 0.25f, 0.025f);
   expect_rgba(t.lookup({-0.01f, 0.5f}, I::Closest, E::Clip), Spectrum(0.0f), 0.0f);
   expect_rgba(t.lookup({1.25f, 0.25f}, I::Linear, E::Repeat), A, 0.1f);
   expect_rgba(t.lookup({-0.75f, 0.25f}, I::Linear, E::Repeat), A, 0.1f);
