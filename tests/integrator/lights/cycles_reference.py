@@ -2,7 +2,8 @@
 # origin (normal +Z) under one light with Cycles, 0 bounces, Standard view transform, and prints
 # the mean radiance of the 8x8 image (albedo 1: radiance = E / pi).
 # Usage: blender -b --factory-startup --python cycles_reference.py -- KIND [SAMPLES]
-#   KIND: area, area_scaled, disk, point, point_radius, spot, spot_radius, sun. Writes /tmp/lights_cycles/out_KIND.exr.
+#   KIND: area, area_scaled, disk, point, point_radius, spot, spot_radius, sun, world,
+#   world_rotated. Writes /tmp/lights_cycles/out_KIND.exr.
 import bpy, math, sys
 argv = sys.argv[sys.argv.index("--") + 1:]
 kind = argv[0]
@@ -55,7 +56,32 @@ elif kind == "spot":
 elif kind == "sun":
     l = bpy.data.lights.new("l", 'SUN'); l.energy = 3.0; l.angle = math.radians(10)
     lo = bpy.data.objects.new("l", l); lo.rotation_euler = (math.radians(30), 0, 0)
-sc.collection.objects.link(lo)
+if kind.startswith("world"):
+    # 16 x 8 scene-linear image with the formula of test_cycles_reference.cpp; the plane and the
+    # camera are tilted 60 degrees towards +X so that the image's orientation matters.
+    W, H = 16, 8
+    img = bpy.data.images.new("env", W, H, float_buffer=True)
+    pix = []
+    for y in range(H):
+        for x in range(W):
+            pix += [0.1 + ((x * 7 + y * 3) % 11) * 0.3, 0.2 + ((x * 5 + y * 11) % 7) * 0.25,
+                    0.05 + ((x * 3 + y * 5) % 13) * 0.1, 1.0]
+    img.pixels = pix
+    wn = sc.world.node_tree
+    bg = wn.nodes["Background"]
+    bg.inputs[1].default_value = 0.7
+    env = wn.nodes.new("ShaderNodeTexEnvironment"); env.image = img
+    wn.links.new(env.outputs[0], bg.inputs[0])
+    if kind == "world_rotated":
+        tc = wn.nodes.new("ShaderNodeTexCoord"); mp = wn.nodes.new("ShaderNodeMapping")
+        mp.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(90))
+        wn.links.new(tc.outputs["Generated"], mp.inputs[0]); wn.links.new(mp.outputs[0], env.inputs[0])
+    plane = [o for o in sc.objects if o.type == 'MESH'][0]
+    plane.rotation_euler = (0, math.radians(60), 0)
+    co.rotation_euler = (0, math.radians(60), 0)
+    co.location = (0.5 * math.sin(math.radians(60)), 0, 0.5 * math.cos(math.radians(60)))
+else:
+    sc.collection.objects.link(lo)
 sc.render.image_settings.file_format = 'OPEN_EXR'
 import os
 os.makedirs("/tmp/lights_cycles", exist_ok=True)
