@@ -3,7 +3,7 @@
 # the mean radiance of the 8x8 image (albedo 1: radiance = E / pi).
 # Usage: blender -b --factory-startup --python cycles_reference.py -- KIND [SAMPLES]
 #   KIND: area, area_scaled, disk, point, point_radius, spot, spot_radius, sun, world,
-#   world_rotated. Writes /tmp/lights_cycles/out_KIND.exr.
+#   world_rotated, mesh_back. Writes /tmp/lights_cycles/out_KIND.exr.
 import bpy, math, sys
 argv = sys.argv[sys.argv.index("--") + 1:]
 kind = argv[0]
@@ -56,7 +56,17 @@ elif kind == "spot":
 elif kind == "sun":
     l = bpy.data.lights.new("l", 'SUN'); l.energy = 3.0; l.angle = math.radians(10)
     lo = bpy.data.objects.new("l", l); lo.rotation_euler = (math.radians(30), 0, 0)
-if kind.startswith("world"):
+if kind == "mesh_back":
+    # 1 x 1 m emission plane (strength 2) at z = 1 with its normal up (+Z): the receiver below
+    # sees its back face; Cycles' mesh lights emit on both sides.
+    bpy.ops.mesh.primitive_plane_add(size=1.0, location=(0.2, 0.1, 1.0))
+    em = bpy.data.materials.new("em"); em.use_nodes = True
+    ent = em.node_tree; ent.nodes.clear()
+    e = ent.nodes.new("ShaderNodeEmission"); e.inputs[1].default_value = 2.0
+    eo = ent.nodes.new("ShaderNodeOutputMaterial"); ent.links.new(e.outputs[0], eo.inputs[0])
+    bpy.context.object.data.materials.append(em)
+    co.location = (0, 0, 0.5)
+elif kind.startswith("world"):
     # 16 x 8 scene-linear image with the formula of test_cycles_reference.cpp; the plane and the
     # camera are tilted 60 degrees towards +X so that the image's orientation matters.
     W, H = 16, 8

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "integrator/light_sampler.h"
 #include "light_test_util.h"
@@ -123,6 +124,27 @@ TEST(CyclesReference, EquirectangularWorldOnATiltedPlane) {
     const double ours = test::estimate(lights, {0, 0, 0}, n, 1000000).irradiance / kPiD;
     EXPECT_NEAR(ours, c.cycles, 3e-3 * c.cycles) << c.name << ": ours " << ours;
   }
+}
+
+// Emission plane (strength 2, 1 x 1 m at z = 1, normal +Z) seen from its back: Cycles' mesh
+// lights emit colour * strength on both sides.
+TEST(CyclesReference, EmissionPlaneSeenFromBehind) {
+  Scene scene = test::black_scene();
+  scene.materials.push_back(test::emission_material({1, 1, 1}, 2.0f));
+  Mesh mesh;  // Blender's plane: counter-clockwise seen from +Z
+  mesh.positions = {{-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0}};
+  mesh.indices = {0, 1, 2, 0, 2, 3};
+  scene.meshes.push_back(mesh);
+  Instance inst;
+  const float rows[12] = {1, 0, 0, 0.2f, 0, 1, 0, 0.1f, 0, 0, 1, 1.0f};
+  inst.object_to_world = Transform::from_rows(rows);
+  inst.slot_material = {0};
+  scene.instances.push_back(inst);
+  const std::vector<Material> materials = {Material(scene.materials[0], {})};
+  const LightSampler lights(scene, materials, {});
+  const double ours = test::estimate(lights, {0, 0, 0}, {0, 0, 1}, 250000).irradiance / kPiD;
+  const double cycles = 0.4524377346970141;  // Blender 3.4.1 Cycles, 1024 spp
+  EXPECT_NEAR(ours, cycles, 3e-3 * cycles) << "ours " << ours;
 }
 
 }  // namespace
