@@ -96,7 +96,14 @@ inline Instance place(uint32_t mesh, int32_t material, Transform t) {
   return i;
 }
 
-enum class SceneKind { CornellDiffuse, CornellGlossy, CornellGlass, Environment, Corner };
+enum class SceneKind {
+  CornellDiffuse,
+  CornellGlossy,
+  CornellGlass,
+  Environment,
+  Corner,
+  MixedLights
+};
 
 // Cornell-like box [-1, 1]^3 open towards +z, camera on +z looking in. Materials:
 //  0 white diffuse, 1 red, 2 green, 3 object material (per kind), 4 emitter (unused by default).
@@ -143,6 +150,31 @@ inline Scene make_scene(SceneKind kind, int res, float object_roughness = 0.3f,
     l.size_x = l.size_y = light_size;
     l.light_to_world = transform(-h, 0, {0, 0.98f, 0});  // emits towards -y
     s.lights.push_back(l);
+  }
+  if (kind == SceneKind::MixedLights) {
+    // Replace the area light: an emissive quad (triangle lights, sampled by area), a point light
+    // (delta), a sphere light (sampled in solid angle) and a sun through the open side.
+    s.lights.clear();
+    s.materials.push_back(emissive({1.0f, 0.9f, 0.8f}, 6.0f));  // 4
+    s.meshes.push_back(quad(0.2f));                             // 3
+    s.instances.push_back(place(3, 4, transform(h, 0, {0.3f, 0.97f, -0.2f})));
+    Light point;
+    point.type = Light::Type::Point;
+    point.power = 3.0f;
+    point.light_to_world = transform(0, 0, {-0.5f, 0.6f, 0.3f});
+    s.lights.push_back(point);
+    Light ball;
+    ball.type = Light::Type::Point;
+    ball.power = 4.0f;
+    ball.radius = 0.1f;
+    ball.light_to_world = transform(0, 0, {0.5f, 0.5f, -0.4f});
+    s.lights.push_back(ball);
+    Light sun;
+    sun.type = Light::Type::Sun;
+    sun.power = 1.5f;
+    sun.sun_angle = 0.05f;
+    sun.light_to_world = transform(0.9f, 0.4f, {0, 0, 5});
+    s.lights.push_back(sun);
   }
   Camera& c = s.camera;
   c.width = c.height = res;

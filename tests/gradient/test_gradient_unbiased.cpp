@@ -122,6 +122,12 @@ TEST(GradientUnbiased, EnvironmentLight) {
   expect_unbiased("environment", make_scene(SceneKind::Environment, 16), 4096, 512);
 }
 
+TEST(GradientUnbiased, MixedLights) {
+  // Emissive triangles (offset light samples by resampling), a point light (delta), a sphere light
+  // (evaluated by intersection) and a soft sun (infinite): every shifted-NEE path.
+  expect_unbiased("mixed-lights", make_scene(SceneKind::MixedLights, 16), 4096, 512);
+}
+
 TEST(GradientUnbiased, EveryVertexHalfVector) {
   // Threshold above every roughness: all vertices (Lambert included) take the half-vector copy,
   // light sampling is never shifted; exercises kills, failed shifts and offset-only light hits.
