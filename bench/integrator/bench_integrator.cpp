@@ -256,13 +256,20 @@ int main(int argc, char** argv) {
   }
   if (!want("features")) return 0;
 
-  std::printf("\nfeature specialisation (diffuse-only Cornell box, 1 thread):\n");
-  const Result lean = run(cornell, 1, budget), all = run(cornell, 1, budget, true);
+  std::printf(
+      "\nfeature specialisation (diffuse-only Cornell box, 1 thread, best of 3 alternating "
+      "runs per kernel to damp the noise of a shared machine):\n");
+  Result lean, all;
+  for (int rep = 0; rep < 3; ++rep) {
+    const Result a = run(cornell, 1, budget), b = run(cornell, 1, budget, true);
+    if (a.samples_per_cpu_s > lean.samples_per_cpu_s) lean = a;
+    if (b.samples_per_cpu_s > all.samples_per_cpu_s) all = b;
+  }
   std::printf("  specialised:  %s\n", lean.summary.c_str());
   report("  specialised", 1, lean);
   std::printf("  forced-all:   %s\n", all.summary.c_str());
   report("  all features forced", 1, all);
-  std::printf("  speed-up of the specialised kernel: %.2fx\n",
-              lean.samples_per_s / all.samples_per_s);
+  std::printf("  speed-up of the specialised kernel (per CPU-second): %.2fx\n",
+              lean.samples_per_cpu_s / all.samples_per_cpu_s);
   return 0;
 }
