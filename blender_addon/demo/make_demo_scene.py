@@ -58,7 +58,9 @@ def sphere(name, radius, location, mat):
 white, _ = material("White", "ShaderNodeBsdfDiffuse", Color=(0.75, 0.75, 0.75, 1))
 red, _ = material("Red", "ShaderNodeBsdfDiffuse", Color=(0.65, 0.08, 0.06, 1))
 green, _ = material("Green", "ShaderNodeBsdfDiffuse", Color=(0.12, 0.5, 0.08, 1))
-glass, _ = material("Glass", "ShaderNodeBsdfGlass", Color=(1, 1, 1, 1), Roughness=0.0, IOR=1.5)
+glass, glass_bsdf = material("Glass", "ShaderNodeBsdfGlass", Color=(1, 1, 1, 1), Roughness=0.0,
+                            IOR=1.5)
+glass_bsdf.distribution = 'SHARP'  # Blender 3.4's default is Beckmann, which GDPT renders as GGX
 metal, _ = material("Metal", "ShaderNodeBsdfPrincipled", **{
     "Base Color": (0.95, 0.7, 0.4, 1), "Metallic": 1.0, "Roughness": 0.25})
 

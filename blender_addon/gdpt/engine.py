@@ -119,7 +119,7 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         t_render = time.perf_counter()
         interval = settings.preview_interval
         state = {"next_preview": t_render + min(1.0, interval), "cancelled": False,
-                 "last_line": 0.0}
+                 "last_line": 0.0, "last_done": -1}
 
         def poll(done, total, elapsed, snapshot_ready):
             flags = 0
@@ -133,18 +133,23 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
             if now >= state["next_preview"]:
                 state["next_preview"] = now + interval
                 flags |= 2
-            # ETA from the sample rate, or from the time limit when that ends first.
+            # ETA from the sample rate of the finished passes, counted down on the wall clock so
+            # it moves between passes; the time limit caps it.
+            now_elapsed = now - t_render
             remaining = None
             if done > 0:
-                remaining = elapsed / done * (total - done)
+                remaining = max(0.0, elapsed / done * total - now_elapsed)
             if settings.time_limit > 0:
-                left = settings.time_limit - elapsed
+                left = max(0.0, settings.time_limit - now_elapsed)
                 remaining = left if remaining is None else min(remaining, left)
             info = f"Sample {done}/{total}"
             if remaining is not None:
                 info += f" | Remaining:{_clock(remaining)}"
-            if now - state["last_line"] >= 0.5 or snapshot_ready:
+            # One console line per finished sample count, at most every 0.5 s, or every 5 s.
+            if (done != state["last_done"] and now - state["last_line"] >= 0.5) or \
+                    now - state["last_line"] >= 5.0:
                 state["last_line"] = now
+                state["last_done"] = done
                 self.update_stats("", info)
                 self.update_progress(done / max(total, 1))
             return flags

@@ -28,11 +28,7 @@ class ImageCache:
         return index
 
     def _add(self, image):
-        width, height = image.size[0], image.size[1]
-        if width == 0 or height == 0:
-            # Not loaded yet (or missing file): reading pixels loads it.
-            image.pixels[0:1] if len(image.pixels) else None
-            width, height = image.size[0], image.size[1]
+        width, height = image.size[0], image.size[1]  # reading the size loads the image
         if width == 0 or height == 0 or image.channels == 0:
             self.warn(f"image '{image.name}' has no pixels (missing file?); using magenta")
             return -1

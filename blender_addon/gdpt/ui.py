@@ -122,7 +122,7 @@ _EXCLUDE = {
     "RENDER_PT_simplify",
 }
 _EXTRA = {
-    "DATA_PT_EEVEE_light", "DATA_PT_spot", "DATA_PT_EEVEE_shadow",
+    "DATA_PT_EEVEE_light", "DATA_PT_spot",
     "EEVEE_MATERIAL_PT_context_material", "EEVEE_MATERIAL_PT_surface",
     "EEVEE_WORLD_PT_surface", "DATA_PT_camera_dof", "DATA_PT_camera_dof_aperture",
 }

@@ -139,12 +139,51 @@ def test_time_limit(out):
     print(f"total {elapsed:.2f} s")
 
 
+def test_geometry_types(out):
+    """Text, a bevelled curve, a metaball and a collection instance all reach the core as
+    triangles; the instanced collection shares its mesh."""
+    import gdpt.engine as engine
+    scene = S.clear()
+    basic_scene(scene)
+    text = bpy.data.curves.new("text", 'FONT')
+    text.body = "GDPT"
+    text.extrude = 0.05
+    S.link(bpy.data.objects.new("text", text)).location = (-1.0, 0.0, 1.0)
+    curve = bpy.data.curves.new("curve", 'CURVE')
+    curve.dimensions = '3D'
+    curve.bevel_depth = 0.05
+    spline = curve.splines.new('POLY')
+    spline.points.add(2)
+    for p, co in zip(spline.points, ((-1, 0, 0.3, 1), (0, 0, 0.6, 1), (1, 0, 0.3, 1))):
+        p.co = co
+    S.link(bpy.data.objects.new("curve", curve))
+    meta = bpy.data.metaballs.new("meta")
+    meta.elements.new().radius = 0.4
+    S.link(bpy.data.objects.new("meta", meta)).location = (1.0, -0.5, 0.5)
+    coll = bpy.data.collections.new("Balls")
+    ball = S.uv_sphere("ball", 0.2, (0, 0, 0), S.diffuse("ball", (0.8, 0.8, 0.8)), 16, 8)
+    scene.collection.objects.unlink(ball)
+    coll.objects.link(ball)
+    for i in range(3):
+        empty = S.link(bpy.data.objects.new(f"inst{i}", None))
+        empty.instance_type = 'COLLECTION'
+        empty.instance_collection = coll
+        empty.location = (-1.0 + i, -1.0, 0.2)
+    S.setup_gdpt(scene, 1)
+    S.render(scene, os.path.join(out, "geometry.exr"))
+    info = engine.LAST_RENDER
+    room_and_balls = 5 * 2 + 3 * 16 * 8 * 2
+    check(info["triangles"] > room_and_balls + 200,
+          f"text, curve and metaball exported ({info['triangles']} triangles in all)")
+
+
 def main():
     out = S.args()["out"]
     os.makedirs(out, exist_ok=True)
     test_unsupported_node(out)
     test_no_camera(out)
     test_time_limit(out)
+    test_geometry_types(out)
     test_cancel(out)  # last: Blender's break flag stays set afterwards
     print("ALL ROBUSTNESS CHECKS PASSED", flush=True)
     # Blender turns the SIGINT break flag into a non-zero exit status at quit; every check has
