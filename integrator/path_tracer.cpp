@@ -16,7 +16,9 @@ namespace gdpt {
 namespace {
 
 constexpr uint32_t kSpecialised =
-    kSceneDoF | kSceneWorld | kSceneAnalyticLights | kSceneEmissiveTriangles;
+    kSceneDoF | kSceneWorld | kSceneAnalyticLights | kSceneEmissiveTriangles | kFeatureTransparent;
+// Cycles' default transparent_max_bounces.
+constexpr int kMaxTransparentBounces = 8;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // Shading normal ns (unit) tilted towards wi until dot(ns, wi) >= kMinCos; ng if that degenerates.
@@ -44,6 +46,7 @@ class PathTracer final : public Integrator {
   static constexpr bool kWorld = (kFeatures & kSceneWorld) != 0;
   static constexpr bool kAnalytic = (kFeatures & kSceneAnalyticLights) != 0;
   static constexpr bool kEmissive = (kFeatures & kSceneEmissiveTriangles) != 0;
+  static constexpr bool kTransparentShadows = (kFeatures & kFeatureTransparent) != 0;
 
  public:
   PathTracer(const SceneContext& ctx, const RenderSettings& settings)
@@ -53,14 +56,14 @@ class PathTracer final : public Integrator {
                    Film& film) const override {
     uint64_t rays = 0;
     Sampler sampler;
-    ClosureSet closures;  // ~0.5 KB: initialised once per tile, not per sample
+    ClosureSet closures, scratch;  // ~0.5 KB each: initialised once per tile, not per sample
     const float clamp = settings_.clamp;
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x) {
         Film::Accumulator& acc = film.pixel(x, y);
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
           sampler.start(settings_.seed, x, y, s);
-          PathResult r = trace(sampler, x, y, closures);
+          PathResult r = trace(sampler, x, y, closures, scratch);
           rays += r.rays;
           // A non-finite sample would poison the pixel forever: drop it (counted as black).
           if (!is_finite(r.primal)) r.primal = Spectrum(0.0f);
@@ -82,7 +85,34 @@ class PathTracer final : public Integrator {
   }
 
  private:
-  PathResult trace(const Sampler& sampler, int px, int py, ClosureSet& closures) const {
+  // Fraction of light passing along the shadow ray: 0 if an opaque surface blocks it, else the
+  // product of the Transparent closure weights of the surfaces crossed (Cycles' transparent
+  // shadows), at most kMaxTransparentBounces of them. Opaque-only scenes use one occlusion query.
+  Spectrum transmittance(Ray ray, ClosureSet& scratch, uint32_t& rays) const {
+    ++rays;
+    if (!kTransparentShadows) return ctx_.bvh().occluded(ray) ? Spectrum(0.0f) : Spectrum(1.0f);
+    Spectrum tr(1.0f);
+    SurfaceHit h;
+    for (int crossing = 0; crossing <= kMaxTransparentBounces; ++crossing) {
+      if (!ctx_.bvh().intersect(ray, h)) return tr;
+      scratch.clear();
+      ctx_.materials()[size_t(h.material)].evaluate(ShadingContext{h.uv, h.front_facing}, scratch);
+      Spectrum through(0.0f);
+      for (int i = 0; i < scratch.count(); ++i)
+        if (scratch[i].type == ClosureType::Transparent) through += scratch[i].weight;
+      tr *= through;
+      if (is_black(tr)) return tr;
+      const Vec3f n =
+          dot(ray.direction, h.geometric_normal) > 0.0f ? h.geometric_normal : -h.geometric_normal;
+      ray.origin = offset_ray_origin(h.position, n);
+      ray.t_max -= h.t;
+      ++rays;
+    }
+    return Spectrum(0.0f);
+  }
+
+  PathResult trace(const Sampler& sampler, int px, int py, ClosureSet& closures,
+                   ClosureSet& scratch) const {
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
     const auto& materials = ctx_.materials();
@@ -101,7 +131,12 @@ class PathTracer final : public Integrator {
     Vec3f prev_position = ray.origin;
     SurfaceHit hit;
 
-    for (int bounce = 0;; ++bounce) {
+    int bounce = 0;           // Cycles' bounce count: scattering events, transparent ones excluded
+    int transparent = 0;      // transparent crossings (Cycles' transparent bounces)
+    bool camera_path = true;  // nothing but transparent crossings since the camera
+
+    // `vertex` numbers every surface interaction (sampler dimensions); `bounce` follows Cycles.
+    for (int vertex = 0;; ++vertex) {
       const bool found = bvh.intersect(ray, hit);
       ++out.rays;
       const float t_hit = found ? hit.t : ray.t_max;
@@ -111,8 +146,8 @@ class PathTracer final : public Integrator {
       if constexpr (kAnalytic) {
         LightHit lh;
         if (lights.intersect(ray.origin, ray.direction, t_hit, lh)) {
-          if (bounce == 0) {
-            out.emission += lh.radiance;
+          if (camera_path) {
+            out.emission += beta * lh.radiance;
           } else {
             const float w = prev_delta ? 1.0f : power_heuristic(prev_pdf, lh.pdf);
             out.primal += beta * lh.radiance * w;
@@ -124,8 +159,8 @@ class PathTracer final : public Integrator {
       if (!found) {
         if constexpr (kWorld) {
           const Spectrum le = lights.environment(ray.direction);
-          if (bounce == 0) {
-            out.emission += le;
+          if (camera_path) {
+            out.emission += beta * le;
           } else if (!is_black(le)) {
             const float w = prev_delta
                                 ? 1.0f
@@ -142,8 +177,8 @@ class PathTracer final : public Integrator {
       if constexpr (kEmissive) {
         if (material.is_emissive()) {
           const Spectrum le = material.emission(sc);
-          if (bounce == 0) {
-            out.emission += le;
+          if (camera_path) {
+            out.emission += beta * le;
           } else if (!is_black(le)) {
             float w = 1.0f;
             if (!prev_delta)
@@ -154,7 +189,7 @@ class PathTracer final : public Integrator {
           }
         }
       }
-      if (bounce > max_bounces) break;
+      if (bounce > max_bounces || transparent > kMaxTransparentBounces) break;
       closures.clear();
       material.evaluate(sc, closures);
       if (!closures.has_bsdf()) break;
@@ -172,8 +207,8 @@ class PathTracer final : public Integrator {
 
       // --- Next-event estimation ---
       if (has_lights) {
-        const float u_select = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kLightSelect));
-        const Vec2f u_light = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kLightPoint));
+        const float u_select = sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kLightSelect));
+        const Vec2f u_light = sampler.get2d(Sampler::bounce_dim(vertex, Sampler::kLightPoint));
         const LightSample ls = lights.sample(hit.position, u_select, u_light);
         if (ls.valid && ls.pdf > 0.0f && !is_black(ls.radiance)) {
           const Vec3f wo = frame.to_local(ls.direction);
@@ -188,10 +223,10 @@ class PathTracer final : public Integrator {
               shadow.t_min = 0.0f;
               // Stop short of the light's own surface (emissive triangles are geometry too).
               shadow.t_max = ls.is_infinite ? kInf : ls.distance * (1.0f - 1e-4f);
-              ++out.rays;
-              if (!bvh.occluded(shadow)) {
+              const Spectrum tr = transmittance(shadow, scratch, out.rays);
+              if (!is_black(tr)) {
                 const float w = ls.is_delta ? 1.0f : power_heuristic(ls.pdf, closures.pdf(wi, wo));
-                out.primal += beta * f * ls.radiance * (w / ls.pdf);
+                out.primal += beta * f * tr * ls.radiance * (w / ls.pdf);
               }
             }
           }
@@ -199,22 +234,33 @@ class PathTracer final : public Integrator {
       }
 
       // --- BSDF sampling: continue the path ---
-      const float u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
-      const Vec2f u_dir = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kBsdfDir));
+      const float u_lobe = sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kBsdfLobe));
+      const Vec2f u_dir = sampler.get2d(Sampler::bounce_dim(vertex, Sampler::kBsdfDir));
       const BsdfSample bs = closures.sample(wi, u_lobe, u_dir);
       if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;
       const Vec3f wo_world = frame.to_world(bs.wo);
       const float cos_ng = dot(wo_world, ng);
       if ((cos_ng > 0.0f) != (bs.wo.z > 0.0f) || cos_ng == 0.0f) break;
       beta *= bs.value / bs.pdf;
-      prev_delta = bs.is_delta();
-      prev_pdf = bs.pdf;
-      prev_position = hit.position;
+      // A transparent crossing (straight through, eta 1) is not a bounce, keeps the camera-path
+      // status and keeps the MIS state of the last real scattering vertex: shadow rays see
+      // through transparent surfaces too (transmittance()), so the NEE density from that vertex
+      // is still the competing technique.
+      const bool crossing = bs.is_delta() && (bs.lobe & kLobeTransmission) != 0 && bs.eta == 1.0f;
+      if (crossing) {
+        ++transparent;
+      } else {
+        prev_delta = bs.is_delta();
+        prev_pdf = bs.pdf;
+        prev_position = hit.position;
+        camera_path = false;
+        ++bounce;
+      }
 
-      // --- Russian roulette ---
-      if (bounce >= settings_.rr_depth) {
+      // --- Russian roulette (real bounces only) ---
+      if (!crossing && bounce - 1 >= settings_.rr_depth) {
         const float q = std::min(max_component(beta), 0.95f);
-        if (!(sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kRoulette)) < q)) break;
+        if (!(sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kRoulette)) < q)) break;
         beta /= q;
       }
 
@@ -237,8 +283,8 @@ std::unique_ptr<Integrator> make_kernel(const SceneContext& ctx, const RenderSet
   return std::make_unique<PathTracer<kMask>>(ctx, s);
 }
 
-constexpr std::array<uint32_t, 4> kBits = {kSceneDoF, kSceneWorld, kSceneAnalyticLights,
-                                           kSceneEmissiveTriangles};
+constexpr std::array<uint32_t, 5> kBits = {kSceneDoF, kSceneWorld, kSceneAnalyticLights,
+                                           kSceneEmissiveTriangles, kFeatureTransparent};
 
 constexpr uint32_t mask_of_index(size_t i) {
   uint32_t m = 0;

@@ -13,8 +13,11 @@
 // 3.x (lights_intersect runs for camera rays unless the object's camera visibility is off).
 //
 // Specialisation: the kernel is a template over the scene features that change per-sample work
-// (depth of field, world lookups, analytic-light intersection, emissive triangles); one of the 16
-// instantiations is chosen per session from SceneContext::features().
+// (depth of field, world lookups, analytic-light intersection, emissive triangles, transparent
+// shadows); one of the 32 instantiations is chosen per session from SceneContext::features().
+//
+// Transparency (Transparent BSDF, Principled alpha) as Cycles: crossings are not bounces, keep the
+// camera-path status and the MIS state; shadow rays are attenuated by the surfaces they cross.
 #pragma once
 
 #include <cstdint>

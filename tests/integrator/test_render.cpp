@@ -278,6 +278,65 @@ TEST(Render, DiskAreaLightMisMatchesTheAnalyticIrradiance) {
   EXPECT_NEAR(sum / img.primal.size(), expect, 0.01 * expect);
 }
 
+// A Transparent BSDF sheet of colour T between a sun and a Lambert floor, viewed from above through
+// the sheet: light crosses it twice, L = albedo E cos / pi * T^2 (Cycles' transparent shadows).
+// Transparent crossings are not bounces: max_bounces = 0 gives the same image, and with a soft
+// sun the BSDF paths through the sheet are MIS-weighted against NEE from the floor.
+Scene transparent_sheet_scene(float sun_angle) {
+  Scene scene;
+  scene.meshes.push_back(quad(50.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  MaterialDesc sheet;
+  ShaderNode t;
+  t.kind = ShaderNodeKind::Transparent;
+  t.color = ColorInput(Spectrum(0.5f, 0.25f, 1.0f));
+  sheet.nodes.push_back(t);
+  sheet.root = 0;
+  scene.materials.push_back(sheet);
+  scene.instances.push_back(place(0, 0));
+  scene.instances.push_back(place(0, 1, translation({0, 0, 1})));
+  scene.world.color = Spectrum(0.0f);
+  Light sun;
+  sun.type = Light::Type::Sun;
+  sun.power = 3.0f;
+  sun.sun_angle = sun_angle;
+  sun.light_to_world = translation({0, 0, 20});
+  scene.lights.push_back(sun);
+  scene.camera = top_camera(4, 1.0f, 5.0f);
+  return scene;
+}
+
+TEST(Render, TransparentSurfacesPassLightAndAreNotBounces) {
+  const Spectrum T(0.5f, 0.25f, 1.0f);
+  for (float angle : {0.0f, 0.05f}) {
+    const Scene scene = transparent_sheet_scene(angle);
+    for (int bounces : {0, 4}) {
+      RenderSettings s = pt(64);
+      s.max_bounces = bounces;
+      const Image img = render(scene, s);
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0.0;
+        for (size_t i = size_t(c); i < img.primal.size(); i += 3) sum += img.primal[i];
+        const double expect = 0.5 * 3.0 / kPi * T[c] * T[c];
+        EXPECT_NEAR(sum / (img.primal.size() / 3), expect, 0.01 * expect)
+            << "sun angle " << angle << " max_bounces " << bounces << " channel " << c;
+      }
+    }
+  }
+}
+
+TEST(Render, EmissionSeenThroughTransparentSurfacesIsCameraVisible) {
+  Scene scene = transparent_sheet_scene(0.0f);
+  scene.lights.clear();
+  scene.materials[0] = emission(Spectrum(1.0f), 2.0f);
+  const Image img = render(scene, pt(4));
+  for (size_t i = 0; i < img.primal.size(); i += 3) {
+    EXPECT_FLOAT_EQ(img.emission[i], 2.0f * 0.5f);
+    EXPECT_FLOAT_EQ(img.emission[i + 1], 2.0f * 0.25f);
+    EXPECT_EQ(img.primal[i], 0.0f);
+  }
+}
+
 // --- Light-path semantics ---
 
 TEST(Render, CameraVisibleEmissionGoesToTheEmissionPass) {
