@@ -128,6 +128,14 @@ TEST(GradientUnbiased, MixedLights) {
   expect_unbiased("mixed-lights", make_scene(SceneKind::MixedLights, 16), 4096, 512);
 }
 
+TEST(GradientUnbiased, ThinLensDepthOfField) {
+  // Base and offsets share the lens sample: no camera Jacobian, still unbiased.
+  Scene scene = make_scene(SceneKind::CornellDiffuse, 16);
+  scene.camera.aperture_radius = 0.08f;
+  scene.camera.focus_distance = 3.0f;
+  expect_unbiased("depth-of-field", scene, 4096, 512);
+}
+
 TEST(GradientUnbiased, EveryVertexHalfVector) {
   // Threshold above every roughness: all vertices (Lambert included) take the half-vector copy,
   // light sampling is never shifted; exercises kills, failed shifts and offset-only light hits.
