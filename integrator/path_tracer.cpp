@@ -134,6 +134,7 @@ class PathTracer final : public Integrator {
     int bounce = 0;           // Cycles' bounce count: scattering events, transparent ones excluded
     int transparent = 0;      // transparent crossings (Cycles' transparent bounces)
     bool camera_path = true;  // nothing but transparent crossings since the camera
+    bool crossed_since_vertex = false;  // transparent crossings since prev_position
 
     // `vertex` numbers every surface interaction (sampler dimensions); `bounce` follows Cycles.
     for (int vertex = 0;; ++vertex) {
@@ -149,7 +150,17 @@ class PathTracer final : public Integrator {
           if (camera_path) {
             out.emission += beta * lh.radiance;
           } else {
-            const float w = prev_delta ? 1.0f : power_heuristic(prev_pdf, lh.pdf);
+            float light_pdf = lh.pdf;
+            if (!prev_delta && crossed_since_vertex) {
+              // NEE ran from prev_position, behind the transparent surfaces just crossed: its
+              // density for this light is the one seen from there along the same line.
+              LightHit from_vertex;
+              if (lights.intersect(prev_position, ray.direction, kInf, from_vertex) &&
+                  std::fabs(from_vertex.distance - length(lh.position - prev_position)) <=
+                      1e-3f * from_vertex.distance)
+                light_pdf = from_vertex.pdf;
+            }
+            const float w = prev_delta ? 1.0f : power_heuristic(prev_pdf, light_pdf);
             out.primal += beta * lh.radiance * w;
           }
         }
@@ -249,7 +260,9 @@ class PathTracer final : public Integrator {
       const bool crossing = bs.is_delta() && (bs.lobe & kLobeTransmission) != 0 && bs.eta == 1.0f;
       if (crossing) {
         ++transparent;
+        crossed_since_vertex = true;
       } else {
+        crossed_since_vertex = false;
         prev_delta = bs.is_delta();
         prev_pdf = bs.pdf;
         prev_position = hit.position;

@@ -325,6 +325,38 @@ TEST(Render, TransparentSurfacesPassLightAndAreNotBounces) {
   }
 }
 
+// Disk area light seen from the floor through a transparent sheet: the BSDF-hit MIS weight must
+// use the light's density from the floor vertex (where NEE ran), not from the sheet.
+TEST(Render, AreaLightThroughTransparentSheetMis) {
+  const float R = 0.8f, h = 1.0f;
+  Light disk;
+  disk.type = Light::Type::Area;
+  disk.shape = Light::Shape::Disk;
+  disk.size_x = disk.size_y = 2.0f * R;
+  disk.power = 50.0f;
+  disk.light_to_world = translation({0, 0, h});
+  Scene look;
+  look.world.color = Spectrum(0.0f);
+  look.lights.push_back(disk);
+  look.camera = top_camera(2, 0.01f, 0.0f);
+  look.camera.camera_to_world = rotation_x(kPi, {0, 0, 0});
+  const double L = render(look, pt(1)).emission[0];
+  ASSERT_GT(L, 0.0);
+
+  Scene scene = transparent_sheet_scene(0.0f);
+  scene.instances[1].object_to_world = translation({0, 0, 0.5f});
+  scene.lights = {disk};
+  scene.camera = top_camera(4, 0.01f, 0.2f);  // between floor and sheet: sees the floor directly
+  const Image img = render(scene, pt(256));
+  const Spectrum T(0.5f, 0.25f, 1.0f);
+  for (int c = 0; c < 3; ++c) {
+    double sum = 0.0;
+    for (size_t i = size_t(c); i < img.primal.size(); i += 3) sum += img.primal[i];
+    const double expect = 0.5 * L * R * R / (h * h + R * R) * T[c];
+    EXPECT_NEAR(sum / (img.primal.size() / 3), expect, 0.01 * expect) << "channel " << c;
+  }
+}
+
 TEST(Render, EmissionSeenThroughTransparentSurfacesIsCameraVisible) {
   Scene scene = transparent_sheet_scene(0.0f);
   scene.lights.clear();
