@@ -329,7 +329,12 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
           auto pb = make_problem(pr, w);
           const auto inv_diag = detail::jacobi_inverse_diagonal(pb);
           pb.inv_diagonal = inv_diag.data();
-          const auto cg = detail::solve_weighted_cg(pb, x.data(), settings.l1_cg_steps, 0.0, ws);
+          // Inner steps fall linearly from first to last: the early reweightings move the image
+          // far from the L2 start, the late ones only refine it (bench_reconstruct --sweep).
+          const int first = settings.l1_cg_steps_first, last = settings.l1_cg_steps_last;
+          const int steps =
+              K > 1 ? int(std::lround(first + double(last - first) * k / (K - 1))) : first;
+          const auto cg = detail::solve_weighted_cg(pb, x.data(), std::max(1, steps), 0.0, ws);
           rep.iterations += cg.iterations;
           rep.relative_residual = cg.relative_residual;
           progress(float(k + 1) / float(K + 1));

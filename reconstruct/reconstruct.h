@@ -32,9 +32,11 @@ struct ReconstructionSettings {
   float alpha = 0.2f;  // must be > 0
   int threads = 0;     // 0 = all cores
 
-  // L1: reweightings, and Jacobi-PCG steps per reweighting (chosen by bench_reconstruct).
+  // L1: reweightings, and Jacobi-PCG steps per reweighting, falling linearly from the first to the
+  // last reweighting (chosen with bench_reconstruct --sweep; docs/reconstruct.md).
   int l1_reweightings = 36;
-  int l1_cg_steps = 10;
+  int l1_cg_steps_first = 12;
+  int l1_cg_steps_last = 3;
   // Weighted (and L2 with missing data): stop at |b - A I| <= tolerance |b| per channel.
   double weighted_tolerance = 1e-4;
   int max_cg_iterations = 2000;

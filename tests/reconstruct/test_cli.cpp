@@ -199,6 +199,25 @@ TEST_F(Cli, InvalidInputExit1WithOneLineReason) {
                 o->write_image(OIIO::TypeDesc::FLOAT, zeros.data()));
     o->close();
   }
+  // Two parts of different sizes.
+  {
+    OIIO::ImageSpec specs[2] = {OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::FLOAT),
+                                OIIO::ImageSpec(5, 4, 3, OIIO::TypeDesc::FLOAT)};
+    specs[0].channelnames = {"ViewLayer.Primal.R", "ViewLayer.Primal.G", "ViewLayer.Primal.B"};
+    specs[1].channelnames = {"ViewLayer.Gradient X.R", "ViewLayer.Gradient X.G",
+                             "ViewLayer.Gradient X.B"};
+    specs[0].full_width = 5;  // parts must share the display window; the data windows differ
+    specs[0].attribute("name", "a");
+    specs[1].attribute("name", "b");
+    std::vector<float> zeros(5 * 4 * 3, 0.f);
+    auto o = OIIO::ImageOutput::create(path("parts.exr"));
+    ASSERT_TRUE(o && o->supports("multiimage"));
+    ASSERT_TRUE(o->open(path("parts.exr"), 2, specs)) << o->geterror();
+    ASSERT_TRUE(o->write_image(OIIO::TypeDesc::FLOAT, zeros.data()));
+    ASSERT_TRUE(o->open(path("parts.exr"), specs[1], OIIO::ImageOutput::AppendSubimage));
+    ASSERT_TRUE(o->write_image(OIIO::TypeDesc::FLOAT, zeros.data()));
+    o->close();
+  }
   // Missing pass.
   write_multilayer_exr(
       path("nogy.exr"), 4, 4, "ViewLayer",
@@ -214,6 +233,7 @@ TEST_F(Cli, InvalidInputExit1WithOneLineReason) {
       {{path("garbage.exr"), "-o", path("o.exr")}, "garbage.exr"},
       {{path("channels.exr"), "-o", path("o.exr")}, "has channels R,G"},
       {{path("nogy.exr"), "-o", path("o.exr")}, "'Gradient Y'"},
+      {{path("parts.exr"), "-o", path("o.exr")}, "different sizes"},
       {{path("nogy.exr"), "-o", path("o.exr"), "--norm", "none"}, ""},  // ok: none needs Primal
       {{path("good.exr"), "-o", path("o.exr"), "--layer", "Other"}, "'Other'"},
       {{path("good.exr"), "-o", path("no/such/dir/o.exr")}, "o.exr"},
