@@ -434,6 +434,34 @@ TEST(Render, EmissiveCeilingDirectLight) {
   EXPECT_NEAR(sum / img.primal.size(), 0.5 * 1.5, 0.01 * 0.75);
 }
 
+// Clamp: every primal sample is scaled to a largest component of at most `clamp`; the Emission
+// pass is not clamped. The emissive-ceiling floor averages 0.75 unclamped.
+TEST(Render, ClampBoundsPrimalSamples) {
+  Scene scene;
+  scene.meshes.push_back(quad(200.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  scene.materials.push_back(emission(Spectrum(1.0f), 1.5f));
+  scene.instances.push_back(place(0, 0));
+  scene.instances.push_back(place(0, 1, rotation_x(kPi, {0, 0, 1})));
+  scene.world.color = Spectrum(0.0f);
+  scene.camera = top_camera(4, 0.5f, 0.5f);
+  RenderSettings s = pt(64);
+  s.max_bounces = 0;
+  s.clamp = 0.3f;
+  const Image img = render(scene, s);
+  double sum = 0.0;
+  for (float v : img.primal) {
+    EXPECT_LE(v, 0.3f + 1e-6f);
+    sum += v;
+  }
+  EXPECT_GT(sum / img.primal.size(), 0.1);
+  EXPECT_LT(sum / img.primal.size(), 0.3 + 1e-6);
+  // Looking at the emitter from below: 1.5 in the Emission pass, untouched by the clamp.
+  scene.camera.camera_to_world = rotation_x(kPi, {0, 0, 0.5f});
+  const Image up = render(scene, s);
+  EXPECT_FLOAT_EQ(up.emission[0], 1.5f);
+}
+
 // Floor of albedo a under a ceiling that emits Le and reflects with albedo b (Add shader). Paths
 // floor -> ceiling (-> floor -> ceiling)^k carry a Le (a b)^k and need 2k + 1 bounces after the
 // camera ray, with Cycles' meaning of max_bounces (0 = direct light only): 0, 1 -> a Le;
