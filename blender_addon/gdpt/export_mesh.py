@@ -5,40 +5,102 @@
 # per evaluated mesh datablock and shared by all its instances (the core builds one BVH per mesh).
 # Curves, text, surfaces and metaballs are converted with to_mesh().
 #
-# Arrays are filled with foreach_get into preallocated numpy buffers: loop triangles give the
-# vertex indices and the corner (loop) indices used to gather split normals and UVs.
+# Arrays are filled with foreach_get into preallocated numpy buffers and gathered per triangle
+# corner with numpy: the corner (loop) indices pick vertex indices, normals and UVs.
 
 import numpy as np
 
 _GEOMETRY_TYPES = {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META', 'CURVES'}
 
 
+def _corner_loops_fast(mesh, loop_total, loop_vertex, co):
+    """Loop indices of the triangle corners and the polygon of each triangle, for meshes made of
+    triangles and quads only, in Blender's loop-triangle order and split (quads: 0-1-2, 0-2-3).
+    foreach_get on loop_triangles goes through Blender's slow per-item path (1.5 s per array for
+    1M triangles); polygon and loop fields are read as raw arrays."""
+    loop_start = np.empty(len(loop_total), dtype=np.int32)
+    mesh.polygons.foreach_get("loop_start", loop_start)
+    per_poly = loop_total - 2
+    tri_poly = np.repeat(np.arange(len(loop_total), dtype=np.int32), per_poly)
+    # k = index of the triangle within its polygon (0, or 1 for the second half of a quad).
+    k = np.arange(len(tri_poly), dtype=np.int32) - np.repeat(np.cumsum(per_poly) - per_poly,
+                                                              per_poly).astype(np.int32)
+    s = loop_start[tri_poly]
+    corners = np.empty((len(tri_poly), 3), dtype=np.int32)
+    corners[:, 0] = s
+    corners[:, 1] = s + 1 + k
+    corners[:, 2] = s + 2 + k
+    # Blender splits a quad along 1-3 instead when the 0-2 split would fold it (concave or
+    # strongly non-planar quads): (v1 - v0) x (v2 - v0) and (v3 - v0) x (v2 - v0) point the same
+    # way. Its triangles are then 0-1-3 and 1-2-3.
+    quads = np.flatnonzero(loop_total == 4)
+    if len(quads):
+        q = loop_start[quads][:, None] + np.arange(4, dtype=np.int32)[None, :]
+        v = np.take(co.reshape(-1, 3), loop_vertex[q], axis=0)  # (quads, 4, 3) float32
+        # Same float32 operation order as Blender's test, so nearly planar quads split alike.
+        a = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+        b = np.cross(v[:, 3] - v[:, 0], v[:, 2] - v[:, 0])
+        flip = (a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]) + a[:, 2] * b[:, 2] > 0.0
+        if flip.any():
+            first = (np.cumsum(per_poly) - per_poly)[quads[flip]]  # first triangle of the quad
+            s = loop_start[quads[flip]]
+            corners[first] = np.stack([s, s + 1, s + 3], axis=1)
+            corners[first + 1] = np.stack([s + 1, s + 2, s + 3], axis=1)
+    return corners.ravel(), tri_poly
+
+
+def _corner_loops_slow(mesh):
+    """Any polygons (n-gons are ear-clipped by Blender): read the loop triangles."""
+    mesh.calc_loop_triangles()
+    tri_count = len(mesh.loop_triangles)
+    corners = np.empty(tri_count * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("loops", corners)
+    tri_poly = np.empty(tri_count, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("polygon_index", tri_poly)
+    return corners, tri_poly
+
+
 def mesh_arrays(mesh):
     """(positions, indices, corner_normals or None, corner_uvs or None, material_slot) of a
     mesh, all float32 / int32 and C-contiguous."""
-    mesh.calc_loop_triangles()
-    tri_count = len(mesh.loop_triangles)
+    poly_count = len(mesh.polygons)
     vert_count = len(mesh.vertices)
     positions = np.empty(vert_count * 3, dtype=np.float32)
     mesh.vertices.foreach_get("co", positions)
-    indices = np.empty(tri_count * 3, dtype=np.int32)
-    mesh.loop_triangles.foreach_get("vertices", indices)
-    material_slot = np.empty(tri_count, dtype=np.int32)
-    mesh.loop_triangles.foreach_get("material_index", material_slot)
+    loop_total = np.empty(poly_count, dtype=np.int32)
+    mesh.polygons.foreach_get("loop_total", loop_total)
+    loop_vertex = np.empty(len(mesh.loops), dtype=np.int32)
+    mesh.loops.foreach_get("vertex_index", loop_vertex)
+    if poly_count and loop_total.min() >= 3 and loop_total.max() <= 4:
+        corner_loops, tri_poly = _corner_loops_fast(mesh, loop_total, loop_vertex, positions)
+    else:
+        corner_loops, tri_poly = _corner_loops_slow(mesh)
+    indices = np.ascontiguousarray(loop_vertex[corner_loops])
+    poly_material = np.empty(poly_count, dtype=np.int32)
+    mesh.polygons.foreach_get("material_index", poly_material)
+    material_slot = np.ascontiguousarray(poly_material[tri_poly])
 
-    # Smooth / flat: split normals already hold face normals for flat faces and sharp edges, so
-    # one gather covers every mix. All-flat meshes skip it: the core then uses geometric normals.
-    smooth = np.empty(len(mesh.polygons), dtype=bool)
+    # Shading normals per corner. Custom / auto-smooth normals need Blender's split normals.
+    # Otherwise smooth faces use vertex normals and flat faces their face normal, which is what
+    # the split normals would be; all-flat meshes send none (the core uses geometric normals).
+    smooth = np.empty(poly_count, dtype=bool)
     mesh.polygons.foreach_get("use_smooth", smooth)
-    corner_loops = None
     corner_normals = None
-    if smooth.any() or mesh.has_custom_normals:
-        corner_loops = np.empty(tri_count * 3, dtype=np.int32)
-        mesh.loop_triangles.foreach_get("loops", corner_loops)
+    if mesh.has_custom_normals or (mesh.use_auto_smooth and smooth.any()):
         mesh.calc_normals_split()
         loop_normals = np.empty(len(mesh.loops) * 3, dtype=np.float32)
         mesh.loops.foreach_get("normal", loop_normals)
-        corner_normals = np.ascontiguousarray(loop_normals.reshape(-1, 3)[corner_loops])
+        corner_normals = np.take(loop_normals.reshape(-1, 3), corner_loops, axis=0)
+    elif smooth.any():
+        vertex_normals = np.empty(vert_count * 3, dtype=np.float32)
+        mesh.vertex_normals.foreach_get("vector", vertex_normals)  # raw array, unlike .normal
+        corner_normals = np.take(vertex_normals.reshape(-1, 3), indices, axis=0)
+        if not smooth.all():
+            face_normals = np.empty(poly_count * 3, dtype=np.float32)
+            mesh.polygon_normals.foreach_get("vector", face_normals)
+            flat_corner = np.repeat(~smooth[tri_poly], 3)
+            corner_normals[flat_corner] = np.take(face_normals.reshape(-1, 3),
+                                                  np.repeat(tri_poly, 3)[flat_corner], axis=0)
 
     corner_uvs = None
     uv_layer = None
@@ -47,13 +109,10 @@ def mesh_arrays(mesh):
             uv_layer = layer
     if uv_layer is None and len(mesh.uv_layers):
         uv_layer = mesh.uv_layers[0]
-    if uv_layer is not None and tri_count:
-        if corner_loops is None:
-            corner_loops = np.empty(tri_count * 3, dtype=np.int32)
-            mesh.loop_triangles.foreach_get("loops", corner_loops)
+    if uv_layer is not None and len(corner_loops):
         loop_uvs = np.empty(len(mesh.loops) * 2, dtype=np.float32)
         uv_layer.data.foreach_get("uv", loop_uvs)
-        corner_uvs = np.ascontiguousarray(loop_uvs.reshape(-1, 2)[corner_loops])
+        corner_uvs = np.take(loop_uvs.reshape(-1, 2), corner_loops, axis=0)
     return positions, indices, corner_normals, corner_uvs, material_slot
 
 
@@ -73,8 +132,13 @@ class GeometryExporter:
         self.export_seconds = 0.0
 
     def _mesh_for(self, obj):
-        data = obj.data
-        key = data.as_pointer() if data is not None else ("object", obj.name)
+        # Meshes: the evaluated mesh datablock (modifiers applied) is what instances share.
+        # Other types: to_mesh() depends on the object's own modifiers, so key by the original
+        # object (instances of it in collections or particles still share one mesh).
+        if obj.type == 'MESH':
+            key = obj.data.as_pointer()
+        else:
+            key = ("object", obj.original.as_pointer())
         if key in self.mesh_index:
             return self.mesh_index[key]
         if obj.type == 'MESH':

@@ -113,6 +113,14 @@ def case_area_disk(scene):
     return 3
 
 
+def case_area_visible(scene):
+    # The camera looks at the lamp itself: Cycles 3.4 does not show area lamps to camera rays.
+    S.room()
+    S.camera((0, -1.5, 1.0), (0, 0.5, 3.9), lens=24)
+    area_ceiling(size=1.0, energy=100.0)
+    return 3
+
+
 def case_mesh_light(scene):
     lit_room(scene)
     S.plane("panel", 1.2, (0, 0, 3.9), (math.pi, 0, 0), S.emission("panel", (1, 0.9, 0.8), 20.0))
