@@ -209,14 +209,21 @@ def case_instancing(scene):
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
 
 
-def run_case(name, out_dir):
+# Cases whose GDPT side is also rendered in PT mode (Combined = Primal + Emission): what the
+# camera sees directly must not depend on the integrator.
+BOTH_MODES = {"area_visible"}
+
+
+def run_case(name, out_dir, mode=None):
     scene = S.clear()
     bounces = CASES[name](scene)
     import gdpt.engine as engine
-    S.setup_gdpt(scene, GDPT_SAMPLES, mode=MODE, reconstruction=RECON, bounces=bounces)
+    mode = mode or MODE
+    recon = RECON if mode == 'GPT' else 'NONE'
+    S.setup_gdpt(scene, GDPT_SAMPLES, mode=mode, reconstruction=recon, bounces=bounces)
     engine.LAST_RENDER.clear()
     t0 = time.time()
-    gdpt_path = S.render(scene, os.path.join(out_dir, f"{name}_gdpt.exr"))
+    gdpt_path = S.render(scene, os.path.join(out_dir, f"{name}_gdpt_{mode}.exr"))
     t_gdpt = time.time() - t0
     if engine.LAST_RENDER.get("samples") != GDPT_SAMPLES:
         raise RuntimeError(f"{name}: Gradient PT did not render (got {engine.LAST_RENDER})")
@@ -228,7 +235,7 @@ def run_case(name, out_dir):
     b = S.read_rgb(cycles_path)
     err = S.rel_mse(a, b)
     ratio = a.mean() / max(b.mean(), 1e-9)
-    print(f"CASE {name}: relMSE {err:.5f} mean GDPT/Cycles {ratio:.4f} (GDPT {GDPT_SAMPLES} spp "
+    print(f"CASE {name} ({mode}): relMSE {err:.5f} mean GDPT/Cycles {ratio:.4f} (GDPT {GDPT_SAMPLES} spp "
           f"{t_gdpt:.1f} s, Cycles {CYCLES_SAMPLES} spp {t_cycles:.1f} s)", flush=True)
     return err, ratio
 
@@ -240,9 +247,10 @@ def main():
     names = a.get("cases", ",".join(CASES)).split(",")
     failures = []
     for name in names:
-        err, ratio = run_case(name, out_dir)
-        if not (err < THRESHOLD and abs(ratio - 1.0) < MEAN_TOLERANCE):
-            failures.append(f"{name} (relMSE {err:.4f}, mean ratio {ratio:.3f})")
+        for mode in ((MODE, 'PT') if name in BOTH_MODES and MODE != 'PT' else (MODE,)):
+            err, ratio = run_case(name, out_dir, mode)
+            if not (err < THRESHOLD and abs(ratio - 1.0) < MEAN_TOLERANCE):
+                failures.append(f"{name} {mode} (relMSE {err:.4f}, mean ratio {ratio:.3f})")
     if failures:
         raise RuntimeError("FAILED: " + ", ".join(failures))
     print("ALL CASES PASSED", flush=True)
