@@ -102,11 +102,13 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
               f"triangles), {stats.lights} lights, {stats.materials} materials in "
               f"{stats.seconds:.3f} s", flush=True)
 
+        t_session = time.perf_counter()
         try:
-            job = module.RenderJob(builder, properties.settings_dict(scene))
+            job = module.RenderJob(builder, properties.settings_dict(scene))  # BVH, lights
         except ValueError as e:
             self._error(str(e))
             return
+        session_seconds = time.perf_counter() - t_session
         for w in job.warnings():
             self._warn(w)
 
@@ -175,11 +177,12 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         LAST_RENDER.clear()
         LAST_RENDER.update(
             view_layer=view_layer.name, status=status, samples=film["samples"], width=width,
-            height=height, export=stats.seconds, render=t_done - t_render,
+            height=height, export=stats.seconds, setup=session_seconds, render=t_done - t_render,
             reconstruct=t_reconstruct - t_done, write=t_end - t_reconstruct,
             total=t_end - t_start, triangles=stats.triangles, warnings=sorted(self._warned))
         print(f"{MARKER} view layer '{view_layer.name}' {status}: {film['samples']}/"
               f"{settings.samples} samples, {width}x{height}, mode {settings.mode}, "
-              f"reconstruction {norm}; export {stats.seconds:.3f} s, render "
+              f"reconstruction {norm}; export {stats.seconds:.3f} s, scene setup "
+              f"{session_seconds:.3f} s, render "
               f"{t_done - t_render:.3f} s, reconstruction {t_reconstruct - t_done:.3f} s, "
               f"write {t_end - t_reconstruct:.3f} s, total {t_end - t_start:.3f} s", flush=True)

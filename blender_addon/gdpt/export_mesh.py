@@ -8,9 +8,41 @@
 # Arrays are filled with foreach_get into preallocated numpy buffers and gathered per triangle
 # corner with numpy: the corner (loop) indices pick vertex indices, normals and UVs.
 
+import ctypes
+
 import numpy as np
 
 _GEOMETRY_TYPES = {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META', 'CURVES'}
+
+
+def _raw_int_column(collection, column, attr):
+    """Column `column` (in 32-bit words) of the C array behind a mesh collection, read directly
+    through as_pointer(): Blender 3.4's RNA foreach_get takes a slow per-item path for
+    loops.vertex_index and polygons.loop_start/loop_total (about 1 s per 1M items). The layout is
+    checked at run time (element stride from consecutive pointers; values against RNA at the
+    first, middle and last element); None means "use foreach_get"."""
+    count = len(collection)
+    if count < 2:
+        return None
+    base = collection[0].as_pointer()
+    stride = collection[1].as_pointer() - base
+    if base == 0 or stride <= 0 or stride % 4 or column >= stride // 4:
+        return None
+    words = stride // 4
+    buffer = (ctypes.c_int32 * (count * words)).from_address(base)
+    values = np.frombuffer(buffer, dtype=np.int32).reshape(count, words)[:, column].copy()
+    for i in (0, count // 2, count - 1):
+        if getattr(collection[i], attr) != values[i]:
+            return None
+    return values
+
+
+def _int_field(collection, column, attr):
+    values = _raw_int_column(collection, column, attr)
+    if values is None:
+        values = np.empty(len(collection), dtype=np.int32)
+        collection.foreach_get(attr, values)
+    return values
 
 
 def _corner_loops_fast(mesh, loop_total, loop_vertex, co):
@@ -18,8 +50,7 @@ def _corner_loops_fast(mesh, loop_total, loop_vertex, co):
     triangles and quads only, in Blender's loop-triangle order and split (quads: 0-1-2, 0-2-3).
     foreach_get on loop_triangles goes through Blender's slow per-item path (1.5 s per array for
     1M triangles); polygon and loop fields are read as raw arrays."""
-    loop_start = np.empty(len(loop_total), dtype=np.int32)
-    mesh.polygons.foreach_get("loop_start", loop_start)
+    loop_start = _int_field(mesh.polygons, 0, "loop_start")  # MPoly.loopstart
     per_poly = loop_total - 2
     tri_poly = np.repeat(np.arange(len(loop_total), dtype=np.int32), per_poly)
     # k = index of the triangle within its polygon (0, or 1 for the second half of a quad).
@@ -67,17 +98,20 @@ def mesh_arrays(mesh):
     vert_count = len(mesh.vertices)
     positions = np.empty(vert_count * 3, dtype=np.float32)
     mesh.vertices.foreach_get("co", positions)
-    loop_total = np.empty(poly_count, dtype=np.int32)
-    mesh.polygons.foreach_get("loop_total", loop_total)
-    loop_vertex = np.empty(len(mesh.loops), dtype=np.int32)
-    mesh.loops.foreach_get("vertex_index", loop_vertex)
+    loop_total = _int_field(mesh.polygons, 1, "loop_total")  # MPoly.totloop
+    loop_vertex = _int_field(mesh.loops, 0, "vertex_index")  # MLoop.v
     if poly_count and loop_total.min() >= 3 and loop_total.max() <= 4:
         corner_loops, tri_poly = _corner_loops_fast(mesh, loop_total, loop_vertex, positions)
     else:
         corner_loops, tri_poly = _corner_loops_slow(mesh)
     indices = np.ascontiguousarray(loop_vertex[corner_loops])
-    poly_material = np.empty(poly_count, dtype=np.int32)
-    mesh.polygons.foreach_get("material_index", poly_material)
+    # Blender 3.4 keeps material indices in an attribute that only exists when one is non-zero.
+    poly_material = np.zeros(poly_count, dtype=np.int32)
+    attribute = mesh.attributes.get("material_index")
+    if attribute is not None and attribute.domain == 'FACE' and attribute.data_type == 'INT':
+        attribute.data.foreach_get("value", poly_material)
+    elif attribute is not None:
+        mesh.polygons.foreach_get("material_index", poly_material)
     material_slot = np.ascontiguousarray(poly_material[tri_poly])
 
     # Shading normals per corner. Custom / auto-smooth normals need Blender's split normals.
