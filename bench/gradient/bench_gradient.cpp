@@ -5,12 +5,14 @@
 // Usage: bench_gradient [resolution [spp [repeats [threads]]]]   (default 128 16 3 2)
 // Each case renders `spp` samples at resolution^2 with PT and with G-PT, alternating, `repeats`
 // times; the cost per sample is the best wall time / (pixels * spp) of each mode (the best of
-// several runs is the least disturbed by other processes on a shared machine).
+// several runs is the least disturbed by other processes on a shared machine), and likewise the
+// best process CPU time per sample (the steadier figure on a loaded machine).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 
 #include "integrator/render_session.h"
 #include "tests/gradient/gradient_scenes.h"
@@ -20,34 +22,50 @@ using namespace gdpt::gradient_test;
 
 namespace {
 
-double seconds_per_sample(const Scene& scene, RenderSettings::Mode mode, int spp, int threads,
-                          uint64_t* rays) {
+// Process CPU time (all threads): on a machine shared with other jobs it is far less disturbed
+// than wall time, which also counts the time this process waits for a core.
+double cpu_seconds() {
+  timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+struct Cost {
+  double wall = 0.0, cpu = 0.0;  // seconds per sample
+};
+
+Cost seconds_per_sample(const Scene& scene, RenderSettings::Mode mode, int spp, int threads,
+                        uint64_t* rays) {
   RenderSettings s = settings(mode, spp, 1, threads);
   s.samples_per_pass = 1;
   RenderSession session(scene, s);
   std::atomic<bool> cancel{false};
+  const double c0 = cpu_seconds();
   const auto t0 = std::chrono::steady_clock::now();
   session.render(nullptr, cancel);
   const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double c = cpu_seconds() - c0;
   if (rays) *rays = session.rays_traced();
-  return t / (double(scene.camera.width) * scene.camera.height * spp);
+  const double n = double(scene.camera.width) * scene.camera.height * spp;
+  return {t / n, c / n};
 }
 
 void run_case(const char* name, const Scene& scene, int spp, int repeats, int threads) {
-  double best_pt = 1e30, best_gpt = 1e30;
+  Cost pt{1e30, 1e30}, gpt{1e30, 1e30};
   uint64_t rays_pt = 0, rays_gpt = 0;
   for (int r = 0; r < repeats; ++r) {
-    best_pt = std::min(best_pt,
-                       seconds_per_sample(scene, RenderSettings::Mode::PT, spp, threads, &rays_pt));
-    best_gpt = std::min(
-        best_gpt, seconds_per_sample(scene, RenderSettings::Mode::GPT, spp, threads, &rays_gpt));
+    const Cost a = seconds_per_sample(scene, RenderSettings::Mode::PT, spp, threads, &rays_pt);
+    const Cost b = seconds_per_sample(scene, RenderSettings::Mode::GPT, spp, threads, &rays_gpt);
+    pt = {std::min(pt.wall, a.wall), std::min(pt.cpu, a.cpu)};
+    gpt = {std::min(gpt.wall, b.wall), std::min(gpt.cpu, b.cpu)};
   }
   const double px = double(scene.camera.width) * scene.camera.height * spp;
   std::printf(
-      "%-14s PT %7.3f us/sample (%5.1f rays/sample)  G-PT %7.3f us/sample (%5.1f rays/sample)  "
-      "G-PT/PT = %.2fx\n",
-      name, best_pt * 1e6, double(rays_pt) / px, best_gpt * 1e6, double(rays_gpt) / px,
-      best_gpt / best_pt);
+      "%-12s PT %6.3f us/sample wall %6.3f cpu (%4.1f rays)  G-PT %6.3f wall %6.3f cpu (%4.1f "
+      "rays)  G-PT/PT = %.2fx wall, %.2fx cpu\n",
+      name, pt.wall * 1e6, pt.cpu * 1e6, double(rays_pt) / px, gpt.wall * 1e6, gpt.cpu * 1e6,
+      double(rays_gpt) / px, gpt.wall / pt.wall, gpt.cpu / pt.cpu);
+  std::fflush(stdout);
 }
 
 }  // namespace
