@@ -41,7 +41,11 @@ void Film::take_rows(Film& pass, int y0, int y1) {
       a.dx[c] += b.dx[c];
       a.dy[c] += b.dy[c];
       a.emission[c] += b.emission[c];
+      a.dx_left[c] += b.dx_left[c];
+      a.dy_down[c] += b.dy_down[c];
     }
+    a.dx_left2 += b.dx_left2;
+    a.dy_down2 += b.dy_down2;
     a.primal2 += b.primal2;
     a.dx2 += b.dx2;
     a.dy2 += b.dy2;
@@ -89,6 +93,10 @@ void Film::gradient_x_rgb(float* out) const {
           }
         } else {
           v = acc_[i].dx[c] * inv;
+          if (x + 1 < width_) {
+            const size_t j = i + 1;
+            v -= acc_[j].dx_left[c] * (samples_[j] ? 1.0 / samples_[j] : 0.0);
+          }
         }
         out[3 * i + c] = float(v);
       }
@@ -112,6 +120,10 @@ void Film::gradient_y_rgb(float* out) const {
           }
         } else {
           v = acc_[i].dy[c] * inv;
+          if (y + 1 < height_) {
+            const size_t j = i + width_;
+            v -= acc_[j].dy_down[c] * (samples_[j] ? 1.0 / samples_[j] : 0.0);
+          }
         }
         out[3 * i + c] = float(v);
       }
@@ -133,8 +145,17 @@ void Film::variance3(float* out) const {
         vdx = x + 1 < width_ ? vp + primal_var(i + 1) : 0.0;
         vdy = y + 1 < height_ ? vp + primal_var(i + width_) : 0.0;
       } else {
+        // G-PT: the two halves come from different pixels' base paths (independent).
         vdx = variance_of_mean(lum(a.dx), a.dx2, samples_[i]);
         vdy = variance_of_mean(lum(a.dy), a.dy2, samples_[i]);
+        if (x + 1 < width_) {
+          const Accumulator& b = acc_[i + 1];
+          vdx += variance_of_mean(lum(b.dx_left), b.dx_left2, samples_[i + 1]);
+        }
+        if (y + 1 < height_) {
+          const Accumulator& b = acc_[i + width_];
+          vdy += variance_of_mean(lum(b.dy_down), b.dy_down2, samples_[i + width_]);
+        }
       }
       out[3 * i + 0] = float(vp);
       out[3 * i + 1] = float(vdx);

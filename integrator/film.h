@@ -20,6 +20,8 @@ class Film {
   size_t pixel_count() const { return size_t(width_) * size_t(height_); }
 
   // Float32 images for passes, interleaved, row 0 at the bottom. Means over the samples done.
+  // Gradients: dx(x) = mean dx(x) - mean dx_left(x + 1) (likewise dy), the variance of dx the sum
+  // of the two independent halves' variances of the mean.
   void primal_rgb(float* out) const;      // 3 per pixel, without camera-visible emission
   void gradient_x_rgb(float* out) const;  // 3 per pixel
   void gradient_y_rgb(float* out) const;  // 3 per pixel
@@ -37,6 +39,12 @@ class Film {
     double dy[3] = {0, 0, 0}, dy2 = 0;
     double emission[3] = {0, 0, 0};
     double shift_attempts = 0, shift_failures = 0;
+    // G-PT: this pixel's one-sided halves G_left and G_down (sum, sum of squared luminance),
+    // written only by the pixel's own tile and subtracted from the neighbours' dx(x - 1) and
+    // dy(y - 1) at read-out, so that no tile has to trace its neighbours' base paths. dx and dy
+    // then hold the G_right / G_up halves; both are zero in PT mode.
+    double dx_left[3] = {0, 0, 0}, dx_left2 = 0;
+    double dy_down[3] = {0, 0, 0}, dy_down2 = 0;
   };
   Accumulator& pixel(int x, int y) { return acc_[size_t(y) * width_ + x]; }
   const Accumulator& pixel(int x, int y) const { return acc_[size_t(y) * width_ + x]; }

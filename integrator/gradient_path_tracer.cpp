@@ -131,10 +131,6 @@ struct PathScratch {
   Vertex verts[2];  // base vertex and the next one, swapped per bounce
 };
 
-struct Halves {
-  Vec3d grad[kOffsets];
-};
-
 class GradientPathTracer final : public Integrator {
  public:
   GradientPathTracer(const SceneContext& ctx, const RenderSettings& settings)
@@ -148,47 +144,31 @@ class GradientPathTracer final : public Integrator {
   void render_tile(const Tile& tile, uint32_t first_sample, uint32_t sample_count,
                    Film& film) const override {
     const int W = film.width(), H = film.height();
-    // Region: the tile plus its right column and top row (halo) when they exist.
-    const int rx1 = std::min(tile.x1 + 1, W), ry1 = std::min(tile.y1 + 1, H);
-    const int rw = rx1 - tile.x0, rh = ry1 - tile.y0;
-    thread_local std::vector<Halves> halves;
-    if (halves.size() < size_t(rw) * size_t(rh)) halves.resize(size_t(rw) * size_t(rh));
-    auto half_at = [&](int x, int y) -> Halves& {
-      return halves[size_t(y - tile.y0) * size_t(rw) + size_t(x - tile.x0)];
-    };
     uint64_t rays = 0;
     Sampler sampler;
     thread_local PathScratch scratch;
     const float clamp = settings_.clamp;
-    for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
-      // --- Trace every base path of the region with the offsets this tile needs ---
-      for (int y = tile.y0; y < ry1; ++y)
-        for (int x = tile.x0; x < rx1; ++x) {
-          const bool in_x = x < tile.x1, in_y = y < tile.y1;
-          if (!in_x && !in_y) continue;  // the corner is never needed
-          bool mask[kOffsets];
-          if (in_x && in_y) {
-            mask[kRight] = x + 1 < W;
-            mask[kUp] = y + 1 < H;
-            mask[kLeft] = x - 1 >= tile.x0;  // dx(x0 - 1) belongs to the left tile
-            mask[kDown] = y - 1 >= tile.y0;
-          } else {
-            mask[kRight] = mask[kUp] = false;
-            mask[kLeft] = !in_x;  // halo column: G_left for dx(x1 - 1)
-            mask[kDown] = !in_y;  // halo row: G_down for dy(y1 - 1)
-          }
+    // Adds one half to a gradient accumulator (sum and squared luminance); a non-finite half
+    // counts as 0, as a non-finite primal does.
+    auto add_half = [](Vec3d g, double* sum, double& sum2) {
+      if (!(std::isfinite(g.x) && std::isfinite(g.y) && std::isfinite(g.z))) g = Vec3d();
+      sum[0] += g.x;
+      sum[1] += g.y;
+      sum[2] += g.z;
+      const double l = 0.2126 * g.x + 0.7152 * g.y + 0.0722 * g.z;
+      sum2 += l * l;
+    };
+    for (uint32_t s = first_sample; s < first_sample + sample_count; ++s)
+      for (int y = tile.y0; y < tile.y1; ++y)
+        for (int x = tile.x0; x < tile.x1; ++x) {
+          // Every offset whose target pixel is inside the image: the pixel's own halves of
+          // dx(x), dy(x), dx(x - 1) and dy(y - 1) (the latter two combined at read-out).
+          const bool mask[kOffsets] = {x + 1 < W, y + 1 < H, x >= 1, y >= 1};
           sampler.start(settings_.seed, x, y, s);
           SampleResult r;
           trace(sampler, x, y, mask, scratch, r);
           rays += r.rays;
-          Halves& h = half_at(x, y);
-          for (int k = 0; k < kOffsets; ++k) {
-            const Vec3d g = r.grad[k];
-            h.grad[k] =
-                (std::isfinite(g.x) && std::isfinite(g.y) && std::isfinite(g.z)) ? g : Vec3d();
-          }
-          if (!(in_x && in_y)) continue;
-          // --- Primal, emission and statistics of the pixel's own base path ---
+          // --- Primal, emission and statistics of the pixel's base path ---
           if (!is_finite(r.primal)) r.primal = Spectrum(0.0f);
           if (!is_finite(r.emission)) r.emission = Spectrum(0.0f);
           if (clamp > 0.0f) {
@@ -204,30 +184,12 @@ class GradientPathTracer final : public Integrator {
           acc.primal2 += lum * lum;
           acc.shift_attempts += r.attempts;
           acc.shift_failures += r.failures;
+          // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
+          if (mask[kRight]) add_half(r.grad[kRight], acc.dx, acc.dx2);
+          if (mask[kUp]) add_half(r.grad[kUp], acc.dy, acc.dy2);
+          if (mask[kLeft]) add_half(r.grad[kLeft], acc.dx_left, acc.dx_left2);
+          if (mask[kDown]) add_half(r.grad[kDown], acc.dy_down, acc.dy_down2);
         }
-      // --- Combine the halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
-      for (int y = tile.y0; y < tile.y1; ++y)
-        for (int x = tile.x0; x < tile.x1; ++x) {
-          Film::Accumulator& acc = film.pixel(x, y);
-          const Halves& h = half_at(x, y);
-          if (x + 1 < W) {
-            const Vec3d d = h.grad[kRight] - half_at(x + 1, y).grad[kLeft];
-            acc.dx[0] += d.x;
-            acc.dx[1] += d.y;
-            acc.dx[2] += d.z;
-            const double l = 0.2126 * d.x + 0.7152 * d.y + 0.0722 * d.z;
-            acc.dx2 += l * l;
-          }
-          if (y + 1 < H) {
-            const Vec3d d = h.grad[kUp] - half_at(x, y + 1).grad[kDown];
-            acc.dy[0] += d.x;
-            acc.dy[1] += d.y;
-            acc.dy[2] += d.z;
-            const double l = 0.2126 * d.x + 0.7152 * d.y + 0.0722 * d.z;
-            acc.dy2 += l * l;
-          }
-        }
-    }
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x) film.add_sample_count(x, y, sample_count);
     count_rays(rays);

@@ -14,14 +14,15 @@
 //
 // Film outputs (integrator/film.h): primal = the base path's ordinary PT estimate (NEE + BSDF
 // sampling, power heuristic), emission = camera-visible emission (never shifted), dx/dy as above
-// with the squared luminance of each per-sample value (the two halves of sample s of pixels p and
-// its neighbour form one sample), shift attempts / failures of the pixel's own offsets. The last
+// (each half with its own sum of squared luminance; the halves come from different pixels' base
+// paths, so their variances add), shift attempts / failures of the pixel's own offsets. The last
 // column has dx = 0 and the last row dy = 0 (the Neumann rows of the reconstruction).
 //
-// Threads: render_tile() writes only the pixels of its tile. The halves a tile needs from its
-// right and top neighbours (G_left of column x1, G_down of row y1) are recomputed inside the
-// tile by tracing those base paths with only the one offset needed: sample values depend only on
-// (seed, pixel, sample index), so the result is bit-identical for any tile order or thread count.
+// Threads: render_tile() writes only the pixels of its tile. Each pixel stores its own four
+// halves (G_right and G_up in Film::Accumulator::dx/dy, G_left and G_down in dx_left/dy_down);
+// the film combines them with the neighbours' at read-out, so no tile traces another tile's base
+// paths. Sample values depend only on (seed, pixel, sample index), so the result is
+// bit-identical for any tile order or thread count.
 #pragma once
 
 #include <memory>
