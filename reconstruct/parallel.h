@@ -6,13 +6,38 @@
 // ReconstructionSettings::threads).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
+
 namespace gdpt::detail {
+
+// Flush-to-zero and denormals-are-zero for the duration of one chunk. CG residuals and IRLS
+// directions decay into the float denormal range late in a solve, and denormal arithmetic is
+// ~100x slower on x86: measured at 960x540, 270 L1 steps took 29 s with denormals, 12 s without.
+// Values below 1e-38 are irrelevant to an image. MXCSR is per thread, so it is set per chunk and
+// restored, leaving the caller's threads as they were.
+class FlushDenormals {
+ public:
+#if defined(__SSE__)
+  FlushDenormals() : saved_(_mm_getcsr()) {
+    _mm_setcsr(saved_ | 0x8040u);
+  }  // FTZ | DAZ
+  ~FlushDenormals() {
+    _mm_setcsr(saved_);
+  }
+
+ private:
+  unsigned saved_;
+#endif
+};
 
 // 8 rows of a 1080p RGB float image are ~180 KB per array: big enough to amortise scheduling,
 // small enough that the five arrays a stencil pass touches stay in L2.
@@ -27,6 +52,7 @@ template <class Body>
 void parallel_rows(int height, const Body& body) {
   const int chunks = chunk_count(height);
   tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& r) {
+    const FlushDenormals ftz;
     for (int c = r.begin(); c != r.end(); ++c)
       body(c * kRowsPerChunk, std::min(height, (c + 1) * kRowsPerChunk));
   });
@@ -39,6 +65,7 @@ std::array<double, N> parallel_rows_sum(int height, const Body& body) {
   const int chunks = chunk_count(height);
   std::vector<std::array<double, N>> partial(chunks);
   tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& r) {
+    const FlushDenormals ftz;
     for (int c = r.begin(); c != r.end(); ++c) {
       partial[c].fill(0.0);
       body(c * kRowsPerChunk, std::min(height, (c + 1) * kRowsPerChunk), partial[c]);
