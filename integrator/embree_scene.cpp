@@ -181,6 +181,76 @@ bool EmbreeScene::occluded(const Ray& ray) const {
   return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
 
+namespace {
+
+// Fills lane i of a packet ray from `ray` (a lane that is not valid is left untouched by Embree).
+template <typename Packet>
+void set_lane(Packet& r, int i, const Ray& ray) {
+  r.org_x[i] = ray.origin.x;
+  r.org_y[i] = ray.origin.y;
+  r.org_z[i] = ray.origin.z;
+  r.dir_x[i] = ray.direction.x;
+  r.dir_y[i] = ray.direction.y;
+  r.dir_z[i] = ray.direction.z;
+  r.tnear[i] = ray.t_min;
+  r.tfar[i] = ray.t_max;
+  r.time[i] = 0.0f;
+  r.mask[i] = 0xffffffffu;
+  r.id[i] = unsigned(i);
+  r.flags[i] = 0;
+}
+
+}  // namespace
+
+void EmbreeScene::intersect4(const Ray rays[4], const bool valid[4], bool found[4],
+                             SurfaceHit hits[4]) const {
+  // An empty packet costs a call; a single ray is faster on its own.
+  const int n = int(valid[0]) + int(valid[1]) + int(valid[2]) + int(valid[3]);
+  if (n <= 1) {
+    for (int i = 0; i < 4; ++i) found[i] = valid[i] && intersect(rays[i], hits[i]);
+    return;
+  }
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(16) int lanes[4];
+  alignas(16) RTCRayHit4 rh;
+  for (int i = 0; i < 4; ++i) {
+    lanes[i] = valid[i] ? -1 : 0;
+    set_lane(rh.ray, i, valid[i] ? rays[i] : Ray{});
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  rtcIntersect4(lanes, top_, &ctx, &rh);
+  for (int i = 0; i < 4; ++i) {
+    found[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+    if (!found[i]) continue;
+    hits[i].t = rh.ray.tfar[i];
+    const unsigned top_id =
+        rh.hit.instID[0][i] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0][i] : rh.hit.geomID[i];
+    complete_hit(top_id, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], rays[i].direction, hits[i]);
+  }
+}
+
+void EmbreeScene::occluded4(const Ray rays[4], const bool valid[4], bool blocked[4]) const {
+  const int n = int(valid[0]) + int(valid[1]) + int(valid[2]) + int(valid[3]);
+  if (n <= 1) {
+    for (int i = 0; i < 4; ++i) blocked[i] = valid[i] && occluded(rays[i]);
+    return;
+  }
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(16) int lanes[4];
+  alignas(16) RTCRay4 r;
+  for (int i = 0; i < 4; ++i) {
+    lanes[i] = valid[i] ? -1 : 0;
+    set_lane(r, i, valid[i] ? rays[i] : Ray{});
+  }
+  rtcOccluded4(lanes, top_, &ctx, &r);
+  for (int i = 0; i < 4; ++i) blocked[i] = valid[i] && r.tfar[i] < 0.0f;  // -inf on a hit
+}
+
 void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v, Vec3f dir,
                                SurfaceHit& hit) const {
   const InstanceData& d = instances_[top_id];

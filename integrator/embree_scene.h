@@ -48,6 +48,11 @@ class EmbreeScene {
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
   // True when something blocks the segment (t_min, t_max).
   bool occluded(const Ray& ray) const;
+  // Four rays at once (Embree ray packets, rtcIntersect4 / rtcOccluded4, coherent context): ray i
+  // is traced only when valid[i]; results as above (found/blocked false for invalid rays). For
+  // the G-PT offsets, whose four rays start at neighbouring pixels.
+  void intersect4(const Ray rays[4], const bool valid[4], bool found[4], SurfaceHit hits[4]) const;
+  void occluded4(const Ray rays[4], const bool valid[4], bool blocked[4]) const;
 
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
   size_t instanced_triangle_count() const { return instanced_triangles_; }

@@ -108,6 +108,8 @@ struct Offset {
   Vec3d seg_value;
   double seg_pdf = 0.0, seg_jacobian = 1.0;
   bool seg_visible = true;
+  bool vis_pending = false;  // Reconnect*: seg_visible awaits the packet test of vis_ray
+  Ray vis_ray;
   Vec3f seg_dir;  // world direction of the offset's segment
   // HalfVector: the offset's own next vertex.
   Ray ray;
@@ -200,14 +202,20 @@ class GradientPathTracer final : public Integrator {
     return shift::classify_vertex(roughness, settings_.shift_roughness_threshold);
   }
 
-  bool occluded(Vec3f from, Vec3f ng, Vec3f dir, float t_max, uint32_t& rays) const {
+  // The segment from `from` (geometric normal `ng`) along `dir` up to t_max, leaving the surface
+  // on the side of `dir`.
+  static Ray shadow_ray(Vec3f from, Vec3f ng, Vec3f dir, float t_max) {
     Ray shadow;
     shadow.origin = offset_ray_origin(from, dot(dir, ng) > 0.0f ? ng : -ng);
     shadow.direction = dir;
     shadow.t_min = 0.0f;
     shadow.t_max = t_max;
+    return shadow;
+  }
+
+  bool occluded(Vec3f from, Vec3f ng, Vec3f dir, float t_max, uint32_t& rays) const {
     ++rays;
-    return ctx_.bvh().occluded(shadow);
+    return ctx_.bvh().occluded(shadow_ray(from, ng, dir, t_max));
   }
 
   // Local outgoing direction at `v` for world `dir`; false when the geometric and shading
@@ -279,29 +287,34 @@ class GradientPathTracer final : public Integrator {
       return;
     }
 
+    // The four offset camera rays start at neighbouring pixels: one coherent packet.
     Offset* off = scratch.off;
+    Ray cam[kOffsets];
+    for (int k = 0; k < kOffsets; ++k) {
+      if (!mask[k]) continue;
+      const Vec2f r{raster.x + float(kShiftX[k]), raster.y + float(kShiftY[k])};
+      cam[k] = ctx_.camera().generate_ray(r, lens);
+      ++out.rays;
+    }
+    bool cam_found[kOffsets];
+    SurfaceHit cam_hit[kOffsets];
+    bvh.intersect4(cam, mask, cam_found, cam_hit);
     for (int k = 0; k < kOffsets; ++k) {
       Offset& o = off[k];
       o.active = mask[k];
       o.alive = false;
       if (!o.active) continue;
       ++out.attempts;
-      o.alive = true;
       o.failed = false;
       o.link = Link::NotConnected;
       o.nee_on = true;
       o.f = Vec3d(1.0, 1.0, 1.0);
       o.p = 1.0;
       o.grad = Vec3d();
-      const Vec2f r{raster.x + float(kShiftX[k]), raster.y + float(kShiftY[k])};
-      o.ray = ctx_.camera().generate_ray(r, lens);
-      SurfaceHit h;
-      ++out.rays;
-      if (!bvh.intersect(o.ray, h)) {
-        o.alive = false;  // base hits a surface, the offset the world: no shift
-        continue;
-      }
-      setup_vertex(ctx_, h, o.ray.direction, o.v);
+      o.ray = cam[k];
+      // Base hits a surface, the offset the world: no shift.
+      o.alive = cam_found[k];
+      if (o.alive) setup_vertex(ctx_, cam_hit[k], o.ray.direction, o.v);
     }
 
     int cur = 0;  // scratch.verts[cur] is the base vertex
@@ -363,52 +376,87 @@ class GradientPathTracer final : public Integrator {
           const PathDensities db{pb, ls.pdf, pdf_bsdf};
 
           // --- Offsets ---
-          for (Offset& o : std::span(off, kOffsets)) {
+          // First pass: the offsets' light samples; the shadow rays of the not-connected ones
+          // start at neighbouring points towards the same light point and go in one packet.
+          enum class NeeCase : uint8_t { Skip, Dead, Shared, NoLight, Shifted };
+          NeeCase nc[kOffsets];
+          LightSample lo[kOffsets];
+          double J[kOffsets];
+          Vec3f wo_o[kOffsets];
+          Spectrum fo[kOffsets];
+          Ray shadow[kOffsets];
+          bool test[kOffsets] = {false, false, false, false};
+          for (int k = 0; k < kOffsets; ++k) {
+            const Offset& o = off[k];
+            nc[k] = NeeCase::Skip;
             if (!o.active) continue;
+            if (!o.alive) {
+              nc[k] = NeeCase::Dead;
+              continue;
+            }
+            if (o.link != Link::NotConnected) {
+              nc[k] = NeeCase::Shared;
+              continue;
+            }
+            if (!ls.is_delta && !o.nee_on) continue;  // not shifted: dropped on both sides
+            if (!offset_light(o.v.hit.position, u_select, u_light, ls, lo[k])) {
+              // The light cannot be sampled from y (e.g. y is behind a one-sided area light):
+              // the offset has density 0, the base keeps its full weight. The base at y skips
+              // this light sample as well, so the pair stays consistent.
+              nc[k] = NeeCase::NoLight;
+              continue;
+            }
+            nc[k] = NeeCase::Shifted;
+            J[k] = ls.is_delta || ls.is_infinite
+                       ? 1.0
+                       : shift::light_reconnection_jacobian(base.hit.position, o.v.hit.position,
+                                                            ls.position, ls.normal, false);
+            fo[k] = Spectrum(0.0f);
+            if (local_dir(o.v, lo[k].direction, wo_o[k])) {
+              fo[k] = o.v.closures.eval(o.v.wi, wo_o[k]);
+              if (!is_black(fo[k]) && !is_black(lo[k].radiance)) {
+                test[k] = true;
+                shadow[k] = shadow_ray(o.v.hit.position, o.v.ng, lo[k].direction,
+                                       lo[k].is_infinite ? kInf : lo[k].distance * (1.0f - 1e-4f));
+                ++out.rays;
+              }
+            }
+          }
+          bool blocked[kOffsets];
+          bvh.occluded4(shadow, test, blocked);
+          // Second pass: contributions and weights.
+          for (int k = 0; k < kOffsets; ++k) {
+            Offset& o = off[k];
             Vec3d co;
             PathDensities d_off{0.0, 0.0, 0.0};
-            if (o.alive) {
-              if (o.link == Link::Connected) {
-                co = mul(o.f, Vec3d(visible ? fs * ls.radiance : Spectrum(0.0f)));
-                d_off = shift::offset_densities(o.p, 1.0, ls.pdf, pdf_bsdf);
-              } else if (o.link == Link::Recent) {
-                Spectrum fo(0.0f);
-                float pdf_o = 0.0f;
-                if (wo.z != 0.0f && visible) {
-                  fo = bc.eval(o.wi_shared, wo);
-                  if (!ls.is_delta) pdf_o = bc.pdf(o.wi_shared, wo);
+            switch (nc[k]) {
+              case NeeCase::Skip:
+                continue;
+              case NeeCase::Dead:
+              case NeeCase::NoLight:
+                break;
+              case NeeCase::Shared:
+                if (o.link == Link::Connected) {
+                  co = mul(o.f, Vec3d(visible ? fs * ls.radiance : Spectrum(0.0f)));
+                  d_off = shift::offset_densities(o.p, 1.0, ls.pdf, pdf_bsdf);
+                } else {
+                  Spectrum f_r(0.0f);
+                  float pdf_o = 0.0f;
+                  if (wo.z != 0.0f && visible) {
+                    f_r = bc.eval(o.wi_shared, wo);
+                    if (!ls.is_delta) pdf_o = bc.pdf(o.wi_shared, wo);
+                  }
+                  co = mul(mul(o.f, f_r), ls.radiance);
+                  d_off = shift::offset_densities(o.p, 1.0, ls.pdf, pdf_o);
                 }
-                co = mul(mul(o.f, fo), ls.radiance);
-                d_off = shift::offset_densities(o.p, 1.0, ls.pdf, pdf_o);
-              } else {
-                if (!ls.is_delta && !o.nee_on) continue;  // not shifted: dropped on both sides
-                LightSample lo;
-                if (!offset_light(o.v.hit.position, u_select, u_light, ls, lo)) {
-                  // The light cannot be sampled from y (e.g. y is behind a one-sided area
-                  // light): the offset has density 0, the base keeps its full weight. The base
-                  // at y skips this light sample as well, so the pair stays consistent.
-                  const double w = shift::mis_weight_over_pdf(db, d_off, db.light);
-                  o.grad = o.grad - cb * w;
-                  continue;
-                }
-                const double J =
-                    ls.is_delta || ls.is_infinite
-                        ? 1.0
-                        : shift::light_reconnection_jacobian(base.hit.position, o.v.hit.position,
-                                                             ls.position, ls.normal, false);
-                Vec3f wo_o;
-                Spectrum fo(0.0f);
-                bool vis_o = false;
-                if (local_dir(o.v, lo.direction, wo_o)) {
-                  fo = o.v.closures.eval(o.v.wi, wo_o);
-                  if (!is_black(fo) && !is_black(lo.radiance))
-                    vis_o =
-                        !occluded(o.v.hit.position, o.v.ng, lo.direction,
-                                  lo.is_infinite ? kInf : lo.distance * (1.0f - 1e-4f), out.rays);
-                }
-                const float pdf_o = (!ls.is_delta && vis_o) ? o.v.closures.pdf(o.v.wi, wo_o) : 0.0f;
-                co = vis_o ? mul(mul(o.f, fo), lo.radiance) * J : Vec3d();
-                d_off = shift::offset_densities(o.p, J, lo.pdf, pdf_o);
+                break;
+              case NeeCase::Shifted: {
+                const bool vis_o = test[k] && !blocked[k];
+                const float pdf_o =
+                    (!ls.is_delta && vis_o) ? o.v.closures.pdf(o.v.wi, wo_o[k]) : 0.0f;
+                co = vis_o ? mul(mul(o.f, fo[k]), lo[k].radiance) * J[k] : Vec3d();
+                d_off = shift::offset_densities(o.p, J[k], lo[k].pdf, pdf_o);
+                break;
               }
             }
             const double w = shift::mis_weight_over_pdf(db, d_off, db.light);
@@ -458,6 +506,18 @@ class GradientPathTracer final : public Integrator {
         if (!o.active || !o.alive) continue;
         shift_segment(o, base, bs, xd_type, wo_world, found, next, next_type, u_lobe, u_dir,
                       out.rays);
+      }
+      // Reconnection visibility of all offsets in one packet (rays towards the same x_{d+1}).
+      {
+        Ray vis[kOffsets];
+        bool test[kOffsets], blocked[kOffsets];
+        for (int k = 0; k < kOffsets; ++k) {
+          test[k] = off[k].active && off[k].alive && off[k].vis_pending;
+          if (test[k]) vis[k] = off[k].vis_ray;
+        }
+        bvh.occluded4(vis, test, blocked);
+        for (int k = 0; k < kOffsets; ++k)
+          if (test[k]) off[k].seg_visible = !blocked[k];
       }
 
       const Vec3d seg_b = Vec3d(bs.value);
@@ -563,6 +623,7 @@ class GradientPathTracer final : public Integrator {
     const EmbreeScene& bvh = ctx_.bvh();
     o.seg_jacobian = 1.0;
     o.seg_visible = true;
+    o.vis_pending = false;
     o.killed = false;
     o.next_found = false;
     switch (o.link) {
@@ -616,8 +677,10 @@ class GradientPathTracer final : public Integrator {
         o.seg_jacobian = r.jacobian;
         o.seg_value = Vec3d(y.closures.eval(y.wi, wo));
         o.seg_pdf = y.closures.pdf(y.wi, wo);
-        o.seg_visible =
-            !occluded(y.hit.position, y.ng, dir, float(r.distance) * (1.0f - 1e-4f), rays);
+        // Visibility: traced with the other offsets' rays in one packet (seg_visible).
+        o.vis_pending = true;
+        o.vis_ray = shadow_ray(y.hit.position, y.ng, dir, float(r.distance) * (1.0f - 1e-4f));
+        ++rays;
       } else {
         // Reconnection at infinity: the same direction, J = 1, visibility from y_d.
         Vec3f wo;
@@ -629,7 +692,9 @@ class GradientPathTracer final : public Integrator {
         o.shift = Shift::ReconnectEnv;
         o.seg_value = Vec3d(y.closures.eval(y.wi, wo));
         o.seg_pdf = y.closures.pdf(y.wi, wo);
-        o.seg_visible = !occluded(y.hit.position, y.ng, wo_world, kInf, rays);
+        o.vis_pending = true;
+        o.vis_ray = shadow_ray(y.hit.position, y.ng, wo_world, kInf);
+        ++rays;
       }
       return;
     }
