@@ -5,8 +5,8 @@
 # per evaluated mesh datablock and shared by all its instances (the core builds one BVH per mesh).
 # Curves, text, surfaces and metaballs are converted with to_mesh().
 #
-# Arrays are filled with foreach_get into preallocated numpy buffers and gathered per triangle
-# corner with numpy: the corner (loop) indices pick vertex indices, normals and UVs.
+# Arrays are filled with foreach_get (or read raw, see _raw_int_column) into preallocated numpy
+# buffers in Blender's own domains (vertices, loops); the module gathers them per triangle corner.
 
 import ctypes
 
@@ -45,41 +45,6 @@ def _int_field(collection, column, attr):
     return values
 
 
-def _corner_loops_fast(mesh, loop_total, loop_vertex, co):
-    """Loop indices of the triangle corners and the polygon of each triangle, for meshes made of
-    triangles and quads only, in Blender's loop-triangle order and split (quads: 0-1-2, 0-2-3).
-    foreach_get on loop_triangles goes through Blender's slow per-item path (1.5 s per array for
-    1M triangles); polygon and loop fields are read as raw arrays."""
-    loop_start = _int_field(mesh.polygons, 0, "loop_start")  # MPoly.loopstart
-    per_poly = loop_total - 2
-    tri_poly = np.repeat(np.arange(len(loop_total), dtype=np.int32), per_poly)
-    # k = index of the triangle within its polygon (0, or 1 for the second half of a quad).
-    k = np.arange(len(tri_poly), dtype=np.int32) - np.repeat(np.cumsum(per_poly) - per_poly,
-                                                              per_poly).astype(np.int32)
-    s = loop_start[tri_poly]
-    corners = np.empty((len(tri_poly), 3), dtype=np.int32)
-    corners[:, 0] = s
-    corners[:, 1] = s + 1 + k
-    corners[:, 2] = s + 2 + k
-    # Blender splits a quad along 1-3 instead when the 0-2 split would fold it (concave or
-    # strongly non-planar quads): (v1 - v0) x (v2 - v0) and (v3 - v0) x (v2 - v0) point the same
-    # way. Its triangles are then 0-1-3 and 1-2-3.
-    quads = np.flatnonzero(loop_total == 4)
-    if len(quads):
-        q = loop_start[quads][:, None] + np.arange(4, dtype=np.int32)[None, :]
-        v = np.take(co.reshape(-1, 3), loop_vertex[q], axis=0)  # (quads, 4, 3) float32
-        # Same float32 operation order as Blender's test, so nearly planar quads split alike.
-        a = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
-        b = np.cross(v[:, 3] - v[:, 0], v[:, 2] - v[:, 0])
-        flip = (a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]) + a[:, 2] * b[:, 2] > 0.0
-        if flip.any():
-            first = (np.cumsum(per_poly) - per_poly)[quads[flip]]  # first triangle of the quad
-            s = loop_start[quads[flip]]
-            corners[first] = np.stack([s, s + 1, s + 3], axis=1)
-            corners[first + 1] = np.stack([s + 1, s + 2, s + 3], axis=1)
-    return corners.ravel(), tri_poly
-
-
 def _corner_loops_slow(mesh):
     """Any polygons (n-gons are ear-clipped by Blender): read the loop triangles."""
     mesh.calc_loop_triangles()
@@ -91,63 +56,70 @@ def _corner_loops_slow(mesh):
     return corners, tri_poly
 
 
-def mesh_arrays(mesh):
-    """(positions, indices, corner_normals or None, corner_uvs or None, material_slot) of a
-    mesh, all float32 / int32 and C-contiguous."""
-    poly_count = len(mesh.polygons)
-    vert_count = len(mesh.vertices)
-    positions = np.empty(vert_count * 3, dtype=np.float32)
-    mesh.vertices.foreach_get("co", positions)
-    loop_total = _int_field(mesh.polygons, 1, "loop_total")  # MPoly.totloop
-    loop_vertex = _int_field(mesh.loops, 0, "vertex_index")  # MLoop.v
-    if poly_count and loop_total.min() >= 3 and loop_total.max() <= 4:
-        corner_loops, tri_poly = _corner_loops_fast(mesh, loop_total, loop_vertex, positions)
-    else:
-        corner_loops, tri_poly = _corner_loops_slow(mesh)
-    indices = np.ascontiguousarray(loop_vertex[corner_loops])
-    # Blender 3.4 keeps material indices in an attribute that only exists when one is non-zero.
-    poly_material = np.zeros(poly_count, dtype=np.int32)
-    attribute = mesh.attributes.get("material_index")
-    if attribute is not None and attribute.domain == 'FACE' and attribute.data_type == 'INT':
-        attribute.data.foreach_get("value", poly_material)
-    elif attribute is not None:
-        mesh.polygons.foreach_get("material_index", poly_material)
-    material_slot = np.ascontiguousarray(poly_material[tri_poly])
-
-    # Shading normals per corner. Custom / auto-smooth normals need Blender's split normals.
-    # Otherwise smooth faces use vertex normals and flat faces their face normal, which is what
-    # the split normals would be; all-flat meshes send none (the core uses geometric normals).
-    smooth = np.empty(poly_count, dtype=bool)
+def _normals_and_uvs(mesh):
+    """(normals, per_loop, loop_uvs) in Blender's domains. All smooth without custom normals:
+    vertex normals. Custom / auto-smooth normals or a smooth/flat mix: Blender's split (per-loop)
+    normals, which hold face normals for flat faces. All flat: none (the core then uses the
+    geometric normals). UVs: the active render UV map, per loop, or none."""
+    smooth = np.empty(len(mesh.polygons), dtype=bool)
     mesh.polygons.foreach_get("use_smooth", smooth)
-    corner_normals = None
-    if mesh.has_custom_normals or (mesh.use_auto_smooth and smooth.any()):
+    normals = np.empty(0, dtype=np.float32)
+    per_loop = False
+    if mesh.has_custom_normals or (smooth.any() and (mesh.use_auto_smooth or not smooth.all())):
         mesh.calc_normals_split()
-        loop_normals = np.empty(len(mesh.loops) * 3, dtype=np.float32)
-        mesh.loops.foreach_get("normal", loop_normals)
-        corner_normals = np.take(loop_normals.reshape(-1, 3), corner_loops, axis=0)
+        normals = np.empty(len(mesh.loops) * 3, dtype=np.float32)
+        mesh.loops.foreach_get("normal", normals)
+        per_loop = True
     elif smooth.any():
-        vertex_normals = np.empty(vert_count * 3, dtype=np.float32)
-        mesh.vertex_normals.foreach_get("vector", vertex_normals)  # raw array, unlike .normal
-        corner_normals = np.take(vertex_normals.reshape(-1, 3), indices, axis=0)
-        if not smooth.all():
-            face_normals = np.empty(poly_count * 3, dtype=np.float32)
-            mesh.polygon_normals.foreach_get("vector", face_normals)
-            flat_corner = np.repeat(~smooth[tri_poly], 3)
-            corner_normals[flat_corner] = np.take(face_normals.reshape(-1, 3),
-                                                  np.repeat(tri_poly, 3)[flat_corner], axis=0)
-
-    corner_uvs = None
+        normals = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertex_normals.foreach_get("vector", normals)  # raw array, unlike vertices.normal
+    loop_uvs = np.empty(0, dtype=np.float32)
     uv_layer = None
     for layer in mesh.uv_layers:
         if layer.active_render:
             uv_layer = layer
     if uv_layer is None and len(mesh.uv_layers):
         uv_layer = mesh.uv_layers[0]
-    if uv_layer is not None and len(corner_loops):
+    if uv_layer is not None:
         loop_uvs = np.empty(len(mesh.loops) * 2, dtype=np.float32)
         uv_layer.data.foreach_get("uv", loop_uvs)
-        corner_uvs = np.take(loop_uvs.reshape(-1, 2), corner_loops, axis=0)
-    return positions, indices, corner_normals, corner_uvs, material_slot
+    return normals, per_loop, loop_uvs
+
+
+def _poly_material(mesh):
+    # Blender 3.4 keeps material indices in an attribute that only exists when one is non-zero.
+    poly_material = np.zeros(len(mesh.polygons), dtype=np.int32)
+    attribute = mesh.attributes.get("material_index")
+    if attribute is not None and attribute.domain == 'FACE' and attribute.data_type == 'INT':
+        attribute.data.foreach_get("value", poly_material)
+    elif attribute is not None:
+        mesh.polygons.foreach_get("material_index", poly_material)
+    return poly_material
+
+
+def add_mesh(builder, mesh):
+    """Adds `mesh` to the scene; returns its index, or -1 when it has no faces. Only Blender's
+    own arrays (vertices, loops, polygons) are read here; the module builds the triangles and
+    gathers the corner attributes in C++."""
+    poly_count = len(mesh.polygons)
+    if poly_count == 0:
+        return -1
+    positions = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", positions)
+    loop_total = _int_field(mesh.polygons, 1, "loop_total")  # MPoly.totloop
+    loop_vertex = _int_field(mesh.loops, 0, "vertex_index")  # MLoop.v
+    normals, per_loop, loop_uvs = _normals_and_uvs(mesh)
+    poly_material = _poly_material(mesh)
+    if loop_total.min() >= 3 and loop_total.max() <= 4:
+        loop_start = _int_field(mesh.polygons, 0, "loop_start")  # MPoly.loopstart
+        return builder.add_mesh_polys(positions, loop_vertex, loop_start, loop_total, normals,
+                                      per_loop, loop_uvs, poly_material)
+    # N-gons: Blender's ear clipping, through its loop triangles (slower reads).
+    corner_loops, tri_poly = _corner_loops_slow(mesh)
+    if len(corner_loops) == 0:
+        return -1
+    return builder.add_mesh_loops(positions, loop_vertex, corner_loops, normals, per_loop,
+                                  loop_uvs, np.ascontiguousarray(poly_material[tri_poly]))
 
 
 def _matrix12(m):
@@ -188,10 +160,7 @@ class GeometryExporter:
         return index
 
     def _add_mesh(self, mesh):
-        positions, indices, normals, uvs, slots = mesh_arrays(mesh)
-        if len(indices) == 0:
-            return -1
-        return self.builder.add_mesh(positions, indices, normals, uvs, slots)
+        return add_mesh(self.builder, mesh)
 
     def visit(self, inst, obj, matrix):
         """Adds one instance of geometry object `obj` placed by `matrix` (already copied)."""

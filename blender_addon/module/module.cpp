@@ -49,6 +49,15 @@ PYBIND11_MODULE(_gdpt, m) {
            py::arg("indices").noconvert(), py::arg("corner_normals").noconvert() = py::none(),
            py::arg("corner_uvs").noconvert() = py::none(),
            py::arg("material_slot").noconvert() = py::none())
+      .def("add_mesh_loops", &SceneBuilder::add_mesh_loops, py::arg("positions").noconvert(),
+           py::arg("loop_vertex").noconvert(), py::arg("corner_loops").noconvert(),
+           py::arg("normals").noconvert(), py::arg("normals_per_loop"),
+           py::arg("loop_uvs").noconvert(), py::arg("material_slot").noconvert())
+      .def("add_mesh_polys", &SceneBuilder::add_mesh_polys, py::arg("positions").noconvert(),
+           py::arg("loop_vertex").noconvert(), py::arg("loop_start").noconvert(),
+           py::arg("loop_total").noconvert(), py::arg("normals").noconvert(),
+           py::arg("normals_per_loop"), py::arg("loop_uvs").noconvert(),
+           py::arg("poly_material").noconvert())
       .def("add_instance", &SceneBuilder::add_instance, py::arg("mesh"), py::arg("matrix"),
            py::arg("slot_material"))
       .def("add_material", &SceneBuilder::add_material)

@@ -157,6 +157,116 @@ int SceneBuilder::add_mesh(const FloatArray& positions, const IntArray& indices,
   return int(scene_.meshes.size()) - 1;
 }
 
+int SceneBuilder::add_mesh_loops(const FloatArray& positions, const IntArray& loop_vertex,
+                                 const IntArray& corner_loops, const FloatArray& normals,
+                                 bool normals_per_loop, const FloatArray& loop_uvs,
+                                 const IntArray& material_slot) {
+  if (corner_loops.size() % 3 != 0)
+    throw std::invalid_argument("corner_loops: size not a multiple of 3");
+  if (material_slot.size() > 0 && material_slot.size() * 3 != corner_loops.size())
+    throw std::invalid_argument("material_slot: expected one value per triangle");
+  return add_mesh_corners(
+      positions, loop_vertex, {corner_loops.data(), size_t(corner_loops.size())}, normals,
+      normals_per_loop, loop_uvs, {material_slot.data(), size_t(material_slot.size())});
+}
+
+int SceneBuilder::add_mesh_polys(const FloatArray& positions, const IntArray& loop_vertex,
+                                 const IntArray& loop_start, const IntArray& loop_total,
+                                 const FloatArray& normals, bool normals_per_loop,
+                                 const FloatArray& loop_uvs, const IntArray& poly_material) {
+  const size_t poly_count = size_t(loop_start.size());
+  if (size_t(loop_total.size()) != poly_count)
+    throw std::invalid_argument("loop_start / loop_total differ in size");
+  if (poly_material.size() > 0 && size_t(poly_material.size()) != poly_count)
+    throw std::invalid_argument("poly_material: expected one value per polygon");
+  const int32_t* start = loop_start.data();
+  const int32_t* total = loop_total.data();
+  const int32_t* lv = loop_vertex.data();
+  const float* co = positions.data();
+  const auto loop_count = int64_t(loop_vertex.size());
+  const auto vertex_count = int64_t(positions.size() / 3);
+  size_t triangle_count = 0;
+  for (size_t p = 0; p < poly_count; ++p) {
+    if (total[p] < 3 || total[p] > 4 || start[p] < 0 || int64_t(start[p]) + total[p] > loop_count)
+      throw std::invalid_argument("add_mesh_polys: only triangles and quads, loops in range");
+    triangle_count += size_t(total[p] - 2);
+  }
+  std::vector<int32_t> corners(triangle_count * 3), material(triangle_count);
+  auto vertex = [&](int32_t loop) {
+    const int64_t v = lv[loop];
+    if (v < 0 || v >= vertex_count) throw std::invalid_argument("loop_vertex out of range");
+    return Vec3f(co[3 * v], co[3 * v + 1], co[3 * v + 2]);
+  };
+  size_t t = 0;
+  for (size_t p = 0; p < poly_count; ++p) {
+    const int32_t s = start[p];
+    const int32_t m = poly_material.size() > 0 ? poly_material.data()[p] : 0;
+    bool flip = false;
+    if (total[p] == 4) {
+      // Blender's fold test: (v1 - v0) x (v2 - v0) and (v3 - v0) x (v2 - v0) agree.
+      const Vec3f v0 = vertex(s), v1 = vertex(s + 1), v2 = vertex(s + 2), v3 = vertex(s + 3);
+      flip = dot(cross(v1 - v0, v2 - v0), cross(v3 - v0, v2 - v0)) > 0.0f;
+    }
+    const int32_t tri[2][3] = {{s, s + 1, flip ? s + 3 : s + 2}, {flip ? s + 1 : s, s + 2, s + 3}};
+    for (int k = 0; k < total[p] - 2; ++k, ++t) {
+      for (int c = 0; c < 3; ++c) corners[3 * t + size_t(c)] = tri[k][c];
+      material[t] = m;
+    }
+  }
+  return add_mesh_corners(positions, loop_vertex, corners, normals, normals_per_loop, loop_uvs,
+                          material);
+}
+
+int SceneBuilder::add_mesh_corners(const FloatArray& positions, const IntArray& loop_vertex,
+                                   std::span<const int32_t> corner_span, const FloatArray& normals,
+                                   bool normals_per_loop, const FloatArray& loop_uvs,
+                                   std::span<const int32_t> material_slot) {
+  if (positions.size() % 3 != 0) throw std::invalid_argument("positions: size not a multiple of 3");
+  const size_t vertex_count = size_t(positions.size()) / 3;
+  const size_t loop_count = size_t(loop_vertex.size());
+  const size_t corner_count = corner_span.size();
+
+  Mesh mesh;
+  mesh.positions.resize(vertex_count);
+  std::memcpy(static_cast<void*>(mesh.positions.data()), positions.data(),
+              vertex_count * sizeof(Vec3f));
+
+  // --- Vertex indices per corner (validated once) ---
+  const int32_t* corners = corner_span.data();
+  const int32_t* lv = loop_vertex.data();
+  for (size_t i = 0; i < corner_count; ++i)
+    if (corners[i] < 0 || size_t(corners[i]) >= loop_count)
+      throw std::invalid_argument("corner_loops: loop index out of range");
+  mesh.indices.resize(corner_count);
+  for (size_t i = 0; i < corner_count; ++i) {
+    const int32_t v = lv[corners[i]];
+    if (v < 0 || size_t(v) >= vertex_count)
+      throw std::invalid_argument("loop_vertex: vertex index out of range");
+    mesh.indices[i] = uint32_t(v);
+  }
+
+  // --- Shading normals per corner ---
+  if (normals.size() > 0) {
+    const size_t expected = (normals_per_loop ? loop_count : vertex_count) * 3;
+    const float* n = checked_data(normals, expected, "normals");
+    mesh.corner_normals.resize(corner_count);
+    for (size_t i = 0; i < corner_count; ++i) {
+      const size_t src = normals_per_loop ? size_t(corners[i]) : size_t(mesh.indices[i]);
+      mesh.corner_normals[i] = Vec3f(n[3 * src], n[3 * src + 1], n[3 * src + 2]);
+    }
+  }
+  // --- UVs per corner ---
+  if (loop_uvs.size() > 0) {
+    const float* uv = checked_data(loop_uvs, loop_count * 2, "loop_uvs");
+    mesh.corner_uvs.resize(corner_count);
+    for (size_t i = 0; i < corner_count; ++i)
+      mesh.corner_uvs[i] = Vec2f(uv[2 * size_t(corners[i])], uv[2 * size_t(corners[i]) + 1]);
+  }
+  if (!material_slot.empty()) mesh.material_slot.assign(material_slot.begin(), material_slot.end());
+  scene_.meshes.push_back(std::move(mesh));
+  return int(scene_.meshes.size()) - 1;
+}
+
 void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material) {
   if (mesh < 0 || size_t(mesh) >= scene_.meshes.size())
     throw std::invalid_argument("add_instance: mesh index out of range");

@@ -24,6 +24,7 @@
 #include <pybind11/pybind11.h>
 
 #include <optional>
+#include <span>
 #include <string>
 
 #include "integrator/scene.h"
@@ -44,6 +45,20 @@ class SceneBuilder {
                const std::optional<FloatArray>& corner_normals,
                const std::optional<FloatArray>& corner_uvs,
                const std::optional<IntArray>& material_slot);
+  // The same mesh from Blender's own arrays, gathered per triangle corner here (memory-bound
+  // loops, much faster than numpy fancy indexing): corner_loops (3 per triangle) index
+  // loop_vertex; normals are per vertex (normals_per_loop false) or per loop, or empty; loop_uvs
+  // (2 per loop) may be empty.
+  int add_mesh_loops(const FloatArray& positions, const IntArray& loop_vertex,
+                     const IntArray& corner_loops, const FloatArray& normals, bool normals_per_loop,
+                     const FloatArray& loop_uvs, const IntArray& material_slot);
+  // Triangle/quad meshes straight from Blender's polygon arrays: triangulated here with Blender's
+  // loop-triangle rule (quads split 0-2, or 1-3 when the 0-2 split folds the quad), so the
+  // add-on never touches per-triangle data in Python. poly_material: one per polygon.
+  int add_mesh_polys(const FloatArray& positions, const IntArray& loop_vertex,
+                     const IntArray& loop_start, const IntArray& loop_total,
+                     const FloatArray& normals, bool normals_per_loop, const FloatArray& loop_uvs,
+                     const IntArray& poly_material);
   void add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material);
   int add_material(const py::dict& material);
   // rgba: (h, w, 4) or flat, row 0 at the bottom; converted to scene linear from `colorspace`
@@ -61,6 +76,10 @@ class SceneBuilder {
   const Scene& scene() const { return scene_; }
 
  private:
+  int add_mesh_corners(const FloatArray& positions, const IntArray& loop_vertex,
+                       std::span<const int32_t> corners, const FloatArray& normals,
+                       bool normals_per_loop, const FloatArray& loop_uvs,
+                       std::span<const int32_t> material_slot);
   Scene scene_;
 };
 
