@@ -6,6 +6,14 @@
 // "cornell", "field", "features", default all three)
 // Each case renders passes of 1 spp at 256x256 until the time budget is used, then reports
 // samples/s = pixels * spp / wall time and rays/s (camera + extension + shadow rays).
+//
+// Instruction-count mode (for a loaded machine, where wall and CPU times drift): with the
+// environment variable GDPT_BENCH_SPP=N, each requested case renders exactly N spp with 1 thread
+// (no time limit) and prints the sample count, so that e.g.
+//   GDPT_BENCH_SPP=4 valgrind --tool=callgrind --toggle-collect='*render_tile*'
+//     bench_integrator 0 cornell
+// gives instructions per sample = callgrind's total / the printed sample count; it also prints the
+// mean per-pixel variance, for comparing sampling techniques at equal cost.
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -13,6 +21,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <string>
+#include <vector>
 
 #include "integrator/render_session.h"
 
@@ -191,6 +200,11 @@ struct Result {
   std::string summary;
 };
 
+int fixed_spp() {
+  const char* e = std::getenv("GDPT_BENCH_SPP");
+  return e ? std::atoi(e) : 0;
+}
+
 Result run(const Scene& scene, int threads, double budget, bool force_all = false) {
   RenderSettings st;
   st.mode = RenderSettings::Mode::PT;
@@ -236,6 +250,31 @@ int main(int argc, char** argv) {
   std::printf("bench_integrator: PT, 8 bounces, %dx%d, %.1f s per case\n", res, res, budget);
 
   const Scene cornell = cornell_box(res);
+  if (fixed_spp() > 0) {  // instruction-count mode: exact spp, 1 thread
+    for (const char* c : {"cornell", "field"}) {
+      if (!want(c)) continue;
+      const Scene scene = std::string(c) == "cornell" ? cornell : sphere_field(res);
+      RenderSettings st;
+      st.mode = RenderSettings::Mode::PT;
+      st.samples = fixed_spp();
+      st.max_bounces = 8;
+      st.threads = 1;
+      RenderSession session(scene, st);
+      std::atomic<bool> cancel{false};
+      session.render(nullptr, cancel);
+      // Mean per-pixel variance of the luminance estimate: times the cost per sample, it compares
+      // sampling techniques at equal time (efficiency = 1 / (variance * cost)).
+      std::vector<float> var(3 * session.film().pixel_count());
+      session.film().variance3(var.data());
+      double mean_var = 0.0;
+      for (size_t i = 0; i < session.film().pixel_count(); ++i) mean_var += var[3 * i];
+      mean_var /= double(session.film().pixel_count());
+      std::printf("%s: %.0f samples, %llu rays, mean pixel variance %.6g\n", c,
+                  double(session.film().pixel_count()) * session.film().min_samples(),
+                  (unsigned long long)session.rays_traced(), mean_var);
+    }
+    return 0;
+  }
   if (want("cornell"))
     for (int t : {1, 2}) report("cornell_box", t, run(cornell, t, budget));
 
