@@ -251,8 +251,8 @@ LightSample LightSampler::sample(Vec3f ref, float u_select, Vec2f u) const {
   if (I.entries.empty()) return s;
   // A single emitter (a Cornell box's lamp) needs no CDF search: its pmf is 1.
   float pmf = I.entries.size() == 1 ? I.selection.pmf(0) : 0.0f;
-  const Entry e = I.entries.size() == 1 ? I.entries[0]
-                                         : I.entries[I.selection.sample_discrete(u_select, &pmf)];
+  const Entry e =
+      I.entries.size() == 1 ? I.entries[0] : I.entries[I.selection.sample_discrete(u_select, &pmf)];
   if (!(pmf > 0.0f)) return s;
   bool ok = false;
   switch (e.kind) {

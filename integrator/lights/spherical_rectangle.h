@@ -28,17 +28,20 @@ class SphericalRectangle {
     }
     x1_ = x0_ + ex;
     y1_ = y0_ + ey;
-    // Corners in the local frame and the normals of the four planes through o and each edge.
-    const Vec3f v00(x0_, y0_, z0_), v01(x0_, y1_, z0_), v10(x1_, y0_, z0_), v11(x1_, y1_, z0_);
-    const Vec3f n0 = normalize(cross(v00, v10));
-    const Vec3f n1 = normalize(cross(v10, v11));
-    const Vec3f n2 = normalize(cross(v11, v01));
-    const Vec3f n3 = normalize(cross(v01, v00));
-    // Interior angles of the spherical quadrilateral; its area is their sum minus 2 pi.
-    const float g0 = safe_acos(-dot(n0, n1)), g1 = safe_acos(-dot(n1, n2));
-    const float g2 = safe_acos(-dot(n2, n3)), g3 = safe_acos(-dot(n3, n0));
-    b0_ = n0.z;
-    b1_ = n2.z;
+    // Unit normals of the four planes through o and each edge, in the local frame. With corners
+    // v00 = (x0, y0, z0) etc., cross(v00, v10) = (x1 - x0) (0, z0, -y0) and likewise for the
+    // others, so each normal is a two-term vector over one square root (no cross products):
+    //   n0 = (0, z0, -y0) / r0, n1 = (-z0, 0, x1) / r1, n2 = (0, -z0, y1) / r2,
+    //   n3 = (z0, 0, -x0) / r3, r the lengths.
+    const float z2 = z0_ * z0_;
+    const float r0 = std::sqrt(z2 + y0_ * y0_), r1 = std::sqrt(z2 + x1_ * x1_);
+    const float r2 = std::sqrt(z2 + y1_ * y1_), r3 = std::sqrt(z2 + x0_ * x0_);
+    // Interior angles of the spherical quadrilateral, acos(-dot(n_i, n_i+1)); its area is their
+    // sum minus 2 pi.
+    const float g0 = safe_acos(x1_ * y0_ / (r0 * r1)), g1 = safe_acos(-x1_ * y1_ / (r1 * r2));
+    const float g2 = safe_acos(x0_ * y1_ / (r2 * r3)), g3 = safe_acos(-x0_ * y0_ / (r3 * r0));
+    b0_ = -y0_ / r0;  // n0.z
+    b1_ = y1_ / r2;   // n2.z
     k_ = 2.0f * kPi - g2 - g3;
     solid_angle_ = g0 + g1 - k_;
   }
