@@ -139,6 +139,7 @@ class GradientPathTracer final : public Integrator {
       : ctx_(ctx),
         settings_(settings),
         has_world_(ctx.lights().has_environment()),
+        has_visible_lamps_(ctx.lights().has_camera_visible_lights()),
         has_dof_(ctx.camera().has_dof()) {}
 
   bool estimates_gradients() const override { return true; }
@@ -281,8 +282,15 @@ class GradientPathTracer final : public Integrator {
     Ray ray = ctx_.camera().generate_ray(raster, lens);
     SurfaceHit hit;
     ++out.rays;
-    if (!bvh.intersect(ray, hit)) {
-      // Very direct light: the world seen by the camera, never shifted.
+    const bool camera_found = bvh.intersect(ray, hit);
+    // Very direct light, never shifted: lamps visible to the camera, and the world.
+    if (has_visible_lamps_) {
+      LightHit lh;
+      if (lights.intersect(ray.origin, ray.direction, camera_found ? hit.t : ray.t_max, lh) &&
+          lh.camera_visible)
+        out.emission += lh.radiance;
+    }
+    if (!camera_found) {
       if (has_world_) out.emission += lights.environment(ray.direction);
       return;
     }
@@ -891,6 +899,7 @@ class GradientPathTracer final : public Integrator {
   const SceneContext& ctx_;
   RenderSettings settings_;
   bool has_world_ = false;
+  bool has_visible_lamps_ = false;
   bool has_dof_ = false;
 };
 

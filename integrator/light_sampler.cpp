@@ -104,7 +104,8 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
     switch (l.type) {
       case Light::Type::Point:
       case Light::Type::Spot: {
-        const lights::PointLight s = lights::PointLight::from_light(l);
+        lights::PointLight s = lights::PointLight::from_light(l);
+        s.camera_visible = l.camera_visible;
         const float p = s.power();
         if (!(p > 0.0f) || !std::isfinite(p)) break;
         I.entries.push_back({Kind::Point, uint32_t(I.points.size())});
@@ -113,7 +114,8 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
         break;
       }
       case Light::Type::Area: {
-        const lights::AreaLight a = lights::AreaLight::from_light(l);
+        lights::AreaLight a = lights::AreaLight::from_light(l);
+        a.camera_visible = l.camera_visible;
         const float p = a.power();
         if (!(p > 0.0f) || !std::isfinite(p)) break;
         I.entries.push_back({Kind::Area, uint32_t(I.areas.size())});
@@ -122,7 +124,8 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
         break;
       }
       case Light::Type::Sun: {
-        const lights::SunLight s = lights::SunLight::from_light(l);
+        lights::SunLight s = lights::SunLight::from_light(l);
+        s.camera_visible = l.camera_visible;
         const float p = s.power(radius);
         if (!(p > 0.0f) || !std::isfinite(p)) break;
         I.entries.push_back({Kind::Sun, uint32_t(I.suns.size())});
@@ -337,11 +340,13 @@ bool LightSampler::intersect(Vec3f origin, Vec3f direction, float t_max, LightHi
   if (point) {
     point->fill_hit(origin, direction, best, hit);
     hit.pdf *= point->select_pmf;
+    hit.camera_visible = point->camera_visible;
     return true;
   }
   if (area) {
     area->fill_hit(origin, direction, best, hit);
     hit.pdf *= area->select_pmf;
+    hit.camera_visible = area->camera_visible;
     return true;
   }
   // Sun discs sit at infinity: only rays that escape the scene reach them, i.e. rays whose
@@ -351,6 +356,7 @@ bool LightSampler::intersect(Vec3f origin, Vec3f direction, float t_max, LightHi
       if (s.hit(direction)) {
         s.fill_hit(origin, direction, hit);
         hit.pdf *= s.select_pmf;
+        hit.camera_visible = s.camera_visible;
         return true;
       }
     }
@@ -366,6 +372,14 @@ Spectrum LightSampler::environment(Vec3f direction) const {
 float LightSampler::pdf_environment(Vec3f direction) const {
   const Impl& I = *impl_;
   return I.world_enabled ? I.world_pdf(direction) * I.world_pmf : 0.0f;
+}
+
+bool LightSampler::has_camera_visible_lights() const {
+  const Impl& I = *impl_;
+  const auto visible = [](const auto& l) { return l.camera_visible; };
+  return std::any_of(I.points.begin(), I.points.end(), visible) ||
+         std::any_of(I.areas.begin(), I.areas.end(), visible) ||
+         std::any_of(I.suns.begin(), I.suns.end(), visible);
 }
 
 }  // namespace gdpt

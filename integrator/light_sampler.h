@@ -32,6 +32,7 @@ struct LightHit {
   float distance = 0;
   float pdf = 0;  // density sample() would have produced this direction from the ray origin
   Vec3f position, normal;
+  bool camera_visible = false;  // the lamp shows to camera rays (Light::camera_visible)
 };
 
 class LightSampler {
@@ -52,7 +53,9 @@ class LightSampler {
   // Radiance of the world along an escaping ray (sun discs excluded: see intersect) and its pdf.
   Spectrum environment(Vec3f direction) const;
   float pdf_environment(Vec3f direction) const;
-  bool has_environment() const;  // world is non-black
+  bool has_environment() const;
+  // Some analytic lamp is visible to camera rays (Light::camera_visible).
+  bool has_camera_visible_lights() const;  // world is non-black
 
  private:
   struct Impl;

@@ -142,13 +142,13 @@ class PathTracer final : public Integrator {
       ++out.rays;
       const float t_hit = found ? hit.t : ray.t_max;
 
-      // --- Analytic lights in front of the surface (visible to camera rays, as in Cycles 3.x
-      // with the object's default camera visibility) ---
+      // --- Analytic lights in front of the surface (camera rays see a lamp only when its object
+      // is visible to the camera, Blender's Object.visible_camera, off by default as in Cycles) ---
       if constexpr (kAnalytic) {
         LightHit lh;
         if (lights.intersect(ray.origin, ray.direction, t_hit, lh)) {
           if (camera_path) {
-            out.emission += beta * lh.radiance;
+            if (lh.camera_visible) out.emission += beta * lh.radiance;
           } else {
             float light_pdf = lh.pdf;
             if (!prev_delta && crossed_since_vertex) {

@@ -62,6 +62,8 @@ struct Light {
   float spot_blend = 0.15f;
   float sun_angle = 0.0f;              // angular diameter, radians
   float size_x = 1.0f, size_y = 1.0f;  // area light extent, metres (before object scale)
+  // Blender's Object.visible_camera: camera rays see the lamp itself (default False in 3.4).
+  bool camera_visible = false;
 };
 
 struct World {

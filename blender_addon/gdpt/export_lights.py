@@ -1,5 +1,5 @@
 # Blender lights -> Scene::Light dicts. Units are Blender's (W, W/m^2 for sun); the core applies
-# Cycles' conversions (point/spot intensity P / 4 pi, area radiance P / (pi A)).
+# Cycles' conversions (point/spot intensity P / 4 pi, area radiance P / (4 A): docs/lights.md).
 import numpy as np
 
 
@@ -20,6 +20,8 @@ def light_dict(obj, matrix, warn):
         "matrix": _matrix12(matrix),
         "color": tuple(light.color),
         "power": float(light.energy),
+        # Object > Visibility > Camera: Cycles shows the lamp itself to camera rays only then.
+        "camera_visible": bool(obj.visible_camera),
     }
     if light.type in {'POINT', 'SPOT'}:
         d["radius"] = float(light.shadow_soft_size)

@@ -386,6 +386,7 @@ void SceneBuilder::add_light(const py::dict& d) {
   get(d, "sun_angle", light.sun_angle);
   get(d, "size_x", light.size_x);
   get(d, "size_y", light.size_y);
+  get(d, "camera_visible", light.camera_visible);
   scene_.lights.push_back(light);
 }
 

@@ -32,7 +32,8 @@ struct AreaLight {
   float area = 0.0f;
   bool ellipse = false;
   Spectrum radiance;
-  float select_pmf = 0.0f;  // filled by LightSampler
+  float select_pmf = 0.0f;      // filled by LightSampler
+  bool camera_visible = false;  // filled by LightSampler
   // Dual basis of (axis_u, axis_v): local coordinates of a point in the plane are dot products.
   Vec3f dual_u, dual_v;
   bool orthogonal = false;  // rectangle with orthogonal axes: spherical sampling possible

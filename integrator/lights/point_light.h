@@ -31,8 +31,9 @@ struct PointLight {
   bool is_spot = false;
   Vec3f axis{0.0f, 0.0f, -1.0f};  // spot emission axis (world, unit)
   float cos_half_angle = -1.0f;
-  float smooth = 0.0f;      // (1 - cos_half_angle) * blend
-  float select_pmf = 0.0f;  // filled by LightSampler
+  float smooth = 0.0f;          // (1 - cos_half_angle) * blend
+  float select_pmf = 0.0f;      // filled by LightSampler
+  bool camera_visible = false;  // filled by LightSampler
 
   static PointLight from_light(const Light& l) {
     PointLight s;

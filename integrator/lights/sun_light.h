@@ -30,6 +30,7 @@ struct SunLight {
   float inv_disc_area = 0.0f;      // 1 / (pi R^2)
   Spectrum strength;               // c P, W/m^2
   float select_pmf = 0.0f;         // filled by LightSampler
+  bool camera_visible = false;     // filled by LightSampler
 
   static SunLight from_light(const Light& l) {
     SunLight s;

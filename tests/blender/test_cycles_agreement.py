@@ -114,10 +114,19 @@ def case_area_disk(scene):
 
 
 def case_area_visible(scene):
-    # The camera looks at the lamp itself: Cycles 3.4 does not show area lamps to camera rays.
+    # The camera looks at the lamp itself: with the object's default camera visibility (off in
+    # Blender 3.4) Cycles does not show the lamp to camera rays.
     S.room()
     S.camera((0, -1.5, 1.0), (0, 0.5, 3.9), lens=24)
     area_ceiling(size=1.0, energy=100.0)
+    return 3
+
+
+def case_area_camera_visible(scene):
+    # The same view with Object > Visibility > Camera on: Cycles shows the lamp (radiance P / 4A).
+    S.room()
+    S.camera((0, -1.5, 1.0), (0, 0.5, 3.9), lens=24)
+    area_ceiling(size=1.0, energy=100.0).visible_camera = True
     return 3
 
 
@@ -211,7 +220,7 @@ CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case
 
 # Cases whose GDPT side is also rendered in PT mode (Combined = Primal + Emission): what the
 # camera sees directly must not depend on the integrator.
-BOTH_MODES = {"area_visible"}
+BOTH_MODES = {"area_visible", "area_camera_visible"}
 
 
 def run_case(name, out_dir, mode=None):
