@@ -3,21 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-namespace gdpt {
+#include "integrator/math/warp_disk.h"
 
-Vec2f sample_concentric_disk(Vec2f u) {
-  const float a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
-  if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f};
-  float r, phi;
-  if (std::fabs(a) > std::fabs(b)) {
-    r = a;
-    phi = (kPi / 4.0f) * (b / a);
-  } else {
-    r = b;
-    phi = (kPi / 2.0f) - (kPi / 4.0f) * (a / b);
-  }
-  return {r * std::cos(phi), r * std::sin(phi)};
-}
+namespace gdpt {
 
 CameraModel::CameraModel(const Camera& cam) {
   camera_to_world_ = cam.camera_to_world;
@@ -91,7 +79,7 @@ Ray CameraModel::generate_ray(Vec2f raster, Vec2f lens) const {
     dir = d;
     if (aperture_radius_ > 0.0f) {
       // Thin lens: all rays through the pixel converge on the focus plane (depth focus_distance).
-      const Vec2f l = sample_concentric_disk(lens) * aperture_radius_;
+      const Vec2f l = square_to_disk_concentric(lens) * aperture_radius_;
       origin = Vec3f(l.x, l.y, 0.0f);
       dir = d * focus_distance_ - origin;
     }
@@ -102,7 +90,7 @@ Ray CameraModel::generate_ray(Vec2f raster, Vec2f lens) const {
     origin = Vec3f(s.x, s.y, 0.0f);
     dir = Vec3f(0.0f, 0.0f, -1.0f);
     if (aperture_radius_ > 0.0f) {
-      const Vec2f l = sample_concentric_disk(lens) * aperture_radius_;
+      const Vec2f l = square_to_disk_concentric(lens) * aperture_radius_;
       const Vec3f focus = origin + dir * focus_distance_;
       origin = origin + Vec3f(l.x, l.y, 0.0f);
       dir = normalize(focus - origin);

@@ -64,7 +64,4 @@ class CameraModel {
   float clip_start_ = 0.1f, clip_end_ = 1000.0f;
 };
 
-// Concentric (Shirley-Chiu) map of [0,1)^2 to the unit disk.
-Vec2f sample_concentric_disk(Vec2f u);
-
 }  // namespace gdpt

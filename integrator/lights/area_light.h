@@ -95,7 +95,8 @@ struct AreaLight {
     if (sph) {
       p = sph->sample(u);
     } else {
-      const Vec2f local = ellipse ? square_to_disk(u) * 0.5f : Vec2f(u.x - 0.5f, u.y - 0.5f);
+      const Vec2f local =
+          ellipse ? square_to_disk_concentric(u) * 0.5f : Vec2f(u.x - 0.5f, u.y - 0.5f);
       p = center + axis_u * local.x + axis_v * local.y;
     }
     const Vec3f to = p - ref;

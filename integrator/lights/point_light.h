@@ -91,7 +91,7 @@ struct PointLight {
     }
     const Vec3f disc_normal = from_center / d;  // faces the receiver
     const Frame f(disc_normal);
-    const Vec2f q = square_to_disk(u) * radius;
+    const Vec2f q = square_to_disk_concentric(u) * radius;
     const Vec3f p = center + f.s * q.x + f.t * q.y;
     const Vec3f to = p - ref;
     const float t2 = length_squared(to);

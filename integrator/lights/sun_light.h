@@ -64,7 +64,7 @@ struct SunLight {
       s.pdf = 1.0f;
       s.is_delta = true;
     } else {
-      const Vec2f disc = square_to_disk(u) * disc_radius;
+      const Vec2f disc = square_to_disk_concentric(u) * disc_radius;
       s.direction = normalize(Frame(to_sun).to_world({disc.x, disc.y, 1.0f}));
       s.pdf = density(dot(s.direction, to_sun));
       s.radiance = strength * s.pdf;

@@ -1,4 +1,5 @@
-// Sample warps shared by the light types: concentric disk, uniform sphere, uniform triangle.
+// Sample warps shared by the light types: uniform sphere, uniform triangle (the concentric disk
+// is integrator/math/warp_disk.h).
 // All map [0,1)^2 to the domain; the densities are stated next to each.
 #pragma once
 
@@ -6,23 +7,9 @@
 
 #include "integrator/math/frame.h"
 #include "integrator/math/vec.h"
+#include "integrator/math/warp_disk.h"
 
 namespace gdpt::lights {
-
-// Shirley-Chiu concentric map to the unit disk (uniform in area, density 1 / pi).
-inline Vec2f square_to_disk(Vec2f u) {
-  const float a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
-  if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f};
-  float r, phi;
-  if (a * a > b * b) {
-    r = a;
-    phi = (kPi / 4.0f) * (b / a);
-  } else {
-    r = b;
-    phi = (kPi / 2.0f) - (kPi / 4.0f) * (a / b);
-  }
-  return {r * std::cos(phi), r * std::sin(phi)};
-}
 
 // Uniform direction on the sphere, density 1 / (4 pi).
 inline Vec3f square_to_sphere(Vec2f u) {

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "integrator/camera.h"
+#include "integrator/math/warp_disk.h"
 
 namespace gdpt {
 namespace {
@@ -165,7 +166,7 @@ TEST(Camera, ConcentricDiskIsInsideAndCoversTheDisk) {
   const int n = 64;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
-      const Vec2f d = sample_concentric_disk({(i + 0.5f) / n, (j + 0.5f) / n});
+      const Vec2f d = square_to_disk_concentric({(i + 0.5f) / n, (j + 0.5f) / n});
       const float r2 = d.x * d.x + d.y * d.y;
       EXPECT_LE(r2, 1.0f + 1e-5f);
       mean_r2 += r2;
