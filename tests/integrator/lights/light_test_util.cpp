@@ -46,41 +46,6 @@ Estimate estimate(const LightSampler& lights, Vec3f ref, Vec3f normal, size_t n,
   return e;
 }
 
-// Regularised upper incomplete gamma Q(a, x): series for x < a + 1, continued fraction otherwise.
-static double gamma_q(double a, double x) {
-  if (x <= 0) return 1.0;
-  const double log_prefix = -x + a * std::log(x) - std::lgamma(a);
-  if (x < a + 1.0) {
-    double term = 1.0 / a, sum = term;
-    for (int k = 1; k < 1000; ++k) {
-      term *= x / (a + k);
-      sum += term;
-      if (std::fabs(term) < std::fabs(sum) * 1e-15) break;
-    }
-    return 1.0 - sum * std::exp(log_prefix);
-  }
-  // Lentz's method for the continued fraction of Q.
-  const double tiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < 1000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::fabs(d) < tiny) d = tiny;
-    c = b + an / c;
-    if (std::fabs(c) < tiny) c = tiny;
-    d = 1.0 / d;
-    const double delta = d * c;
-    h *= delta;
-    if (std::fabs(delta - 1.0) < 1e-15) break;
-  }
-  return std::exp(log_prefix) * h;
-}
-
-double chi2_p_value(double chi2, double dof) {
-  return gamma_q(0.5 * dof, 0.5 * chi2);
-}
-
 MaterialDesc emission_material(Spectrum color, float strength) {
   MaterialDesc d;
   d.name = "emission";

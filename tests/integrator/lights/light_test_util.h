@@ -1,5 +1,6 @@
 // Shared helpers for the light tests: scene construction, Monte Carlo estimators of the solid
-// angle (mean of 1 / pdf) and irradiance (mean of L cos / pdf), and a chi-square p-value.
+// angle (mean of 1 / pdf) and irradiance (mean of L cos / pdf); chi-square statistics come from
+// tests/common/statistics.h.
 #pragma once
 
 #include <cstdint>
@@ -9,6 +10,7 @@
 #include "integrator/light_sampler.h"
 #include "integrator/scene.h"
 #include "shaders/material.h"
+#include "tests/common/statistics.h"
 
 namespace gdpt::test {
 
@@ -28,9 +30,6 @@ struct Estimate {
 
 // Stratified 3-D samples (u_select, u) from a fixed seed; pdfs include the selection pmf.
 Estimate estimate(const LightSampler& lights, Vec3f ref, Vec3f normal, size_t n, uint32_t seed = 1);
-
-// Upper tail probability of a chi-square variable with `dof` degrees of freedom.
-double chi2_p_value(double chi2, double dof);
 
 // Emission-only material (Blender Emission shader: radiance = colour * strength).
 MaterialDesc emission_material(Spectrum color, float strength);
