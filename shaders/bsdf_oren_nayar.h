@@ -8,6 +8,7 @@
 #pragma once
 
 #include "shaders/bsdf.h"
+#include "shaders/diffuse_sampling.h"
 #include "shaders/lobe_util.h"
 #include "shaders/sampling.h"
 
@@ -26,22 +27,11 @@ inline Spectrum eval(const Closure& c, Vec3f wi_, Vec3f wo_) {
 }
 
 inline float pdf(const Closure&, Vec3f wi, Vec3f wo) {
-  if (!(wi.z * wo.z > 0.0f)) return 0.0f;
-  return std::fabs(wo.z) * kInvPi;
+  return cosine_lobe_pdf(wi, wo);
 }
 
 inline BsdfSample sample(const Closure& c, Vec3f wi, float, Vec2f u) {
-  BsdfSample s;
-  if (wi.z == 0.0f) return s;
-  const Vec3f w = square_to_cosine_hemisphere(u);
-  if (w.z <= 0.0f) return s;
-  s.wo = flip_z(w, wi.z < 0.0f ? -1.0f : 1.0f);
-  s.pdf = w.z * kInvPi;
-  s.value = eval(c, wi, s.wo);
-  s.lobe = kLobeReflection | kLobeDiffuse;
-  s.roughness = 1.0f;
-  s.valid = true;
-  return s;
+  return sample_cosine_lobe(wi, u, [&](Vec3f wo) { return eval(c, wi, wo); });
 }
 
 inline float albedo_hint(const Closure&, Vec3f) {
