@@ -227,6 +227,11 @@ class GradientPathTracer final : public Integrator {
     return cos_ng != 0.0f && (cos_ng > 0.0f) == (wo.z > 0.0f);
   }
 
+  // Squared distance of two unit normals of the same surface point evaluated from two
+  // reference points (rounding only); receiver-facing discs differ by the angle between the
+  // two receivers seen from the light, far above this.
+  static constexpr float kSameNormal2 = 1e-8f;
+
   // The offset's light sample for a not-connected pair: the same point on the light (same
   // direction for infinite lights) as the base's sample `ls`, seen from y. Resampling with the
   // same random numbers gives that point for area-sampled lights, the world and the sun;
@@ -248,8 +253,12 @@ class GradientPathTracer final : public Integrator {
       if (!(d > 0.0f)) return false;
       const Vec3f dir = to / d;
       LightHit lh;
+      // The same point on the same surface: point/spot lights with a radius are discs facing
+      // each receiver, so y's disc passes near (never through) the base's point with another
+      // normal; accepting it would shift onto a different light surface (biased gradients).
       if (lights.intersect(y, dir, d * (1.0f + 1e-3f), lh) &&
-          length_squared(lh.position - ls.position) <= 1e-6f * scale * scale) {
+          length_squared(lh.position - ls.position) <= 1e-6f * scale * scale &&
+          length_squared(lh.normal - ls.normal) <= kSameNormal2) {
         out.radiance = lh.radiance;
         out.position = ls.position;
         out.normal = ls.normal;
@@ -258,7 +267,9 @@ class GradientPathTracer final : public Integrator {
         out.pdf = lh.pdf;
         out.is_delta = false;
         out.is_infinite = false;
-        out.valid = lh.pdf > 0.0f;
+        // sample() rejects a direction the light does not emit into (outside a spot's cone):
+        // from y this point then has density 0, exactly like the base at y skipping it.
+        out.valid = lh.pdf > 0.0f && !is_black(lh.radiance);
         return out.valid;
       }
     }
@@ -801,14 +812,20 @@ class GradientPathTracer final : public Integrator {
     if (!local_dir(y, dir, wo)) return;
     LightHit lo;
     const float d = float(r.distance);
+    // The base's light point itself (same surface normal): y's own receiver-facing disc of a
+    // point/spot light with a radius passes near it but is another surface (see offset_light).
     const bool reaches = ctx_.lights().intersect(y.hit.position, dir, d * (1.0f + 1e-3f), lo) &&
-                         std::fabs(lo.distance - d) < 1e-3f * d;
+                         std::fabs(lo.distance - d) < 1e-3f * d &&
+                         length_squared(lo.normal - lh.normal) <= kSameNormal2;
     const Spectrum fo = y.closures.eval(y.wi, wo);
     const float pdf_o = y.closures.pdf(y.wi, wo);
     const bool vis = reaches && !occluded(y.hit.position, y.ng, dir, d * (1.0f - 1e-4f), rays);
     co = vis ? mul(mul(o.f, fo), lo.radiance) * r.jacobian : Vec3d();
-    d_off = shift::offset_densities(o.p, r.jacobian, pl_pair > 0.0f && reaches ? lo.pdf : 0.0f,
-                                    vis ? pdf_o : 0.0f);
+    // Light sampling from y produces this point only where the light emits towards y (a spot's
+    // cone), as the base's pl is counted only for a lit hit.
+    d_off = shift::offset_densities(
+        o.p, r.jacobian, pl_pair > 0.0f && reaches && !is_black(lo.radiance) ? lo.pdf : 0.0f,
+        vis ? pdf_o : 0.0f);
   }
 
   // (b)/(c): the offset's contribution and densities for the emission at the end of the segment
