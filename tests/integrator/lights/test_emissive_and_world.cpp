@@ -77,6 +77,23 @@ TEST(EmissiveTriangle, SolidAngleAndIrradianceBothSides) {
   }
 }
 
+TEST(EmissiveTriangle, LargeTriangleCloseAbove) {
+  // Half of a 1.2 m panel 0.1 m under a ceiling (the Blender mesh_light scene): receivers close
+  // to a triangle subtending a large solid angle, above its interior, near an edge and outside.
+  const Vec3f v0(-0.6f, -0.6f, 0.0f), v1(0.6f, -0.6f, 0.0f), v2(0.6f, 0.6f, 0.0f);
+  TriangleScene t = triangle_scene(v0, v1, v2, 2.0f);
+  const LightSampler lights(t.scene, t.materials, {});
+  const Vec3f nn(0, 0, -1);
+  for (const Vec3f ref : {Vec3f(0.3f, -0.2f, 0.1f), Vec3f(0.55f, 0.4f, 0.1f),
+                          Vec3f(0.8f, -0.7f, 0.1f), Vec3f(0.2f, -0.3f, 0.02f)}) {
+    const test::Estimate e = test::estimate(lights, ref, nn, 250000);
+    const double omega = triangle_solid_angle(v0 - ref, v1 - ref, v2 - ref);
+    EXPECT_NEAR(e.solid_angle, omega, 5e-3 * omega) << ref.x << " " << ref.y << " " << ref.z;
+    const double E = triangle_irradiance(2.0, v0 - ref, v1 - ref, v2 - ref, nn);
+    EXPECT_NEAR(e.irradiance, E, 3e-3 * E) << ref.x << " " << ref.y << " " << ref.z;
+  }
+}
+
 TEST(EmissiveTriangle, PdfTriangleMatchesSample) {
   const Vec3f v0(-0.5f, -0.3f, 1.5f), v1(0.8f, -0.2f, 1.7f), v2(0.1f, 0.9f, 1.2f);
   TriangleScene t = triangle_scene(v0, v1, v2, 2.0f);
