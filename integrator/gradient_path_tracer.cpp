@@ -211,6 +211,17 @@ class GradientPathTracer final : public Integrator {
     shadow.direction = dir;
     shadow.t_min = 0.0f;
     shadow.t_max = t_max;
+    if (std::isfinite(t_max)) {
+      // Aim at the same end point from the offset origin: the offset shortens the path to a
+      // light surface by up to offset / cos, which at grazing angles exceeded the caller's
+      // 1e-4 margin and made an emitter occlude itself.
+      const Vec3f to = from + dir * t_max - shadow.origin;
+      const float len = length(to);
+      if (len > 0.0f) {
+        shadow.direction = to / len;
+        shadow.t_max = len;
+      }
+    }
     return shadow;
   }
 

@@ -232,8 +232,17 @@ class PathTracer final : public Integrator {
               shadow.origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);
               shadow.direction = ls.direction;
               shadow.t_min = 0.0f;
-              // Stop short of the light's own surface (emissive triangles are geometry too).
-              shadow.t_max = ls.is_infinite ? kInf : ls.distance * (1.0f - 1e-4f);
+              // Stop short of the light's own surface (emissive triangles are geometry too),
+              // aiming from the offset origin: the offset shortens the path to a light surface
+              // by up to offset / cos, which at grazing angles (a ceiling just above a panel)
+              // exceeded the 1e-4 margin and made the emitter occlude itself.
+              shadow.t_max = kInf;
+              if (!ls.is_infinite) {
+                const Vec3f to = ls.position - shadow.origin;
+                const float len = length(to);
+                shadow.direction = to / len;
+                shadow.t_max = len * (1.0f - 1e-4f);
+              }
               const Spectrum tr = transmittance(shadow, scratch, out.rays);
               if (!is_black(tr)) {
                 const float w = ls.is_delta ? 1.0f : power_heuristic(ls.pdf, closures.pdf(wi, wo));

@@ -159,6 +159,53 @@ TEST(GradientUnbiased, SpotLight) {
   expect_unbiased("spot-radius-hard", spot_scene(0.08f, 0.0f), 4096, 512);
 }
 
+// A diffuse ceiling 0.1 m / 0.3 m above a two-sided emissive 1.2 m panel (the Blender mesh_light
+// scene), seen 0.2 m beside the panel's edge: the light arrives at grazing angles. One bounce
+// against Lambert's polygon irradiance (rho / pi E), in PT and G-PT. Before the shadow rays aimed
+// from their offset origin, every shadow ray at the 0.1 m gap hit the panel itself (1% of E).
+double ceiling_radiance(RenderSettings::Mode mode, float gap) {
+  Scene s;
+  s.world.color = Spectrum(0.0f);
+  s.meshes.push_back(quad(3.0f));
+  s.meshes.push_back(quad(0.6f));
+  s.materials.push_back(diffuse({0.75f, 0.75f, 0.75f}));
+  s.materials.push_back(emissive({1, 1, 1}, 1.0f));
+  s.instances.push_back(place(0, 0, transform(kPi, 0, {0, 0, 0})));     // ceiling, normal -z
+  s.instances.push_back(place(1, 1, transform(kPi, 0, {0, 0, -gap})));  // panel, facing down
+  Camera& c = s.camera;
+  c.width = c.height = 4;
+  c.focal_length_mm = 3000.0f;  // all pixels see the ceiling around (0.8, 0, 0)
+  c.sensor_width_mm = 36.0f;
+  c.camera_to_world = transform(kPi, 0, {0.8f, 0, -2.0f});  // looks up (+z)
+  RenderSettings rs = settings(mode, 1024, 3);
+  rs.max_bounces = 1;
+  const Passes p = render(s, rs);
+  double m = 0.0;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) m += p.lum(p.primal, x, y) / 16.0;
+  return m;
+}
+
+TEST(ShadowRays, CeilingBesideEmissivePanel) {
+  for (const float gap : {0.1f, 0.3f}) {
+    const Vec3f q(0.8f, 0, 0), n(0, 0, -1);
+    const Vec3f v[4] = {
+        {-0.6f, -0.6f, -gap}, {0.6f, -0.6f, -gap}, {0.6f, 0.6f, -gap}, {-0.6f, 0.6f, -gap}};
+    double sum = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      const Vec3f a = normalize(v[i] - q), b = normalize(v[(i + 1) % 4] - q);
+      sum += std::acos(std::clamp(double(dot(a, b)), -1.0, 1.0)) * dot(n, normalize(cross(a, b)));
+    }
+    const double expected = 0.75 / kPi * std::fabs(sum) / 2.0;  // L = 1
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      const double got = ceiling_radiance(mode, gap);
+      std::printf("[ceiling gap %.1f %s] %.5f, Lambert %.5f\n", gap,
+                  mode == RenderSettings::Mode::PT ? "PT" : "GPT", got, expected);
+      EXPECT_NEAR(got, expected, 0.02 * expected) << gap;
+    }
+  }
+}
+
 TEST(GradientUnbiased, ThinLensDepthOfField) {
   // Base and offsets share the lens sample: no camera Jacobian, still unbiased.
   Scene scene = make_scene(SceneKind::CornellDiffuse, 16);
