@@ -76,58 +76,38 @@ void Film::emission_rgb(float* out) const {
   }
 }
 
-void Film::gradient_x_rgb(float* out) const {
+// One routine for both axes: the neighbour of pixel i along the axis is i + step when `inside`;
+// G-PT gradients combine this pixel's forward half with the neighbour's backward half, PT ones are
+// forward differences of the primal means. The last column / row is 0 (Neumann).
+void Film::gradient_rgb(float* out, bool along_x, double (Accumulator::*forward)[3],
+                        double (Accumulator::*backward)[3]) const {
+  const size_t step = along_x ? 1 : size_t(width_);
+  const auto inv_samples = [&](size_t i) { return samples_[i] ? 1.0 / samples_[i] : 0.0; };
   for (int y = 0; y < height_; ++y)
     for (int x = 0; x < width_; ++x) {
       const size_t i = size_t(y) * width_ + x;
-      const double inv = samples_[i] ? 1.0 / samples_[i] : 0.0;
+      const bool inside = along_x ? x + 1 < width_ : y + 1 < height_;
+      const double inv = inv_samples(i);
+      const double inv_next = inside ? inv_samples(i + step) : 0.0;
       for (int c = 0; c < 3; ++c) {
         double v;
         if (gradients_from_primal_) {
-          if (x + 1 < width_) {
-            const size_t j = i + 1;
-            const double invj = samples_[j] ? 1.0 / samples_[j] : 0.0;
-            v = acc_[j].primal[c] * invj - acc_[i].primal[c] * inv;
-          } else {
-            v = 0.0;
-          }
+          v = inside ? acc_[i + step].primal[c] * inv_next - acc_[i].primal[c] * inv : 0.0;
         } else {
-          v = acc_[i].dx[c] * inv;
-          if (x + 1 < width_) {
-            const size_t j = i + 1;
-            v -= acc_[j].dx_left[c] * (samples_[j] ? 1.0 / samples_[j] : 0.0);
-          }
+          v = (acc_[i].*forward)[c] * inv;
+          if (inside) v -= (acc_[i + step].*backward)[c] * inv_next;
         }
         out[3 * i + c] = float(v);
       }
     }
 }
 
+void Film::gradient_x_rgb(float* out) const {
+  gradient_rgb(out, true, &Accumulator::dx, &Accumulator::dx_left);
+}
+
 void Film::gradient_y_rgb(float* out) const {
-  for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) {
-      const size_t i = size_t(y) * width_ + x;
-      const double inv = samples_[i] ? 1.0 / samples_[i] : 0.0;
-      for (int c = 0; c < 3; ++c) {
-        double v;
-        if (gradients_from_primal_) {
-          if (y + 1 < height_) {
-            const size_t j = i + width_;
-            const double invj = samples_[j] ? 1.0 / samples_[j] : 0.0;
-            v = acc_[j].primal[c] * invj - acc_[i].primal[c] * inv;
-          } else {
-            v = 0.0;
-          }
-        } else {
-          v = acc_[i].dy[c] * inv;
-          if (y + 1 < height_) {
-            const size_t j = i + width_;
-            v -= acc_[j].dy_down[c] * (samples_[j] ? 1.0 / samples_[j] : 0.0);
-          }
-        }
-        out[3 * i + c] = float(v);
-      }
-    }
+  gradient_rgb(out, false, &Accumulator::dy, &Accumulator::dy_down);
 }
 
 void Film::variance3(float* out) const {

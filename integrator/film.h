@@ -63,6 +63,9 @@ class Film {
   void take_rows(Film& pass, int y0, int y1);
 
  private:
+  void gradient_rgb(float* out, bool along_x, double (Accumulator::*forward)[3],
+                    double (Accumulator::*backward)[3]) const;
+
   int width_ = 0, height_ = 0;
   std::vector<Accumulator> acc_;
   std::vector<uint32_t> samples_;

@@ -28,6 +28,19 @@ struct StackEntry {
   float weight;
 };
 
+// The value a scalar input reads from a texel (Blender links Color or Alpha to a float socket).
+float channel(const Rgba& c, FloatInput::Channel which) {
+  switch (which) {
+    case FloatInput::Channel::Red:
+      return c.rgb.x;
+    case FloatInput::Channel::Alpha:
+      return c.a;
+    case FloatInput::Channel::Luminance:
+      break;
+  }
+  return luminance(c.rgb);
+}
+
 // Inputs at a hit point: texture lookups at the mapped UV.
 struct PointInputs {
   std::span<const Texture> textures;
@@ -44,15 +57,7 @@ struct PointInputs {
   float scalar(const FloatInput& in) const {
     if (in.texture.image < 0) return in.value;
     const Rgba c = fetch(in.texture);
-    switch (in.channel) {
-      case FloatInput::Channel::Red:
-        return c.rgb.x;
-      case FloatInput::Channel::Alpha:
-        return c.a;
-      case FloatInput::Channel::Luminance:
-        break;
-    }
-    return luminance(c.rgb);
+    return channel(c, in.channel);
   }
 };
 
@@ -67,15 +72,7 @@ struct AverageInputs {
   float scalar(const FloatInput& in) const {
     if (in.texture.image < 0) return in.value;
     const Rgba& c = (*means)[size_t(in.texture.image)];
-    switch (in.channel) {
-      case FloatInput::Channel::Red:
-        return c.rgb.x;
-      case FloatInput::Channel::Alpha:
-        return c.a;
-      case FloatInput::Channel::Luminance:
-        break;
-    }
-    return luminance(c.rgb);
+    return channel(c, in.channel);
   }
 };
 
