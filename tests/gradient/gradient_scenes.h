@@ -7,21 +7,12 @@
 
 #include "integrator/render_session.h"
 #include "integrator/scene.h"
+#include "tests/common/materials.h"
 
 namespace gdpt::gradient_test {
 
-inline MaterialDesc single_node(ShaderNodeKind kind, Spectrum color, float roughness = 0.0f,
-                                float ior = 1.45f) {
-  MaterialDesc m;
-  ShaderNode n;
-  n.kind = kind;
-  n.color = ColorInput(color);
-  n.roughness = FloatInput(roughness);
-  n.ior = FloatInput(ior);
-  m.nodes.push_back(n);
-  m.root = 0;
-  return m;
-}
+using test::single_node;
+
 inline MaterialDesc diffuse(Spectrum c) {
   return single_node(ShaderNodeKind::Diffuse, c);
 }

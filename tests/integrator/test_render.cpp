@@ -15,6 +15,7 @@
 #include "integrator/integrator.h"
 #include "integrator/render_session.h"
 #include "integrator/scene_context.h"
+#include "tests/common/materials.h"
 
 namespace gdpt {
 namespace {
@@ -22,31 +23,15 @@ namespace {
 // --- Scene helpers ---
 
 MaterialDesc diffuse(Spectrum color, float roughness = 0.0f) {
-  MaterialDesc m;
-  ShaderNode n;
-  n.kind = ShaderNodeKind::Diffuse;
-  n.color = ColorInput(color);
-  n.roughness = FloatInput(roughness);
-  m.nodes.push_back(n);
-  m.root = 0;
-  return m;
+  return test::single_node(ShaderNodeKind::Diffuse, color, roughness);
 }
 
 MaterialDesc glossy(Spectrum color, float roughness) {
-  MaterialDesc m = diffuse(color, roughness);
-  m.nodes[0].kind = ShaderNodeKind::Glossy;
-  return m;
+  return test::single_node(ShaderNodeKind::Glossy, color, roughness);
 }
 
 MaterialDesc emission(Spectrum color, float strength) {
-  MaterialDesc m;
-  ShaderNode n;
-  n.kind = ShaderNodeKind::Emission;
-  n.color = ColorInput(color);
-  n.strength = FloatInput(strength);
-  m.nodes.push_back(n);
-  m.root = 0;
-  return m;
+  return test::emission_material(color, strength);
 }
 
 Transform translation(Vec3f t) {

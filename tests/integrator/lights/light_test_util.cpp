@@ -46,16 +46,4 @@ Estimate estimate(const LightSampler& lights, Vec3f ref, Vec3f normal, size_t n,
   return e;
 }
 
-MaterialDesc emission_material(Spectrum color, float strength) {
-  MaterialDesc d;
-  d.name = "emission";
-  ShaderNode n;
-  n.kind = ShaderNodeKind::Emission;
-  n.color = ColorInput(color);
-  n.strength = FloatInput(strength);
-  d.nodes.push_back(n);
-  d.root = 0;
-  return d;
-}
-
 }  // namespace gdpt::test

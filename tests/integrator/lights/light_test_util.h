@@ -10,6 +10,7 @@
 #include "integrator/light_sampler.h"
 #include "integrator/scene.h"
 #include "shaders/material.h"
+#include "tests/common/materials.h"
 #include "tests/common/statistics.h"
 
 namespace gdpt::test {
@@ -30,8 +31,5 @@ struct Estimate {
 
 // Stratified 3-D samples (u_select, u) from a fixed seed; pdfs include the selection pmf.
 Estimate estimate(const LightSampler& lights, Vec3f ref, Vec3f normal, size_t n, uint32_t seed = 1);
-
-// Emission-only material (Blender Emission shader: radiance = colour * strength).
-MaterialDesc emission_material(Spectrum color, float strength);
 
 }  // namespace gdpt::test
