@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -37,7 +38,9 @@ Vec3f offset_ray_origin(Vec3f p, Vec3f n) {
 
 EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     : default_material_(default_material) {
-  device_ = rtcNewDevice(nullptr);
+  // $GDPT_EMBREE_CONFIG is passed to Embree as its device configuration (e.g. "isa=avx2",
+  // "verbose=2"), for benchmarking Embree's kernels on a given machine.
+  device_ = rtcNewDevice(std::getenv("GDPT_EMBREE_CONFIG"));
   if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
 
   // How often each mesh is placed: a mesh placed once is flattened into the top level in world

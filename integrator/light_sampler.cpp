@@ -244,6 +244,10 @@ bool LightSampler::empty() const {
   return impl_->entries.empty();
 }
 
+bool LightSampler::needs_selection() const {
+  return impl_->entries.size() > 1;
+}
+
 bool LightSampler::has_environment() const {
   return impl_->world_enabled;
 }

@@ -42,6 +42,9 @@ class LightSampler {
   ~LightSampler();
 
   bool empty() const;
+  // Whether sample() reads u_select: a scene with one emitter (a Cornell box's lamp) needs no
+  // selection number, and integrators skip drawing it.
+  bool needs_selection() const;
   LightSample sample(Vec3f ref_position, float u_select, Vec2f u) const;
   // Density of sample() choosing the point hit on emissive triangle (instance, primitive).
   float pdf_triangle(uint32_t instance, uint32_t primitive, Vec3f ref_position,

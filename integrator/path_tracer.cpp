@@ -118,6 +118,7 @@ class PathTracer final : public Integrator {
     const auto& materials = ctx_.materials();
     const int max_bounces = settings_.max_bounces;
     const bool has_lights = !lights.empty();
+    const bool needs_selection = lights.needs_selection();
 
     PathResult out;
     // --- Camera ray ---
@@ -218,7 +219,10 @@ class PathTracer final : public Integrator {
 
       // --- Next-event estimation ---
       if (has_lights) {
-        const float u_select = sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kLightSelect));
+        // Dimensions are indexed, not streamed: skipping an unused one changes no other value.
+        const float u_select =
+            needs_selection ? sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kLightSelect))
+                            : 0.0f;
         const Vec2f u_light = sampler.get2d(Sampler::bounce_dim(vertex, Sampler::kLightPoint));
         const LightSample ls = lights.sample(hit.position, u_select, u_light);
         if (ls.valid && ls.pdf > 0.0f && !is_black(ls.radiance)) {
@@ -254,7 +258,9 @@ class PathTracer final : public Integrator {
       }
 
       // --- BSDF sampling: continue the path ---
-      const float u_lobe = sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kBsdfLobe));
+      const float u_lobe = closures.uses_lobe_choice()
+                               ? sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kBsdfLobe))
+                               : 0.0f;
       const Vec2f u_dir = sampler.get2d(Sampler::bounce_dim(vertex, Sampler::kBsdfDir));
       const BsdfSample bs = closures.sample(wi, u_lobe, u_dir);
       if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;

@@ -93,6 +93,11 @@ class ClosureSet {
   float pdf(Vec3f wi, Vec3f wo) const;
   // u_lobe picks the lobe (by weight luminance), u the direction within it.
   BsdfSample sample(Vec3f wi, float u_lobe, Vec2f u) const;
+  // Whether sample() reads u_lobe at all: only to pick among several lobes or, for a single
+  // dielectric, reflection against refraction. Integrators skip drawing it otherwise.
+  bool uses_lobe_choice() const {
+    return count_ > 1 || (count_ == 1 && closures_[0].type == ClosureType::GGXDielectric);
+  }
   // Minimum roughness over non-delta lobes (1 for pure diffuse); 0 if only delta lobes.
   float roughness() const;
   bool has_delta() const;

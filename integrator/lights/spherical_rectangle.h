@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "integrator/math/atan2_fast.h"
 #include "integrator/math/vec.h"
 
 namespace gdpt::lights {
@@ -28,22 +29,25 @@ class SphericalRectangle {
     }
     x1_ = x0_ + ex;
     y1_ = y0_ + ey;
-    // Unit normals of the four planes through o and each edge, in the local frame. With corners
-    // v00 = (x0, y0, z0) etc., cross(v00, v10) = (x1 - x0) (0, z0, -y0) and likewise for the
-    // others, so each normal is a two-term vector over one square root (no cross products):
-    //   n0 = (0, z0, -y0) / r0, n1 = (-z0, 0, x1) / r1, n2 = (0, -z0, y1) / r2,
-    //   n3 = (z0, 0, -x0) / r3, r the lengths.
-    const float z2 = z0_ * z0_;
-    const float r0 = std::sqrt(z2 + y0_ * y0_), r1 = std::sqrt(z2 + x1_ * x1_);
-    const float r2 = std::sqrt(z2 + y1_ * y1_), r3 = std::sqrt(z2 + x0_ * x0_);
-    // Interior angles of the spherical quadrilateral, acos(-dot(n_i, n_i+1)); its area is their
-    // sum minus 2 pi.
-    const float g0 = safe_acos(x1_ * y0_ / (r0 * r1)), g1 = safe_acos(-x1_ * y1_ / (r1 * r2));
-    const float g2 = safe_acos(x0_ * y1_ / (r2 * r3)), g3 = safe_acos(-x0_ * y0_ / (r3 * r0));
-    b0_ = -y0_ / r0;  // n0.z
-    b1_ = y1_ / r2;   // n2.z
-    k_ = 2.0f * kPi - g2 - g3;
-    solid_angle_ = g0 + g1 - k_;
+    // Interior angles of the spherical quadrilateral: g_i = acos(-dot(n_i, n_i+1)) with n_i the
+    // unit normals of the planes through o and each edge. With corners v00 = (x0, y0, z0) etc.
+    // the normals are two-term vectors, e.g. n0 = (0, z0, -y0) / r0, n1 = (-z0, 0, x1) / r1
+    // (r their lengths), so cos g0 = x1 y0 / (r0 r1) and, by Lagrange's identity,
+    // sin g0 = |z0| |v10| / (r0 r1): each angle is atan2(|z0| |corner|, +-x y) and the common
+    // factor r_i r_i+1 drops out. Sums of two angles come from one complex product and one
+    // atan2 (each pair sum lies in (0, 2 pi)), instead of four acos. The area is the angle sum
+    // minus 2 pi.
+    const float z2 = z0_ * z0_, az = std::fabs(z0_);
+    const float l00 = az * std::sqrt(x0_ * x0_ + y0_ * y0_ + z2);
+    const float l10 = az * std::sqrt(x1_ * x1_ + y0_ * y0_ + z2);
+    const float l11 = az * std::sqrt(x1_ * x1_ + y1_ * y1_ + z2);
+    const float l01 = az * std::sqrt(x0_ * x0_ + y1_ * y1_ + z2);
+    const float g01 = angle_sum(x1_ * y0_, l10, -x1_ * y1_, l11);  // g0 + g1
+    const float g23 = angle_sum(x0_ * y1_, l01, -x0_ * y0_, l00);  // g2 + g3
+    b0_ = -y0_ / std::sqrt(z2 + y0_ * y0_);                        // n0.z
+    b1_ = y1_ / std::sqrt(z2 + y1_ * y1_);                         // n2.z
+    k_ = 2.0f * kPi - g23;
+    solid_angle_ = g01 - k_;
   }
 
   float solid_angle() const { return solid_angle_; }
@@ -68,7 +72,12 @@ class SphericalRectangle {
   }
 
  private:
-  static float safe_acos(float c) { return std::acos(std::clamp(c, -1.0f, 1.0f)); }
+  // a + b for the angles a = atan2(sa, ca), b = atan2(sb, cb) in [0, pi] (sa, sb >= 0): the
+  // argument of (ca + i sa)(cb + i sb), mapped to [0, 2 pi).
+  static float angle_sum(float ca, float sa, float cb, float sb) {
+    const float a = atan2_fast(ca * sb + sa * cb, ca * cb - sa * sb);
+    return a < 0.0f ? a + 2.0f * kPi : a;
+  }
 
   Vec3f o_, x_, y_, z_;
   float x0_, y0_, z0_, x1_, y1_;
