@@ -19,11 +19,13 @@ if "bpy" in locals():
     import importlib
 
     for _module in (properties, passes, export_images, export_materials, export_mesh,  # noqa: F821
-                    export_lights, export_camera, export_world, export_scene, engine, ui):
+                    export_lights, export_camera, export_world, export_scene, engine, ui,
+                    compositor_node):  # noqa: F821
         importlib.reload(_module)
 else:
     from . import (properties, passes, export_images, export_materials, export_mesh,
-                   export_lights, export_camera, export_world, export_scene, engine, ui)
+                   export_lights, export_camera, export_world, export_scene, engine, ui,
+                   compositor_node)
 
 import bpy  # noqa: E402
 
@@ -32,9 +34,11 @@ def register():
     properties.register()
     bpy.utils.register_class(engine.GDPTRenderEngine)
     ui.register()
+    compositor_node.register()
 
 
 def unregister():
+    compositor_node.unregister()
     ui.unregister()
     bpy.utils.unregister_class(engine.GDPTRenderEngine)
     properties.unregister()

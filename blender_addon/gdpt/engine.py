@@ -10,7 +10,7 @@ import time
 
 import bpy
 
-from . import export_camera, export_scene, passes, properties
+from . import compositor_node, export_camera, export_scene, passes, properties
 
 MARKER = "GDPT:"  # every console line of the engine starts with it (tests look for it)
 
@@ -172,6 +172,13 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         t_reconstruct = time.perf_counter()
         self._write(result, layer, film, combined)
         self.end_result(result)
+        # Gradient Reconstruct compositor nodes solve from this layer's passes now: Blender
+        # composites after render() returns (compositor_node.py).
+        try:
+            compositor_node.fill_after_render(scene.original, view_layer.name, film,
+                                              settings.threads, self._warn)
+        except Exception as e:  # the node must never cost the render
+            self._warn(f"Gradient Reconstruct compositor nodes were not updated: {e}")
         t_end = time.perf_counter()
         status = "cancelled" if state["cancelled"] else "finished"
         LAST_RENDER.clear()

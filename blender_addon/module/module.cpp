@@ -3,8 +3,11 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cstring>
+
 #include "blender_addon/module/render_job.h"
 #include "blender_addon/module/scene_convert.h"
+#include "reconstruct/exr_io.h"
 
 namespace py = pybind11;
 using namespace gdpt;
@@ -36,6 +39,29 @@ RenderSettings settings_from_dict(const py::dict& d) {
   get("shift_threshold", s.shift_roughness_threshold);
   get("samples_per_pass", s.samples_per_pass);
   return s;
+}
+
+// The passes of one view layer of a multilayer EXR (the compositor node reads files behind an
+// Image node through this): {pass name: float32 (height, width, 3)}, rows bottom-up as Blender
+// stores them. A missing required pass raises RuntimeError naming it.
+py::dict read_exr_passes_dict(const std::string& path, const std::string& layer,
+                              const std::vector<std::string>& required,
+                              const std::vector<std::string>& optional) {
+  ExrPasses passes;
+  {
+    py::gil_scoped_release no_gil;
+    passes = read_exr_passes(path, layer, required, optional);
+  }
+  py::dict d;
+  d["width"] = passes.width;
+  d["height"] = passes.height;
+  d["layer"] = passes.layer;
+  for (const auto& [name, rgb] : passes.passes) {
+    py::array_t<float> a({py::ssize_t(passes.height), py::ssize_t(passes.width), py::ssize_t(3)});
+    std::memcpy(a.mutable_data(), rgb.data(), rgb.size() * sizeof(float));
+    d[py::str(name)] = std::move(a);
+  }
+  return d;
 }
 
 }  // namespace
@@ -85,4 +111,6 @@ PYBIND11_MODULE(_gdpt, m) {
         py::arg("gradient_x").noconvert(), py::arg("gradient_y").noconvert(),
         py::arg("variance").noconvert() = py::none(), py::arg("emission").noconvert() = py::none(),
         py::arg("norm") = "L1", py::arg("alpha") = 0.2f, py::arg("threads") = 0);
+  m.def("read_exr_passes", &read_exr_passes_dict, py::arg("path"), py::arg("layer"),
+        py::arg("required"), py::arg("optional") = std::vector<std::string>{});
 }

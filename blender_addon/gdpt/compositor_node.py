@@ -1,0 +1,404 @@
+# The compositor node "Gradient Reconstruct": a screened Poisson solve of Primal, Gradient X and
+# Gradient Y (+ Emission) with its own alpha and norm, tweakable without re-rendering.
+#
+# A Python add-on cannot run native code inside Blender's compositor, so the node is a
+# CompositorNodeCustomGroup whose internal node group only outputs an internal float Image
+# datablock (".GDPT Reconstruct"). The add-on fills that image before the compositor reads it:
+#   - the engine: render() calls `fill_after_render` once its film is final (Blender composites
+#     only after every view layer has been rendered). The passes of the layer are cached in
+#     memory (`_CACHE`, per (scene, view layer)), but only while some scene has such a node.
+#   - a change of the node's `alpha` or `norm`: the update callback solves again from the cached
+#     passes (or re-reads the EXR file) and rewrites the image; a node property change makes the
+#     compositor run again, so the artist sees the result without re-rendering.
+#   - a render_pre handler, for nodes that read only EXR files (Blender does not call the engine
+#     at all when the compositor has no Render Layers node).
+# An input is read from what it is linked to (through reroutes): a Render Layers pass (the cached
+# passes of that scene and view layer) or a multilayer EXR Image node (read through OpenImageIO by
+# the `_gdpt` module). Anything else (an unlinked Primal / Gradient input, a Blur in between, no
+# cached passes) is reported on the node, in the console (`GDPT:` lines) and, during a render,
+# with RenderEngine.report; a render then clears the image to black, so a stale result is never
+# composited silently. (Blender's composite_pre handlers do not run for a render's compositing.)
+#
+# Reconstruction rule (docs/blender.md): Image = solve(Primal, Gradient X, Gradient Y) + Emission,
+# through `_gdpt.reconstruct`, the same C++ code as the engine and the gdpt-reconstruct CLI.
+import os
+import sys
+
+import bpy
+import nodeitems_utils
+import numpy as np
+from bpy.app.handlers import persistent
+from bpy.props import EnumProperty, FloatProperty
+from nodeitems_utils import NodeItem
+
+NODE_IDNAME = "CompositorNodeGDPTReconstruct"
+MARKER = "GDPT:"
+INPUTS = ("Primal", "Gradient X", "Gradient Y", "Emission")
+REQUIRED = INPUTS[:3]
+# Render Layers pass names the node can read, and their keys in the engine's film dict.
+FILM_KEYS = {"Primal": "primal", "Gradient X": "gradient_x", "Gradient Y": "gradient_y",
+             "Emission": "emission"}
+
+# (scene name, view layer name) -> {film key: (height, width, 3) float32} of the last render.
+_CACHE = {}
+# node.as_pointer() -> (level, message): the last outcome, drawn on the node.
+_STATUS = {}
+# Files read for Image-node inputs: (path, layer) -> (mtime, passes dict); one entry per file.
+_EXR_CACHE = {}
+
+
+class InputError(Exception):
+    """An input that cannot be read; the message names the node and what to do."""
+
+
+def _module():
+    from . import engine
+    module, error = engine._load_module()
+    if module is None:
+        raise InputError(f"the _gdpt module could not be loaded ({error})")
+    return module
+
+
+def _say(node, level, message):
+    _STATUS[node.as_pointer()] = (level, message)
+    print(f"{MARKER} {'compositor' if level == 'INFO' else 'warning'}: "
+          f"Gradient Reconstruct '{node.name}': {message}", flush=True)
+
+
+# --- the node's internal group and image --------------------------------------------------------
+
+def _new_image(width, height):
+    image = bpy.data.images.new(".GDPT Reconstruct", max(width, 1), max(height, 1), alpha=True,
+                                float_buffer=True)
+    image.generated_color = (0.0, 0.0, 0.0, 0.0)
+    image.colorspace_settings.name = 'Linear'  # the solve is scene linear: no conversion
+    return image
+
+
+def _new_group(image):
+    tree = bpy.data.node_groups.new(".GDPT Reconstruct", "CompositorNodeTree")
+    for name in INPUTS:
+        socket = tree.inputs.new("NodeSocketColor", name)
+        socket.default_value = (0.0, 0.0, 0.0, 1.0)
+    tree.outputs.new("NodeSocketColor", "Image")
+    group_in = tree.nodes.new("NodeGroupInput")
+    group_in.location = (-300, 0)
+    group_out = tree.nodes.new("NodeGroupOutput")
+    group_out.location = (300, 0)
+    image_node = tree.nodes.new("CompositorNodeImage")
+    image_node.name = "Reconstruction"
+    image_node.image = image
+    tree.links.new(image_node.outputs["Image"], group_out.inputs["Image"])
+    return tree
+
+
+def node_image(node):
+    tree = node.node_tree
+    image_node = tree.nodes.get("Reconstruction") if tree is not None else None
+    return image_node.image if image_node is not None else None
+
+
+def _write_image(node, rgb):
+    """rgb: (height, width, 3) float32, rows bottom-up; written with alpha 1."""
+    image = node_image(node)
+    if image is None:
+        raise InputError("the node's internal image is missing (delete and re-add the node)")
+    height, width = rgb.shape[:2]
+    if tuple(image.size) != (width, height):
+        # A generated image regenerates its buffer at the new size.
+        image.generated_width, image.generated_height = width, height
+    rgba = np.ones((height, width, 4), dtype=np.float32)
+    rgba[..., :3] = rgb
+    image.pixels.foreach_set(rgba.ravel())
+    image.update()
+
+
+def _clear_image(node):
+    image = node_image(node)
+    if image is not None:
+        width, height = image.size
+        image.pixels.foreach_set(np.zeros(width * height * 4, dtype=np.float32))
+        image.update()
+
+
+# --- where the inputs come from ------------------------------------------------------------------
+
+def _upstream(socket):
+    """(node, output socket) feeding `socket`, through reroutes; None when not linked."""
+    while socket.is_linked:
+        link = socket.links[0]
+        if link.is_muted:
+            return None
+        node = link.from_node
+        if node.type != 'REROUTE':
+            return node, link.from_socket
+        socket = node.inputs[0]
+    return None
+
+
+def _source(scene, node, name):
+    """Where input `name` reads from: ('LAYER', scene name, view layer, pass) or
+    ('FILE', path, layer, pass); None for an unlinked optional input."""
+    found = _upstream(node.inputs[name])
+    if found is None:
+        if name in REQUIRED:
+            raise InputError(f"input '{name}' is not linked: connect it to the '{name}' output "
+                             f"of a Render Layers node (or of a multilayer EXR Image node)")
+        return None
+    src, socket = found
+    if src.mute:
+        raise InputError(f"input '{name}' comes from the muted node '{src.name}'")
+    if socket.name not in FILM_KEYS:
+        raise InputError(f"input '{name}' is linked to output '{socket.name}' of '{src.name}'; "
+                         f"it must be one of the passes {', '.join(FILM_KEYS)}")
+    if src.type == 'R_LAYERS':
+        source_scene = src.scene or scene
+        return ('LAYER', source_scene.name, src.layer, socket.name)
+    if src.type == 'IMAGE':
+        image = src.image
+        if image is None or image.type != 'MULTILAYER':
+            raise InputError(f"input '{name}': Image node '{src.name}' does not hold a "
+                             f"multilayer EXR")
+        path = bpy.path.abspath(image.filepath, library=image.library)
+        return ('FILE', os.path.normpath(path), src.layer, socket.name)
+    raise InputError(f"input '{name}' is linked to '{src.name}' ({src.bl_label}); Gradient "
+                     f"Reconstruct reads passes straight from a Render Layers node or a "
+                     f"multilayer EXR Image node (reroutes are fine, other nodes are not)")
+
+
+def _read_file(path, layer, passes):
+    if not os.path.isfile(path):
+        raise InputError(f"the EXR file '{path}' does not exist")
+    mtime = os.path.getmtime(path)
+    key = (path, layer)
+    cached = _EXR_CACHE.get(key)
+    if cached is None or cached[0] != mtime or not set(passes) <= set(cached[1]):
+        try:
+            data = _module().read_exr_passes(path, layer, sorted(set(passes)))
+        except RuntimeError as e:
+            raise InputError(str(e)) from None
+        _EXR_CACHE.clear()  # one file at a time: these are full-resolution float images
+        cached = (mtime, data)
+        _EXR_CACHE[key] = cached
+    return cached[1]
+
+
+class NoCache(InputError):
+    """The passes of a Render Layers input are not in memory (not rendered in this session)."""
+
+
+def _array(source):
+    kind, where, layer, pass_name = source
+    if kind == 'LAYER':
+        film = _CACHE.get((where, layer))
+        if film is None:
+            raise NoCache(f"no cached passes of view layer '{layer}' of scene '{where}': the "
+                          f"node is solved at the next render (F12); passes are kept in memory "
+                          f"for this Blender session only")
+        return film[FILM_KEYS[pass_name]]
+    return _read_file(where, layer, [pass_name])[pass_name]
+
+
+def sources(scene, node):
+    """{input name: source} for the linked inputs (raises InputError for a bad one)."""
+    found = {}
+    for name in INPUTS:
+        src = _source(scene, node, name)
+        if src is not None:
+            found[name] = src
+    return found
+
+
+def reconstruct_node(scene, node, threads=0):
+    """Solves the node from its inputs and writes its image; returns the RGB result. Raises
+    InputError when an input cannot be read (the image is then left untouched)."""
+    srcs = sources(scene, node)
+    arrays = {name: _array(src) for name, src in srcs.items()}
+    shapes = {a.shape for a in arrays.values()}
+    if len(shapes) != 1:
+        raise InputError("the inputs differ in resolution: "
+                         + ", ".join(f"{n} {a.shape[1]}x{a.shape[0]}" for n, a in arrays.items()))
+    emission = arrays.get("Emission")
+    rgb = _module().reconstruct(
+        np.ascontiguousarray(arrays["Primal"], dtype=np.float32),
+        np.ascontiguousarray(arrays["Gradient X"], dtype=np.float32),
+        np.ascontiguousarray(arrays["Gradient Y"], dtype=np.float32), None,
+        None if emission is None else np.ascontiguousarray(emission, dtype=np.float32),
+        node.norm, float(node.alpha), int(threads))
+    _write_image(node, rgb)
+    height, width = rgb.shape[:2]
+    _say(node, 'INFO', f"{node.norm}, alpha {node.alpha:g}, {width}x{height}"
+                       + ("" if emission is not None else ", no Emission input"))
+    return rgb
+
+
+# --- the engine's hook and the update callback --------------------------------------------------
+
+def nodes_in(scene):
+    tree = scene.node_tree if scene.use_nodes else None
+    if tree is None:
+        return []
+    return [n for n in tree.nodes if n.bl_idname == NODE_IDNAME]
+
+
+def any_node():
+    return any(nodes_in(s) for s in bpy.data.scenes)
+
+
+def fill_after_render(scene, view_layer_name, film, threads, warn):
+    """Called by the engine's render() with the final film of one view layer (scene: original
+    datablock). Caches the passes while some scene has a Gradient Reconstruct node, then solves
+    every node that reads this view layer; bad inputs of this scene's nodes are reported with
+    warn(). (In PT mode the film's gradients are differences of the primal: the node then returns
+    the PT image + Emission whatever its settings.)"""
+    if not any_node():
+        _CACHE.clear()
+        return
+    key = (scene.name, view_layer_name)
+    _CACHE[key] = {k: film[k] for k in FILM_KEYS.values()}
+    for owner in bpy.data.scenes:
+        for node in nodes_in(owner):
+            try:
+                srcs = sources(owner, node)
+                if key in {(s[1], s[2]) for s in srcs.values() if s[0] == 'LAYER'}:
+                    reconstruct_node(owner, node, threads)
+            except InputError as e:
+                if owner != scene:
+                    continue  # reported when its own scene renders
+                _clear_image(node)
+                _say(node, 'ERROR', str(e))
+                warn(f"compositor node '{node.name}' (Gradient Reconstruct): {e}")
+
+
+def _owner_scene(node):
+    tree = node.id_data
+    for scene in bpy.data.scenes:
+        if scene.node_tree == tree:
+            return scene
+    return None
+
+
+def _on_setting(node, context):
+    scene = _owner_scene(node)
+    if scene is None:
+        return
+    try:
+        reconstruct_node(scene, node, scene.gdpt.threads)
+    except NoCache as e:
+        _say(node, 'WARNING', f"{e} (the image was not updated)")
+    except InputError as e:
+        _say(node, 'ERROR', f"{e} (the image was not updated)")
+
+
+@persistent
+def _render_pre(scene, _depsgraph=None):
+    """Nodes that read only EXR files are solved before every render: Blender does not even call
+    the engine when the compositor has no Render Layers node. (Nodes reading Render Layers are
+    solved by the engine; bad inputs are reported there.)"""
+    for node in nodes_in(scene):
+        try:
+            srcs = sources(scene, node)
+            if all(s[0] == 'FILE' for s in srcs.values()):
+                reconstruct_node(scene, node, scene.gdpt.threads)
+        except InputError as e:
+            _say(node, 'ERROR', str(e))
+
+
+# --- the node -------------------------------------------------------------------------------------
+
+class GDPTReconstructNode(bpy.types.CompositorNodeCustomGroup):
+    """Screened Poisson reconstruction of Gradient PT passes: solve(Primal, Gradient X,
+    Gradient Y) + Emission"""
+    bl_idname = NODE_IDNAME
+    bl_label = "Gradient Reconstruct"
+    bl_icon = 'NODE_COMPOSITING'
+    bl_width_default = 180
+
+    alpha: FloatProperty(
+        name="Alpha", description="Weight of the primal image against the gradients (higher "
+        "keeps more of the noisy primal)", default=0.2, min=1e-4, max=100.0, soft_max=2.0,
+        update=_on_setting)
+    norm: EnumProperty(
+        name="Norm",
+        items=[('L1', "L1", "Robust iteratively reweighted solve (fewer outliers, slightly "
+                "biased)"),
+               ('L2', "L2", "Unbiased screened Poisson solve (exact DCT)")],
+        default='L1', update=_on_setting)
+
+    @classmethod
+    def poll(cls, tree):
+        return tree.bl_idname == "CompositorNodeTree"
+
+    def init(self, context):
+        r = context.scene.render if context and context.scene else None
+        size = (r.resolution_x * r.resolution_percentage // 100,
+                r.resolution_y * r.resolution_percentage // 100) if r else (64, 64)
+        self.node_tree = _new_group(_new_image(*size))
+
+    def copy(self, node):
+        # Each node owns its group and image: a duplicate must not overwrite the original's.
+        image = node_image(node)
+        width, height = image.size if image is not None else (64, 64)
+        self.node_tree = _new_group(_new_image(width, height))
+
+    def free(self):
+        # The group and image become orphans (0 users) and go with the next save / reload;
+        # removing datablocks from inside a node's free callback is not safe.
+        _STATUS.pop(self.as_pointer(), None)
+
+    def draw_buttons(self, context, layout):
+        layout.prop(self, "norm", expand=True)
+        layout.prop(self, "alpha")
+        status = _STATUS.get(self.as_pointer())
+        if status is not None:
+            level, message = status
+            icon = {'ERROR': 'ERROR', 'WARNING': 'INFO'}.get(level, 'NONE')
+            layout.label(text=message, icon=icon)
+
+    def draw_label(self):
+        return self.bl_label
+
+
+class _Category(nodeitems_utils.NodeCategory):
+    @classmethod
+    def poll(cls, context):
+        return context.space_data.tree_type == "CompositorNodeTree"
+
+
+_CATEGORIES = "GDPT_COMPOSITOR_NODES"
+
+
+def register():
+    bpy.utils.register_class(GDPTReconstructNode)
+    # Add > Gradient PT > Gradient Reconstruct (and the node search).
+    nodeitems_utils.register_node_categories(
+        _CATEGORIES, [_Category("GDPT_CMP", "Gradient PT", items=[NodeItem(NODE_IDNAME)])])
+    bpy.app.handlers.render_pre.append(_render_pre)
+
+
+def _quitting():
+    """True inside Blender's exit sequence (WM_exit calls addon_utils.disable_all, and only
+    there)."""
+    frame = sys._getframe()
+    while frame is not None:
+        if frame.f_code.co_name == "disable_all" and \
+                frame.f_globals.get("__name__") == "addon_utils":
+            return True
+        frame = frame.f_back
+    return False
+
+
+def unregister():
+    if _render_pre in bpy.app.handlers.render_pre:
+        bpy.app.handlers.render_pre.remove(_render_pre)
+    nodeitems_utils.unregister_node_categories(_CATEGORIES)
+    # Blender 3.4 frees an unregistered node type but only retypes the nodes of the main
+    # database: the copies of the scene in the dependency graphs (the view layers', the render
+    # pipeline's) keep pointing at the freed type and crash when Blender frees them after the
+    # add-ons, at quit (exit status 139 after a successful `blender -b ... -f 1`). Blender frees
+    # everything at quit anyway, so the type stays registered then.
+    if not _quitting():
+        bpy.utils.unregister_class(GDPTReconstructNode)
+    _CACHE.clear()
+    _EXR_CACHE.clear()
+    _STATUS.clear()
