@@ -51,6 +51,13 @@ inline bool is_zero(Vec3d a) {
   return a.x == 0.0 && a.y == 0.0 && a.z == 0.0;
 }
 
+// Event part of the pair weight for a connected offset (see add_connected): Y p_tech /
+// (p_L^2 + p_B^2), 0 when both densities are 0 (mis_weight_over_pdf's zero denominator).
+inline Vec3d connected_event(Vec3d y, double p_tech, double p_light, double p_bsdf) {
+  const double d = p_light * p_light + p_bsdf * p_bsdf;
+  return d > 0.0 ? y * (p_tech / d) : Vec3d();
+}
+
 // A shading point of a path: the hit, the frame facing the incoming ray, the closures.
 struct Vertex {
   SurfaceHit hit;
@@ -127,10 +134,18 @@ struct SampleResult {
 };
 
 // Per-thread working storage of trace(), reused across samples: no allocation or large
-// initialisation per sample (a ClosureSet holds kMaxClosures lobes).
+// initialisation per sample (a ClosureSet holds kMaxClosures lobes). The per-offset arrays of the
+// packets live here too: as locals their default member initialisers ran on every bounce.
 struct PathScratch {
   Offset off[kOffsets];
   Vertex verts[2];  // base vertex and the next one, swapped per bounce
+  Ray cam[kOffsets];
+  SurfaceHit cam_hit[kOffsets];
+  LightSample lo[kOffsets];
+  Ray shadow[kOffsets];
+  Ray vis[kOffsets];
+  Vec3f wo_o[kOffsets];
+  Spectrum fo[kOffsets];
 };
 
 class GradientPathTracer final : public Integrator {
@@ -296,6 +311,7 @@ class GradientPathTracer final : public Integrator {
     const LightSampler& lights = ctx_.lights();
     const int max_bounces = settings_.max_bounces;
     const bool has_lights = !lights.empty();
+    const bool needs_selection = lights.needs_selection();
 
     // --- Camera rays: same jitter and lens sample for the base and the offsets ---
     const Vec2f jitter = sampler.get2d(Sampler::kDimCamera);
@@ -319,7 +335,7 @@ class GradientPathTracer final : public Integrator {
 
     // The four offset camera rays start at neighbouring pixels: one coherent packet.
     Offset* off = scratch.off;
-    Ray cam[kOffsets];
+    Ray* cam = scratch.cam;
     for (int k = 0; k < kOffsets; ++k) {
       if (!mask[k]) continue;
       const Vec2f r{raster.x + float(kShiftX[k]), raster.y + float(kShiftY[k])};
@@ -327,7 +343,7 @@ class GradientPathTracer final : public Integrator {
       ++out.rays;
     }
     bool cam_found[kOffsets];
-    SurfaceHit cam_hit[kOffsets];
+    SurfaceHit* cam_hit = scratch.cam_hit;
     bvh.intersect4(cam, mask, cam_found, cam_hit);
     for (int k = 0; k < kOffsets; ++k) {
       Offset& o = off[k];
@@ -383,7 +399,11 @@ class GradientPathTracer final : public Integrator {
             !o.alive || o.link != Link::NotConnected ||
             (base_type == VertexType::Diffuse && classify(o.v.roughness) == VertexType::Diffuse);
       if (has_lights) {
-        const float u_select = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kLightSelect));
+        // Dimensions are indexed, not streamed: skipping an unused one changes no other value
+        // (as in the path tracer). Offsets resample with the base's numbers.
+        const float u_select =
+            needs_selection ? sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kLightSelect))
+                            : 0.0f;
         const Vec2f u_light = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kLightPoint));
         const LightSample ls = lights.sample(base.hit.position, u_select, u_light);
         if (ls.valid && ls.pdf > 0.0f) {
@@ -410,11 +430,11 @@ class GradientPathTracer final : public Integrator {
           // start at neighbouring points towards the same light point and go in one packet.
           enum class NeeCase : uint8_t { Skip, Dead, Shared, NoLight, Shifted };
           NeeCase nc[kOffsets];
-          LightSample lo[kOffsets];
+          LightSample* lo = scratch.lo;
           double J[kOffsets];
-          Vec3f wo_o[kOffsets];
-          Spectrum fo[kOffsets];
-          Ray shadow[kOffsets];
+          Vec3f* wo_o = scratch.wo_o;
+          Spectrum* fo = scratch.fo;
+          Ray* shadow = scratch.shadow;
           bool test[kOffsets] = {false, false, false, false};
           for (int k = 0; k < kOffsets; ++k) {
             const Offset& o = off[k];
@@ -424,6 +444,7 @@ class GradientPathTracer final : public Integrator {
               nc[k] = NeeCase::Dead;
               continue;
             }
+            if (o.link == Link::Connected) continue;  // add_connected below
             if (o.link != Link::NotConnected) {
               nc[k] = NeeCase::Shared;
               continue;
@@ -465,21 +486,18 @@ class GradientPathTracer final : public Integrator {
               case NeeCase::Dead:
               case NeeCase::NoLight:
                 break;
-              case NeeCase::Shared:
-                if (o.link == Link::Connected) {
-                  co = mul(o.f, Vec3d(visible ? fs * ls.radiance : Spectrum(0.0f)));
-                  d_off = shift::offset_densities(o.p, 1.0, ls.pdf, pdf_bsdf);
-                } else {
-                  Spectrum f_r(0.0f);
-                  float pdf_o = 0.0f;
-                  if (wo.z != 0.0f && visible) {
-                    f_r = bc.eval(o.wi_shared, wo);
-                    if (!ls.is_delta) pdf_o = bc.pdf(o.wi_shared, wo);
-                  }
-                  co = mul(mul(o.f, f_r), ls.radiance);
-                  d_off = shift::offset_densities(o.p, 1.0, ls.pdf, pdf_o);
+              case NeeCase::Shared: {
+                // Recently connected: the shared vertex seen from the offset's own wi.
+                Spectrum f_r(0.0f);
+                float pdf_o = 0.0f;
+                if (wo.z != 0.0f && visible) {
+                  f_r = bc.eval(o.wi_shared, wo);
+                  if (!ls.is_delta) pdf_o = bc.pdf(o.wi_shared, wo);
                 }
+                co = mul(mul(o.f, f_r), ls.radiance);
+                d_off = shift::offset_densities(o.p, 1.0, ls.pdf, pdf_o);
                 break;
+              }
               case NeeCase::Shifted: {
                 const bool vis_o = test[k] && !blocked[k];
                 const float pdf_o =
@@ -492,11 +510,18 @@ class GradientPathTracer final : public Integrator {
             const double w = shift::mis_weight_over_pdf(db, d_off, db.light);
             o.grad = o.grad + (co - cb) * w;
           }
+          if (visible)
+            add_connected(off, fb, pb,
+                          connected_event(mul(Vec3d(fs), ls.radiance), ls.pdf, ls.pdf, pdf_bsdf));
         }
       }
 
       // ==================== BSDF sampling: extend the base ====================
-      const float u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
+      // The lobe number is drawn when the base's closures read it, or below when a delta shift
+      // samples an offset's closures that do.
+      bool lobe_drawn = bc.uses_lobe_choice();
+      float u_lobe =
+          lobe_drawn ? sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe)) : 0.0f;
       const Vec2f u_dir = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kBsdfDir));
       const BsdfSample bs = bc.sample(base.wi, u_lobe, u_dir);
       if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;
@@ -532,14 +557,30 @@ class GradientPathTracer final : public Integrator {
       const VertexType next_type = found ? classify(next_base.roughness) : VertexType::Diffuse;
 
       // --- Shift every offset over this segment ---
+      const Vec3d seg_b = Vec3d(bs.value);
+      const float pdf_b = bs.pdf;
       for (Offset& o : std::span(off, kOffsets)) {
         if (!o.active || !o.alive) continue;
+        if (o.link == Link::Connected) {
+          // The same segment as the base (inlined from shift_segment: the common case).
+          o.shift = Shift::Follow;
+          o.seg_value = seg_b;
+          o.seg_pdf = pdf_b;
+          o.seg_jacobian = 1.0;
+          o.vis_pending = false;
+          continue;
+        }
+        if (!lobe_drawn && delta && o.link == Link::NotConnected &&
+            o.v.closures.uses_lobe_choice()) {
+          u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
+          lobe_drawn = true;
+        }
         shift_segment(o, base, bs, xd_type, wo_world, found, next, next_type, u_lobe, u_dir,
                       out.rays);
       }
       // Reconnection visibility of all offsets in one packet (rays towards the same x_{d+1}).
       {
-        Ray vis[kOffsets];
+        Ray* vis = scratch.vis;
         bool test[kOffsets], blocked[kOffsets];
         for (int k = 0; k < kOffsets; ++k) {
           test[k] = off[k].active && off[k].alive && off[k].vis_pending;
@@ -550,12 +591,12 @@ class GradientPathTracer final : public Integrator {
           if (test[k]) off[k].seg_visible = !blocked[k];
       }
 
-      const Vec3d seg_b = Vec3d(bs.value);
-      const float pdf_b = bs.pdf;
-
       // ==================== Emission events at the end of the segment ====================
       // Emission events are processed per pair whenever the base OR the offset finds emission:
       // a half-vector offset has its own end vertex and can reach a light the base misses.
+
+      // Connected offsets: the events' common part, applied once after (a)-(c).
+      Vec3d emit_connected;
 
       // (a) analytic lights crossed by the rays (before their surfaces).
       {
@@ -564,8 +605,9 @@ class GradientPathTracer final : public Integrator {
         if (base_lit)
           out.primal += beta * lh.radiance * (delta ? 1.0f : power_heuristic(pdf_b, pl));
         const Vec3d cb = base_lit ? mul(mul(fb, seg_b), lh.radiance) : Vec3d();
+        if (base_lit) emit_connected = connected_event(mul(seg_b, lh.radiance), pdf_b, pl, pdf_b);
         for (Offset& o : std::span(off, kOffsets)) {
-          if (!o.active) continue;
+          if (!o.active || (o.alive && o.link == Link::Connected)) continue;
           Vec3d co;
           PathDensities d_off{0.0, 0.0, 0.0};
           const float pl_pair = o.nee_on ? pl : 0.0f;
@@ -616,8 +658,10 @@ class GradientPathTracer final : public Integrator {
         }
         if (!is_black(le)) out.primal += beta * le * (delta ? 1.0f : power_heuristic(pdf_b, pl));
         const Vec3d cb = mul(mul(fb, seg_b), le);
+        if (!is_black(le))
+          emit_connected = emit_connected + connected_event(mul(seg_b, le), pdf_b, pl, pdf_b);
         for (Offset& o : std::span(off, kOffsets)) {
-          if (!o.active) continue;
+          if (!o.active || (o.alive && o.link == Link::Connected)) continue;
           Vec3d co;
           PathDensities d_off{0.0, 0.0, 0.0};
           const float pl_pair = o.nee_on ? pl : 0.0f;
@@ -628,6 +672,8 @@ class GradientPathTracer final : public Integrator {
           o.grad = o.grad + (co - cb) * w;
         }
       }
+
+      if (!is_zero(emit_connected)) add_connected(off, fb, pb, emit_connected);
 
       // ==================== Advance ====================
       fb = mul(fb, seg_b);
@@ -643,6 +689,20 @@ class GradientPathTracer final : public Integrator {
     for (int k = 0; k < kOffsets; ++k) {
       out.grad[k] = off[k].grad;
       if (off[k].active && (off[k].failed || !off[k].alive)) ++out.failures;
+    }
+  }
+
+  // Connected offsets share the rest of the base path: for an emission event with base
+  // contribution C = fb Y and offset contribution C' = f' Y the two sides have the same technique
+  // densities, so the pair weight of shift::mis_weight_over_pdf factors into
+  // [p / (p^2 + p'^2)] [p_tech / (p_L^2 + p_B^2)], and w (C' - C) = (f' - fb) p / (p^2 + p'^2) E
+  // with the event part E = connected_event(Y, ...) shared by all offsets (equal up to rounding
+  // to the per-pair evaluation, which the not-yet-connected offsets still use).
+  static void add_connected(Offset* off, Vec3d fb, double pb, Vec3d event) {
+    for (Offset& o : std::span(off, kOffsets)) {
+      if (!o.active || !o.alive || o.link != Link::Connected) continue;
+      const double d = pb * pb + o.p * o.p;
+      if (d > 0.0) o.grad = o.grad + mul(o.f - fb, event) * (pb / d);
     }
   }
 

@@ -7,11 +7,19 @@
 // times; the cost per sample is the best wall time / (pixels * spp) of each mode (the best of
 // several runs is the least disturbed by other processes on a shared machine), and likewise the
 // best process CPU time per sample (the steadier figure on a loaded machine).
+//
+// Instruction-count mode (stable on a loaded machine, where times drift): the environment
+// variables GDPT_BENCH_CASE (cornell, glossy-0.09, glossy-4e-4) and GDPT_BENCH_MODE (pt, gpt)
+// restrict the run to that case and mode, each rendered once, so that e.g.
+//   GDPT_BENCH_CASE=cornell GDPT_BENCH_MODE=gpt valgrind --tool=callgrind
+//     --toggle-collect='*render_tile*' bench_gradient 32 4 1 1
+// gives instructions per sample = callgrind's total / the printed sample count.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 
 #include "integrator/render_session.h"
@@ -50,7 +58,26 @@ Cost seconds_per_sample(const Scene& scene, RenderSettings::Mode mode, int spp, 
   return {t / n, c / n};
 }
 
+// Whether the environment variable `var` is unset or equals `value`.
+bool selected(const char* var, const char* value) {
+  const char* e = std::getenv(var);
+  return e == nullptr || std::strcmp(e, value) == 0;
+}
+
 void run_case(const char* name, const Scene& scene, int spp, int repeats, int threads) {
+  if (!selected("GDPT_BENCH_CASE", name)) return;
+  const bool run_pt = selected("GDPT_BENCH_MODE", "pt"),
+             run_gpt = selected("GDPT_BENCH_MODE", "gpt");
+  if (!run_pt || !run_gpt) {
+    // Instruction-count mode: one render of one mode.
+    uint64_t rays = 0;
+    const Cost c = seconds_per_sample(
+        scene, run_pt ? RenderSettings::Mode::PT : RenderSettings::Mode::GPT, spp, threads, &rays);
+    const double n = double(scene.camera.width) * scene.camera.height * spp;
+    std::printf("%-12s %s %.0f samples, %.1f rays/sample, %.3f us/sample cpu\n", name,
+                run_pt ? "PT" : "G-PT", n, double(rays) / n, c.cpu * 1e6);
+    return;
+  }
   Cost pt{1e30, 1e30}, gpt{1e30, 1e30};
   uint64_t rays_pt = 0, rays_gpt = 0;
   for (int r = 0; r < repeats; ++r) {
