@@ -234,8 +234,9 @@ def reconstruct_node(scene, node, threads=0):
 
 # --- the engine's hook and the update callback --------------------------------------------------
 
-def nodes_in(scene):
-    tree = scene.node_tree if scene.use_nodes else None
+def nodes_in(scene, all_trees=False):
+    """The Gradient Reconstruct nodes of the scene's compositor (when it is used)."""
+    tree = scene.node_tree if scene.use_nodes or all_trees else None
     if tree is None:
         return []
     return [n for n in tree.nodes if n.bl_idname == NODE_IDNAME]
@@ -270,6 +271,34 @@ def fill_after_render(scene, view_layer_name, film, threads, warn):
                 warn(f"compositor node '{node.name}' (Gradient Reconstruct): {e}")
 
 
+def _unshare():
+    """Gives every node its own group and image. A copied node (Shift+D, Scene > Full Copy)
+    starts out sharing the original's group: Blender 3.4 counts the users of some copies after the
+    node's copy() callback, so reassigning node_tree there corrupts the user counts (measured:
+    'ID user decrement error' after a Full Copy). This runs after depsgraph updates instead."""
+    seen = set()
+    for scene in bpy.data.scenes:
+        for node in nodes_in(scene, all_trees=True):
+            tree = node.node_tree
+            if tree is None or tree.as_pointer() not in seen:
+                if tree is not None:
+                    seen.add(tree.as_pointer())
+                continue
+            image = node_image(node)
+            width, height = image.size if image is not None else (64, 64)
+            node.node_tree = _new_group(_new_image(width, height))
+            seen.add(node.node_tree.as_pointer())
+            try:  # same result as the original, when its inputs can be read now
+                reconstruct_node(scene, node, scene.gdpt.threads)
+            except InputError:
+                pass
+
+
+@persistent
+def _depsgraph_update_post(_scene, _depsgraph=None):
+    _unshare()
+
+
 def _owner_scene(node):
     tree = node.id_data
     for scene in bpy.data.scenes:
@@ -282,6 +311,7 @@ def _on_setting(node, context):
     scene = _owner_scene(node)
     if scene is None:
         return
+    _unshare()  # a copy must not overwrite its original's image
     try:
         reconstruct_node(scene, node, scene.gdpt.threads)
     except NoCache as e:
@@ -335,15 +365,9 @@ class GDPTReconstructNode(bpy.types.CompositorNodeCustomGroup):
                 r.resolution_y * r.resolution_percentage // 100) if r else (64, 64)
         self.node_tree = _new_group(_new_image(*size))
 
-    def copy(self, node):
-        # Each node owns its group and image: a duplicate must not overwrite the original's.
-        image = node_image(node)
-        width, height = image.size if image is not None else (64, 64)
-        self.node_tree = _new_group(_new_image(width, height))
-
     def free(self):
-        # The group and image become orphans (0 users) and go with the next save / reload;
-        # removing datablocks from inside a node's free callback is not safe.
+        # The group and image go with the next save / reload once nothing uses them (a copy of
+        # the node may still share them); removing datablocks from a free callback is not safe.
         _STATUS.pop(self.as_pointer(), None)
 
     def draw_buttons(self, context, layout):
@@ -374,6 +398,7 @@ def register():
     nodeitems_utils.register_node_categories(
         _CATEGORIES, [_Category("GDPT_CMP", "Gradient PT", items=[NodeItem(NODE_IDNAME)])])
     bpy.app.handlers.render_pre.append(_render_pre)
+    bpy.app.handlers.depsgraph_update_post.append(_depsgraph_update_post)
 
 
 def _quitting():
@@ -391,6 +416,8 @@ def _quitting():
 def unregister():
     if _render_pre in bpy.app.handlers.render_pre:
         bpy.app.handlers.render_pre.remove(_render_pre)
+    if _depsgraph_update_post in bpy.app.handlers.depsgraph_update_post:
+        bpy.app.handlers.depsgraph_update_post.remove(_depsgraph_update_post)
     nodeitems_utils.unregister_node_categories(_CATEGORIES)
     # Blender 3.4 frees an unregistered node type but only retypes the nodes of the main
     # database: the copies of the scene in the dependency graphs (the view layers', the render

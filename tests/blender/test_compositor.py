@@ -12,7 +12,10 @@
 #  - tweaking alpha / norm after the render re-solves from the cached passes (the node's image
 #    equals the reconstruction with the new settings); without cached passes the node says so
 #    and leaves its image alone;
-#  - a multilayer EXR Image node as the source (read through the module's OpenImageIO reader).
+#  - a copied node owns its image (tweaking the copy leaves the original alone);
+#  - two view layers: each node solves the layer its Render Layers node names;
+#  - a multilayer EXR Image node as the source (read through the module's OpenImageIO reader),
+#    also at render time when Blender does not call the engine (no Render Layers node).
 import math
 import os
 import subprocess
@@ -210,6 +213,58 @@ def test_update_from_cache(scene, node, ch):
     bpy.data.scenes.remove(fresh)
 
 
+def test_copy_owns_its_image(scene, node, ch):
+    """A copied node (Scene > Full Copy here; Shift+D alike) gets its own image: tweaking the
+    copy leaves the original's result alone."""
+    from gdpt import compositor_node
+    original = node_pixels(node).copy()
+    bpy.context.window.scene = scene
+    bpy.ops.scene.new(type='FULL_COPY')
+    copy_scene = bpy.context.scene
+    copy = next(n for n in copy_scene.node_tree.nodes if n.bl_idname == NODE)
+    copy_scene.node_tree.nodes["Render Layers"].scene = scene  # read the rendered passes
+    copy.alpha = 0.9
+    check(compositor_node.node_image(copy) != compositor_node.node_image(node),
+          "the copy has its own image")
+    err = max_rel_diff(node_pixels(copy)[..., :3], solve(ch, copy.norm, 0.9))
+    check(err < 1e-4, f"the copy solved with its own alpha 0.9 ({err:.2e})")
+    check(np.array_equal(node_pixels(node), original), "the original's image is unchanged")
+    bpy.context.window.scene = scene
+    bpy.data.scenes.remove(copy_scene)
+
+
+def test_two_view_layers(out):
+    """Each node solves the view layer its Render Layers node names (render() runs per layer)."""
+    scene = S.clear()
+    build(scene)
+    coll = bpy.data.collections.new("Sphere")
+    scene.collection.children.link(coll)
+    ball = scene.objects["ball"]
+    scene.collection.objects.unlink(ball)
+    coll.objects.link(ball)
+    second = scene.view_layers.new("Second")
+    second.layer_collection.children["Sphere"].exclude = True  # the layers differ
+    node = compositor(scene)
+    node.norm, node.alpha = 'L2', 0.2
+    tree = scene.node_tree
+    rl2 = tree.nodes.new("CompositorNodeRLayers")
+    rl2.layer = "Second"
+    other = tree.nodes.new(NODE)
+    other.norm, other.alpha = 'L2', 0.2
+    for name in ("Primal", "Gradient X", "Gradient Y", "Emission"):
+        tree.links.new(rl2.outputs[name], other.inputs[name])
+    ch, _ = render(scene, os.path.join(out, "two_layers.exr"))
+    from gdpt import _gdpt
+    for n, layer in ((node, "ViewLayer"), (other, "Second")):
+        get = lambda name: layer_rgb(ch, layer, name)  # noqa: E731
+        ref = _gdpt.reconstruct(get("Primal"), get("Gradient X"), get("Gradient Y"), None,
+                                get("Emission"), 'L2', 0.2)
+        err = max_rel_diff(node_pixels(n)[..., :3], ref)
+        check(err < 1e-4, f"node reading '{layer}' = L2 solve of that layer's passes ({err:.2e})")
+    diff = float(np.abs(node_pixels(node) - node_pixels(other)).max())
+    check(diff > 1e-3, f"the two layers' solves differ (max diff {diff:.3f})")
+
+
 def test_unlinked_inputs(out):
     import gdpt.engine as engine
     scene = S.clear()
@@ -268,6 +323,8 @@ def main():
     exr_path = test_command_line(out, a["build"])
     scene, node, ch = test_render_layers(out)
     test_update_from_cache(scene, node, ch)
+    test_copy_owns_its_image(scene, node, ch)
+    test_two_view_layers(out)
     test_unlinked_inputs(out)
     test_exr_image_node(out, exr_path)
     print("ALL COMPOSITOR CHECKS PASSED", flush=True)
