@@ -51,7 +51,7 @@ inline bool is_zero(Vec3d a) {
   return a.x == 0.0 && a.y == 0.0 && a.z == 0.0;
 }
 
-// Event part of the pair weight for a connected offset (see add_connected): Y p_tech /
+// Event part of the pair weight for a merged offset (see add_merged): Y p_tech /
 // (p_L^2 + p_B^2), 0 when both densities are 0 (mis_weight_over_pdf's zero denominator).
 inline Vec3d connected_event(Vec3d y, double p_tech, double p_light, double p_bsdf) {
   const double d = p_light * p_light + p_bsdf * p_bsdf;
@@ -378,26 +378,32 @@ class GradientPathTracer final : public Integrator {
       Vertex& next_base = scratch.verts[cur ^ 1];
       if (!base.closures.has_bsdf()) break;
 
-      // Offsets arriving at a shared vertex see it from their own direction.
-      for (Offset& o : std::span(off, kOffsets)) {
-        if (!o.active || !o.alive) continue;
-        if (o.link == Link::Recent) {
-          o.wi_shared = base.frame.to_local(o.wi_world);
-        } else if (o.link == Link::NotConnected && !o.v.closures.has_bsdf()) {
-          o.alive = false;  // the offset ends on a surface without BSDF: it cannot follow
-        }
-      }
       const VertexType base_type = classify(base.roughness);
       const ClosureSet& bc = base.closures;
 
-      // ==================== Next-event estimation ====================
-      // Per-pair rule, shared by light sampling here and BSDF-sampled light hits at the next
+      // Offsets arriving at a shared vertex see it from their own direction. `open` counts the
+      // offsets with work of their own at this bounce (alive, not connected); connected and dead
+      // ones are "merged" (add_merged) and once all are, the bounce skips every offset loop.
+      //
+      // Per-pair NEE rule, shared by light sampling here and BSDF-sampled light hits at the next
       // vertex: a not-connected pair shifts light samples only when both vertices are diffuse.
-      // A dead offset leaves the base alone with both of its techniques: light sampling stays on.
-      for (Offset& o : std::span(off, kOffsets))
-        o.nee_on =
-            !o.alive || o.link != Link::NotConnected ||
-            (base_type == VertexType::Diffuse && classify(o.v.roughness) == VertexType::Diffuse);
+      // A dead offset leaves the base alone with both of its techniques: light sampling stays on
+      // (nee_on, as for connected offsets).
+      int open = 0;
+      for (Offset& o : std::span(off, kOffsets)) {
+        o.nee_on = true;
+        if (!o.active || !o.alive || o.link == Link::Connected) continue;
+        if (o.link == Link::Recent) {
+          o.wi_shared = base.frame.to_local(o.wi_world);
+        } else if (!o.v.closures.has_bsdf()) {
+          o.alive = false;  // the offset ends on a surface without BSDF: it cannot follow
+          continue;
+        } else {
+          o.nee_on =
+              base_type == VertexType::Diffuse && classify(o.v.roughness) == VertexType::Diffuse;
+        }
+        ++open;
+      }
       if (has_lights) {
         // Dimensions are indexed, not streamed: skipping an unused one changes no other value
         // (as in the path tracer). Offsets resample with the base's numbers.
@@ -425,10 +431,15 @@ class GradientPathTracer final : public Integrator {
           const Vec3d cb = visible ? mul(mul(fb, fs), ls.radiance) : Vec3d();
           const PathDensities db{pb, ls.pdf, pdf_bsdf};
 
-          // --- Offsets ---
+          // --- Merged offsets (connected or dead) ---
+          if (visible)
+            add_merged(off, fb, pb,
+                       connected_event(mul(Vec3d(fs), ls.radiance), ls.pdf, ls.pdf, pdf_bsdf));
+
+          // --- Open offsets ---
           // First pass: the offsets' light samples; the shadow rays of the not-connected ones
           // start at neighbouring points towards the same light point and go in one packet.
-          enum class NeeCase : uint8_t { Skip, Dead, Shared, NoLight, Shifted };
+          enum class NeeCase : uint8_t { Skip, Shared, NoLight, Shifted };
           NeeCase nc[kOffsets];
           LightSample* lo = scratch.lo;
           double J[kOffsets];
@@ -436,15 +447,10 @@ class GradientPathTracer final : public Integrator {
           Spectrum* fo = scratch.fo;
           Ray* shadow = scratch.shadow;
           bool test[kOffsets] = {false, false, false, false};
-          for (int k = 0; k < kOffsets; ++k) {
+          for (int k = 0; k < kOffsets && open > 0; ++k) {
             const Offset& o = off[k];
             nc[k] = NeeCase::Skip;
-            if (!o.active) continue;
-            if (!o.alive) {
-              nc[k] = NeeCase::Dead;
-              continue;
-            }
-            if (o.link == Link::Connected) continue;  // add_connected below
+            if (!o.active || !o.alive || o.link == Link::Connected) continue;  // merged
             if (o.link != Link::NotConnected) {
               nc[k] = NeeCase::Shared;
               continue;
@@ -474,16 +480,15 @@ class GradientPathTracer final : public Integrator {
             }
           }
           bool blocked[kOffsets];
-          bvh.occluded4(shadow, test, blocked);
+          if (open > 0) bvh.occluded4(shadow, test, blocked);
           // Second pass: contributions and weights.
-          for (int k = 0; k < kOffsets; ++k) {
+          for (int k = 0; k < kOffsets && open > 0; ++k) {
             Offset& o = off[k];
             Vec3d co;
             PathDensities d_off{0.0, 0.0, 0.0};
             switch (nc[k]) {
               case NeeCase::Skip:
                 continue;
-              case NeeCase::Dead:
               case NeeCase::NoLight:
                 break;
               case NeeCase::Shared: {
@@ -510,9 +515,6 @@ class GradientPathTracer final : public Integrator {
             const double w = shift::mis_weight_over_pdf(db, d_off, db.light);
             o.grad = o.grad + (co - cb) * w;
           }
-          if (visible)
-            add_connected(off, fb, pb,
-                          connected_event(mul(Vec3d(fs), ls.radiance), ls.pdf, ls.pdf, pdf_bsdf));
         }
       }
 
@@ -560,16 +562,8 @@ class GradientPathTracer final : public Integrator {
       const Vec3d seg_b = Vec3d(bs.value);
       const float pdf_b = bs.pdf;
       for (Offset& o : std::span(off, kOffsets)) {
-        if (!o.active || !o.alive) continue;
-        if (o.link == Link::Connected) {
-          // The same segment as the base (inlined from shift_segment: the common case).
-          o.shift = Shift::Follow;
-          o.seg_value = seg_b;
-          o.seg_pdf = pdf_b;
-          o.seg_jacobian = 1.0;
-          o.vis_pending = false;
-          continue;
-        }
+        if (open == 0) break;
+        if (!o.active || !o.alive || o.link == Link::Connected) continue;
         if (!lobe_drawn && delta && o.link == Link::NotConnected &&
             o.v.closures.uses_lobe_choice()) {
           u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
@@ -579,11 +573,12 @@ class GradientPathTracer final : public Integrator {
                       out.rays);
       }
       // Reconnection visibility of all offsets in one packet (rays towards the same x_{d+1}).
-      {
+      if (open > 0) {
         Ray* vis = scratch.vis;
         bool test[kOffsets], blocked[kOffsets];
         for (int k = 0; k < kOffsets; ++k) {
-          test[k] = off[k].active && off[k].alive && off[k].vis_pending;
+          test[k] =
+              off[k].active && off[k].alive && off[k].link != Link::Connected && off[k].vis_pending;
           if (test[k]) vis[k] = off[k].vis_ray;
         }
         bvh.occluded4(vis, test, blocked);
@@ -595,8 +590,8 @@ class GradientPathTracer final : public Integrator {
       // Emission events are processed per pair whenever the base OR the offset finds emission:
       // a half-vector offset has its own end vertex and can reach a light the base misses.
 
-      // Connected offsets: the events' common part, applied once after (a)-(c).
-      Vec3d emit_connected;
+      // Merged offsets: the events' common part, applied once after (a)-(c).
+      Vec3d emit_merged;
 
       // (a) analytic lights crossed by the rays (before their surfaces).
       {
@@ -605,9 +600,10 @@ class GradientPathTracer final : public Integrator {
         if (base_lit)
           out.primal += beta * lh.radiance * (delta ? 1.0f : power_heuristic(pdf_b, pl));
         const Vec3d cb = base_lit ? mul(mul(fb, seg_b), lh.radiance) : Vec3d();
-        if (base_lit) emit_connected = connected_event(mul(seg_b, lh.radiance), pdf_b, pl, pdf_b);
+        if (base_lit) emit_merged = connected_event(mul(seg_b, lh.radiance), pdf_b, pl, pdf_b);
         for (Offset& o : std::span(off, kOffsets)) {
-          if (!o.active || (o.alive && o.link == Link::Connected)) continue;
+          if (open == 0) break;
+          if (!o.active || !o.alive || o.link == Link::Connected) continue;
           Vec3d co;
           PathDensities d_off{0.0, 0.0, 0.0};
           const float pl_pair = o.nee_on ? pl : 0.0f;
@@ -659,9 +655,10 @@ class GradientPathTracer final : public Integrator {
         if (!is_black(le)) out.primal += beta * le * (delta ? 1.0f : power_heuristic(pdf_b, pl));
         const Vec3d cb = mul(mul(fb, seg_b), le);
         if (!is_black(le))
-          emit_connected = emit_connected + connected_event(mul(seg_b, le), pdf_b, pl, pdf_b);
+          emit_merged = emit_merged + connected_event(mul(seg_b, le), pdf_b, pl, pdf_b);
         for (Offset& o : std::span(off, kOffsets)) {
-          if (!o.active || (o.alive && o.link == Link::Connected)) continue;
+          if (open == 0) break;
+          if (!o.active || !o.alive || o.link == Link::Connected) continue;
           Vec3d co;
           PathDensities d_off{0.0, 0.0, 0.0};
           const float pl_pair = o.nee_on ? pl : 0.0f;
@@ -673,14 +670,19 @@ class GradientPathTracer final : public Integrator {
         }
       }
 
-      if (!is_zero(emit_connected)) add_connected(off, fb, pb, emit_connected);
+      if (!is_zero(emit_merged)) add_merged(off, fb, pb, emit_merged);
 
       // ==================== Advance ====================
       fb = mul(fb, seg_b);
       pb *= pdf_b;
       for (Offset& o : std::span(off, kOffsets)) {
         if (!o.active || !o.alive) continue;
-        advance(o, next_base);
+        if (o.link == Link::Connected) {  // the base's segment (shift_segment skipped them)
+          o.f = mul(o.f, seg_b);
+          o.p *= pdf_b;
+        } else {
+          advance(o, next_base);
+        }
       }
       if (!found) break;
       cur ^= 1;
@@ -692,17 +694,20 @@ class GradientPathTracer final : public Integrator {
     }
   }
 
-  // Connected offsets share the rest of the base path: for an emission event with base
-  // contribution C = fb Y and offset contribution C' = f' Y the two sides have the same technique
-  // densities, so the pair weight of shift::mis_weight_over_pdf factors into
-  // [p / (p^2 + p'^2)] [p_tech / (p_L^2 + p_B^2)], and w (C' - C) = (f' - fb) p / (p^2 + p'^2) E
-  // with the event part E = connected_event(Y, ...) shared by all offsets (equal up to rounding
-  // to the per-pair evaluation, which the not-yet-connected offsets still use).
-  static void add_connected(Offset* off, Vec3d fb, double pb, Vec3d event) {
+  // Merged offsets: a connected offset shares the rest of the base path, so for an emission
+  // event with base contribution C = fb Y its contribution is C' = f' Y with the same technique
+  // densities, and the pair weight of shift::mis_weight_over_pdf factors into
+  // [p / (p^2 + p'^2)] [p_tech / (p_L^2 + p_B^2)]: w (C' - C) = (f' - fb) p / (p^2 + p'^2) E with
+  // the event part E = connected_event(Y, ...) common to all offsets. A dead offset is the same
+  // with f' = 0 and p' = 0 (it adds -w C, the base keeping both of its techniques). Equal up to
+  // rounding to the per-pair evaluation, which the open offsets still use.
+  static void add_merged(Offset* off, Vec3d fb, double pb, Vec3d event) {
     for (Offset& o : std::span(off, kOffsets)) {
-      if (!o.active || !o.alive || o.link != Link::Connected) continue;
-      const double d = pb * pb + o.p * o.p;
-      if (d > 0.0) o.grad = o.grad + mul(o.f - fb, event) * (pb / d);
+      if (!o.active || (o.alive && o.link != Link::Connected)) continue;
+      const Vec3d f = o.alive ? o.f : Vec3d();
+      const double p = o.alive ? o.p : 0.0;
+      const double d = pb * pb + p * p;
+      if (d > 0.0) o.grad = o.grad + mul(f - fb, event) * (pb / d);
     }
   }
 
