@@ -12,6 +12,7 @@
 #include <tbb/task_arena.h>
 
 #include "reconstruct/dct_solver.h"
+#include "reconstruct/irls_reweight.h"
 #include "reconstruct/parallel.h"
 #include "reconstruct/weighted_cg.h"
 
@@ -30,7 +31,8 @@ constexpr double kL1InitialRegulariser = 0.05;
 constexpr double kL1FinalRegulariser = 0.05 / 524288.0;  // 0.05 / 2^19
 constexpr double kVarianceFloor = 1e-3;                  // variances floored at 1e-3 x their mean
 
-enum TermBits : uint8_t { kPrimal = 1, kDx = 2, kDy = 4, kAll = 7 };
+constexpr uint8_t kPrimal = detail::kPrimalTerm, kDx = detail::kDxTerm, kDy = detail::kDyTerm,
+                  kAll = detail::kAllTerms;
 
 // Inputs with non-finite values replaced by 0, and which terms of each pixel take part.
 struct Prepared {
@@ -311,30 +313,35 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
       } else if (settings.norm == ReconstructionNorm::L1) {
         // IRLS: each reweighting solves  min sum w e^2  with w = s^2 / (s |e| + reg) from the
         // current iterate (s = alpha for the primal term, 1 for gradients), which majorises the
-        // L1 objective.
+        // L1 objective. One pass forms the weights, the Jacobi diagonal and the CG's starting
+        // residual (irls_reweight.h); the buffers live across the reweightings.
         Weights w(n);
+        std::vector<float> inv_diag(n);
+        ws.resize(3 * n);
+        const detail::IrlsData data{W,
+                                    H,
+                                    pr.primal,
+                                    pr.gradient_x,
+                                    pr.gradient_y,
+                                    pr.terms.empty() ? nullptr : pr.terms.data(),
+                                    float(alpha)};
+        const detail::IrlsWeights out{w.w0.data(), w.wx.data(), w.wy.data(), inv_diag.data()};
+        auto pb = make_problem(pr, w);
+        pb.inv_diagonal = inv_diag.data();
         const int K = std::max(1, settings.l1_reweightings);
         const double decay =
             K > 1 ? std::pow(kL1FinalRegulariser / kL1InitialRegulariser, 1.0 / (K - 1)) : 1.0;
         double reg = K > 1 ? kL1InitialRegulariser : kL1FinalRegulariser;
         for (int k = 0; k < K; ++k, reg *= decay) {
-          for_each_term(
-              pr, x.data(),
-              [&](size_t i, uint8_t t, const float* e0, const float* ex, const float* ey) {
-                w.w0[i] = (t & kPrimal) ? float(alpha * alpha / (alpha * norm3(e0) + reg)) : 0.f;
-                w.wx[i] = (t & kDx) ? float(1.0 / (norm3(ex) + reg)) : 0.f;
-                w.wy[i] = (t & kDy) ? float(1.0 / (norm3(ey) + reg)) : 0.f;
-                return 0.0;
-              });
-          auto pb = make_problem(pr, w);
-          const auto inv_diag = detail::jacobi_inverse_diagonal(pb);
-          pb.inv_diagonal = inv_diag.data();
+          const detail::CgStart start =
+              detail::irls_reweight(data, float(reg), x.data(), out, ws.r.data());
           // Inner steps fall linearly from first to last: the early reweightings move the image
           // far from the L2 start, the late ones only refine it (bench_reconstruct --sweep).
           const int first = settings.l1_cg_steps_first, last = settings.l1_cg_steps_last;
           const int steps =
               K > 1 ? int(std::lround(first + double(last - first) * k / (K - 1))) : first;
-          const auto cg = detail::solve_weighted_cg(pb, x.data(), std::max(1, steps), 0.0, ws);
+          const auto cg = detail::solve_weighted_cg_from_residual(pb, x.data(), start,
+                                                                  std::max(1, steps), 0.0, ws);
           rep.iterations += cg.iterations;
           rep.relative_residual = cg.relative_residual;
           progress(float(k + 1) / float(K + 1));

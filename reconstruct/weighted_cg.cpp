@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <vector>
 
 #include "reconstruct/parallel.h"
 
 namespace gdpt::detail {
 
 void CgWorkspace::resize(size_t values) {
+  if (r.size() == values) return;
   r.resize(values);
   p.resize(values);
   p_next.resize(values);
@@ -64,41 +66,87 @@ std::array<double, 9> residual_pass(const WeightedProblem& pb, const float* x, f
   });
 }
 
-// Pass 1 of a CG step: p_next = z + beta p (z = D^-1 r) and q = A p_next; returns <p_next, q>.
+// Search direction v = z + beta p (z = D^-1 r) of the pixels [i0, i0 + W) of one row, into `v`.
+// p == nullptr on the first step (beta = 0): p is not read, so it needs no clearing.
+template <bool kPreconditioned>
+inline void direction_row(const float* dg, const float* r, const float* p,
+                          const std::array<float, 3>& beta, size_t i0, int W, float* v) {
+  if (!p) {
+    for (int x = 0; x < W; ++x) {
+      const float d = precondition<kPreconditioned>(dg, i0 + x);
+      for (int c = 0; c < 3; ++c) v[3 * x + c] = d * r[3 * (i0 + x) + c];
+    }
+    return;
+  }
+  for (int x = 0; x < W; ++x) {
+    const size_t i = i0 + x;
+    const float d = precondition<kPreconditioned>(dg, i);
+    for (int c = 0; c < 3; ++c) v[3 * x + c] = d * r[3 * i + c] + beta[c] * p[3 * i + c];
+  }
+}
+
+// Per-thread rows of v above and below a chunk: those rows belong to the neighbouring chunks,
+// whose threads may be writing them, so each chunk forms its own copy.
+struct HaloRows {
+  std::vector<float> above, below;
+};
+
+HaloRows& halo_rows(int W) {
+  thread_local HaloRows rows;
+  if (rows.above.size() < size_t(3) * W) {
+    rows.above.resize(size_t(3) * W);
+    rows.below.resize(size_t(3) * W);
+  }
+  return rows;
+}
+
+// Pass 1 of a CG step: p_next = z + beta p (z = D^-1 r; p == nullptr on the first step) and
+// q = A p_next; returns <p_next, q>.
 // A v = W0 v + Wx (v - v_right) + Wx_left (v - v_left) + Wy (v - v_down) + Wy_up (v - v_up).
+// Each chunk first writes its rows of p_next (plus private copies of the rows just above and
+// below it), then applies the stencil to them while they are still in cache: v is formed once
+// per value, not once per stencil point.
 template <bool kPreconditioned>
 std::array<double, 3> direction_pass(const WeightedProblem& pb, const float* r, const float* p,
                                      const std::array<float, 3>& beta, float* p_next, float* q) {
   const int W = pb.width, H = pb.height;
   const float* dg = pb.inv_diagonal;
   return parallel_rows_sum<3>(H, [&](int y0, int y1, std::array<double, 3>& s) {
+    HaloRows& halo = halo_rows(W);
+    // --- v for the chunk's rows and the two halo rows.
+    for (int y = y0; y < y1; ++y)
+      direction_row<kPreconditioned>(dg, r, p, beta, size_t(y) * W, W, p_next + 3 * size_t(y) * W);
+    if (y0 > 0)
+      direction_row<kPreconditioned>(dg, r, p, beta, size_t(y0 - 1) * W, W, halo.above.data());
+    if (y1 < H)
+      direction_row<kPreconditioned>(dg, r, p, beta, size_t(y1) * W, W, halo.below.data());
+
+    // --- q = A v row by row. A missing neighbour (image border) has zero weight; the row itself
+    // stands in for it so that every read stays in bounds.
     for (int y = y0; y < y1; ++y) {
       const size_t row = size_t(y) * W;
-      const size_t up = size_t(y > 0 ? y - 1 : y) * W, down = size_t(y < H - 1 ? y + 1 : y) * W;
-      for (int xx = 0; xx < W; ++xx) {
-        const size_t i = row + xx;
-        const size_t ir = row + std::min(xx + 1, W - 1), il = row + std::max(xx - 1, 0);
-        const size_t id = down + xx, iu = up + xx;
-        const float w0 = pb.w0[i], wx = pb.wx[i], wy = pb.wy[i];
-        const float wxl = xx > 0 ? pb.wx[il] : 0.f, wyu = y > 0 ? pb.wy[iu] : 0.f;
-        const float d = precondition<kPreconditioned>(dg, i);
-        const float dr = precondition<kPreconditioned>(dg, ir);
-        const float dl = precondition<kPreconditioned>(dg, il);
-        const float dd = precondition<kPreconditioned>(dg, id);
-        const float du = precondition<kPreconditioned>(dg, iu);
+      const float* vc = p_next + 3 * row;
+      const float* vu = y == 0 ? vc : y == y0 ? halo.above.data() : vc - 3 * size_t(W);
+      const float* vd = y == H - 1 ? vc : y == y1 - 1 ? halo.below.data() : vc + 3 * size_t(W);
+      const float* w0 = pb.w0 + row;
+      const float* wx = pb.wx + row;
+      const float* wy = pb.wy + row;
+      const float* wyu = y > 0 ? pb.wy + row - W : nullptr;
+      float* qr = q + 3 * row;
+      auto pixel = [&](int x, int xl, int xr, float wxl) {
+        const float a0 = w0[x], ax = wx[x], ay = wy[x], ayu = wyu ? wyu[x] : 0.f;
         for (int c = 0; c < 3; ++c) {
-          const float b = beta[c];
-          const float v = d * r[3 * i + c] + b * p[3 * i + c];
-          const float vr = dr * r[3 * ir + c] + b * p[3 * ir + c];
-          const float vl = dl * r[3 * il + c] + b * p[3 * il + c];
-          const float vd = dd * r[3 * id + c] + b * p[3 * id + c];
-          const float vu = du * r[3 * iu + c] + b * p[3 * iu + c];
-          const float av = w0 * v + wx * (v - vr) + wxl * (v - vl) + wy * (v - vd) + wyu * (v - vu);
-          p_next[3 * i + c] = v;
-          q[3 * i + c] = av;
+          const float v = vc[3 * x + c];
+          const float vr = vc[3 * xr + c], vl = vc[3 * xl + c];
+          const float av = a0 * v + ax * (v - vr) + wxl * (v - vl) + ay * (v - vd[3 * x + c]) +
+                           ayu * (v - vu[3 * x + c]);
+          qr[3 * x + c] = av;
           s[c] += double(v) * av;
         }
-      }
+      };
+      pixel(0, 0, std::min(1, W - 1), 0.f);
+      for (int x = 1; x < W - 1; ++x) pixel(x, x - 1, x + 1, wx[x - 1]);
+      if (W > 1) pixel(W - 1, W - 2, W - 1, wx[W - 2]);
     }
   });
 }
@@ -124,18 +172,13 @@ std::array<double, 6> update_pass(const WeightedProblem& pb, const std::array<fl
 }
 
 template <bool kPreconditioned>
-CgResult run_cg(const WeightedProblem& pb, float* x, int max_iterations, double tolerance,
-                CgWorkspace& ws) {
-  const size_t n = size_t(pb.width) * pb.height * 3;
-  ws.resize(n);
-  std::fill(ws.p.begin(), ws.p.end(), 0.f);  // beta = 0 on the first step must not meet garbage
-
-  const auto s = residual_pass<kPreconditioned>(pb, x, ws.r.data());
-  std::array<double, 3> rr = {s[0], s[1], s[2]}, rz = {s[6], s[7], s[8]};
-  const double bb_max = std::max({s[3], s[4], s[5]});
+CgResult run_cg(const WeightedProblem& pb, float* x, const CgStart& start, int max_iterations,
+                double tolerance, CgWorkspace& ws) {
+  std::array<double, 3> rr = start.rr, rz = start.rz;
+  const double bb_max = std::max({start.bb[0], start.bb[1], start.bb[2]});
   // A channel whose b is zero (a black channel) is measured against the brightest channel.
   std::array<double, 3> denom{};
-  for (int c = 0; c < 3; ++c) denom[c] = std::max(s[3 + c], 1e-12 * bb_max);
+  for (int c = 0; c < 3; ++c) denom[c] = std::max(start.bb[c], 1e-12 * bb_max);
 
   CgResult result;
   auto relative = [&] {
@@ -160,8 +203,8 @@ CgResult run_cg(const WeightedProblem& pb, float* x, int max_iterations, double 
     if (it > 0)
       for (int c = 0; c < 3; ++c)
         beta[c] = active[c] && rz_prev[c] > 0 ? float(rz[c] / rz_prev[c]) : 0.f;
-    const auto pq = direction_pass<kPreconditioned>(pb, ws.r.data(), ws.p.data(), beta,
-                                                    ws.p_next.data(), ws.q.data());
+    const auto pq = direction_pass<kPreconditioned>(pb, ws.r.data(), it > 0 ? ws.p.data() : nullptr,
+                                                    beta, ws.p_next.data(), ws.q.data());
     ws.p.swap(ws.p_next);
 
     std::array<float, 3> a{};
@@ -207,8 +250,23 @@ double weighted_relative_residual(const WeightedProblem& problem, const float* x
 
 CgResult solve_weighted_cg(const WeightedProblem& pb, float* x, int max_iterations,
                            double tolerance, CgWorkspace& ws) {
-  return pb.inv_diagonal ? run_cg<true>(pb, x, max_iterations, tolerance, ws)
-                         : run_cg<false>(pb, x, max_iterations, tolerance, ws);
+  ws.resize(size_t(pb.width) * pb.height * 3);
+  const auto s = pb.inv_diagonal ? residual_pass<true>(pb, x, ws.r.data())
+                                 : residual_pass<false>(pb, x, ws.r.data());
+  CgStart start;
+  for (int c = 0; c < 3; ++c) {
+    start.rr[c] = s[c];
+    start.bb[c] = s[3 + c];
+    start.rz[c] = s[6 + c];
+  }
+  return solve_weighted_cg_from_residual(pb, x, start, max_iterations, tolerance, ws);
+}
+
+CgResult solve_weighted_cg_from_residual(const WeightedProblem& pb, float* x, const CgStart& start,
+                                         int max_iterations, double tolerance, CgWorkspace& ws) {
+  ws.resize(size_t(pb.width) * pb.height * 3);
+  return pb.inv_diagonal ? run_cg<true>(pb, x, start, max_iterations, tolerance, ws)
+                         : run_cg<false>(pb, x, start, max_iterations, tolerance, ws);
 }
 
 }  // namespace gdpt::detail

@@ -11,6 +11,7 @@
 //   2. x += a p, r -= a q, with <r, r>.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -34,7 +35,7 @@ std::vector<float> jacobi_inverse_diagonal(const WeightedProblem& problem);
 
 struct CgWorkspace {
   std::vector<float> r, p, p_next, q;
-  void resize(size_t values);
+  void resize(size_t values);  // no-op when already that size
 };
 
 struct CgResult {
@@ -46,6 +47,18 @@ struct CgResult {
 // `max_iterations` steps were taken (tolerance 0: exactly max_iterations steps).
 CgResult solve_weighted_cg(const WeightedProblem& problem, float* x, int max_iterations,
                            double tolerance, CgWorkspace& workspace);
+
+// The sums of a starting residual r = b - A x, per channel: |r_c|^2, |b_c|^2 and <r_c, z_c>
+// (z = D^-1 r; equal to |r_c|^2 for plain CG).
+struct CgStart {
+  std::array<double, 3> rr{}, bb{}, rz{};
+};
+
+// As solve_weighted_cg, for a caller that has already formed r = b - A x in `workspace.r`
+// (resized with workspace.resize) together with its sums, e.g. in the pass that made the weights.
+CgResult solve_weighted_cg_from_residual(const WeightedProblem& problem, float* x,
+                                         const CgStart& start, int max_iterations, double tolerance,
+                                         CgWorkspace& workspace);
 
 // |b - A x| / |b| per channel, maximum over the channels (in double; for tests and reports).
 double weighted_relative_residual(const WeightedProblem& problem, const float* x);
