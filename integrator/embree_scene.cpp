@@ -107,6 +107,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
                       T.m[0][2] * (T.m[1][0] * T.m[2][1] - T.m[1][1] * T.m[2][0]);
     if (!(std::fabs(det) > 0.0f) || !std::isfinite(det)) continue;  // flattened: invisible
     RTCGeometry geom;
+    const Vec3f* world_positions = nullptr;
     if (mesh_scenes_[inst.mesh]) {
       geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
       rtcSetGeometryInstancedScene(geom, mesh_scenes_[inst.mesh]);
@@ -115,6 +116,9 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
       rtcCommitGeometry(geom);
     } else {
       geom = new_triangle_geometry(mesh, &T);
+      // The top-level scene keeps the geometry, hence this buffer, alive.
+      world_positions =
+          static_cast<const Vec3f*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
     }
     const unsigned id = rtcAttachGeometry(top_, geom);
     rtcReleaseGeometry(geom);
@@ -124,6 +128,8 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     d.instance = &inst;
     d.index = uint32_t(i);
     d.to_world = T;
+    d.world_positions = world_positions;
+    d.winding = det < 0.0f ? -1.0f : 1.0f;
     const Transform inv = T.inverse();
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) d.normal_matrix[r][c] = inv.m[c][r];
@@ -267,11 +273,9 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
   const InstanceData& d = instances_[top_id];
   const Mesh& mesh = *d.mesh;
   const uint32_t* idx = &mesh.indices[size_t(primitive) * 3];
-  const Vec3f p0 = mesh.positions[idx[0]], p1 = mesh.positions[idx[1]], p2 = mesh.positions[idx[2]];
   const float w = 1.0f - u - v;
   hit.instance = d.index;
   hit.primitive = primitive;
-  hit.position = d.to_world.point(p0 * w + p1 * u + p2 * v);
 
   auto to_world_normal = [&](Vec3f n) {
     const auto& M = d.normal_matrix;
@@ -280,7 +284,18 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
                  M[2][0] * n.x + M[2][1] * n.y + M[2][2] * n.z);
   };
   // Degenerate triangles have no normal: face the ray so shading stays finite.
-  const Vec3f ng = safe_normalize(to_world_normal(cross(p1 - p0, p2 - p0)), -dir);
+  Vec3f ng;
+  if (d.world_positions) {
+    const Vec3f* P = d.world_positions;
+    const Vec3f p0 = P[idx[0]], p1 = P[idx[1]], p2 = P[idx[2]];
+    hit.position = p0 * w + p1 * u + p2 * v;
+    ng = safe_normalize(cross(p1 - p0, p2 - p0) * d.winding, -dir);
+  } else {
+    const Vec3f* P = mesh.positions.data();
+    const Vec3f p0 = P[idx[0]], p1 = P[idx[1]], p2 = P[idx[2]];
+    hit.position = d.to_world.point(p0 * w + p1 * u + p2 * v);
+    ng = safe_normalize(to_world_normal(cross(p1 - p0, p2 - p0)), -dir);
+  }
   hit.geometric_normal = ng;
   hit.front_facing = dot(dir, ng) < 0.0f;
 

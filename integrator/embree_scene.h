@@ -67,6 +67,11 @@ class EmbreeScene {
     uint32_t index = 0;  // in Scene::instances
     Transform to_world;
     float normal_matrix[3][3];  // inverse transpose of the linear part
+    // Flattened (world-space) meshes: Embree's own vertex buffer, so hits need no transform.
+    const Vec3f* world_positions = nullptr;
+    // -1 for mirroring transforms: a world-space cross product then points against the
+    // transformed object-space normal, whose orientation front_facing is defined by (as Cycles).
+    float winding = 1.0f;
   };
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;

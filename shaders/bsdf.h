@@ -80,6 +80,12 @@ class ClosureSet {
     count_ = 0;
     emission_ = Spectrum(0.0f);
   }
+  // Becomes a copy of `other` (only its live lobes are copied: cheaper than assignment).
+  void assign(const ClosureSet& other) {
+    count_ = other.count_;
+    for (int i = 0; i < count_; ++i) closures_[i] = other.closures_[i];
+    emission_ = other.emission_;
+  }
   // Adds a lobe; weights that are zero are dropped; a full set drops the lobe of least weight.
   void add(const Closure& c);
   void add_emission(Spectrum e) { emission_ += e; }

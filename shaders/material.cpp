@@ -217,6 +217,7 @@ Material::Material() {
   diffuse.roughness = FloatInput(0.0f);
   nodes_.push_back(diffuse);
   root_ = 0;
+  cache_if_constant();
 }
 
 Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
@@ -341,9 +342,26 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
   }
   if (features_ & kFeatureEmission)
     average_emission_ = walk(nodes_, root_, AverageInputs{&means, true}, nullptr);
+  cache_if_constant();
+}
+
+void Material::cache_if_constant() {
+  constant_ = false;
+  if (features_ & kFeatureTextures) return;
+  for (int side = 0; side < 2; ++side) {
+    ClosureSet& set = constant_closures_[side];
+    set.clear();
+    set.add_emission(
+        walk(nodes_, root_, PointInputs{textures_, Vec2f(0.0f, 0.0f), side == 1}, &set));
+  }
+  constant_ = true;
 }
 
 void Material::evaluate(const ShadingContext& ctx, ClosureSet& out) const {
+  if (constant_) {
+    out.assign(constant_closures_[ctx.front_facing ? 1 : 0]);
+    return;
+  }
   out.clear();
   const Spectrum e = walk(nodes_, root_, PointInputs{textures_, ctx.uv, ctx.front_facing}, &out);
   out.add_emission(e);

@@ -36,6 +36,12 @@ class Material {
   uint32_t features() const { return features_; }
 
  private:
+  void cache_if_constant();
+
+  // Materials without textures give the same closures at every hit of a side: evaluated once
+  // at load, indexed by front_facing, and copied per hit instead of walking the tree.
+  bool constant_ = false;
+  ClosureSet constant_closures_[2];
   std::vector<ShaderNode> nodes_;
   int32_t root_ = -1;
   std::span<const Texture> textures_;

@@ -3,7 +3,7 @@
 // diffuse-only scene against the same scene with every feature path forced on.
 //
 // Usage: bench_integrator [seconds_per_case [cases]]   (default 3 s; cases: any of
-// "cornell", "field", "features", default all three)
+// "cornell", "textured", "field", "features", default all four)
 // Each case renders passes of 1 spp at 256x256 until the time budget is used, then reports
 // samples/s = pixels * spp / wall time and rays/s (camera + extension + shadow rays).
 //
@@ -70,6 +70,8 @@ Mesh quad() {
   Mesh m;
   m.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
   m.indices = {0, 1, 2, 0, 2, 3};
+  // Planar UVs, 2x2 repeats over the quad (textured case).
+  for (uint32_t i : m.indices) m.corner_uvs.push_back({m.positions[i].x + 1, m.positions[i].y + 1});
   return m;
 }
 
@@ -145,6 +147,28 @@ Scene cornell_box(int res) {
   s.lights.push_back(area);
   s.world.color = Spectrum(0.0f);
   s.camera = camera_looking_y(-3.9f, 35.0f, res);
+  return s;
+}
+
+// The Cornell box with a 256x256 colour grid (sRGB-decoded, bilinear, repeat) as the base colour
+// of the floor and the back wall: what an image texture costs per sample.
+Scene textured_cornell_box(int res) {
+  Scene s = cornell_box(res);
+  ImageDesc img;
+  img.name = "grid";
+  img.width = img.height = 256;
+  for (int y = 0; y < 256; ++y)
+    for (int x = 0; x < 256; ++x) {
+      const bool line = x % 32 == 0 || y % 32 == 0;
+      const float r = line ? 0.9f : float(x) / 255.0f, g = line ? 0.9f : float(y) / 255.0f;
+      img.rgba.insert(img.rgba.end(), {r * r, g * g, 0.2f, 1.0f});
+    }
+  s.images.push_back(std::move(img));
+  MaterialDesc tex = diffuse(Spectrum(0.8f));
+  tex.nodes[0].color.texture.image = 0;
+  s.materials.push_back(tex);
+  s.instances[0].slot_material = {int32_t(s.materials.size() - 1)};  // floor
+  s.instances[2].slot_material = {int32_t(s.materials.size() - 1)};  // back wall
   return s;
 }
 
@@ -244,16 +268,19 @@ void report(const char* name, int threads, const Result& r) {
 
 int main(int argc, char** argv) {
   const double budget = argc > 1 ? std::atof(argv[1]) : 3.0;
-  const std::string cases = argc > 2 ? argv[2] : "cornell,field,features";
+  const std::string cases = argc > 2 ? argv[2] : "cornell,textured,field,features";
   auto want = [&](const char* c) { return cases.find(c) != std::string::npos; };
   const int res = 256;
   std::printf("bench_integrator: PT, 8 bounces, %dx%d, %.1f s per case\n", res, res, budget);
 
   const Scene cornell = cornell_box(res);
   if (fixed_spp() > 0) {  // instruction-count mode: exact spp, 1 thread
-    for (const char* c : {"cornell", "field"}) {
+    for (const char* c : {"cornell", "textured", "field"}) {
       if (!want(c)) continue;
-      const Scene scene = std::string(c) == "cornell" ? cornell : sphere_field(res);
+      const std::string name = c;
+      const Scene scene = name == "cornell"    ? cornell
+                          : name == "textured" ? textured_cornell_box(res)
+                                               : sphere_field(res);
       RenderSettings st;
       st.mode = RenderSettings::Mode::PT;
       st.samples = fixed_spp();
@@ -277,6 +304,10 @@ int main(int argc, char** argv) {
   }
   if (want("cornell"))
     for (int t : {1, 2}) report("cornell_box", t, run(cornell, t, budget));
+  if (want("textured")) {
+    const Scene textured = textured_cornell_box(res);
+    for (int t : {1, 2}) report("cornell_box_textured", t, run(textured, t, budget));
+  }
 
   if (want("field")) {
     const auto t0 = std::chrono::steady_clock::now();

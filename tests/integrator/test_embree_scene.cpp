@@ -227,5 +227,26 @@ TEST(EmbreeScene, ManyInstancesShareOneMesh) {
   }
 }
 
+TEST(EmbreeScene, MirroringTransformsKeepTheObjectSpaceFrontFace) {
+  // The quad faces +z in object space; mirrored in x its inverse-transpose normal still faces +z
+  // (Cycles keeps the object's orientation for negatively scaled objects), although the world
+  // winding is reversed. Placed once (flattened into world space) and 200 times (instanced).
+  for (int copies : {1, 200}) {
+    Scene scene;
+    scene.meshes.push_back(quad());
+    for (int i = 0; i < copies; ++i) {
+      Instance inst;
+      inst.object_to_world = translate_scale({float(3 * i), 0, 0}, {-1, 1, 1});
+      scene.instances.push_back(inst);
+    }
+    EmbreeScene bvh(scene, 0);
+    SurfaceHit hit;
+    ASSERT_TRUE(bvh.intersect(down(0.3f, 0.2f), hit)) << copies;
+    EXPECT_NEAR(hit.geometric_normal.z, 1.0f, 1e-6f) << copies;
+    EXPECT_TRUE(hit.front_facing) << copies;
+    EXPECT_NEAR(hit.position.x, 0.3f, 1e-6f) << copies;
+  }
+}
+
 }  // namespace
 }  // namespace gdpt
