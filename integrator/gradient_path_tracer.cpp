@@ -416,14 +416,15 @@ class GradientPathTracer final : public Integrator {
           // --- Base ---
           Vec3f wo;
           Spectrum fs(0.0f);
+          float pdf_fs = 0.0f;
           bool visible = false;
           if (local_dir(base, ls.direction, wo)) {
-            fs = bc.eval(base.wi, wo);
+            fs = bc.eval_pdf(base.wi, wo, pdf_fs);
             if (!is_black(fs) && !is_black(ls.radiance))
               visible = !occluded(base.hit.position, base.ng, ls.direction,
                                   ls.is_infinite ? kInf : ls.distance * (1.0f - 1e-4f), out.rays);
           }
-          const float pdf_bsdf = (!ls.is_delta && visible) ? bc.pdf(base.wi, wo) : 0.0f;
+          const float pdf_bsdf = (!ls.is_delta && visible) ? pdf_fs : 0.0f;
           if (visible) {
             const float w = ls.is_delta ? 1.0f : power_heuristic(ls.pdf, pdf_bsdf);
             out.primal += beta * fs * ls.radiance * (w / ls.pdf);
@@ -445,6 +446,7 @@ class GradientPathTracer final : public Integrator {
           double J[kOffsets];
           Vec3f* wo_o = scratch.wo_o;
           Spectrum* fo = scratch.fo;
+          float pdf_fo[kOffsets];
           Ray* shadow = scratch.shadow;
           bool test[kOffsets] = {false, false, false, false};
           for (int k = 0; k < kOffsets && open > 0; ++k) {
@@ -470,7 +472,7 @@ class GradientPathTracer final : public Integrator {
                                                             ls.position, ls.normal, false);
             fo[k] = Spectrum(0.0f);
             if (local_dir(o.v, lo[k].direction, wo_o[k])) {
-              fo[k] = o.v.closures.eval(o.v.wi, wo_o[k]);
+              fo[k] = o.v.closures.eval_pdf(o.v.wi, wo_o[k], pdf_fo[k]);
               if (!is_black(fo[k]) && !is_black(lo[k].radiance)) {
                 test[k] = true;
                 shadow[k] = shadow_ray(o.v.hit.position, o.v.ng, lo[k].direction,
@@ -496,8 +498,8 @@ class GradientPathTracer final : public Integrator {
                 Spectrum f_r(0.0f);
                 float pdf_o = 0.0f;
                 if (wo.z != 0.0f && visible) {
-                  f_r = bc.eval(o.wi_shared, wo);
-                  if (!ls.is_delta) pdf_o = bc.pdf(o.wi_shared, wo);
+                  f_r = bc.eval_pdf(o.wi_shared, wo, pdf_o);
+                  if (ls.is_delta) pdf_o = 0.0f;
                 }
                 co = mul(mul(o.f, f_r), ls.radiance);
                 d_off = shift::offset_densities(o.p, 1.0, ls.pdf, pdf_o);
@@ -505,8 +507,7 @@ class GradientPathTracer final : public Integrator {
               }
               case NeeCase::Shifted: {
                 const bool vis_o = test[k] && !blocked[k];
-                const float pdf_o =
-                    (!ls.is_delta && vis_o) ? o.v.closures.pdf(o.v.wi, wo_o[k]) : 0.0f;
+                const float pdf_o = (!ls.is_delta && vis_o) ? pdf_fo[k] : 0.0f;
                 co = vis_o ? mul(mul(o.f, fo[k]), lo[k].radiance) * J[k] : Vec3d();
                 d_off = shift::offset_densities(o.p, J[k], lo[k].pdf, pdf_o);
                 break;
@@ -734,8 +735,9 @@ class GradientPathTracer final : public Integrator {
           o.shift = Shift::Failed;  // a delta lobe cannot map another wi onto the same wo
           return;
         }
-        o.seg_value = Vec3d(base.closures.eval(o.wi_shared, bs.wo));
-        o.seg_pdf = base.closures.pdf(o.wi_shared, bs.wo);
+        float pdf = 0.0f;
+        o.seg_value = Vec3d(base.closures.eval_pdf(o.wi_shared, bs.wo, pdf));
+        o.seg_pdf = pdf;
         if (!(o.seg_pdf > 0.0)) o.shift = Shift::Failed;
         return;
       }
@@ -770,8 +772,9 @@ class GradientPathTracer final : public Integrator {
         }
         o.shift = Shift::Reconnect;
         o.seg_jacobian = r.jacobian;
-        o.seg_value = Vec3d(y.closures.eval(y.wi, wo));
-        o.seg_pdf = y.closures.pdf(y.wi, wo);
+        float pdf = 0.0f;
+        o.seg_value = Vec3d(y.closures.eval_pdf(y.wi, wo, pdf));
+        o.seg_pdf = pdf;
         // Visibility: traced with the other offsets' rays in one packet (seg_visible).
         o.vis_pending = true;
         o.vis_ray = shadow_ray(y.hit.position, y.ng, dir, float(r.distance) * (1.0f - 1e-4f));
@@ -785,8 +788,9 @@ class GradientPathTracer final : public Integrator {
           return;
         }
         o.shift = Shift::ReconnectEnv;
-        o.seg_value = Vec3d(y.closures.eval(y.wi, wo));
-        o.seg_pdf = y.closures.pdf(y.wi, wo);
+        float pdf = 0.0f;
+        o.seg_value = Vec3d(y.closures.eval_pdf(y.wi, wo, pdf));
+        o.seg_pdf = pdf;
         o.vis_pending = true;
         o.vis_ray = shadow_ray(y.hit.position, y.ng, wo_world, kInf);
         ++rays;
@@ -822,8 +826,9 @@ class GradientPathTracer final : public Integrator {
         return;
       }
       wo = hv.wo.to_float();
-      o.seg_value = Vec3d(y.closures.eval(y.wi, wo));
-      o.seg_pdf = y.closures.pdf(y.wi, wo);
+      float pdf = 0.0f;
+      o.seg_value = Vec3d(y.closures.eval_pdf(y.wi, wo, pdf));
+      o.seg_pdf = pdf;
       o.seg_jacobian = hv.jacobian;
       if (!(o.seg_pdf > 0.0)) {
         o.shift = Shift::Failed;
@@ -873,8 +878,8 @@ class GradientPathTracer final : public Integrator {
       // A sun disc: reconnection at infinity, the same direction and radiance, J = 1.
       Vec3f wo;
       if (!local_dir(y, base_dir, wo)) return;
-      const Spectrum fo = y.closures.eval(y.wi, wo);
-      const float pdf_o = y.closures.pdf(y.wi, wo);
+      float pdf_o = 0.0f;
+      const Spectrum fo = y.closures.eval_pdf(y.wi, wo, pdf_o);
       const bool vis = !occluded(y.hit.position, y.ng, base_dir, kInf, rays);
       co = vis ? mul(mul(o.f, fo), lh.radiance) : Vec3d();
       d_off = shift::offset_densities(o.p, 1.0, pl_pair, vis ? pdf_o : 0.0f);
@@ -893,8 +898,8 @@ class GradientPathTracer final : public Integrator {
     const bool reaches = ctx_.lights().intersect(y.hit.position, dir, d * (1.0f + 1e-3f), lo) &&
                          std::fabs(lo.distance - d) < 1e-3f * d &&
                          length_squared(lo.normal - lh.normal) <= kSameNormal2;
-    const Spectrum fo = y.closures.eval(y.wi, wo);
-    const float pdf_o = y.closures.pdf(y.wi, wo);
+    float pdf_o = 0.0f;
+    const Spectrum fo = y.closures.eval_pdf(y.wi, wo, pdf_o);
     const bool vis = reaches && !occluded(y.hit.position, y.ng, dir, d * (1.0f - 1e-4f), rays);
     co = vis ? mul(mul(o.f, fo), lo.radiance) * r.jacobian : Vec3d();
     // Light sampling from y produces this point only where the light emits towards y (a spot's

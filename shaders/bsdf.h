@@ -97,6 +97,9 @@ class ClosureSet {
 
   Spectrum eval(Vec3f wi, Vec3f wo) const;
   float pdf(Vec3f wi, Vec3f wo) const;
+  // eval() and pdf() of the same directions in one call (same values, one pass over the lobes),
+  // for integrators that need both, e.g. G-PT's shifted vertices.
+  Spectrum eval_pdf(Vec3f wi, Vec3f wo, float& pdf) const;
   // u_lobe picks the lobe (by weight luminance), u the direction within it.
   BsdfSample sample(Vec3f wi, float u_lobe, Vec2f u) const;
   // Whether sample() reads u_lobe at all: only to pick among several lobes or, for a single

@@ -112,6 +112,24 @@ float ClosureSet::pdf(Vec3f wi, Vec3f wo) const {
   return p / total;
 }
 
+Spectrum ClosureSet::eval_pdf(Vec3f wi, Vec3f wo, float& pdf_out) const {
+  if (count_ == 1) {
+    pdf_out = lobe_pdf(closures_[0], wi, wo);
+    return lobe_eval(closures_[0], wi, wo);
+  }
+  // The loops of eval() and pdf() merged, each sum in the same order: identical values.
+  float w[kMaxClosures];
+  const float total = selection_weights(closures_, count_, wi, w);
+  Spectrum f(0.0f);
+  float p = 0.0f;
+  for (int i = 0; i < count_; ++i) {
+    f += lobe_eval(closures_[i], wi, wo);
+    if (w[i] > 0.0f) p += w[i] * lobe_pdf(closures_[i], wi, wo);
+  }
+  pdf_out = total > 0.0f ? p / total : 0.0f;
+  return f;
+}
+
 BsdfSample ClosureSet::sample(Vec3f wi, float u_lobe, Vec2f u) const {
   if (count_ == 0) return {};
   if (count_ == 1) return lobe_sample(closures_[0], wi, u_lobe, u);
