@@ -23,6 +23,7 @@
 # through `_gdpt.reconstruct`, the same C++ code as the engine and the gdpt-reconstruct CLI.
 import os
 import sys
+import textwrap
 
 import bpy
 import nodeitems_utils
@@ -375,12 +376,12 @@ class GDPTReconstructNode(bpy.types.CompositorNodeCustomGroup):
         layout.prop(self, "alpha")
         status = _STATUS.get(self.as_pointer())
         if status is not None:
+            # Wrapped to the node's width: an error message is the whole point of the line.
             level, message = status
             icon = {'ERROR': 'ERROR', 'WARNING': 'INFO'}.get(level, 'NONE')
-            layout.label(text=message, icon=icon)
-
-    def draw_label(self):
-        return self.bl_label
+            col = layout.column(align=True)
+            for i, line in enumerate(textwrap.wrap(message, max(16, int(self.width / 7)))):
+                col.label(text=line, icon=icon if i == 0 else 'BLANK1')
 
 
 class _Category(nodeitems_utils.NodeCategory):
