@@ -66,22 +66,29 @@ std::array<double, 9> residual_pass(const WeightedProblem& pb, const float* x, f
   });
 }
 
+// Pixels are processed in groups of kGroup so that the compiler can vectorise the interleaved
+// RGB values: lane k of a group is channel k % 3 of pixel k / 3. Reductions keep one double
+// accumulator per lane, folded into the channel sums in a fixed order (deterministic).
+constexpr int kGroup = 4, kLanes = 3 * kGroup;
+
 // Search direction v = z + beta p (z = D^-1 r) of the pixels [i0, i0 + W) of one row, into `v`.
 // p == nullptr on the first step (beta = 0): p is not read, so it needs no clearing.
 template <bool kPreconditioned>
 inline void direction_row(const float* dg, const float* r, const float* p,
                           const std::array<float, 3>& beta, size_t i0, int W, float* v) {
-  if (!p) {
-    for (int x = 0; x < W; ++x) {
-      const float d = precondition<kPreconditioned>(dg, i0 + x);
-      for (int c = 0; c < 3; ++c) v[3 * x + c] = d * r[3 * (i0 + x) + c];
-    }
-    return;
+  float b[kLanes];
+  for (int k = 0; k < kLanes; ++k) b[k] = p ? beta[k % 3] : 0.f;
+  const float* rr = r + 3 * i0;
+  const float* pp = p ? p + 3 * i0 : rr;  // read but multiplied by 0 when there is no p
+  int x = 0;
+  for (; x + kGroup <= W; x += kGroup) {
+    float d[kLanes];
+    for (int k = 0; k < kLanes; ++k) d[k] = precondition<kPreconditioned>(dg, i0 + x + k / 3);
+    for (int k = 0; k < kLanes; ++k) v[3 * x + k] = d[k] * rr[3 * x + k] + b[k] * pp[3 * x + k];
   }
-  for (int x = 0; x < W; ++x) {
-    const size_t i = i0 + x;
-    const float d = precondition<kPreconditioned>(dg, i);
-    for (int c = 0; c < 3; ++c) v[3 * x + c] = d * r[3 * i + c] + beta[c] * p[3 * i + c];
+  for (; x < W; ++x) {
+    const float d = precondition<kPreconditioned>(dg, i0 + x);
+    for (int c = 0; c < 3; ++c) v[3 * x + c] = d * rr[3 * x + c] + b[c] * pp[3 * x + c];
   }
 }
 
@@ -89,6 +96,7 @@ inline void direction_row(const float* dg, const float* r, const float* p,
 // whose threads may be writing them, so each chunk forms its own copy.
 struct HaloRows {
   std::vector<float> above, below;
+  std::vector<float> no_weights;  // zeros: the weights above the first row
 };
 
 HaloRows& halo_rows(int W) {
@@ -96,6 +104,7 @@ HaloRows& halo_rows(int W) {
   if (rows.above.size() < size_t(3) * W) {
     rows.above.resize(size_t(3) * W);
     rows.below.resize(size_t(3) * W);
+    rows.no_weights.assign(size_t(W), 0.f);
   }
   return rows;
 }
@@ -123,6 +132,7 @@ std::array<double, 3> direction_pass(const WeightedProblem& pb, const float* r, 
 
     // --- q = A v row by row. A missing neighbour (image border) has zero weight; the row itself
     // stands in for it so that every read stays in bounds.
+    double acc[kLanes] = {};
     for (int y = y0; y < y1; ++y) {
       const size_t row = size_t(y) * W;
       const float* vc = p_next + 3 * row;
@@ -131,23 +141,45 @@ std::array<double, 3> direction_pass(const WeightedProblem& pb, const float* r, 
       const float* w0 = pb.w0 + row;
       const float* wx = pb.wx + row;
       const float* wy = pb.wy + row;
-      const float* wyu = y > 0 ? pb.wy + row - W : nullptr;
+      const float* wyu = y > 0 ? pb.wy + row - W : halo.no_weights.data();
       float* qr = q + 3 * row;
       auto pixel = [&](int x, int xl, int xr, float wxl) {
-        const float a0 = w0[x], ax = wx[x], ay = wy[x], ayu = wyu ? wyu[x] : 0.f;
+        const float a0 = w0[x], ax = wx[x], ay = wy[x], ayu = wyu[x];
         for (int c = 0; c < 3; ++c) {
           const float v = vc[3 * x + c];
           const float vr = vc[3 * xr + c], vl = vc[3 * xl + c];
           const float av = a0 * v + ax * (v - vr) + wxl * (v - vl) + ay * (v - vd[3 * x + c]) +
                            ayu * (v - vu[3 * x + c]);
           qr[3 * x + c] = av;
-          s[c] += double(v) * av;
+          acc[c] += double(v) * av;
         }
       };
       pixel(0, 0, std::min(1, W - 1), 0.f);
-      for (int x = 1; x < W - 1; ++x) pixel(x, x - 1, x + 1, wx[x - 1]);
+      int x = 1;
+      for (; x + kGroup <= W - 1; x += kGroup) {  // interior pixels: both x-neighbours exist
+        float a0[kLanes], ax[kLanes], axl[kLanes], ay[kLanes], ayu[kLanes];
+        for (int k = 0; k < kLanes; ++k) {
+          const int xk = x + k / 3;
+          a0[k] = w0[xk];
+          ax[k] = wx[xk];
+          axl[k] = wx[xk - 1];
+          ay[k] = wy[xk];
+          ayu[k] = wyu[xk];
+        }
+        const float *vg = vc + 3 * x, *vdg = vd + 3 * x, *vug = vu + 3 * x;
+        float* qg = qr + 3 * x;
+        for (int k = 0; k < kLanes; ++k) {
+          const float v = vg[k];
+          const float av = a0[k] * v + ax[k] * (v - vg[k + 3]) + axl[k] * (v - vg[k - 3]) +
+                           ay[k] * (v - vdg[k]) + ayu[k] * (v - vug[k]);
+          qg[k] = av;
+          acc[k] += double(v) * av;
+        }
+      }
+      for (; x < W - 1; ++x) pixel(x, x - 1, x + 1, wx[x - 1]);
       if (W > 1) pixel(W - 1, W - 2, W - 1, wx[W - 2]);
     }
+    for (int k = 0; k < kLanes; ++k) s[k % 3] += acc[k];
   });
 }
 
@@ -156,17 +188,41 @@ template <bool kPreconditioned>
 std::array<double, 6> update_pass(const WeightedProblem& pb, const std::array<float, 3>& a,
                                   const float* p, const float* q, float* x, float* r) {
   const int W = pb.width;
+  float a_lane[kLanes];
+  for (int k = 0; k < kLanes; ++k) a_lane[k] = a[k % 3];
   return parallel_rows_sum<6>(pb.height, [&](int y0, int y1, std::array<double, 6>& s) {
     const size_t begin = size_t(y0) * W, end = size_t(y1) * W;
-    for (size_t i = begin; i < end; ++i) {
+    double rr[kLanes] = {}, rz[kLanes] = {};
+    size_t i = begin;
+    for (; i + kGroup <= end; i += kGroup) {
+      float d[kLanes];
+      for (int k = 0; k < kLanes; ++k)
+        d[k] = precondition<kPreconditioned>(pb.inv_diagonal, i + k / 3);
+      float* xg = x + 3 * i;
+      float* rg = r + 3 * i;
+      const float* pg = p + 3 * i;
+      const float* qg = q + 3 * i;
+      for (int k = 0; k < kLanes; ++k) {
+        xg[k] += a_lane[k] * pg[k];
+        const float ri = rg[k] - a_lane[k] * qg[k];
+        rg[k] = ri;
+        rr[k] += double(ri) * ri;
+        rz[k] += double(ri) * d[k] * ri;
+      }
+    }
+    for (; i < end; ++i) {  // the chunk's last pixels, lanes 0..2
       const float d = precondition<kPreconditioned>(pb.inv_diagonal, i);
       for (int c = 0; c < 3; ++c) {
         x[3 * i + c] += a[c] * p[3 * i + c];
         const float ri = r[3 * i + c] - a[c] * q[3 * i + c];
         r[3 * i + c] = ri;
-        s[c] += double(ri) * ri;
-        s[3 + c] += double(ri) * d * ri;
+        rr[c] += double(ri) * ri;
+        rz[c] += double(ri) * d * ri;
       }
+    }
+    for (int k = 0; k < kLanes; ++k) {
+      s[k % 3] += rr[k];
+      s[3 + k % 3] += rz[k];
     }
   });
 }
