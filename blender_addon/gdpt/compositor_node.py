@@ -315,6 +315,11 @@ def _on_setting(node, context):
     _unshare()  # a copy must not overwrite its original's image
     try:
         reconstruct_node(scene, node, scene.gdpt.threads)
+        # A Python property's update sends no node-tree notifier, and the image's own "edited"
+        # notifier is only matched against top-level nodes: an interface update of the internal
+        # group propagates a change to the scene's tree, whose NC_SCENE | ND_NODES notifier makes
+        # the Compositor re-run with the new image.
+        node.node_tree.interface_update(context)
     except NoCache as e:
         _say(node, 'WARNING', f"{e} (the image was not updated)")
     except InputError as e:

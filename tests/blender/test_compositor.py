@@ -210,11 +210,11 @@ def test_update_from_cache(scene, node, ch):
     check(level == 'WARNING' and "no cached passes" in message and "'Fresh'" in message,
           f"no cache is reported on the node: '{message}'")
     check(np.array_equal(node_pixels(other), image_before), "and its image is left alone")
-    bpy.data.scenes.remove(fresh)
+    fresh.use_nodes = False
 
 
 def test_copy_owns_its_image(scene, node, ch):
-    """A copied node (Scene > Full Copy here; Shift+D alike) gets its own image: tweaking the
+    """A copied node (a scene copy here; Shift+D alike) gets its own image: tweaking the
     copy leaves the original's result alone."""
     from gdpt import compositor_node
     original = node_pixels(node).copy()
@@ -230,7 +230,10 @@ def test_copy_owns_its_image(scene, node, ch):
     check(err < 1e-4, f"the copy solved with its own alpha 0.9 ({err:.2e})")
     check(np.array_equal(node_pixels(node), original), "the original's image is unchanged")
     bpy.context.window.scene = scene
-    bpy.data.scenes.remove(copy_scene)
+    # Kept with its compositor off. (After any scene copy, Blender 3.4 logs "Deleting OB... which
+    # still has 1 users" when the next test clears the objects; seen without the add-on's node
+    # too, harmless.)
+    copy_scene.use_nodes = False
 
 
 def test_two_view_layers(out):
