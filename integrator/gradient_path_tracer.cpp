@@ -605,6 +605,8 @@ class GradientPathTracer final : public Integrator {
         for (Offset& o : std::span(off, kOffsets)) {
           if (open == 0) break;
           if (!o.active || !o.alive || o.link == Link::Connected) continue;
+          // Without a lit base only a half-vector offset's own ray can find a light.
+          if (!base_lit && o.shift != Shift::HalfVector) continue;
           Vec3d co;
           PathDensities d_off{0.0, 0.0, 0.0};
           const float pl_pair = o.nee_on ? pl : 0.0f;
@@ -653,13 +655,17 @@ class GradientPathTracer final : public Integrator {
             pl = lights.pdf_triangle(next.instance, next.primitive, base.hit.position,
                                      next.position, next.geometric_normal);
         }
-        if (!is_black(le)) out.primal += beta * le * (delta ? 1.0f : power_heuristic(pdf_b, pl));
+        const bool base_emits = !is_black(le);
+        if (base_emits) out.primal += beta * le * (delta ? 1.0f : power_heuristic(pdf_b, pl));
         const Vec3d cb = mul(mul(fb, seg_b), le);
-        if (!is_black(le))
+        if (base_emits)
           emit_merged = emit_merged + connected_event(mul(seg_b, le), pdf_b, pl, pdf_b);
         for (Offset& o : std::span(off, kOffsets)) {
           if (open == 0) break;
           if (!o.active || !o.alive || o.link == Link::Connected) continue;
+          // Without emission at the base's end point only a half-vector offset's own end point
+          // can have some (the other shifts end at the same point, seen from the same side).
+          if (!base_emits && o.shift != Shift::HalfVector) continue;
           Vec3d co;
           PathDensities d_off{0.0, 0.0, 0.0};
           const float pl_pair = o.nee_on ? pl : 0.0f;
