@@ -44,7 +44,7 @@ FILM_KEYS = {"Primal": "primal", "Gradient X": "gradient_x", "Gradient Y": "grad
 _CACHE = {}
 # node.as_pointer() -> (level, message): the last outcome, drawn on the node.
 _STATUS = {}
-# Files read for Image-node inputs: (path, layer) -> (mtime, passes dict); one entry per file.
+# The file last read for Image-node inputs: (path, layer) -> (mtime, {pass: (h, w, 3)}).
 _EXR_CACHE = {}
 
 
@@ -167,21 +167,25 @@ def _source(scene, node, name):
                      f"multilayer EXR Image node (reroutes are fine, other nodes are not)")
 
 
-def _read_file(path, layer, passes):
+def _read_file(path, layer, pass_name):
+    """Pass `pass_name` of view layer `layer` of a multilayer EXR. The four passes the node can
+    use are read together and kept until the file changes (one file at a time: these are
+    full-resolution float images)."""
     if not os.path.isfile(path):
         raise InputError(f"the EXR file '{path}' does not exist")
     mtime = os.path.getmtime(path)
-    key = (path, layer)
-    cached = _EXR_CACHE.get(key)
-    if cached is None or cached[0] != mtime or not set(passes) <= set(cached[1]):
+    cached = _EXR_CACHE.get((path, layer))
+    if cached is None or cached[0] != mtime:
         try:
-            data = _module().read_exr_passes(path, layer, sorted(set(passes)))
+            data = _module().read_exr_passes(path, layer, [], list(FILM_KEYS))
         except RuntimeError as e:
             raise InputError(str(e)) from None
-        _EXR_CACHE.clear()  # one file at a time: these are full-resolution float images
+        _EXR_CACHE.clear()
         cached = (mtime, data)
-        _EXR_CACHE[key] = cached
-    return cached[1]
+        _EXR_CACHE[(path, layer)] = cached
+    if pass_name not in cached[1]:
+        raise InputError(f"'{path}' has no pass '{pass_name}' in view layer '{layer}'")
+    return cached[1][pass_name]
 
 
 class NoCache(InputError):
@@ -197,7 +201,7 @@ def _array(source):
                           f"node is solved at the next render (F12); passes are kept in memory "
                           f"for this Blender session only")
         return film[FILM_KEYS[pass_name]]
-    return _read_file(where, layer, [pass_name])[pass_name]
+    return _read_file(where, layer, pass_name)
 
 
 def sources(scene, node):
