@@ -239,6 +239,11 @@ def reconstruct_node(scene, node, threads=0):
 
 # --- the engine's hook and the update callback --------------------------------------------------
 
+def _threads(scene):
+    settings = getattr(scene, "gdpt", None)  # absent while the add-on is disabled
+    return settings.threads if settings is not None else 0
+
+
 def nodes_in(scene, all_trees=False):
     """The Gradient Reconstruct nodes of the scene's compositor (when it is used)."""
     tree = scene.node_tree if scene.use_nodes or all_trees else None
@@ -294,7 +299,7 @@ def _unshare():
             node.node_tree = _new_group(_new_image(width, height))
             seen.add(node.node_tree.as_pointer())
             try:  # same result as the original, when its inputs can be read now
-                reconstruct_node(scene, node, scene.gdpt.threads)
+                reconstruct_node(scene, node, _threads(scene))
             except InputError:
                 pass
 
@@ -318,7 +323,7 @@ def _on_setting(node, context):
         return
     _unshare()  # a copy must not overwrite its original's image
     try:
-        reconstruct_node(scene, node, scene.gdpt.threads)
+        reconstruct_node(scene, node, _threads(scene))
         # A Python property's update sends no node-tree notifier, and the image's own "edited"
         # notifier is only matched against top-level nodes: an interface update of the internal
         # group propagates a change to the scene's tree, whose NC_SCENE | ND_NODES notifier makes
@@ -339,12 +344,43 @@ def _render_pre(scene, _depsgraph=None):
         try:
             srcs = sources(scene, node)
             if all(s[0] == 'FILE' for s in srcs.values()):
-                reconstruct_node(scene, node, scene.gdpt.threads)
+                reconstruct_node(scene, node, _threads(scene))
         except InputError as e:
             _say(node, 'ERROR', str(e))
 
 
 # --- the node -------------------------------------------------------------------------------------
+
+def _current():
+    """This module as loaded now. The node class registered first in a Blender session stays
+    registered across disable / enable / Reload Scripts (see unregister), so its callbacks look
+    the implementation up at call time instead of binding to the module that defined them."""
+    return sys.modules[__name__]
+
+
+def _update_setting(node, context):
+    _current()._on_setting(node, context)
+
+
+def _init_node(node, context):
+    r = context.scene.render if context and context.scene else None
+    size = (r.resolution_x * r.resolution_percentage // 100,
+            r.resolution_y * r.resolution_percentage // 100) if r else (64, 64)
+    node.node_tree = _new_group(_new_image(*size))
+
+
+def _draw_node(node, layout):
+    layout.prop(node, "norm", expand=True)
+    layout.prop(node, "alpha")
+    status = _STATUS.get(node.as_pointer())
+    if status is not None:
+        # Wrapped to the node's width: an error message is the whole point of the line.
+        level, message = status
+        icon = {'ERROR': 'ERROR', 'WARNING': 'INFO'}.get(level, 'NONE')
+        col = layout.column(align=True)
+        for i, line in enumerate(textwrap.wrap(message, max(16, int(node.width / 7)))):
+            col.label(text=line, icon=icon if i == 0 else 'BLANK1')
+
 
 class GDPTReconstructNode(bpy.types.CompositorNodeCustomGroup):
     """Screened Poisson reconstruction of Gradient PT passes: solve(Primal, Gradient X,
@@ -357,40 +393,28 @@ class GDPTReconstructNode(bpy.types.CompositorNodeCustomGroup):
     alpha: FloatProperty(
         name="Alpha", description="Weight of the primal image against the gradients (higher "
         "keeps more of the noisy primal)", default=0.2, min=1e-4, max=100.0, soft_max=2.0,
-        update=_on_setting)
+        update=_update_setting)
     norm: EnumProperty(
         name="Norm",
         items=[('L1', "L1", "Robust iteratively reweighted solve (fewer outliers, slightly "
                 "biased)"),
                ('L2', "L2", "Unbiased screened Poisson solve (exact DCT)")],
-        default='L1', update=_on_setting)
+        default='L1', update=_update_setting)
 
     @classmethod
     def poll(cls, tree):
         return tree.bl_idname == "CompositorNodeTree"
 
     def init(self, context):
-        r = context.scene.render if context and context.scene else None
-        size = (r.resolution_x * r.resolution_percentage // 100,
-                r.resolution_y * r.resolution_percentage // 100) if r else (64, 64)
-        self.node_tree = _new_group(_new_image(*size))
+        _current()._init_node(self, context)
 
     def free(self):
         # The group and image go with the next save / reload once nothing uses them (a copy of
         # the node may still share them); removing datablocks from a free callback is not safe.
-        _STATUS.pop(self.as_pointer(), None)
+        _current()._STATUS.pop(self.as_pointer(), None)
 
     def draw_buttons(self, context, layout):
-        layout.prop(self, "norm", expand=True)
-        layout.prop(self, "alpha")
-        status = _STATUS.get(self.as_pointer())
-        if status is not None:
-            # Wrapped to the node's width: an error message is the whole point of the line.
-            level, message = status
-            icon = {'ERROR': 'ERROR', 'WARNING': 'INFO'}.get(level, 'NONE')
-            col = layout.column(align=True)
-            for i, line in enumerate(textwrap.wrap(message, max(16, int(self.width / 7)))):
-                col.label(text=line, icon=icon if i == 0 else 'BLANK1')
+        _current()._draw_node(self, layout)
 
 
 class _Category(nodeitems_utils.NodeCategory):
@@ -403,24 +427,14 @@ _CATEGORIES = "GDPT_COMPOSITOR_NODES"
 
 
 def register():
-    bpy.utils.register_class(GDPTReconstructNode)
+    # Registered once per Blender session (see unregister).
+    if bpy.types.Node.bl_rna_get_subclass_py(NODE_IDNAME) is None:
+        bpy.utils.register_class(GDPTReconstructNode)
     # Add > Gradient PT > Gradient Reconstruct (and the node search).
     nodeitems_utils.register_node_categories(
         _CATEGORIES, [_Category("GDPT_CMP", "Gradient PT", items=[NodeItem(NODE_IDNAME)])])
     bpy.app.handlers.render_pre.append(_render_pre)
     bpy.app.handlers.depsgraph_update_post.append(_depsgraph_update_post)
-
-
-def _quitting():
-    """True inside Blender's exit sequence (WM_exit calls addon_utils.disable_all, and only
-    there)."""
-    frame = sys._getframe()
-    while frame is not None:
-        if frame.f_code.co_name == "disable_all" and \
-                frame.f_globals.get("__name__") == "addon_utils":
-            return True
-        frame = frame.f_back
-    return False
 
 
 def unregister():
@@ -429,13 +443,12 @@ def unregister():
     if _depsgraph_update_post in bpy.app.handlers.depsgraph_update_post:
         bpy.app.handlers.depsgraph_update_post.remove(_depsgraph_update_post)
     nodeitems_utils.unregister_node_categories(_CATEGORIES)
-    # Blender 3.4 frees an unregistered node type but only retypes the nodes of the main
-    # database: the copies of the scene in the dependency graphs (the view layers', the render
-    # pipeline's) keep pointing at the freed type and crash when Blender frees them after the
-    # add-ons, at quit (exit status 139 after a successful `blender -b ... -f 1`). Blender frees
-    # everything at quit anyway, so the type stays registered then.
-    if not _quitting():
-        bpy.utils.unregister_class(GDPTReconstructNode)
+    # The node class is never unregistered. Blender 3.4 frees an unregistered node type but only
+    # retypes the nodes of the main database: the copies of the scene in the dependency graphs
+    # (the view layers', the render pipeline's) keep pointing at the freed type and crash when
+    # Blender frees them: at quit (exit status 139 after a successful `blender -b ... -f 1`) or
+    # at the next file load after disabling the add-on (both reproduced). So the type lives until
+    # Blender exits; while the add-on is disabled, existing nodes keep their last image.
     _CACHE.clear()
     _EXR_CACHE.clear()
     _STATUS.clear()

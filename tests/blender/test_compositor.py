@@ -15,7 +15,9 @@
 #  - a copied node owns its image (tweaking the copy leaves the original alone);
 #  - two view layers: each node solves the layer its Render Layers node names;
 #  - a multilayer EXR Image node as the source (read through the module's OpenImageIO reader),
-#    also at render time when Blender does not call the engine (no Render Layers node).
+#    also at render time when Blender does not call the engine (no Render Layers node);
+#  - disabling the add-on with the node in a rendered scene, then loading another file, and
+#    quitting: no crash (exit status 0).
 import math
 import os
 import subprocess
@@ -319,6 +321,20 @@ def test_exr_image_node(out, exr_path):
                       f"file ({err:.2e})")
 
 
+def test_disable_with_nodes():
+    """Disabling the add-on while a rendered scene holds the node, then loading another file:
+    Blender 3.4 crashed here (SIGSEGV) when the node type was unregistered, because dependency
+    graph copies of the scene still pointed at the freed type. The test process must survive it
+    and then quit cleanly (the quit path crashed the same way)."""
+    import addon_utils
+    check(any(n.bl_idname == NODE for n in bpy.context.scene.node_tree.nodes),
+          "the current scene holds a Gradient Reconstruct node")
+    bpy.context.evaluated_depsgraph_get()
+    addon_utils.disable("gdpt")
+    bpy.ops.wm.read_factory_settings()
+    check(True, "disabling the add-on and loading another file did not crash Blender")
+
+
 def main():
     a = S.args()
     out = a["out"]
@@ -330,6 +346,7 @@ def main():
     test_two_view_layers(out)
     test_unlinked_inputs(out)
     test_exr_image_node(out, exr_path)
+    test_disable_with_nodes()  # last: it unloads the add-on
     print("ALL COMPOSITOR CHECKS PASSED", flush=True)
 
 
