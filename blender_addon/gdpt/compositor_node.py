@@ -149,22 +149,22 @@ def _source(scene, node, name):
     src, socket = found
     if src.mute:
         raise InputError(f"input '{name}' comes from the muted node '{src.name}'")
+    if src.type not in ('R_LAYERS', 'IMAGE'):
+        raise InputError(f"input '{name}' is linked to '{src.name}' ({src.bl_label}); Gradient "
+                         f"Reconstruct reads passes straight from a Render Layers node or a "
+                         f"multilayer EXR Image node (reroutes are fine, other nodes are not)")
     if socket.name not in FILM_KEYS:
         raise InputError(f"input '{name}' is linked to output '{socket.name}' of '{src.name}'; "
                          f"it must be one of the passes {', '.join(FILM_KEYS)}")
     if src.type == 'R_LAYERS':
         source_scene = src.scene or scene
         return ('LAYER', source_scene.name, src.layer, socket.name)
-    if src.type == 'IMAGE':
-        image = src.image
-        if image is None or image.type != 'MULTILAYER':
-            raise InputError(f"input '{name}': Image node '{src.name}' does not hold a "
-                             f"multilayer EXR")
-        path = bpy.path.abspath(image.filepath, library=image.library)
-        return ('FILE', os.path.normpath(path), src.layer, socket.name)
-    raise InputError(f"input '{name}' is linked to '{src.name}' ({src.bl_label}); Gradient "
-                     f"Reconstruct reads passes straight from a Render Layers node or a "
-                     f"multilayer EXR Image node (reroutes are fine, other nodes are not)")
+    image = src.image  # an Image node
+    if image is None or image.type != 'MULTILAYER':
+        raise InputError(f"input '{name}': Image node '{src.name}' does not hold a multilayer "
+                         f"EXR")
+    path = bpy.path.abspath(image.filepath, library=image.library)
+    return ('FILE', os.path.normpath(path), src.layer, socket.name)
 
 
 def _read_file(path, layer, pass_name):

@@ -286,6 +286,21 @@ def test_unlinked_inputs(out):
     check(np.all(composite == 0.0), "the node outputs black, not a stale image")
     check(layer_rgb(ch, "ViewLayer", "Combined").mean() > 0.05, "the passes were still written")
 
+    # A node between the pass and the input cannot be evaluated by the add-on: said so, by name.
+    from gdpt import compositor_node
+    tree = scene.node_tree
+    rl = tree.nodes["Render Layers"]
+    for name in ("Gradient X", "Gradient Y"):
+        tree.links.new(rl.outputs[name], node.inputs[name])
+    blur = tree.nodes.new("CompositorNodeBlur")
+    blur.name = "My Blur"
+    tree.links.new(rl.outputs["Primal"], blur.inputs["Image"])
+    tree.links.new(blur.outputs["Image"], node.inputs["Primal"])
+    node.alpha = 0.3
+    level, message = compositor_node._STATUS[node.as_pointer()]
+    check(level == 'ERROR' and "'My Blur' (Blur)" in message and "input 'Primal'" in message,
+          f"an input fed through a Blur node is reported: '{message}'")
+
 
 def test_exr_image_node(out, exr_path):
     """A multilayer EXR loaded in an Image node feeds the node (no render needed to tweak it)."""
