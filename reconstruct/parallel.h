@@ -60,6 +60,8 @@ void parallel_rows(int height, const Body& body) {
 
 // Deterministic reduction of N doubles: body(y_begin, y_end, std::array<double, N>& sums) adds
 // its chunk's contribution to `sums` (zeroed per chunk); the chunk sums are then added in order.
+// The body accumulates into a local array, stored once per chunk: neighbouring entries of
+// `partial` share cache lines and belong to chunks of different threads (false sharing).
 template <int N, class Body>
 std::array<double, N> parallel_rows_sum(int height, const Body& body) {
   const int chunks = chunk_count(height);
@@ -67,8 +69,9 @@ std::array<double, N> parallel_rows_sum(int height, const Body& body) {
   tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& r) {
     const FlushDenormals ftz;
     for (int c = r.begin(); c != r.end(); ++c) {
-      partial[c].fill(0.0);
-      body(c * kRowsPerChunk, std::min(height, (c + 1) * kRowsPerChunk), partial[c]);
+      std::array<double, N> sums{};
+      body(c * kRowsPerChunk, std::min(height, (c + 1) * kRowsPerChunk), sums);
+      partial[c] = sums;
     }
   });
   std::array<double, N> total{};
