@@ -281,6 +281,38 @@ TEST(GradientHardCases, GlassWithTotalInternalReflection) {
   expect_hard_case("rough-glass-tir", rough);
 }
 
+// Materials whose closure set mixes a delta lobe with rough ones: the base picks one lobe per
+// vertex and the offset must follow the same discrete choice (a delta event copied as delta, a
+// rough one shifted as such), with the lobe-selection probabilities of each side in its density.
+MaterialDesc mix_of(MaterialDesc a, MaterialDesc b, float fac) {
+  MaterialDesc m;
+  m.nodes = a.nodes;
+  m.nodes.push_back(b.nodes[0]);
+  ShaderNode mix;
+  mix.kind = ShaderNodeKind::Mix;
+  mix.fac = FloatInput(fac);
+  mix.a = 0;
+  mix.b = 1;
+  m.nodes.push_back(mix);
+  m.root = 2;
+  return m;
+}
+
+TEST(GradientUnbiased, MultiLobeMaterialsWithADeltaLobe) {
+  Scene diffuse_glass = make_scene(SceneKind::CornellDiffuse, 16);
+  diffuse_glass.materials[3] = mix_of(diffuse({0.5f, 0.5f, 0.8f}), glass(0.0f), 0.5f);
+  expect_unbiased("mix-diffuse-smooth-glass", diffuse_glass, 4096, 512);
+  Scene diffuse_mirror = make_scene(SceneKind::CornellDiffuse, 16);
+  diffuse_mirror.materials[3] =
+      mix_of(diffuse({0.5f, 0.5f, 0.8f}), glossy({0.9f, 0.9f, 0.9f}, 0.0f), 0.5f);
+  expect_unbiased("mix-diffuse-mirror", diffuse_mirror, 4096, 512);
+  // Principled v1 with half transmission at roughness 0: diffuse, specular and smooth glass.
+  Scene principled = make_scene(SceneKind::CornellDiffuse, 16);
+  principled.materials[3] = single_node(ShaderNodeKind::Principled, {0.8f, 0.6f, 0.5f}, 0.0f);
+  principled.materials[3].nodes[0].transmission = FloatInput(0.5f);
+  expect_unbiased("principled-transmission", principled, 4096, 512);
+}
+
 TEST(GradientIntegrator, DeterministicAcrossThreadCounts) {
   const Scene scene = make_scene(SceneKind::CornellGlossy, 24, 0.02f);
   const Passes a = render(scene, settings(RenderSettings::Mode::GPT, 8, 3, 1));
