@@ -25,15 +25,6 @@ using namespace gdpt::gradient_test;
 
 namespace {
 
-double rel_mse(const std::vector<float>& a, const std::vector<float>& ref) {
-  double s = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    const double d = double(a[i]) - ref[i];
-    s += d * d / (double(ref[i]) * ref[i] + 1e-2);
-  }
-  return s / double(a.size());
-}
-
 double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -56,17 +47,7 @@ Timed render_for(const Scene& scene, RenderSettings::Mode mode, double budget, i
   Timed t;
   t.seconds = now() - t0;
   t.spp = session.film().min_samples();
-  const Film& f = session.film();
-  Passes& p = t.passes;
-  p.w = f.width();
-  p.h = f.height();
-  const size_t n = f.pixel_count();
-  p.primal.resize(n * 3);
-  p.dx.resize(n * 3);
-  p.dy.resize(n * 3);
-  f.primal_rgb(p.primal.data());
-  f.gradient_x_rgb(p.dx.data());
-  f.gradient_y_rgb(p.dy.data());
+  t.passes = read_film(session.film());
   return t;
 }
 

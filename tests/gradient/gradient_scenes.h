@@ -201,11 +201,8 @@ inline RenderSettings settings(RenderSettings::Mode mode, int spp, uint32_t seed
   return s;
 }
 
-inline Passes render(const Scene& scene, const RenderSettings& s) {
-  RenderSession session(scene, s);
-  std::atomic<bool> cancel{false};
-  session.render(nullptr, cancel);
-  const Film& f = session.film();
+// Every pass of a film, in the RGB / per-pixel layouts above.
+inline Passes read_film(const Film& f) {
   Passes p;
   p.w = f.width();
   p.h = f.height();
@@ -223,6 +220,23 @@ inline Passes render(const Scene& scene, const RenderSettings& s) {
   f.variance3(p.variance.data());
   f.shift_failures(p.failures.data());
   return p;
+}
+
+inline Passes render(const Scene& scene, const RenderSettings& s) {
+  RenderSession session(scene, s);
+  std::atomic<bool> cancel{false};
+  session.render(nullptr, cancel);
+  return read_film(session.film());
+}
+
+// Relative MSE of the G-PT papers: mean over pixels and channels of (a - ref)^2 / (ref^2 + 0.01).
+inline double rel_mse(const std::vector<float>& a, const std::vector<float>& ref) {
+  double s = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const double d = double(a[i]) - ref[i];
+    s += d * d / (double(ref[i]) * ref[i] + 1e-2);
+  }
+  return s / double(a.size());
 }
 
 }  // namespace gdpt::gradient_test

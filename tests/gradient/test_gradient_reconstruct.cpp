@@ -13,16 +13,6 @@
 namespace gdpt::gradient_test {
 namespace {
 
-// mean over pixels and channels of (a - b)^2 / (b^2 + 1e-2)
-double rel_mse(const std::vector<float>& a, const std::vector<float>& b) {
-  double s = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    const double d = double(a[i]) - b[i];
-    s += d * d / (double(b[i]) * b[i] + 1e-2);
-  }
-  return s / double(a.size());
-}
-
 TEST(GradientReconstruct, L2ConvergesToPathTracedReference) {
   const Scene scene = make_scene(SceneKind::CornellDiffuse, 16);
   const Passes ref = render(scene, settings(RenderSettings::Mode::PT, 8192, 21));
