@@ -133,6 +133,21 @@ struct SampleResult {
   uint32_t rays = 0;
 };
 
+// The base's segment x_d -> x_{d+1} as the offsets' shift_segment() calls see it.
+struct BaseStep {
+  const Vertex* base;
+  const BsdfSample* bs;
+  VertexType xd_type, next_type;
+  Vec3f wo_world;
+  bool found;
+  const SurfaceHit* next;
+  float u_lobe;
+  Vec2f u_dir;
+  // Reconnection target x_{d+1} (when found): its base side, and the side the base arrives on.
+  shift::ReconnectionBase target;
+  bool base_front;
+};
+
 // Per-thread working storage of trace(), reused across samples: no allocation or large
 // initialisation per sample (a ClosureSet holds kMaxClosures lobes). The per-offset arrays of the
 // packets live here too: as locals their default member initialisers ran on every bounce.
@@ -449,6 +464,8 @@ class GradientPathTracer final : public Integrator {
           float pdf_fo[kOffsets];
           Ray* shadow = scratch.shadow;
           bool test[kOffsets] = {false, false, false, false};
+          shift::ReconnectionBase light_base;  // the shared light point's base side, on demand
+          bool light_base_set = false;
           for (int k = 0; k < kOffsets && open > 0; ++k) {
             const Offset& o = off[k];
             nc[k] = NeeCase::Skip;
@@ -466,10 +483,13 @@ class GradientPathTracer final : public Integrator {
               continue;
             }
             nc[k] = NeeCase::Shifted;
+            if (!light_base_set && !ls.is_delta && !ls.is_infinite) {
+              light_base = shift::reconnection_base(base.hit.position, ls.position, ls.normal);
+              light_base_set = true;
+            }
             J[k] = ls.is_delta || ls.is_infinite
                        ? 1.0
-                       : shift::light_reconnection_jacobian(base.hit.position, o.v.hit.position,
-                                                            ls.position, ls.normal, false);
+                       : shift::light_reconnection_jacobian(light_base, o.v.hit.position);
             fo[k] = Spectrum(0.0f);
             if (local_dir(o.v, lo[k].direction, wo_o[k])) {
               fo[k] = o.v.closures.eval_pdf(o.v.wi, wo_o[k], pdf_fo[k]);
@@ -523,7 +543,7 @@ class GradientPathTracer final : public Integrator {
       // The lobe number is drawn when the base's closures read it, or below when a delta shift
       // samples an offset's closures that do.
       bool lobe_drawn = bc.uses_lobe_choice();
-      float u_lobe =
+      const float u_lobe =
           lobe_drawn ? sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe)) : 0.0f;
       const Vec2f u_dir = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kBsdfDir));
       const BsdfSample bs = bc.sample(base.wi, u_lobe, u_dir);
@@ -562,16 +582,24 @@ class GradientPathTracer final : public Integrator {
       // --- Shift every offset over this segment ---
       const Vec3d seg_b = Vec3d(bs.value);
       const float pdf_b = bs.pdf;
+      BaseStep st;
+      if (open > 0) {
+        st = {&base, &bs, xd_type, next_type, wo_world, found, &next, u_lobe, u_dir, {}, false};
+        if (found) {
+          st.target =
+              shift::reconnection_base(base.hit.position, next.position, next.geometric_normal);
+          st.base_front = dot(base.hit.position - next.position, next.geometric_normal) > 0;
+        }
+      }
       for (Offset& o : std::span(off, kOffsets)) {
         if (open == 0) break;
         if (!o.active || !o.alive || o.link == Link::Connected) continue;
         if (!lobe_drawn && delta && o.link == Link::NotConnected &&
             o.v.closures.uses_lobe_choice()) {
-          u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
+          st.u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
           lobe_drawn = true;
         }
-        shift_segment(o, base, bs, xd_type, wo_world, found, next, next_type, u_lobe, u_dir,
-                      out.rays);
+        shift_segment(o, st, out.rays);
       }
       // Reconnection visibility of all offsets in one packet (rays towards the same x_{d+1}).
       if (open > 0) {
@@ -719,10 +747,16 @@ class GradientPathTracer final : public Integrator {
   }
 
   // Decides and evaluates the offset's version of the base segment x_d -> x_{d+1}.
-  void shift_segment(Offset& o, const Vertex& base, const BsdfSample& bs, VertexType xd_type,
-                     Vec3f wo_world, bool found, const SurfaceHit& next, VertexType next_type,
-                     float u_lobe, Vec2f u_dir, uint32_t& rays) const {
+  void shift_segment(Offset& o, const BaseStep& st, uint32_t& rays) const {
     const EmbreeScene& bvh = ctx_.bvh();
+    const Vertex& base = *st.base;
+    const BsdfSample& bs = *st.bs;
+    const VertexType xd_type = st.xd_type, next_type = st.next_type;
+    const Vec3f wo_world = st.wo_world;
+    const bool found = st.found;
+    const SurfaceHit& next = *st.next;
+    const float u_lobe = st.u_lobe;
+    const Vec2f u_dir = st.u_dir;
     o.seg_jacobian = 1.0;
     o.seg_visible = true;
     o.vis_pending = false;
@@ -759,8 +793,7 @@ class GradientPathTracer final : public Integrator {
     if (xd_type == VertexType::Diffuse && yd_type == VertexType::Diffuse &&
         next_type == VertexType::Diffuse) {
       if (found) {
-        const shift::Reconnection r = shift::reconnect(base.hit.position, y.hit.position,
-                                                       next.position, next.geometric_normal);
+        const shift::Reconnection r = shift::reconnect(st.target, y.hit.position);
         if (!r.valid) {
           o.shift = Shift::Failed;
           return;
@@ -769,10 +802,9 @@ class GradientPathTracer final : public Integrator {
         o.seg_dir = dir;
         // The offset must arrive on the same side of x_{d+1} as the base (the closures there
         // depend on the side).
-        const bool base_front = dot(base.hit.position - next.position, next.geometric_normal) > 0;
         const bool off_front = dot(y.hit.position - next.position, next.geometric_normal) > 0;
         Vec3f wo;
-        if (base_front != off_front || !local_dir(y, dir, wo)) {
+        if (st.base_front != off_front || !local_dir(y, dir, wo)) {
           o.shift = Shift::Failed;
           return;
         }

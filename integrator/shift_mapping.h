@@ -85,23 +85,41 @@ struct Reconnection {
   bool valid = false;  // false on degenerate geometry (coincident points, grazing target)
 };
 
-inline Reconnection reconnect(Vec3f base_source, Vec3f offset_source, Vec3f target,
-                              Vec3f target_normal) {
+// The base's side of a reconnection (source x_i, target x_{i+1} and its normal): the same for the
+// four offsets of a path, computed once.
+struct ReconnectionBase {
+  Vec3d target, normal;
+  double base_d2 = 0.0;   // |x_i - x_{i+1}|^2
+  double base_cos = 0.0;  // |cos theta| at the target, 0 when base_d2 is not positive
+};
+
+inline ReconnectionBase reconnection_base(Vec3f base_source, Vec3f target, Vec3f target_normal) {
+  ReconnectionBase b;
+  b.target = Vec3d(target);
+  b.normal = Vec3d(target_normal);
+  const Vec3d base_edge = Vec3d(base_source) - b.target;
+  b.base_d2 = length_squared(base_edge);
+  if (b.base_d2 > 0.0) b.base_cos = std::fabs(dot(base_edge, b.normal)) / std::sqrt(b.base_d2);
+  return b;
+}
+
+inline Reconnection reconnect(const ReconnectionBase& b, Vec3f offset_source) {
   Reconnection r;
-  const Vec3d t(target), n(target_normal);
-  const Vec3d base_edge = Vec3d(base_source) - t;
-  const Vec3d offset_edge = Vec3d(offset_source) - t;
-  const double base_d2 = length_squared(base_edge);
+  const Vec3d offset_edge = Vec3d(offset_source) - b.target;
   const double offset_d2 = length_squared(offset_edge);
-  if (!(base_d2 > 0.0) || !(offset_d2 > 0.0)) return r;
-  const double base_cos = std::fabs(dot(base_edge, n)) / std::sqrt(base_d2);
-  const double offset_cos = std::fabs(dot(offset_edge, n)) / std::sqrt(offset_d2);
-  if (!(base_cos > 0.0)) return r;
+  if (!(b.base_d2 > 0.0) || !(offset_d2 > 0.0)) return r;
+  const double offset_cos = std::fabs(dot(offset_edge, b.normal)) / std::sqrt(offset_d2);
+  if (!(b.base_cos > 0.0)) return r;
   r.distance = std::sqrt(offset_d2);
   r.direction = -offset_edge / r.distance;
-  r.jacobian = (offset_cos * base_d2) / (base_cos * offset_d2);
+  r.jacobian = (offset_cos * b.base_d2) / (b.base_cos * offset_d2);
   r.valid = std::isfinite(r.jacobian);
   return r;
+}
+
+inline Reconnection reconnect(Vec3f base_source, Vec3f offset_source, Vec3f target,
+                              Vec3f target_normal) {
+  return reconnect(reconnection_base(base_source, target, target_normal), offset_source);
 }
 
 // Light reconnection for next-event estimation. A point-like light (zero normal) has no surface:
@@ -113,6 +131,11 @@ inline double light_reconnection_jacobian(Vec3f base_source, Vec3f offset_source
                                           bool point_like_or_infinite) {
   if (point_like_or_infinite) return 1.0;
   const Reconnection r = reconnect(base_source, offset_source, light_position, light_normal);
+  return r.valid ? r.jacobian : 0.0;
+}
+// The same for a surface light point whose base side is already computed.
+inline double light_reconnection_jacobian(const ReconnectionBase& b, Vec3f offset_source) {
+  const Reconnection r = reconnect(b, offset_source);
   return r.valid ? r.jacobian : 0.0;
 }
 
