@@ -13,6 +13,13 @@ import exr  # noqa: E402
 WIDTH, HEIGHT = 64, 48
 
 
+def check(cond, message):
+    """Test assertion that also logs what passed (the test's output lists every check)."""
+    if not cond:
+        raise AssertionError(message)
+    print("ok:", message, flush=True)
+
+
 def args():
     """Arguments after `--` as a dict: --out DIR --build DIR ..."""
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []

@@ -30,14 +30,10 @@ sys.path.insert(0, os.path.dirname(__file__))
 import exr  # noqa: E402
 import scenes as S  # noqa: E402
 
+check = S.check
+
 SAMPLES = 16
 NODE = "CompositorNodeGDPTReconstruct"
-
-
-def check(cond, message):
-    if not cond:
-        raise AssertionError(message)
-    print("ok:", message, flush=True)
 
 
 def build(scene):

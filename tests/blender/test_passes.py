@@ -23,6 +23,8 @@ sys.path.insert(0, os.path.dirname(__file__))
 import exr  # noqa: E402
 import scenes as S  # noqa: E402
 
+check = S.check
+
 PASSES = {"Combined": "RGBA", "Primal": "RGB", "Gradient X": "RGB", "Gradient Y": "RGB",
           "Emission": "RGB", "Variance": "XYZ", "Shift Failures": "X"}
 PANEL_RADIANCE = np.array([1.0, 0.9, 0.8]) * 5.0
@@ -43,12 +45,6 @@ def build(scene):
     coll.objects.link(ball)
     second = scene.view_layers.new("Second")
     second.layer_collection.children["Sphere"].exclude = True
-
-
-def check(cond, message):
-    if not cond:
-        raise AssertionError(message)
-    print("ok:", message, flush=True)
 
 
 def main():

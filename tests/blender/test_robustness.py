@@ -15,11 +15,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(__file__))
 import scenes as S  # noqa: E402
 
-
-def check(cond, message):
-    if not cond:
-        raise AssertionError(message)
-    print("ok:", message, flush=True)
+check = S.check
 
 
 def basic_scene(scene):
