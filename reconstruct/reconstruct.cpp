@@ -333,8 +333,9 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
             K > 1 ? std::pow(kL1FinalRegulariser / kL1InitialRegulariser, 1.0 / (K - 1)) : 1.0;
         double reg = K > 1 ? kL1InitialRegulariser : kL1FinalRegulariser;
         for (int k = 0; k < K; ++k, reg *= decay) {
+          // |b| only for the last solve, whose exit residual is reported.
           const detail::CgStart start =
-              detail::irls_reweight(data, float(reg), x.data(), out, ws.r.data());
+              detail::irls_reweight(data, float(reg), x.data(), out, ws.r.data(), k == K - 1);
           // Inner steps fall linearly from first to last: the early reweightings move the image
           // far from the L2 start, the late ones only refine it (bench_reconstruct --sweep).
           const int first = settings.l1_cg_steps_first, last = settings.l1_cg_steps_last;
