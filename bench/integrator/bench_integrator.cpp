@@ -3,7 +3,8 @@
 // diffuse-only scene against the same scene with every feature path forced on.
 //
 // Usage: bench_integrator [seconds_per_case [cases]]   (default 3 s; cases: any of
-// "cornell", "textured", "field", "features", default all four)
+// "cornell", "textured", "field", "features", "blender", default all five; "blender" is
+// compare_cycles.py's Cornell box with its 4 bounces, at 256x192)
 // Each case renders passes of 1 spp at 256x256 until the time budget is used, then reports
 // samples/s = pixels * spp / wall time and rays/s (camera + extension + shadow rays).
 //
@@ -218,6 +219,106 @@ Scene sphere_field(int res) {
   return s;
 }
 
+// The Cornell-box scene of bench/blender/compare_cycles.py rebuilt in C++ (its GDPT-vs-Cycles
+// comparison runs max_bounces 4): a 4 m open-front room (white 0.7, red and green walls), a
+// diffuse and a GGX glossy (roughness 0.3) smooth-shaded UV sphere of 48 x 24 segments, a 1 m
+// 150 W square area light under the ceiling. Profiling it here shows what the Blender bench's
+// samples cost without Blender around them.
+Mesh uv_sphere(float radius, int segments, int rings) {
+  Mesh m;
+  for (int i = 0; i <= rings; ++i) {
+    const float th = kPi * float(i) / float(rings);
+    for (int j = 0; j < segments; ++j) {
+      const float ph = 2.0f * kPi * float(j) / float(segments);
+      m.positions.push_back(
+          Vec3f(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)) * radius);
+    }
+  }
+  // Blender's quads (a, b, b + seg, a + seg) split along a - (b + seg), with smooth corner normals.
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const uint32_t a = uint32_t(i * segments + j),
+                     b = uint32_t(i * segments + (j + 1) % segments);
+      const uint32_t c = b + uint32_t(segments), d = a + uint32_t(segments);
+      for (uint32_t v : {a, b, c, a, c, d}) {
+        m.indices.push_back(v);
+        m.corner_normals.push_back(normalize(m.positions[v]));
+      }
+    }
+  return m;
+}
+
+Transform rotation_x(float angle, Vec3f t) {
+  Transform T = affine(1, 1, 1, 0, t);
+  T.m[1][1] = std::cos(angle);
+  T.m[1][2] = -std::sin(angle);
+  T.m[2][1] = std::sin(angle);
+  T.m[2][2] = std::cos(angle);
+  return T;
+}
+
+Transform rotation_y(float angle, Vec3f t) {
+  Transform T = affine(1, 1, 1, 0, t);
+  T.m[0][0] = std::cos(angle);
+  T.m[0][2] = std::sin(angle);
+  T.m[2][0] = -std::sin(angle);
+  T.m[2][2] = std::cos(angle);
+  return T;
+}
+
+Scene blender_cornell(int width, int height) {
+  Scene s;
+  MaterialDesc glossy;
+  ShaderNode g;
+  g.kind = ShaderNodeKind::Glossy;
+  g.color = ColorInput(Spectrum(0.9f));
+  g.roughness = FloatInput(0.3f);
+  glossy.nodes.push_back(g);
+  glossy.root = 0;
+  s.materials = {diffuse(Spectrum(0.7f)), diffuse({0.7f, 0.2f, 0.2f}), diffuse({0.2f, 0.6f, 0.2f}),
+                 diffuse(Spectrum(0.8f)), glossy};
+  auto wall = [&](int mat, Transform t) {
+    Mesh q = quad();
+    for (Vec3f& p : q.positions) p = p * 2.0f;  // 4 m
+    s.meshes.push_back(std::move(q));
+    s.instances.push_back(place(uint32_t(s.meshes.size() - 1), mat, t));
+  };
+  wall(0, affine(1, 1, 1, 0, {0, 0, 0}));    // floor
+  wall(0, rotation_x(kPi, {0, 0, 4}));       // ceiling
+  wall(0, rotation_x(kPi / 2, {0, 2, 2}));   // back
+  wall(1, rotation_y(kPi / 2, {-2, 0, 2}));  // left (red)
+  wall(2, rotation_y(-kPi / 2, {2, 0, 2}));  // right (green)
+  s.meshes.push_back(uv_sphere(0.7f, 48, 24));
+  s.instances.push_back(
+      place(uint32_t(s.meshes.size() - 1), 3, affine(1, 1, 1, 0, {-0.8f, 0.2f, 0.7f})));
+  s.meshes.push_back(uv_sphere(0.7f, 48, 24));
+  s.instances.push_back(
+      place(uint32_t(s.meshes.size() - 1), 4, affine(1, 1, 1, 0, {0.8f, 0.6f, 0.7f})));
+  Light area;
+  area.type = Light::Type::Area;
+  area.size_x = area.size_y = 1.0f;
+  area.power = 150.0f;
+  area.light_to_world.m[2][3] = 3.95f;  // emits along local -Z: down
+  s.lights.push_back(area);
+  s.world.color = Spectrum(0.0f);
+  // Camera at (0, -5.5, 2) looking at (0, 0, 1.7), Y up (Blender's to_track_quat('-Z', 'Y')).
+  const Vec3f z = normalize(Vec3f(0.0f, -5.5f, 0.3f)), x(1, 0, 0), y = cross(z, x);
+  Camera c;
+  for (int r = 0; r < 3; ++r) {
+    c.camera_to_world.m[r][0] = x[r];
+    c.camera_to_world.m[r][1] = y[r];
+    c.camera_to_world.m[r][2] = z[r];
+  }
+  c.camera_to_world.m[0][3] = 0.0f;
+  c.camera_to_world.m[1][3] = -5.5f;
+  c.camera_to_world.m[2][3] = 2.0f;
+  c.focal_length_mm = 30.0f;
+  c.width = width;
+  c.height = height;
+  s.camera = c;
+  return s;
+}
+
 struct Result {
   double samples_per_s = 0, rays_per_s = 0, rays_per_sample = 0, seconds = 0;
   double samples_per_cpu_s = 0;  // per second of process CPU time: robust on a loaded machine
@@ -229,12 +330,13 @@ int fixed_spp() {
   return e ? std::atoi(e) : 0;
 }
 
-Result run(const Scene& scene, int threads, double budget, bool force_all = false) {
+Result run(const Scene& scene, int threads, double budget, bool force_all = false,
+           int bounces = 8) {
   RenderSettings st;
   st.mode = RenderSettings::Mode::PT;
   st.samples = 1 << 20;
   st.time_limit = budget;
-  st.max_bounces = 8;
+  st.max_bounces = bounces;
   st.threads = threads;
   st.force_all_features = force_all;
   RenderSession session(scene, st);
@@ -268,23 +370,24 @@ void report(const char* name, int threads, const Result& r) {
 
 int main(int argc, char** argv) {
   const double budget = argc > 1 ? std::atof(argv[1]) : 3.0;
-  const std::string cases = argc > 2 ? argv[2] : "cornell,textured,field,features";
+  const std::string cases = argc > 2 ? argv[2] : "cornell,textured,field,features,blender";
   auto want = [&](const char* c) { return cases.find(c) != std::string::npos; };
   const int res = 256;
   std::printf("bench_integrator: PT, 8 bounces, %dx%d, %.1f s per case\n", res, res, budget);
 
   const Scene cornell = cornell_box(res);
   if (fixed_spp() > 0) {  // instruction-count mode: exact spp, 1 thread
-    for (const char* c : {"cornell", "textured", "field"}) {
+    for (const char* c : {"cornell", "textured", "field", "blender"}) {
       if (!want(c)) continue;
       const std::string name = c;
       const Scene scene = name == "cornell"    ? cornell
                           : name == "textured" ? textured_cornell_box(res)
+                          : name == "blender"  ? blender_cornell(res, res * 3 / 4)
                                                : sphere_field(res);
       RenderSettings st;
       st.mode = RenderSettings::Mode::PT;
       st.samples = fixed_spp();
-      st.max_bounces = 8;
+      st.max_bounces = name == "blender" ? 4 : 8;
       st.threads = 1;
       RenderSession session(scene, st);
       std::atomic<bool> cancel{false};
@@ -307,6 +410,11 @@ int main(int argc, char** argv) {
   if (want("textured")) {
     const Scene textured = textured_cornell_box(res);
     for (int t : {1, 2}) report("cornell_box_textured", t, run(textured, t, budget));
+  }
+
+  if (want("blender")) {
+    const Scene b = blender_cornell(res, res * 3 / 4);
+    for (int t : {1, 2}) report("blender_cornell (4 bounces)", t, run(b, t, budget, false, 4));
   }
 
   if (want("field")) {
