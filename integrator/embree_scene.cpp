@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <emmintrin.h>
+
 namespace gdpt {
 
 namespace {
@@ -17,13 +19,6 @@ constexpr float kOriginRegion = 1.0f / 32.0f;
 constexpr float kFloatScale = 1.0f / 65536.0f;
 constexpr float kIntScale = 256.0f;
 
-float nudge(float p, float n) {
-  const int32_t of = int32_t(kIntScale * n);
-  const int32_t bits = std::bit_cast<int32_t>(p);
-  const float stepped = std::bit_cast<float>(bits + (p < 0.0f ? -of : of));
-  return std::fabs(p) < kOriginRegion ? p + kFloatScale * n : stepped;
-}
-
 Vec3f safe_normalize(Vec3f v, Vec3f fallback) {
   const float l2 = length_squared(v);
   if (!(l2 > 0.0f) || !std::isfinite(l2)) return fallback;
@@ -32,8 +27,25 @@ Vec3f safe_normalize(Vec3f v, Vec3f fallback) {
 
 }  // namespace
 
+// The three components at once in SSE2 lanes (branch-free; the scalar form cost ~60
+// instructions a call, with a data-dependent branch per component).
 Vec3f offset_ray_origin(Vec3f p, Vec3f n) {
-  return {nudge(p.x, n.x), nudge(p.y, n.y), nudge(p.z, n.z)};
+  const __m128 P = _mm_setr_ps(p.x, p.y, p.z, 0.0f), N = _mm_setr_ps(n.x, n.y, n.z, 0.0f);
+  // Integer ULP steps, away from zero: add kIntScale * n ULPs to |p|'s bits, i.e. subtract for
+  // negative p (sign = -1 there: (of ^ sign) - sign negates).
+  const __m128i of = _mm_cvttps_epi32(_mm_mul_ps(N, _mm_set1_ps(kIntScale)));
+  const __m128i bits = _mm_castps_si128(P);
+  const __m128i sign = _mm_srai_epi32(bits, 31);
+  const __m128 stepped =
+      _mm_castsi128_ps(_mm_add_epi32(bits, _mm_sub_epi32(_mm_xor_si128(of, sign), sign)));
+  // Near the origin an absolute step.
+  const __m128 absolute = _mm_add_ps(P, _mm_mul_ps(N, _mm_set1_ps(kFloatScale)));
+  const __m128 abs_p = _mm_andnot_ps(_mm_set1_ps(-0.0f), P);
+  const __m128 near = _mm_cmplt_ps(abs_p, _mm_set1_ps(kOriginRegion));
+  const __m128 r = _mm_or_ps(_mm_and_ps(near, absolute), _mm_andnot_ps(near, stepped));
+  alignas(16) float out[4];
+  _mm_store_ps(out, r);
+  return {out[0], out[1], out[2]};
 }
 
 EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)

@@ -20,6 +20,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <string>
 #include <vector>
@@ -399,9 +400,19 @@ int main(int argc, char** argv) {
       double mean_var = 0.0;
       for (size_t i = 0; i < session.film().pixel_count(); ++i) mean_var += var[3 * i];
       mean_var /= double(session.film().pixel_count());
-      std::printf("%s: %.0f samples, %llu rays, mean pixel variance %.6g\n", c,
-                  double(session.film().pixel_count()) * session.film().min_samples(),
-                  (unsigned long long)session.rays_traced(), mean_var);
+      // FNV-1a of the primal image's bits: equal checksums mean a bit-identical image.
+      std::vector<float> primal(3 * session.film().pixel_count());
+      session.film().primal_rgb(primal.data());
+      uint64_t checksum = 1469598103934665603ull;
+      for (float v : primal) {
+        uint32_t b;
+        std::memcpy(&b, &v, sizeof b);
+        checksum = (checksum ^ b) * 1099511628211ull;
+      }
+      std::printf("%s: %.0f samples, %llu rays, mean pixel variance %.6g, image checksum %016llx\n",
+                  c, double(session.film().pixel_count()) * session.film().min_samples(),
+                  (unsigned long long)session.rays_traced(), mean_var,
+                  (unsigned long long)checksum);
     }
     return 0;
   }
