@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "integrator/math/atan2_fast.h"
+#include "integrator/math/sincos_fast.h"
 #include "integrator/math/vec.h"
 
 namespace gdpt::lights {
@@ -56,7 +57,9 @@ class SphericalRectangle {
   Vec3f sample(Vec2f u) const {
     // 1. Pick the x coordinate by inverting the partial solid angle of the strip [x0, xu].
     const float au = u.x * solid_angle_ + k_;
-    const float fu = (std::cos(au) * b0_ - b1_) / std::sin(au);
+    float sin_au, cos_au;
+    sincos_fast(au, &sin_au, &cos_au);
+    const float fu = (cos_au * b0_ - b1_) / sin_au;
     float cu = std::copysign(1.0f, fu) / std::sqrt(fu * fu + b0_ * b0_);
     cu = std::clamp(cu, -1.0f, 1.0f);
     float xu = -(cu * z0_) / std::sqrt(std::max(1e-12f, 1.0f - cu * cu));
