@@ -111,7 +111,7 @@ class PathTracer final : public Integrator {
     return Spectrum(0.0f);
   }
 
-  PathResult trace(const Sampler& sampler, int px, int py, ClosureSet& closures,
+  PathResult trace(const Sampler& sampler, int px, int py, ClosureSet& closure_scratch,
                    ClosureSet& scratch) const {
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
@@ -202,8 +202,7 @@ class PathTracer final : public Integrator {
         }
       }
       if (bounce > max_bounces || transparent > kMaxTransparentBounces) break;
-      closures.clear();
-      material.evaluate(sc, closures);
+      const ClosureSet& closures = material.closures(sc, closure_scratch);
       if (!closures.has_bsdf()) break;
 
       // Frame facing the incoming ray (Cycles flips N and Ng for back faces; materials learn the

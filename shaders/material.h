@@ -29,7 +29,14 @@ class Material {
   Material();
 
   void evaluate(const ShadingContext& ctx, ClosureSet& out) const;  // BSDF lobes + emission
-  Spectrum emission(const ShadingContext& ctx) const;               // emission only, cheaper
+  // The same closures without a copy: the cached set of a constant material, else `scratch`
+  // filled by evaluate(). The reference lives as long as the material or `scratch`.
+  const ClosureSet& closures(const ShadingContext& ctx, ClosureSet& scratch) const {
+    if (constant_) return constant_closures_[ctx.front_facing ? 1 : 0];
+    evaluate(ctx, scratch);
+    return scratch;
+  }
+  Spectrum emission(const ShadingContext& ctx) const;  // emission only, cheaper
   bool is_emissive() const { return (features_ & kFeatureEmission) != 0; }
   // Emission averaged over textures (for sampling emissive triangles by power).
   Spectrum average_emission() const { return average_emission_; }
