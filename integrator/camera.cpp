@@ -67,9 +67,28 @@ CameraModel::CameraModel(const Camera& cam) {
   focus_distance_ = std::max(cam.focus_distance, 1e-4f);
   clip_start_ = std::max(cam.clip_start, 0.0f);
   clip_end_ = std::max(cam.clip_end, clip_start_);
+
+  pinhole_ = !ortho_ && !(aperture_radius_ > 0.0f);
+  if (pinhole_) {
+    // Camera-space direction (sx tan_half, sy tan_half, -1) with s affine in the raster position.
+    pinhole_origin_ = camera_to_world_.point(Vec3f(0.0f));
+    w0_ = camera_to_world_.vector(Vec3f(left_ * tan_half_, bottom_ * tan_half_, -1.0f));
+    wx_ = camera_to_world_.vector(Vec3f((right_ - left_) * inv_width_ * tan_half_, 0.0f, 0.0f));
+    wy_ = camera_to_world_.vector(Vec3f(0.0f, (top_ - bottom_) * inv_height_ * tan_half_, 0.0f));
+  }
 }
 
 Ray CameraModel::generate_ray(Vec2f raster, Vec2f lens) const {
+  if (pinhole_) {
+    const Vec3f w = w0_ + wx_ * raster.x + wy_ * raster.y;
+    const float len = length(w);
+    Ray ray;
+    ray.origin = pinhole_origin_;
+    ray.direction = w / len;
+    ray.t_min = clip_start_ * len;
+    ray.t_max = clip_end_ * len;
+    return ray;
+  }
   const Vec2f s = raster_to_screen(raster);
   Vec3f origin, dir;
   float z_scale;  // distance along the ray per unit of view depth

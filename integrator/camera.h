@@ -62,6 +62,11 @@ class CameraModel {
   float tan_half_ = 1.0f;
   float aperture_radius_ = 0.0f, focus_distance_ = 10.0f;
   float clip_start_ = 0.1f, clip_end_ = 1000.0f;
+  // Pinhole perspective (no depth of field), the common case: the unnormalised world direction
+  // is affine in the raster position, W = w0 + x wx + y wy, and |W| is the distance along the
+  // ray per unit of view depth (clip distances scale by it).
+  bool pinhole_ = false;
+  Vec3f pinhole_origin_, w0_, wx_, wy_;
 };
 
 }  // namespace gdpt
