@@ -229,7 +229,8 @@ class PathTracer final : public Integrator {
           const float cos_ng = dot(ls.direction, ng);
           // The geometric and shading hemispheres must agree, or light leaks through the surface.
           if ((cos_ng > 0.0f) == (wo.z > 0.0f) && cos_ng != 0.0f) {
-            const Spectrum f = closures.eval(wi, wo);
+            float bsdf_pdf;
+            const Spectrum f = closures.eval_pdf(wi, wo, bsdf_pdf);
             if (!is_black(f)) {
               Ray shadow;
               shadow.origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);
@@ -248,7 +249,7 @@ class PathTracer final : public Integrator {
               }
               const Spectrum tr = transmittance(shadow, scratch, out.rays);
               if (!is_black(tr)) {
-                const float w = ls.is_delta ? 1.0f : power_heuristic(ls.pdf, closures.pdf(wi, wo));
+                const float w = ls.is_delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
                 out.primal += beta * f * tr * ls.radiance * (w / ls.pdf);
               }
             }
