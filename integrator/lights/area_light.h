@@ -9,11 +9,11 @@
 //                        eval_fac = 0.25 / area and strength = colour * power, and no 1/pi
 //                        anywhere, so a 1 W area light emits pi/4 W in total
 // Area A: |u x v| for rectangles, pi/4 |u x v| for ellipses (u, v the scaled full extents).
-// Rectangles (orthogonal axes) are sampled uniformly in the solid angle they subtend, as Cycles;
-// ellipses, sheared rectangles and rectangles subtending under kMinSphericalSolidAngle (where
-// the spherical construction loses float precision and area sampling is as good) are sampled
-// uniformly by area with the pdf converted to solid angle. The choice depends only on the
-// reference point, so sample() and intersect() agree on the density.
+// Rectangles (orthogonal axes) that subtend a large solid angle (kSphericalSolidAngle) are
+// sampled uniformly in that solid angle, as Cycles does for every rectangle; ellipses, sheared
+// rectangles and rectangles seen under a smaller angle are sampled uniformly by area with the pdf
+// converted to solid angle (the spherical set-up costs more than it saves there). The choice
+// depends only on the reference point, so sample() and intersect() agree on the density.
 #pragma once
 
 #include <cmath>
@@ -41,10 +41,22 @@ struct AreaLight {
   float len_u = 0.0f, len_v = 0.0f;
 
   static constexpr float kMinSphericalSolidAngle = 1e-3f;
+  // Spherical sampling only where the rectangle subtends at least this much, estimated as
+  // area cos / d^2 from its centre: its set-up is a chain of square roots, divisions and two
+  // atan2 whose latency cost ~45% of a Cornell-box sample, while below ~0.1 sr (an angular
+  // radius of ~10 degrees) the cosines and 1 / d^2 barely vary over the light, so area sampling
+  // is almost as good (bench_integrator, Cornell box, 16 spp: luminance MSE +2% against
+  // spherical sampling everywhere, +8% for area sampling everywhere; samples per CPU-second
+  // 1.27x, as fast as area sampling everywhere; docs/lights.md).
+  static constexpr float kSphericalSolidAngle = 0.1f;
 
   // The spherical rectangle seen from ref when it is used for sampling (see the header).
   std::optional<SphericalRectangle> spherical(Vec3f ref) const {
     if (!orthogonal) return std::nullopt;
+    const Vec3f to = ref - center;
+    const float d2 = length_squared(to);
+    // area cos / d^2 >= threshold, with cos = dot(to, normal) / d, without the division.
+    if (area * dot(to, normal) < kSphericalSolidAngle * d2 * std::sqrt(d2)) return std::nullopt;
     const SphericalRectangle r(ref, corner, unit_u, unit_v, len_u, len_v);
     if (!(r.solid_angle() >= kMinSphericalSolidAngle)) return std::nullopt;
     return r;
