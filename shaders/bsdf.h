@@ -2,74 +2,15 @@
 // a weighted sum of BSDF lobes (like Cycles' closures), sampled and evaluated in the local shading
 // frame (normal = +z).
 //
-// Conventions (Mitsuba-style):
-//  - wi points from the surface towards the previous path vertex, wo towards the next one.
-//  - eval() returns f(wi, wo) * |cos theta_o| (the cosine-weighted BSDF value).
-//  - pdf() is the solid-angle density of sample() producing wo, including lobe selection.
-//  - Delta lobes (smooth glass, mirror, transparent) are never returned by eval()/pdf(); sample()
-//    reports them with is_delta = true, value = weight of the discrete choice, pdf = its
-//    probability.
-//  - roughness() is what the gradient-domain shift uses to classify a vertex: the minimum GGX alpha
-//    (or 1 for diffuse lobes) over the non-delta lobes; a sampled delta lobe counts as 0.
+// Lobe conventions (wi, wo, eval, pdf, delta lobes, roughness) are in closure.h. A set made of a
+// single Lambert lobe, the commonest, is evaluated and sampled inline, without the mixture code.
 #pragma once
 
-#include <cstdint>
-
-#include "integrator/math/frame.h"
 #include "integrator/math/vec.h"
+#include "shaders/bsdf_lambert.h"
+#include "shaders/closure.h"
 
 namespace gdpt {
-
-enum class ClosureType : uint8_t {
-  Lambert,            // color / pi
-  OrenNayar,          // Cycles' Oren-Nayar with sigma = roughness
-  PrincipledDiffuse,  // Disney/Burley diffuse as in Cycles' Principled v1
-  GGXReflection,  // GGX with Fresnel mode below (Glossy: none; Principled specular: Schlick mix)
-  GGXDielectric,  // GGX glass: reflection + refraction by dielectric Fresnel; alpha 0 = smooth
-  Transparent,    // straight through, delta
-};
-
-enum class FresnelMode : uint8_t {
-  None,          // Glossy BSDF: colour only
-  Dielectric,    // exact dielectric Fresnel with ior
-  PrincipledV1,  // Cycles principled v1: mix(F0 tinted, base colour by metallic) via Schlick weight
-};
-
-struct Closure {
-  ClosureType type = ClosureType::Lambert;
-  FresnelMode fresnel = FresnelMode::None;
-  Spectrum weight{1.0f, 1.0f, 1.0f};  // colour * mix weight
-  float alpha = 0.0f;                 // GGX alpha (= Blender roughness^2); diffuse roughness
-  // Relative IOR: GGXDielectric: n(below the frame normal) / n(above), i.e. the IOR crossed by
-  // a ray arriving with wi.z > 0 (Material sets 1/ior for back-face hits, since the integrators
-  // orient the frame towards the ray); PrincipledV1 reflection: the IOR giving its F0.
-  float ior = 1.45f;
-  Spectrum f0{0.04f, 0.04f, 0.04f};  // PrincipledV1 specular colour at normal incidence
-  // GGXDielectric: extra factor on the refracted part only (Principled transmission: base colour;
-  // the reflected part is weight * Fresnel colour). Glass BSDF: 1 (its colour is in weight).
-  Spectrum transmission_tint{1.0f, 1.0f, 1.0f};
-  Vec3f normal{0.0f, 0.0f, 1.0f};  // local-frame normal of the lobe (reserved; +z today)
-};
-
-enum LobeFlags : uint8_t {
-  kLobeReflection = 1 << 0,
-  kLobeTransmission = 1 << 1,
-  kLobeDiffuse = 1 << 2,
-  kLobeGlossy = 1 << 3,
-  kLobeDelta = 1 << 4,
-};
-
-struct BsdfSample {
-  Vec3f wo;                // local frame
-  Spectrum value;          // eval(wi, wo) (or the delta weight * pdf for delta lobes)
-  float pdf = 0.0f;        // solid angle (or discrete probability for delta lobes)
-  float eta = 1.0f;        // relative IOR crossed (1 for reflection)
-  float roughness = 1.0f;  // roughness of the sampled lobe (0 for delta)
-  uint8_t lobe = 0;        // LobeFlags of the sampled lobe
-  bool valid = false;
-  bool is_delta() const { return (lobe & kLobeDelta) != 0; }
-  Spectrum weight() const { return pdf > 0.0f ? value / pdf : Spectrum(0.0f); }
-};
 
 // At most kMaxClosures lobes per shading point: fixed storage, no allocation in the hot loop.
 inline constexpr int kMaxClosures = 8;
@@ -95,13 +36,24 @@ class ClosureSet {
   Spectrum emission() const { return emission_; }
   bool has_bsdf() const { return count_ > 0; }
 
-  Spectrum eval(Vec3f wi, Vec3f wo) const;
-  float pdf(Vec3f wi, Vec3f wo) const;
+  Spectrum eval(Vec3f wi, Vec3f wo) const {
+    return single_lambert() ? lambert::eval(closures_[0], wi, wo) : eval_mixture(wi, wo);
+  }
+  float pdf(Vec3f wi, Vec3f wo) const {
+    return single_lambert() ? lambert::pdf(closures_[0], wi, wo) : pdf_mixture(wi, wo);
+  }
   // eval() and pdf() of the same directions in one call (same values, one pass over the lobes),
-  // for integrators that need both, e.g. G-PT's shifted vertices.
-  Spectrum eval_pdf(Vec3f wi, Vec3f wo, float& pdf) const;
+  // for integrators that need both, e.g. next-event estimation and G-PT's shifted vertices.
+  Spectrum eval_pdf(Vec3f wi, Vec3f wo, float& pdf_out) const {
+    if (!single_lambert()) return eval_pdf_mixture(wi, wo, pdf_out);
+    pdf_out = lambert::pdf(closures_[0], wi, wo);
+    return lambert::eval(closures_[0], wi, wo);
+  }
   // u_lobe picks the lobe (by weight luminance), u the direction within it.
-  BsdfSample sample(Vec3f wi, float u_lobe, Vec2f u) const;
+  BsdfSample sample(Vec3f wi, float u_lobe, Vec2f u) const {
+    return single_lambert() ? lambert::sample(closures_[0], wi, u_lobe, u)
+                            : sample_mixture(wi, u_lobe, u);
+  }
   // Whether sample() reads u_lobe at all: only to pick among several lobes or, for a single
   // dielectric, reflection against refraction. Integrators skip drawing it otherwise.
   bool uses_lobe_choice() const {
@@ -112,6 +64,13 @@ class ClosureSet {
   bool has_delta() const;
 
  private:
+  bool single_lambert() const { return count_ == 1 && closures_[0].type == ClosureType::Lambert; }
+  // Any set (the same values as the fast path for a single Lambert lobe).
+  Spectrum eval_mixture(Vec3f wi, Vec3f wo) const;
+  float pdf_mixture(Vec3f wi, Vec3f wo) const;
+  Spectrum eval_pdf_mixture(Vec3f wi, Vec3f wo, float& pdf_out) const;
+  BsdfSample sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const;
+
   Closure closures_[kMaxClosures];
   int count_ = 0;
   Spectrum emission_{0.0f, 0.0f, 0.0f};

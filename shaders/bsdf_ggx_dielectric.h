@@ -25,7 +25,7 @@
 // P_R (Fresnel weighted by colour luminances), value = R F, transmission value = T (1 - F).
 #pragma once
 
-#include "shaders/bsdf.h"
+#include "shaders/closure.h"
 #include "shaders/fresnel.h"
 #include "shaders/lobe_util.h"
 #include "shaders/microfacet.h"

@@ -7,7 +7,7 @@
 // alpha < kDeltaAlpha: a perfect mirror (delta), value = weight F(cos_i), pdf = 1.
 #pragma once
 
-#include "shaders/bsdf.h"
+#include "shaders/closure.h"
 #include "shaders/fresnel.h"
 #include "shaders/lobe_util.h"
 #include "shaders/microfacet.h"

@@ -2,7 +2,7 @@
 // Cosine-weighted sampling makes sample().weight() exactly the colour.
 #pragma once
 
-#include "shaders/bsdf.h"
+#include "shaders/closure.h"
 #include "shaders/diffuse_sampling.h"
 #include "shaders/lobe_util.h"
 #include "shaders/sampling.h"

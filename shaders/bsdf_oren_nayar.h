@@ -7,7 +7,7 @@
 // is the same, the variance lower).
 #pragma once
 
-#include "shaders/bsdf.h"
+#include "shaders/closure.h"
 #include "shaders/diffuse_sampling.h"
 #include "shaders/lobe_util.h"
 #include "shaders/sampling.h"

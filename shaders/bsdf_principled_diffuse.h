@@ -6,7 +6,7 @@
 // Sampled cosine-weighted, as Cycles.
 #pragma once
 
-#include "shaders/bsdf.h"
+#include "shaders/closure.h"
 #include "shaders/diffuse_sampling.h"
 #include "shaders/lobe_util.h"
 #include "shaders/sampling.h"

@@ -2,7 +2,7 @@
 // eval and pdf are 0, sample() returns value = weight, pdf = 1.
 #pragma once
 
-#include "shaders/bsdf.h"
+#include "shaders/closure.h"
 
 namespace gdpt::transparent {
 

@@ -95,13 +95,13 @@ void ClosureSet::add(const Closure& c) {
     closures_[weakest] = c;
 }
 
-Spectrum ClosureSet::eval(Vec3f wi, Vec3f wo) const {
+Spectrum ClosureSet::eval_mixture(Vec3f wi, Vec3f wo) const {
   Spectrum f(0.0f);
   for (int i = 0; i < count_; ++i) f += lobe_eval(closures_[i], wi, wo);
   return f;
 }
 
-float ClosureSet::pdf(Vec3f wi, Vec3f wo) const {
+float ClosureSet::pdf_mixture(Vec3f wi, Vec3f wo) const {
   if (count_ == 1) return lobe_pdf(closures_[0], wi, wo);
   float w[kMaxClosures];
   const float total = selection_weights(closures_, count_, wi, w);
@@ -112,7 +112,7 @@ float ClosureSet::pdf(Vec3f wi, Vec3f wo) const {
   return p / total;
 }
 
-Spectrum ClosureSet::eval_pdf(Vec3f wi, Vec3f wo, float& pdf_out) const {
+Spectrum ClosureSet::eval_pdf_mixture(Vec3f wi, Vec3f wo, float& pdf_out) const {
   if (count_ == 1) {
     pdf_out = lobe_pdf(closures_[0], wi, wo);
     return lobe_eval(closures_[0], wi, wo);
@@ -130,7 +130,7 @@ Spectrum ClosureSet::eval_pdf(Vec3f wi, Vec3f wo, float& pdf_out) const {
   return f;
 }
 
-BsdfSample ClosureSet::sample(Vec3f wi, float u_lobe, Vec2f u) const {
+BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
   if (count_ == 0) return {};
   if (count_ == 1) return lobe_sample(closures_[0], wi, u_lobe, u);
 

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "shaders/bsdf.h"
+#include "shaders/closure.h"
 #include "shaders/lobe_util.h"
 #include "shaders/sampling.h"
 

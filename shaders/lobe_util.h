@@ -11,7 +11,7 @@
 #pragma once
 
 #include "integrator/math/vec.h"
-#include "shaders/bsdf.h"
+#include "shaders/closure.h"
 
 namespace gdpt {
 

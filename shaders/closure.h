@@ -1,0 +1,74 @@
+// One BSDF lobe (Closure) and the result of sampling it (BsdfSample): the data every lobe
+// implementation (bsdf_*.h) works on. ClosureSet, the weighted sum of lobes a material
+// evaluates to, is in bsdf.h.
+//
+// Conventions (Mitsuba-style):
+//  - wi points from the surface towards the previous path vertex, wo towards the next one.
+//  - eval() returns f(wi, wo) * |cos theta_o| (the cosine-weighted BSDF value).
+//  - pdf() is the solid-angle density of sample() producing wo, including lobe selection.
+//  - Delta lobes (smooth glass, mirror, transparent) are never returned by eval()/pdf(); sample()
+//    reports them with is_delta = true, value = weight of the discrete choice, pdf = its
+//    probability.
+//  - roughness() is what the gradient-domain shift uses to classify a vertex: the minimum GGX alpha
+//    (or 1 for diffuse lobes) over the non-delta lobes; a sampled delta lobe counts as 0.
+#pragma once
+
+#include <cstdint>
+
+#include "integrator/math/frame.h"
+#include "integrator/math/vec.h"
+
+namespace gdpt {
+
+enum class ClosureType : uint8_t {
+  Lambert,            // color / pi
+  OrenNayar,          // Cycles' Oren-Nayar with sigma = roughness
+  PrincipledDiffuse,  // Disney/Burley diffuse as in Cycles' Principled v1
+  GGXReflection,  // GGX with Fresnel mode below (Glossy: none; Principled specular: Schlick mix)
+  GGXDielectric,  // GGX glass: reflection + refraction by dielectric Fresnel; alpha 0 = smooth
+  Transparent,    // straight through, delta
+};
+
+enum class FresnelMode : uint8_t {
+  None,          // Glossy BSDF: colour only
+  Dielectric,    // exact dielectric Fresnel with ior
+  PrincipledV1,  // Cycles principled v1: mix(F0 tinted, base colour by metallic) via Schlick weight
+};
+
+struct Closure {
+  ClosureType type = ClosureType::Lambert;
+  FresnelMode fresnel = FresnelMode::None;
+  Spectrum weight{1.0f, 1.0f, 1.0f};  // colour * mix weight
+  float alpha = 0.0f;                 // GGX alpha (= Blender roughness^2); diffuse roughness
+  // Relative IOR: GGXDielectric: n(below the frame normal) / n(above), i.e. the IOR crossed by
+  // a ray arriving with wi.z > 0 (Material sets 1/ior for back-face hits, since the integrators
+  // orient the frame towards the ray); PrincipledV1 reflection: the IOR giving its F0.
+  float ior = 1.45f;
+  Spectrum f0{0.04f, 0.04f, 0.04f};  // PrincipledV1 specular colour at normal incidence
+  // GGXDielectric: extra factor on the refracted part only (Principled transmission: base colour;
+  // the reflected part is weight * Fresnel colour). Glass BSDF: 1 (its colour is in weight).
+  Spectrum transmission_tint{1.0f, 1.0f, 1.0f};
+  Vec3f normal{0.0f, 0.0f, 1.0f};  // local-frame normal of the lobe (reserved; +z today)
+};
+
+enum LobeFlags : uint8_t {
+  kLobeReflection = 1 << 0,
+  kLobeTransmission = 1 << 1,
+  kLobeDiffuse = 1 << 2,
+  kLobeGlossy = 1 << 3,
+  kLobeDelta = 1 << 4,
+};
+
+struct BsdfSample {
+  Vec3f wo;                // local frame
+  Spectrum value;          // eval(wi, wo) (or the delta weight * pdf for delta lobes)
+  float pdf = 0.0f;        // solid angle (or discrete probability for delta lobes)
+  float eta = 1.0f;        // relative IOR crossed (1 for reflection)
+  float roughness = 1.0f;  // roughness of the sampled lobe (0 for delta)
+  uint8_t lobe = 0;        // LobeFlags of the sampled lobe
+  bool valid = false;
+  bool is_delta() const { return (lobe & kLobeDelta) != 0; }
+  Spectrum weight() const { return pdf > 0.0f ? value / pdf : Spectrum(0.0f); }
+};
+
+}  // namespace gdpt
