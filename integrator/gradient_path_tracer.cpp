@@ -66,7 +66,17 @@ struct Vertex {
   Vec3f wi;  // local incoming direction
   ClosureSet closures;
   float roughness = 1.0f;  // ClosureSet::roughness(), 1 for a vertex without BSDF
+  // A single Lambert lobe: eval() and pdf() depend on wi only through the sign of wi.z * wo.z,
+  // so an offset sharing this vertex with another wi reuses the base's values (same_side()).
+  bool lambert = false;
 };
+
+// Whether a single-Lambert vertex gives wi_a and wi_b the same eval() and pdf() for wo: the
+// lobe's only use of wi is the test wi.z * wo.z > 0 (shaders/bsdf_lambert.h), so equal test
+// outcomes mean bit-identical values.
+inline bool same_side(const Vertex& v, Vec3f wi_a, Vec3f wi_b, Vec3f wo) {
+  return v.lambert && (wi_a.z * wo.z > 0.0f) == (wi_b.z * wo.z > 0.0f);
+}
 
 // Sets up `v` at `hit` reached along `dir` (world, unit), as the path tracer does: Cycles-style
 // flipped normals for back faces, geometric-normal fallback for a shading normal that puts the
@@ -83,6 +93,7 @@ void setup_vertex(const SceneContext& ctx, const SurfaceHit& hit, Vec3f dir, Ver
   v.frame = Frame(ns);
   v.wi = v.frame.to_local(wi_world);
   v.roughness = v.closures.has_bsdf() ? v.closures.roughness() : 1.0f;
+  v.lambert = v.closures.count() == 1 && v.closures[0].type == ClosureType::Lambert;
 }
 
 // Emitted radiance of an emissive triangle at `hit` towards the point `from`.
@@ -518,7 +529,12 @@ class GradientPathTracer final : public Integrator {
                 Spectrum f_r(0.0f);
                 float pdf_o = 0.0f;
                 if (wo.z != 0.0f && visible) {
-                  f_r = bc.eval_pdf(o.wi_shared, wo, pdf_o);
+                  if (same_side(base, o.wi_shared, base.wi, wo)) {
+                    f_r = fs;
+                    pdf_o = pdf_fs;
+                  } else {
+                    f_r = bc.eval_pdf(o.wi_shared, wo, pdf_o);
+                  }
                   if (ls.is_delta) pdf_o = 0.0f;
                 }
                 co = mul(mul(o.f, f_r), ls.radiance);
@@ -775,9 +791,15 @@ class GradientPathTracer final : public Integrator {
           o.shift = Shift::Failed;  // a delta lobe cannot map another wi onto the same wo
           return;
         }
-        float pdf = 0.0f;
-        o.seg_value = Vec3d(base.closures.eval_pdf(o.wi_shared, bs.wo, pdf));
-        o.seg_pdf = pdf;
+        if (same_side(base, o.wi_shared, base.wi, bs.wo)) {
+          // A Lambert sample's value and pdf are eval() and pdf() of wo (bit-identical).
+          o.seg_value = Vec3d(bs.value);
+          o.seg_pdf = bs.pdf;
+        } else {
+          float pdf = 0.0f;
+          o.seg_value = Vec3d(base.closures.eval_pdf(o.wi_shared, bs.wo, pdf));
+          o.seg_pdf = pdf;
+        }
         if (!(o.seg_pdf > 0.0)) o.shift = Shift::Failed;
         return;
       }
