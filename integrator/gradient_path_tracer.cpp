@@ -69,7 +69,21 @@ struct Vertex {
   // A single Lambert lobe: eval() and pdf() depend on wi only through the sign of wi.z * wo.z,
   // so an offset sharing this vertex with another wi reuses the base's values (same_side()).
   bool lambert = false;
+  // offset_ray_origin() on the side of ng, computed on first use (ray_origin()): light samples,
+  // the extension ray and reconnection rays of a vertex mostly leave on that side.
+  mutable bool origin_set = false;
+  mutable Vec3f origin;
 };
+
+// Origin of a ray leaving `v` on the side of ng (`front`) or the other side.
+inline Vec3f ray_origin(const Vertex& v, bool front) {
+  if (!front) return offset_ray_origin(v.hit.position, -v.ng);
+  if (!v.origin_set) {
+    v.origin = offset_ray_origin(v.hit.position, v.ng);
+    v.origin_set = true;
+  }
+  return v.origin;
+}
 
 // Whether a single-Lambert vertex gives wi_a and wi_b the same eval() and pdf() for wo: the
 // lobe's only use of wi is the test wi.z * wo.z > 0 (shaders/bsdf_lambert.h), so equal test
@@ -94,6 +108,7 @@ void setup_vertex(const SceneContext& ctx, const SurfaceHit& hit, Vec3f dir, Ver
   v.wi = v.frame.to_local(wi_world);
   v.roughness = v.closures.has_bsdf() ? v.closures.roughness() : 1.0f;
   v.lambert = v.closures.count() == 1 && v.closures[0].type == ClosureType::Lambert;
+  v.origin_set = false;
 }
 
 // Emitted radiance of an emissive triangle at `hit` towards the point `from`.
@@ -246,9 +261,10 @@ class GradientPathTracer final : public Integrator {
 
   // The segment from `from` (geometric normal `ng`) along `dir` up to t_max, leaving the surface
   // on the side of `dir`.
-  static Ray shadow_ray(Vec3f from, Vec3f ng, Vec3f dir, float t_max) {
+  static Ray shadow_ray(const Vertex& v, Vec3f dir, float t_max) {
+    const Vec3f from = v.hit.position;
     Ray shadow;
-    shadow.origin = offset_ray_origin(from, dot(dir, ng) > 0.0f ? ng : -ng);
+    shadow.origin = ray_origin(v, dot(dir, v.ng) > 0.0f);
     shadow.direction = dir;
     shadow.t_min = 0.0f;
     shadow.t_max = t_max;
@@ -266,9 +282,9 @@ class GradientPathTracer final : public Integrator {
     return shadow;
   }
 
-  bool occluded(Vec3f from, Vec3f ng, Vec3f dir, float t_max, uint32_t& rays) const {
+  bool occluded(const Vertex& v, Vec3f dir, float t_max, uint32_t& rays) const {
     ++rays;
-    return ctx_.bvh().occluded(shadow_ray(from, ng, dir, t_max));
+    return ctx_.bvh().occluded(shadow_ray(v, dir, t_max));
   }
 
   // Local outgoing direction at `v` for world `dir`; false when the geometric and shading
@@ -447,7 +463,7 @@ class GradientPathTracer final : public Integrator {
           if (local_dir(base, ls.direction, wo)) {
             fs = bc.eval_pdf(base.wi, wo, pdf_fs);
             if (!is_black(fs) && !is_black(ls.radiance))
-              visible = !occluded(base.hit.position, base.ng, ls.direction,
+              visible = !occluded(base, ls.direction,
                                   ls.is_infinite ? kInf : ls.distance * (1.0f - 1e-4f), out.rays);
           }
           const float pdf_bsdf = (!ls.is_delta && visible) ? pdf_fs : 0.0f;
@@ -506,7 +522,7 @@ class GradientPathTracer final : public Integrator {
               fo[k] = o.v.closures.eval_pdf(o.v.wi, wo_o[k], pdf_fo[k]);
               if (!is_black(fo[k]) && !is_black(lo[k].radiance)) {
                 test[k] = true;
-                shadow[k] = shadow_ray(o.v.hit.position, o.v.ng, lo[k].direction,
+                shadow[k] = shadow_ray(o.v, lo[k].direction,
                                        lo[k].is_infinite ? kInf : lo[k].distance * (1.0f - 1e-4f));
                 ++out.rays;
               }
@@ -582,7 +598,7 @@ class GradientPathTracer final : public Integrator {
       }
 
       // --- Trace the base's next segment ---
-      ray.origin = offset_ray_origin(base.hit.position, cos_ng > 0.0f ? base.ng : -base.ng);
+      ray.origin = ray_origin(base, cos_ng > 0.0f);
       ray.direction = normalize(wo_world);
       ray.t_min = 0.0f;
       ray.t_max = kInf;
@@ -837,7 +853,7 @@ class GradientPathTracer final : public Integrator {
         o.seg_pdf = pdf;
         // Visibility: traced with the other offsets' rays in one packet (seg_visible).
         o.vis_pending = true;
-        o.vis_ray = shadow_ray(y.hit.position, y.ng, dir, float(r.distance) * (1.0f - 1e-4f));
+        o.vis_ray = shadow_ray(y, dir, float(r.distance) * (1.0f - 1e-4f));
         ++rays;
       } else {
         // Reconnection at infinity: the same direction, J = 1, visibility from y_d.
@@ -852,7 +868,7 @@ class GradientPathTracer final : public Integrator {
         o.seg_value = Vec3d(y.closures.eval_pdf(y.wi, wo, pdf));
         o.seg_pdf = pdf;
         o.vis_pending = true;
-        o.vis_ray = shadow_ray(y.hit.position, y.ng, wo_world, kInf);
+        o.vis_ray = shadow_ray(y, wo_world, kInf);
         ++rays;
       }
       return;
@@ -903,7 +919,7 @@ class GradientPathTracer final : public Integrator {
     }
     o.shift = Shift::HalfVector;
     o.seg_dir = dir;
-    o.ray.origin = offset_ray_origin(y.hit.position, cos_ng > 0.0f ? y.ng : -y.ng);
+    o.ray.origin = ray_origin(y, cos_ng > 0.0f);
     o.ray.direction = dir;
     o.ray.t_min = 0.0f;
     o.ray.t_max = kInf;
@@ -940,7 +956,7 @@ class GradientPathTracer final : public Integrator {
       if (!local_dir(y, base_dir, wo)) return;
       float pdf_o = 0.0f;
       const Spectrum fo = y.closures.eval_pdf(y.wi, wo, pdf_o);
-      const bool vis = !occluded(y.hit.position, y.ng, base_dir, kInf, rays);
+      const bool vis = !occluded(y, base_dir, kInf, rays);
       co = vis ? mul(mul(o.f, fo), lh.radiance) : Vec3d();
       d_off = shift::offset_densities(o.p, 1.0, pl_pair, vis ? pdf_o : 0.0f);
       return;
@@ -960,7 +976,7 @@ class GradientPathTracer final : public Integrator {
                          length_squared(lo.normal - lh.normal) <= kSameNormal2;
     float pdf_o = 0.0f;
     const Spectrum fo = y.closures.eval_pdf(y.wi, wo, pdf_o);
-    const bool vis = reaches && !occluded(y.hit.position, y.ng, dir, d * (1.0f - 1e-4f), rays);
+    const bool vis = reaches && !occluded(y, dir, d * (1.0f - 1e-4f), rays);
     co = vis ? mul(mul(o.f, fo), lo.radiance) * r.jacobian : Vec3d();
     // Light sampling from y produces this point only where the light emits towards y (a spot's
     // cone), as the base's pl is counted only for a lit hit.
