@@ -128,6 +128,52 @@ Ray CameraModel::generate_ray(Vec2f raster, Vec2f lens) const {
   return ray;
 }
 
+void CameraModel::generate_offset_rays(Vec2f raster, Vec2f lens, const bool mask[4],
+                                       Ray out[4]) const {
+  // One raster unit moves the screen position by these amounts.
+  const float sx = (right_ - left_) * inv_width_, sy = (top_ - bottom_) * inv_height_;
+  const float step_x[4] = {1.0f, 0.0f, -1.0f, 0.0f}, step_y[4] = {0.0f, 1.0f, 0.0f, -1.0f};
+  const Vec2f s = raster_to_screen(raster);
+  if (ortho_) {
+    // The direction does not depend on the raster position; the origin moves in the view plane.
+    const Ray base = generate_ray(raster, lens);
+    const Vec3f ax = camera_to_world_.column(0) * sx, ay = camera_to_world_.column(1) * sy;
+    for (int k = 0; k < 4; ++k) {
+      if (!mask[k]) continue;
+      out[k] = base;
+      out[k].origin = base.origin + ax * step_x[k] + ay * step_y[k];
+    }
+    return;
+  }
+  // Perspective (as generate_ray): camera-space direction d = (s.x t, s.y t, -1), times the focus
+  // distance minus the lens point with depth of field. Its z component f is the same for every
+  // raster position, so along the ray t_min = clip_start |W| / f for the world direction W.
+  Vec3f origin(0.0f);
+  Vec3f dir(s.x * tan_half_, s.y * tan_half_, -1.0f);
+  float scale = tan_half_;
+  if (aperture_radius_ > 0.0f) {
+    const Vec2f l = square_to_disk_concentric(lens) * aperture_radius_;
+    origin = Vec3f(l.x, l.y, 0.0f);
+    dir = dir * focus_distance_ - origin;
+    scale *= focus_distance_;
+  }
+  const float depth = -dir.z;
+  const Vec3f world_origin = camera_to_world_.point(origin);
+  const Vec3f w = camera_to_world_.vector(dir);
+  const Vec3f ax = camera_to_world_.column(0) * (sx * scale);
+  const Vec3f ay = camera_to_world_.column(1) * (sy * scale);
+  for (int k = 0; k < 4; ++k) {
+    if (!mask[k]) continue;
+    const Vec3f wk = w + ax * step_x[k] + ay * step_y[k];
+    const float len = length(wk);
+    const float z_scale = len / std::max(depth, 1e-8f * len);
+    out[k].origin = world_origin;
+    out[k].direction = wk / len;
+    out[k].t_min = clip_start_ * z_scale;
+    out[k].t_max = clip_end_ * z_scale;
+  }
+}
+
 bool CameraModel::project(Vec3f world, Vec2f& raster) const {
   const Vec3f p = world_to_camera_.point(world);
   Vec2f s;

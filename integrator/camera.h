@@ -35,6 +35,12 @@ class CameraModel {
   // builds its offset paths.
   Ray generate_ray(Vec2f raster, Vec2f lens) const;
 
+  // G-PT's offset rays: the rays through raster + (+1, 0), (0, +1), (-1, 0), (0, -1) (in that
+  // order, where `mask` is set) with the same lens sample, equal to generate_ray() up to
+  // rounding. The camera-space direction is affine in the raster position, so each ray costs one
+  // step from the common part and a normalisation instead of a full generate_ray().
+  void generate_offset_rays(Vec2f raster, Vec2f lens, const bool mask[4], Ray out[4]) const;
+
   // World point -> raster position (pinhole); returns false behind the camera. For tests.
   bool project(Vec3f world, Vec2f& raster) const;
 
