@@ -36,9 +36,7 @@ using shift::VertexType;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kOffsets = 4;
-// Offset order: +x (right), +y (up), -x (left), -y (down).
-constexpr int kShiftX[kOffsets] = {1, 0, -1, 0};
-constexpr int kShiftY[kOffsets] = {0, 1, 0, -1};
+// Offset order: +x (right), +y (up), -x (left), -y (down), as CameraModel::generate_offset_rays.
 enum : int { kRight = 0, kUp = 1, kLeft = 2, kDown = 3 };
 
 inline Vec3d mul(Vec3d a, Vec3d b) {
@@ -378,12 +376,8 @@ class GradientPathTracer final : public Integrator {
     // The four offset camera rays start at neighbouring pixels: one coherent packet.
     Offset* off = scratch.off;
     Ray* cam = scratch.cam;
-    for (int k = 0; k < kOffsets; ++k) {
-      if (!mask[k]) continue;
-      const Vec2f r{raster.x + float(kShiftX[k]), raster.y + float(kShiftY[k])};
-      cam[k] = ctx_.camera().generate_ray(r, lens);
-      ++out.rays;
-    }
+    ctx_.camera().generate_offset_rays(raster, lens, mask, cam);  // kRight, kUp, kLeft, kDown
+    for (int k = 0; k < kOffsets; ++k) out.rays += mask[k];
     bool cam_found[kOffsets];
     SurfaceHit* cam_hit = scratch.cam_hit;
     bvh.intersect4(cam, mask, cam_found, cam_hit);

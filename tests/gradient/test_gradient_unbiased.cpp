@@ -15,6 +15,7 @@
 #include <cstdio>
 
 #include "gradient_scenes.h"
+#include "integrator/camera.h"
 
 namespace gdpt::gradient_test {
 namespace {
@@ -323,6 +324,52 @@ TEST(GradientIntegrator, DeterministicAcrossThreadCounts) {
   EXPECT_EQ(a.emission, b.emission);
   EXPECT_EQ(a.variance, b.variance);
   EXPECT_EQ(a.failures, b.failures);
+}
+
+// The offsets' camera rays (CameraModel::generate_offset_rays, one affine step from the base's
+// raster position) are the rays generate_ray() gives at raster +-1, up to float rounding:
+// perspective with shift and pixel aspect, thin lens, orthographic with and without a lens,
+// a scaled camera transform, clip distances.
+TEST(GradientCamera, OffsetRaysMatchGenerateRay) {
+  for (int variant = 0; variant < 5; ++variant) {
+    Camera c = make_scene(SceneKind::CornellDiffuse, 8).camera;
+    c.width = 40;
+    c.height = 30;
+    c.shift_x = 0.1f;
+    c.shift_y = -0.05f;
+    c.pixel_aspect = 1.3f;
+    c.clip_start = 0.2f;
+    c.clip_end = 50.0f;
+    c.camera_to_world = transform(0.3f, -0.7f, {0.5f, -0.2f, 3.0f});
+    if (variant == 1 || variant == 3) {
+      c.aperture_radius = 0.1f;
+      c.focus_distance = 2.5f;
+    }
+    if (variant >= 2 && variant <= 3) {
+      c.projection = Camera::Projection::Orthographic;
+      c.ortho_scale = 3.0f;
+    }
+    if (variant == 4)  // a scaled camera object
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) c.camera_to_world.m[r][k] *= 1.7f;
+    const CameraModel cam(c);
+    const bool mask[4] = {true, true, true, true};
+    const float sx[4] = {1, 0, -1, 0}, sy[4] = {0, 1, 0, -1};
+    for (int i = 0; i < 50; ++i) {
+      const Vec2f raster{1.0f + 38.0f * float(i % 7) / 7.0f + 0.13f,
+                         1.0f + 28.0f * float(i % 11) / 11.0f + 0.71f};
+      const Vec2f lens{float(i % 5) / 5.0f + 0.1f, float(i % 3) / 3.0f + 0.2f};
+      Ray off[4];
+      cam.generate_offset_rays(raster, lens, mask, off);
+      for (int k = 0; k < 4; ++k) {
+        const Ray e = cam.generate_ray({raster.x + sx[k], raster.y + sy[k]}, lens);
+        EXPECT_NEAR(length(off[k].origin - e.origin), 0.0f, 1e-5f) << variant << " " << k;
+        EXPECT_NEAR(length(off[k].direction - e.direction), 0.0f, 1e-6f) << variant << " " << k;
+        EXPECT_NEAR(off[k].t_min, e.t_min, 1e-5f * e.t_min) << variant << " " << k;
+        EXPECT_NEAR(off[k].t_max, e.t_max, 1e-5f * e.t_max) << variant << " " << k;
+      }
+    }
+  }
 }
 
 }  // namespace
