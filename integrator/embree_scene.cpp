@@ -280,6 +280,48 @@ void EmbreeScene::occluded4(const Ray rays[4], const bool valid[4], bool blocked
   for (int i = 0; i < 4; ++i) blocked[i] = valid[i] && r.tfar[i] < 0.0f;  // -inf on a hit
 }
 
+void EmbreeScene::intersect_stream(const Ray* rays, const bool* valid, int n, bool* found,
+                                   SurfaceHit* hits) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  constexpr int kChunk = 64;
+  alignas(16) RTCRayHit rh[kChunk];
+  for (int first = 0; first < n; first += kChunk) {
+    const int m = std::min(kChunk, n - first);
+    for (int j = 0; j < m; ++j) {
+      const Ray& ray = rays[first + j];
+      RTCRayHit& r = rh[j];
+      r.ray.org_x = ray.origin.x;
+      r.ray.org_y = ray.origin.y;
+      r.ray.org_z = ray.origin.z;
+      r.ray.dir_x = ray.direction.x;
+      r.ray.dir_y = ray.direction.y;
+      r.ray.dir_z = ray.direction.z;
+      // An inactive ray of a stream has tnear > tfar.
+      r.ray.tnear = valid[first + j] ? ray.t_min : 1.0f;
+      r.ray.tfar = valid[first + j] ? ray.t_max : 0.0f;
+      r.ray.time = 0.0f;
+      r.ray.mask = 0xffffffffu;
+      r.ray.id = unsigned(j);
+      r.ray.flags = 0;
+      r.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      r.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect1M(top_, &ctx, rh, unsigned(m), sizeof(RTCRayHit));
+    for (int j = 0; j < m; ++j) {
+      const int i = first + j;
+      const RTCRayHit& r = rh[j];
+      found[i] = valid[i] && r.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      if (!found[i]) continue;
+      hits[i].t = r.ray.tfar;
+      const unsigned top_id =
+          r.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? r.hit.instID[0] : r.hit.geomID;
+      complete_hit(top_id, r.hit.primID, r.hit.u, r.hit.v, rays[i].direction, hits[i]);
+    }
+  }
+}
+
 void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v, Vec3f dir,
                                SurfaceHit& hit) const {
   const InstanceData& d = instances_[top_id];

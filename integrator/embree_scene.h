@@ -53,6 +53,12 @@ class EmbreeScene {
   // the G-PT offsets, whose four rays start at neighbouring pixels.
   void intersect4(const Ray rays[4], const bool valid[4], bool found[4], SurfaceHit hits[4]) const;
   void occluded4(const Ray rays[4], const bool valid[4], bool blocked[4]) const;
+  // A stream of n rays (Embree rtcIntersect1M, coherent context: Embree groups consecutive rays
+  // into packets of its native width, on any ISA). Ray i is traced only when valid[i]; results as
+  // intersect(). For G-PT's camera rays of a row of pixels (consecutive rays start at neighbouring
+  // pixels).
+  void intersect_stream(const Ray* rays, const bool* valid, int n, bool* found,
+                        SurfaceHit* hits) const;
 
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
   size_t instanced_triangle_count() const { return instanced_triangles_; }
