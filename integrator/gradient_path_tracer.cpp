@@ -175,11 +175,29 @@ struct BaseStep {
 // Per-thread working storage of trace(), reused across samples: no allocation or large
 // initialisation per sample (a ClosureSet holds kMaxClosures lobes). The per-offset arrays of the
 // packets live here too: as locals their default member initialisers ran on every bounce.
+// Camera rays are traced for a row of up to kRow pixels at once (render_tile): the base rays of
+// the row in one Embree stream, then the offsets' rays, offset-major (the kRow rays of one offset
+// direction are as coherent as the base rays), in another; Embree packs them into its own
+// packets. Per-pixel rays as packets of four cost about twice as much time.
+constexpr int kRow = 16;
+
+struct CameraRow {
+  Sampler sampler[kRow];
+  Vec2f raster[kRow], lens[kRow];
+  bool mask[kRow][kOffsets];
+  Ray ray[kRow];
+  bool valid[kRow], found[kRow];
+  SurfaceHit hit[kRow];
+  // Offset k of pixel i at k * kRow + i, traced when the pixel's base ray found a surface.
+  Ray cam[kOffsets * kRow];
+  bool cam_valid[kOffsets * kRow], cam_found[kOffsets * kRow];
+  SurfaceHit cam_hit[kOffsets * kRow];
+};
+
 struct PathScratch {
   Offset off[kOffsets];
   Vertex verts[2];  // base vertex and the next one, swapped per bounce
-  Ray cam[kOffsets];
-  SurfaceHit cam_hit[kOffsets];
+  CameraRow row;
   LightSample lo[kOffsets];
   Ray shadow[kOffsets];
   Ray vis[kOffsets];
@@ -202,7 +220,6 @@ class GradientPathTracer final : public Integrator {
                    Film& film) const override {
     const int W = film.width(), H = film.height();
     uint64_t rays = 0;
-    Sampler sampler;
     thread_local PathScratch scratch;
     const float clamp = settings_.clamp;
     // Adds one half to a gradient accumulator (sum and squared luminance); a non-finite half
@@ -215,37 +232,71 @@ class GradientPathTracer final : public Integrator {
       const double l = 0.2126 * g.x + 0.7152 * g.y + 0.0722 * g.z;
       sum2 += l * l;
     };
+    CameraRow& row = scratch.row;
+    const bool has_dof = has_dof_;
     for (uint32_t s = first_sample; s < first_sample + sample_count; ++s)
       for (int y = tile.y0; y < tile.y1; ++y)
-        for (int x = tile.x0; x < tile.x1; ++x) {
-          // Every offset whose target pixel is inside the image: the pixel's own halves of
-          // dx(x), dy(x), dx(x - 1) and dy(y - 1) (the latter two combined at read-out).
-          const bool mask[kOffsets] = {x + 1 < W, y + 1 < H, x >= 1, y >= 1};
-          sampler.start(settings_.seed, x, y, s);
-          SampleResult r;
-          trace(sampler, x, y, mask, scratch, r);
-          rays += r.rays;
-          // --- Primal, emission and statistics of the pixel's base path ---
-          if (!is_finite(r.primal)) r.primal = Spectrum(0.0f);
-          if (!is_finite(r.emission)) r.emission = Spectrum(0.0f);
-          if (clamp > 0.0f) {
-            const float m = max_component(r.primal);
-            if (m > clamp) r.primal *= clamp / m;
+        for (int x0 = tile.x0; x0 < tile.x1; x0 += kRow) {
+          const int n = std::min(kRow, tile.x1 - x0);
+          // --- Camera rays of the row: same jitter and lens sample for a base and its offsets ---
+          for (int i = 0; i < kRow; ++i) {
+            row.valid[i] = i < n;
+            if (!row.valid[i]) continue;
+            const int x = x0 + i;
+            row.sampler[i].start(settings_.seed, x, y, s);
+            const Vec2f jitter = row.sampler[i].get2d(Sampler::kDimCamera);
+            row.lens[i] = has_dof ? row.sampler[i].get2d(Sampler::kDimLens) : Vec2f(0.5f, 0.5f);
+            row.raster[i] = Vec2f(float(x) + jitter.x, float(y) + jitter.y);
+            row.ray[i] = ctx_.camera().generate_ray(row.raster[i], row.lens[i]);
           }
-          Film::Accumulator& acc = film.pixel(x, y);
-          const double lum = luminance(r.primal);
-          for (int c = 0; c < 3; ++c) {
-            acc.primal[c] += r.primal[c];
-            acc.emission[c] += r.emission[c];
+          ctx_.bvh().intersect_stream(row.ray, row.valid, kRow, row.found, row.hit);
+          for (int i = 0; i < kRow; ++i) {
+            const int x = x0 + i;
+            // Every offset whose target pixel is inside the image: the pixel's own halves of
+            // dx(x), dy(x), dx(x - 1) and dy(y - 1) (the latter two combined at read-out).
+            bool* mask = row.mask[i];
+            mask[kRight] = x + 1 < W;
+            mask[kUp] = y + 1 < H;
+            mask[kLeft] = x >= 1;
+            mask[kDown] = y >= 1;
+            const bool traced = row.valid[i] && row.found[i];
+            Ray cam[kOffsets];
+            if (traced) ctx_.camera().generate_offset_rays(row.raster[i], row.lens[i], mask, cam);
+            for (int k = 0; k < kOffsets; ++k) {
+              row.cam_valid[k * kRow + i] = traced && mask[k];
+              if (row.cam_valid[k * kRow + i]) row.cam[k * kRow + i] = cam[k];
+            }
           }
-          acc.primal2 += lum * lum;
-          acc.shift_attempts += r.attempts;
-          acc.shift_failures += r.failures;
-          // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
-          if (mask[kRight]) add_half(r.grad[kRight], acc.dx, acc.dx2);
-          if (mask[kUp]) add_half(r.grad[kUp], acc.dy, acc.dy2);
-          if (mask[kLeft]) add_half(r.grad[kLeft], acc.dx_left, acc.dx_left2);
-          if (mask[kDown]) add_half(r.grad[kDown], acc.dy_down, acc.dy_down2);
+          ctx_.bvh().intersect_stream(row.cam, row.cam_valid, kOffsets * kRow, row.cam_found,
+                                      row.cam_hit);
+          for (int i = 0; i < n; ++i) {
+            const int x = x0 + i;
+            const bool* mask = row.mask[i];
+            SampleResult r;
+            trace(row.sampler[i], i, scratch, r);
+            rays += r.rays;
+            // --- Primal, emission and statistics of the pixel's base path ---
+            if (!is_finite(r.primal)) r.primal = Spectrum(0.0f);
+            if (!is_finite(r.emission)) r.emission = Spectrum(0.0f);
+            if (clamp > 0.0f) {
+              const float m = max_component(r.primal);
+              if (m > clamp) r.primal *= clamp / m;
+            }
+            Film::Accumulator& acc = film.pixel(x, y);
+            const double lum = luminance(r.primal);
+            for (int c = 0; c < 3; ++c) {
+              acc.primal[c] += r.primal[c];
+              acc.emission[c] += r.emission[c];
+            }
+            acc.primal2 += lum * lum;
+            acc.shift_attempts += r.attempts;
+            acc.shift_failures += r.failures;
+            // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
+            if (mask[kRight]) add_half(r.grad[kRight], acc.dx, acc.dx2);
+            if (mask[kUp]) add_half(r.grad[kUp], acc.dy, acc.dy2);
+            if (mask[kLeft]) add_half(r.grad[kLeft], acc.dx_left, acc.dx_left2);
+            if (mask[kDown]) add_half(r.grad[kDown], acc.dy_down, acc.dy_down2);
+          }
         }
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x) film.add_sample_count(x, y, sample_count);
@@ -257,8 +308,8 @@ class GradientPathTracer final : public Integrator {
     return shift::classify_vertex(roughness, settings_.shift_roughness_threshold);
   }
 
-  // The segment from `from` (geometric normal `ng`) along `dir` up to t_max, leaving the surface
-  // on the side of `dir`.
+  // The segment from vertex `v` along `dir` up to t_max, leaving the surface on the side of
+  // `dir`.
   static Ray shadow_ray(const Vertex& v, Vec3f dir, float t_max) {
     const Vec3f from = v.hit.position;
     Ray shadow;
@@ -345,22 +396,21 @@ class GradientPathTracer final : public Integrator {
     return out.valid && length_squared(out.position - ls.position) < 1e-8f * scale * scale;
   }
 
-  void trace(const Sampler& sampler, int px, int py, const bool mask[kOffsets],
-             PathScratch& scratch, SampleResult& out) const {
+  // Traces pixel `i` of scratch.row, whose camera rays render_tile() has traced.
+  void trace(const Sampler& sampler, int i, PathScratch& scratch, SampleResult& out) const {
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
     const int max_bounces = settings_.max_bounces;
     const bool has_lights = !lights.empty();
     const bool needs_selection = lights.needs_selection();
+    const CameraRow& row = scratch.row;
+    const bool* mask = row.mask[i];
 
-    // --- Camera rays: same jitter and lens sample for the base and the offsets ---
-    const Vec2f jitter = sampler.get2d(Sampler::kDimCamera);
-    const Vec2f lens = has_dof_ ? sampler.get2d(Sampler::kDimLens) : Vec2f(0.5f, 0.5f);
-    const Vec2f raster{float(px) + jitter.x, float(py) + jitter.y};
-    Ray ray = ctx_.camera().generate_ray(raster, lens);
-    SurfaceHit hit;
+    // --- Camera rays (traced by render_tile) ---
+    Ray ray = row.ray[i];
+    const SurfaceHit& hit = row.hit[i];
     ++out.rays;
-    const bool camera_found = bvh.intersect(ray, hit);
+    const bool camera_found = row.found[i];
     // Very direct light, never shifted: lamps visible to the camera, and the world.
     if (has_visible_lamps_) {
       LightHit lh;
@@ -373,19 +423,13 @@ class GradientPathTracer final : public Integrator {
       return;
     }
 
-    // The four offset camera rays start at neighbouring pixels: one coherent packet.
     Offset* off = scratch.off;
-    Ray* cam = scratch.cam;
-    ctx_.camera().generate_offset_rays(raster, lens, mask, cam);  // kRight, kUp, kLeft, kDown
-    for (int k = 0; k < kOffsets; ++k) out.rays += mask[k];
-    bool cam_found[kOffsets];
-    SurfaceHit* cam_hit = scratch.cam_hit;
-    bvh.intersect4(cam, mask, cam_found, cam_hit);
     for (int k = 0; k < kOffsets; ++k) {
       Offset& o = off[k];
       o.active = mask[k];
       o.alive = false;
       if (!o.active) continue;
+      ++out.rays;
       ++out.attempts;
       o.failed = false;
       o.link = Link::NotConnected;
@@ -393,10 +437,10 @@ class GradientPathTracer final : public Integrator {
       o.f = Vec3d(1.0, 1.0, 1.0);
       o.p = 1.0;
       o.grad = Vec3d();
-      o.ray = cam[k];
+      o.ray = row.cam[k * kRow + i];
       // Base hits a surface, the offset the world: no shift.
-      o.alive = cam_found[k];
-      if (o.alive) setup_vertex(ctx_, cam_hit[k], o.ray.direction, o.v);
+      o.alive = row.cam_found[k * kRow + i];
+      if (o.alive) setup_vertex(ctx_, row.cam_hit[k * kRow + i], o.ray.direction, o.v);
     }
 
     int cur = 0;  // scratch.verts[cur] is the base vertex
