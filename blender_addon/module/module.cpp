@@ -92,6 +92,7 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("add_light", &SceneBuilder::add_light)
       .def("set_camera", &SceneBuilder::set_camera)
       .def("set_world", &SceneBuilder::set_world)
+      .def("mesh_arrays", &SceneBuilder::mesh_arrays, py::arg("index"))
       .def_property_readonly("mesh_count", &SceneBuilder::mesh_count)
       .def_property_readonly("instance_count", &SceneBuilder::instance_count)
       .def_property_readonly("triangle_count", &SceneBuilder::triangle_count);
@@ -107,6 +108,8 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("features_summary", &RenderJob::features_summary)
       .def("warnings", &RenderJob::warnings);
 
+  m.def("empty", &empty_array, py::arg("count"), py::arg("dtype"),
+        "numpy.empty((count,), dtype), its large pages advised as huge pages (faster first touch)");
   m.def("reconstruct", &reconstruct_arrays, py::arg("primal").noconvert(),
         py::arg("gradient_x").noconvert(), py::arg("gradient_y").noconvert(),
         py::arg("variance").noconvert() = py::none(), py::arg("emission").noconvert() = py::none(),

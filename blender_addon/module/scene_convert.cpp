@@ -1,9 +1,17 @@
 // See scene_convert.h for the dict layouts.
 #include "blender_addon/module/scene_convert.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <type_traits>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "shaders/image_io.h"
 
@@ -100,6 +108,29 @@ ShaderNodeKind to_kind(const std::string& kind) {
   bad_enum("shader node kind", kind);
 }
 
+// Asks the kernel to back the whole 2 MB pages inside [data, data + bytes) with transparent huge
+// pages before anything touches them. Where THP is in `madvise` mode (as on the benchmark VM),
+// first touching fresh memory then takes one fault per 2 MB instead of one per 4 KB: there,
+// touching 256 MB took 1.0-1.2 s in 4 KB pages (15-19 us per fault under load) and 48-66 ms
+// advised, so a 1M-triangle mesh's 80 MB of arrays cost about 0.3 s in faults alone. Only whole
+// pages inside the buffer are advised. A no-op elsewhere and for buffers under 2 MB.
+void advise_huge_pages([[maybe_unused]] const void* data, [[maybe_unused]] size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(data) + bytes) & ~(kHuge - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#endif
+}
+
+// An empty vector with room for n elements, its fresh pages advised as huge pages.
+template <typename T>
+void reserve_fresh(std::vector<T>& v, size_t n) {
+  v.clear();
+  v.reserve(n);
+  advise_huge_pages(v.data(), n * sizeof(T));
+}
+
 template <typename T>
 const T* checked_data(const py::array_t<T, py::array::c_style>& a, size_t expected,
                       const char* what) {
@@ -110,6 +141,19 @@ const T* checked_data(const py::array_t<T, py::array::c_style>& a, size_t expect
 }
 
 }  // namespace
+
+py::array empty_array(py::ssize_t count, const py::dtype& dtype) {
+  if (count < 0) throw std::invalid_argument("empty: negative count");
+  const size_t bytes = size_t(count) * size_t(dtype.itemsize());
+  constexpr size_t kHuge = size_t(2) << 20;
+  // Large buffers start on a 2 MB boundary so that every page of them can be a huge page.
+  void* p = bytes >= kHuge ? std::aligned_alloc(kHuge, (bytes + kHuge - 1) & ~(kHuge - 1))
+                           : std::malloc(std::max<size_t>(bytes, 1));
+  if (!p) throw std::bad_alloc();
+  advise_huge_pages(p, bytes);
+  py::capsule owner(p, [](void* q) { std::free(q); });
+  return py::array(dtype, {count}, {}, p, owner);
+}
 
 // --- Geometry ----------------------------------------------------------------------------------
 
@@ -157,6 +201,102 @@ int SceneBuilder::add_mesh(const FloatArray& positions, const IntArray& indices,
   return int(scene_.meshes.size()) - 1;
 }
 
+// Blender's own arrays -> Mesh, one pass per output array. A 1M-triangle mesh writes about 80 MB
+// of fresh memory (per-corner normals and UVs are most of it), and on Linux first touching fresh
+// memory in 4 KB pages costs more than the gathering itself: the buffers are reserved first and
+// advised as huge pages (advise_huge_pages), then filled in order with no zero-fill and no
+// temporary arrays. Runs without the GIL: only numpy buffers the caller keeps alive are read.
+namespace {
+
+struct CornerSource {
+  const float* positions = nullptr;
+  size_t vertex_count = 0;
+  const int32_t* loop_vertex = nullptr;
+  size_t loop_count = 0;
+  const float* normals = nullptr;  // per loop or per vertex, or null
+  bool normals_per_loop = false;
+  const float* loop_uvs = nullptr;  // per loop, or null
+};
+
+CornerSource corner_source(const FloatArray& positions, const IntArray& loop_vertex,
+                           const FloatArray& normals, bool normals_per_loop,
+                           const FloatArray& loop_uvs) {
+  if (positions.size() % 3 != 0) throw std::invalid_argument("positions: size not a multiple of 3");
+  CornerSource s;
+  s.positions = positions.data();
+  s.vertex_count = size_t(positions.size()) / 3;
+  s.loop_vertex = loop_vertex.data();
+  s.loop_count = size_t(loop_vertex.size());
+  // Every loop's vertex is validated once here, so the gathers below index without checks.
+  for (size_t l = 0; l < s.loop_count; ++l)
+    if (s.loop_vertex[l] < 0 || size_t(s.loop_vertex[l]) >= s.vertex_count)
+      throw std::invalid_argument("loop_vertex: vertex index out of range");
+  if (normals.size() > 0) {
+    const size_t expected = (normals_per_loop ? s.loop_count : s.vertex_count) * 3;
+    s.normals = checked_data(normals, expected, "normals");
+    s.normals_per_loop = normals_per_loop;
+  }
+  if (loop_uvs.size() > 0) s.loop_uvs = checked_data(loop_uvs, s.loop_count * 2, "loop_uvs");
+  return s;
+}
+
+// Fills `mesh` from `triangles` triangles whose corner loops `corners(emit)` produces in order
+// (emit(loop) per corner, emit_material(slot) per triangle). Loops must be in range.
+template <typename Corners>
+Mesh gather_mesh(const CornerSource& src, size_t triangles, bool with_material,
+                 const Corners& corners) {
+  Mesh mesh;
+  const size_t corner_count = triangles * 3;
+  reserve_fresh(mesh.positions, src.vertex_count);
+  mesh.positions.resize(src.vertex_count);
+  std::memcpy(static_cast<void*>(mesh.positions.data()), src.positions,
+              src.vertex_count * sizeof(Vec3f));
+  reserve_fresh(mesh.indices, corner_count);
+  if (src.normals) reserve_fresh(mesh.corner_normals, corner_count);
+  if (src.loop_uvs) reserve_fresh(mesh.corner_uvs, corner_count);
+  if (with_material) reserve_fresh(mesh.material_slot, triangles);
+  // One loop per output array: each streams through its own buffer.
+  corners([&](int32_t loop) { mesh.indices.push_back(uint32_t(src.loop_vertex[loop])); },
+          [](int32_t) {});
+  if (src.normals) {
+    const float* n = src.normals;
+    if (src.normals_per_loop)
+      corners(
+          [&](int32_t loop) {
+            const size_t i = 3 * size_t(loop);
+            mesh.corner_normals.emplace_back(n[i], n[i + 1], n[i + 2]);
+          },
+          [](int32_t) {});
+    else
+      corners(
+          [&](int32_t loop) {
+            const size_t i = 3 * size_t(src.loop_vertex[loop]);
+            mesh.corner_normals.emplace_back(n[i], n[i + 1], n[i + 2]);
+          },
+          [](int32_t) {});
+  }
+  if (src.loop_uvs) {
+    const float* uv = src.loop_uvs;
+    corners(
+        [&](int32_t loop) {
+          mesh.corner_uvs.emplace_back(uv[2 * size_t(loop)], uv[2 * size_t(loop) + 1]);
+        },
+        [](int32_t) {});
+  }
+  if (with_material)
+    corners([](int32_t) {}, [&](int32_t slot) { mesh.material_slot.push_back(slot); });
+  return mesh;
+}
+
+bool any_nonzero(const IntArray& a) {
+  const int32_t* p = a.data();
+  for (py::ssize_t i = 0; i < a.size(); ++i)
+    if (p[i] != 0) return true;
+  return false;
+}
+
+}  // namespace
+
 int SceneBuilder::add_mesh_loops(const FloatArray& positions, const IntArray& loop_vertex,
                                  const IntArray& corner_loops, const FloatArray& normals,
                                  bool normals_per_loop, const FloatArray& loop_uvs,
@@ -165,9 +305,29 @@ int SceneBuilder::add_mesh_loops(const FloatArray& positions, const IntArray& lo
     throw std::invalid_argument("corner_loops: size not a multiple of 3");
   if (material_slot.size() > 0 && material_slot.size() * 3 != corner_loops.size())
     throw std::invalid_argument("material_slot: expected one value per triangle");
-  return add_mesh_corners(
-      positions, loop_vertex, {corner_loops.data(), size_t(corner_loops.size())}, normals,
-      normals_per_loop, loop_uvs, {material_slot.data(), size_t(material_slot.size())});
+  Mesh mesh;
+  {
+    py::gil_scoped_release no_gil;
+    const CornerSource src =
+        corner_source(positions, loop_vertex, normals, normals_per_loop, loop_uvs);
+    const int32_t* corners = corner_loops.data();
+    const size_t triangles = size_t(corner_loops.size()) / 3;
+    for (size_t i = 0; i < triangles * 3; ++i)
+      if (corners[i] < 0 || size_t(corners[i]) >= src.loop_count)
+        throw std::invalid_argument("corner_loops: loop index out of range");
+    const int32_t* slot = material_slot.data();
+    mesh = gather_mesh(src, triangles, any_nonzero(material_slot),
+                       [&](const auto& emit, const auto& emit_material) {
+                         for (size_t t = 0; t < triangles; ++t) {
+                           emit(corners[3 * t]);
+                           emit(corners[3 * t + 1]);
+                           emit(corners[3 * t + 2]);
+                           emit_material(slot[t]);
+                         }
+                       });
+  }
+  scene_.meshes.push_back(std::move(mesh));
+  return int(scene_.meshes.size()) - 1;
 }
 
 int SceneBuilder::add_mesh_polys(const FloatArray& positions, const IntArray& loop_vertex,
@@ -179,92 +339,100 @@ int SceneBuilder::add_mesh_polys(const FloatArray& positions, const IntArray& lo
     throw std::invalid_argument("loop_start / loop_total differ in size");
   if (poly_material.size() > 0 && size_t(poly_material.size()) != poly_count)
     throw std::invalid_argument("poly_material: expected one value per polygon");
-  const int32_t* start = loop_start.data();
-  const int32_t* total = loop_total.data();
-  const int32_t* lv = loop_vertex.data();
-  const float* co = positions.data();
-  const auto loop_count = int64_t(loop_vertex.size());
-  const auto vertex_count = int64_t(positions.size() / 3);
-  size_t triangle_count = 0;
-  for (size_t p = 0; p < poly_count; ++p) {
-    if (total[p] < 3 || total[p] > 4 || start[p] < 0 || int64_t(start[p]) + total[p] > loop_count)
-      throw std::invalid_argument("add_mesh_polys: only triangles and quads, loops in range");
-    triangle_count += size_t(total[p] - 2);
-  }
-  std::vector<int32_t> corners(triangle_count * 3), material(triangle_count);
-  auto vertex = [&](int32_t loop) {
-    const int64_t v = lv[loop];
-    if (v < 0 || v >= vertex_count) throw std::invalid_argument("loop_vertex out of range");
-    return Vec3f(co[3 * v], co[3 * v + 1], co[3 * v + 2]);
-  };
-  size_t t = 0;
-  for (size_t p = 0; p < poly_count; ++p) {
-    const int32_t s = start[p];
-    const int32_t m = poly_material.size() > 0 ? poly_material.data()[p] : 0;
-    bool flip = false;
-    if (total[p] == 4) {
-      // Blender's fold test: (v1 - v0) x (v2 - v0) and (v3 - v0) x (v2 - v0) agree.
-      const Vec3f v0 = vertex(s), v1 = vertex(s + 1), v2 = vertex(s + 2), v3 = vertex(s + 3);
-      flip = dot(cross(v1 - v0, v2 - v0), cross(v3 - v0, v2 - v0)) > 0.0f;
-    }
-    const int32_t tri[2][3] = {{s, s + 1, flip ? s + 3 : s + 2}, {flip ? s + 1 : s, s + 2, s + 3}};
-    for (int k = 0; k < total[p] - 2; ++k, ++t) {
-      for (int c = 0; c < 3; ++c) corners[3 * t + size_t(c)] = tri[k][c];
-      material[t] = m;
-    }
-  }
-  return add_mesh_corners(positions, loop_vertex, corners, normals, normals_per_loop, loop_uvs,
-                          material);
-}
-
-int SceneBuilder::add_mesh_corners(const FloatArray& positions, const IntArray& loop_vertex,
-                                   std::span<const int32_t> corner_span, const FloatArray& normals,
-                                   bool normals_per_loop, const FloatArray& loop_uvs,
-                                   std::span<const int32_t> material_slot) {
-  if (positions.size() % 3 != 0) throw std::invalid_argument("positions: size not a multiple of 3");
-  const size_t vertex_count = size_t(positions.size()) / 3;
-  const size_t loop_count = size_t(loop_vertex.size());
-  const size_t corner_count = corner_span.size();
-
   Mesh mesh;
-  mesh.positions.resize(vertex_count);
-  std::memcpy(static_cast<void*>(mesh.positions.data()), positions.data(),
-              vertex_count * sizeof(Vec3f));
-
-  // --- Vertex indices per corner (validated once) ---
-  const int32_t* corners = corner_span.data();
-  const int32_t* lv = loop_vertex.data();
-  for (size_t i = 0; i < corner_count; ++i)
-    if (corners[i] < 0 || size_t(corners[i]) >= loop_count)
-      throw std::invalid_argument("corner_loops: loop index out of range");
-  mesh.indices.resize(corner_count);
-  for (size_t i = 0; i < corner_count; ++i) {
-    const int32_t v = lv[corners[i]];
-    if (v < 0 || size_t(v) >= vertex_count)
-      throw std::invalid_argument("loop_vertex: vertex index out of range");
-    mesh.indices[i] = uint32_t(v);
-  }
-
-  // --- Shading normals per corner ---
-  if (normals.size() > 0) {
-    const size_t expected = (normals_per_loop ? loop_count : vertex_count) * 3;
-    const float* n = checked_data(normals, expected, "normals");
-    mesh.corner_normals.resize(corner_count);
-    for (size_t i = 0; i < corner_count; ++i) {
-      const size_t src = normals_per_loop ? size_t(corners[i]) : size_t(mesh.indices[i]);
-      mesh.corner_normals[i] = Vec3f(n[3 * src], n[3 * src + 1], n[3 * src + 2]);
+  {
+    py::gil_scoped_release no_gil;
+    const CornerSource src =
+        corner_source(positions, loop_vertex, normals, normals_per_loop, loop_uvs);
+    const int32_t* start = loop_start.data();
+    const int32_t* total = loop_total.data();
+    size_t triangles = 0;
+    for (size_t p = 0; p < poly_count; ++p) {
+      if (total[p] < 3 || total[p] > 4 || start[p] < 0 ||
+          size_t(start[p]) + size_t(total[p]) > src.loop_count)
+        throw std::invalid_argument("add_mesh_polys: only triangles and quads, loops in range");
+      triangles += size_t(total[p] - 2);
     }
+    // Quads split as Blender 3.4's loop triangles do when its face normals are up to date (they
+    // are once anything read the mesh's normals, as the export and renderers do): along 0-2
+    // (0-1-2 + 0-2-3) unless, seen along the face normal n = (v0 - v2) x (v1 - v3), v1 and v3 are
+    // not strictly on opposite sides of the 0-2 diagonal; then along 1-3 (0-1-3 + 1-2-3). That
+    // covers folded and concave quads and degenerate ones (two corners at one position, as at
+    // the poles of a quad sphere), where the 1-3 split keeps the real triangle's own corners.
+    // (Quads within rounding of such a tie may split either way, as in Blender, whose result
+    // depends on how its cached face normal was computed.)
+    // The choice is made once per quad, not once per output array.
+    std::vector<uint8_t> flip(poly_count, 0);
+    const float* co = src.positions;
+    const int32_t* lv = src.loop_vertex;
+    auto vertex = [&](int32_t loop) {
+      const size_t v = 3 * size_t(lv[loop]);
+      return Vec3f(co[v], co[v + 1], co[v + 2]);
+    };
+    for (size_t p = 0; p < poly_count; ++p) {
+      if (total[p] != 4) continue;
+      const int32_t s = start[p];
+      const Vec3f v0 = vertex(s), v1 = vertex(s + 1), v2 = vertex(s + 2), v3 = vertex(s + 3);
+      Vec3f n = cross(v0 - v2, v1 - v3);  // Blender's normal_quad_v3
+      const float len2 = dot(n, n);
+      n = len2 > 1e-35f ? n * (1.0f / std::sqrt(len2)) : Vec3f(0.0f);  // and normalize_v3
+      const Vec3f tangent = cross(v2 - v0, n);
+      const float d = dot(v0, tangent);
+      flip[p] = dot(v3, tangent) >= d || dot(v1, tangent) <= d;
+    }
+    const int32_t* material = poly_material.data();
+    mesh = gather_mesh(src, triangles, poly_material.size() > 0 && any_nonzero(poly_material),
+                       [&](const auto& emit, const auto& emit_material) {
+                         for (size_t p = 0; p < poly_count; ++p) {
+                           const int32_t s = start[p];
+                           if (total[p] == 3) {
+                             emit(s);
+                             emit(s + 1);
+                             emit(s + 2);
+                             emit_material(material[p]);
+                           } else if (!flip[p]) {
+                             emit(s);
+                             emit(s + 1);
+                             emit(s + 2);
+                             emit_material(material[p]);
+                             emit(s);
+                             emit(s + 2);
+                             emit(s + 3);
+                             emit_material(material[p]);
+                           } else {
+                             emit(s);
+                             emit(s + 1);
+                             emit(s + 3);
+                             emit_material(material[p]);
+                             emit(s + 1);
+                             emit(s + 2);
+                             emit(s + 3);
+                             emit_material(material[p]);
+                           }
+                         }
+                       });
   }
-  // --- UVs per corner ---
-  if (loop_uvs.size() > 0) {
-    const float* uv = checked_data(loop_uvs, loop_count * 2, "loop_uvs");
-    mesh.corner_uvs.resize(corner_count);
-    for (size_t i = 0; i < corner_count; ++i)
-      mesh.corner_uvs[i] = Vec2f(uv[2 * size_t(corners[i])], uv[2 * size_t(corners[i]) + 1]);
-  }
-  if (!material_slot.empty()) mesh.material_slot.assign(material_slot.begin(), material_slot.end());
   scene_.meshes.push_back(std::move(mesh));
   return int(scene_.meshes.size()) - 1;
+}
+
+py::dict SceneBuilder::mesh_arrays(int index) const {
+  if (index < 0 || size_t(index) >= scene_.meshes.size())
+    throw std::invalid_argument("mesh_arrays: mesh index out of range");
+  const Mesh& m = scene_.meshes[size_t(index)];
+  auto copy = [](const auto& v, std::vector<py::ssize_t> shape, auto scalar) {
+    py::array_t<decltype(scalar)> a(shape);
+    std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(v[0]));
+    return a;
+  };
+  const auto t = py::ssize_t(m.triangle_count());
+  py::dict d;
+  d["positions"] = copy(m.positions, {py::ssize_t(m.positions.size()), 3}, 0.0f);
+  d["indices"] = copy(m.indices, {t, 3}, uint32_t(0));
+  d["corner_normals"] = copy(m.corner_normals, {m.corner_normals.empty() ? 0 : t, 3, 3}, 0.0f);
+  d["corner_uvs"] = copy(m.corner_uvs, {m.corner_uvs.empty() ? 0 : t, 3, 2}, 0.0f);
+  d["material_slot"] = copy(m.material_slot, {py::ssize_t(m.material_slot.size())}, int32_t(0));
+  return d;
 }
 
 void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material) {

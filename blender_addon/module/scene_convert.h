@@ -36,6 +36,10 @@ namespace py = pybind11;
 using FloatArray = py::array_t<float, py::array::c_style>;
 using IntArray = py::array_t<int32_t, py::array::c_style>;
 
+// numpy.empty(count, dtype) for arrays that Blender's foreach_get fills: large ones are advised as
+// transparent huge pages before their first touch (see advise_huge_pages in scene_convert.cpp).
+py::array empty_array(py::ssize_t count, const py::dtype& dtype);
+
 // Incrementally filled scene; handed over (moved) to a render session.
 class SceneBuilder {
  public:
@@ -69,6 +73,10 @@ class SceneBuilder {
   void set_camera(const py::dict& camera);
   void set_world(const py::dict& world);
 
+  // The arrays of mesh `index` as the core holds them (copies), for the export tests:
+  // positions (n, 3), indices (m, 3), corner_normals (m, 3, 3) or empty, corner_uvs (m, 3, 2) or
+  // empty, material_slot (m,) or empty.
+  py::dict mesh_arrays(int index) const;
   size_t mesh_count() const { return scene_.meshes.size(); }
   size_t instance_count() const { return scene_.instances.size(); }
   size_t triangle_count() const;
@@ -76,10 +84,6 @@ class SceneBuilder {
   const Scene& scene() const { return scene_; }
 
  private:
-  int add_mesh_corners(const FloatArray& positions, const IntArray& loop_vertex,
-                       std::span<const int32_t> corners, const FloatArray& normals,
-                       bool normals_per_loop, const FloatArray& loop_uvs,
-                       std::span<const int32_t> material_slot);
   Scene scene_;
 };
 

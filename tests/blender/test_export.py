@@ -1,0 +1,171 @@
+# Mesh export: what export_mesh.add_mesh hands to the core equals Blender's own loop triangles
+# (Mesh.loop_triangles), triangle by triangle and corner by corner: vertex indices, positions,
+# shading normals (Blender's split normals; none for an all-flat mesh), the active render UV map
+# and the material slot. The fast path (triangles and quads, triangulated in the module with
+# Blender's rule) and the n-gon path (Blender's ear clipping) both run, on:
+#  - triangles, planar and non-planar quads, and an arrowhead quad that Blender splits along 1-3,
+#    smooth and flat faces mixed (split normals), two materials, per-loop (discontinuous) UVs;
+#  - an all-smooth quad sphere (vertex normals) with degenerate quads at its poles, whose active
+#    render UV map is not the first;
+#  - n-gons (convex and concave), all flat (no normals), material indices;
+#  - custom split normals;
+#  - an evaluated mesh (Subdivision Surface modifier) from the depsgraph.
+import os
+import sys
+
+import bpy
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(__file__))
+import scenes as S  # noqa: E402
+
+check = S.check
+
+
+def make_mesh(name, verts, faces, smooth, materials=(), uv_layers=("UVMap",), render_uv=0):
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(verts, [], faces)
+    for k, layer_name in enumerate(uv_layers):
+        layer = me.uv_layers.new(name=layer_name)
+        for loop in me.loops:  # discontinuous: a per-vertex gather would be caught
+            layer.data[loop.index].uv = (0.01 * loop.index + k, 0.1 * loop.vertex_index)
+    if uv_layers:
+        me.uv_layers[render_uv].active_render = True
+    for p in me.polygons:
+        p.use_smooth = smooth(p.index)
+    for m in materials:
+        me.materials.append(m)
+    for p in me.polygons:
+        p.material_index = (p.index % len(materials)) if len(materials) > 1 else 0
+    me.update()
+    return me
+
+
+def reference(mesh):
+    """Blender's triangles and corner attributes, read item by item through RNA."""
+    # Blender splits quads with its face normals when they are up to date, as they are whenever a
+    # renderer has read the mesh's normals (the export does): compute them first.
+    [p.normal for p in mesh.polygons]
+    mesh.calc_loop_triangles()
+    tris = list(mesh.loop_triangles)
+    corner_loops = np.array([list(t.loops) for t in tris], dtype=np.int64)
+    loop_vertex = np.array([l.vertex_index for l in mesh.loops], dtype=np.int64)
+    smooth = [p.use_smooth for p in mesh.polygons]
+    ref = {
+        "indices": loop_vertex[corner_loops],
+        "positions": np.array([v.co[:] for v in mesh.vertices], dtype=np.float32),
+        "material_slot": np.array([mesh.polygons[t.polygon_index].material_index for t in tris]),
+        "normals": None,
+        "uvs": None,
+    }
+    if any(smooth) or mesh.has_custom_normals:
+        mesh.calc_normals_split()
+        normals = np.array([l.normal[:] for l in mesh.loops], dtype=np.float32)
+        ref["normals"] = normals[corner_loops]
+    layer = next((u for u in mesh.uv_layers if u.active_render), None)
+    if layer is not None:
+        uvs = np.array([d.uv[:] for d in layer.data], dtype=np.float32)
+        ref["uvs"] = uvs[corner_loops]
+    return ref
+
+
+def compare(name, mesh):
+    import gdpt.export_mesh as export_mesh
+    from gdpt import _gdpt
+    builder = _gdpt.SceneBuilder()
+    index = export_mesh.add_mesh(builder, mesh)
+    got = builder.mesh_arrays(index)
+    ref = reference(mesh)
+    check(np.array_equal(got["positions"], ref["positions"]), f"{name}: positions")
+    check(got["indices"].shape == ref["indices"].shape,
+          f"{name}: {len(ref['indices'])} triangles, as Blender's loop triangles")
+    # A quad with two corners at one position has one real triangle either way; which of the two
+    # coincident corners it uses is a rounding tie in Blender's own test. Such quads may differ.
+    same = (got["indices"] == ref["indices"]).all(axis=1)
+    tri_poly = [t.polygon_index for t in mesh.loop_triangles]
+    degenerate = [len({tuple(mesh.vertices[v].co) for v in mesh.polygons[p].vertices}) < 4 and
+                  len(mesh.polygons[p].vertices) == 4 for p in tri_poly]
+    check(all(same[t] or degenerate[t] for t in range(len(same))),
+          f"{name}: the same vertices at every corner, in Blender's order ({int(same.sum())} of "
+          f"{len(same)} triangles; the others in quads with two corners at one position)")
+    if ref["normals"] is None:
+        check(got["corner_normals"].size == 0, f"{name}: all flat, no shading normals")
+    else:
+        err = float(np.abs(got["corner_normals"][same] - ref["normals"][same]).max())
+        check(err < 1e-5, f"{name}: corner normals are Blender's split normals (max error {err})")
+    if ref["uvs"] is None:
+        check(got["corner_uvs"].size == 0, f"{name}: no UV map, no UVs")
+    else:
+        check(np.array_equal(got["corner_uvs"][same], ref["uvs"][same]),
+              f"{name}: corner UVs from the active render UV map")
+    slots = got["material_slot"] if got["material_slot"].size else np.zeros(len(ref["indices"]))
+    check(np.array_equal(slots, ref["material_slot"]), f"{name}: material slot per triangle")
+    return ref
+
+
+def main():
+    S.clear()
+    red, green = S.diffuse("red", (0.8, 0.1, 0.1)), S.diffuse("green", (0.1, 0.8, 0.1))
+
+    # Triangles and quads: planar, non-planar, and an arrowhead (reflex vertex 1: the 0-2
+    # diagonal lies outside, Blender splits along 1-3).
+    verts = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0),  # planar quad
+             (2, 0, 0), (2, 1, 0.5),  # with 1, 2: non-planar quad 1-4-5-2
+             (3, 0, 0), (3.5, 0.25, 0), (4, 0, 0), (3.5, 1.5, 0),  # arrowhead 6-7-8-9
+             (5, 0, 0), (6, 0, 0), (5.5, 1, 0.2)]  # triangle
+    faces = [(0, 1, 2, 3), (1, 4, 5, 2), (6, 7, 8, 9), (10, 11, 12)]
+    me = make_mesh("mixed", verts, faces, smooth=lambda i: i % 2 == 0, materials=(red, green))
+    ref = compare("mixed", me)
+    arrow = ref["indices"][4:6]  # faces 0 and 1 give two triangles each
+    check(sorted(map(tuple, arrow.tolist())) == [(6, 7, 9), (7, 8, 9)],
+          "the arrowhead quad is split along its 1-3 diagonal")
+
+    # All smooth quads (a UV sphere), the second UV map used for rendering.
+    n_seg, n_ring = 12, 6
+    verts, faces = [], []
+    for i in range(n_ring + 1):
+        # Exact poles: degenerate quads (two corners at one position) split along 1-3.
+        z = 1.0 if i == 0 else -1.0 if i == n_ring else np.cos(np.pi * i / n_ring)
+        r = 0.0 if i in (0, n_ring) else np.sin(np.pi * i / n_ring)
+        for j in range(n_seg):
+            verts.append((r * np.cos(2 * np.pi * j / n_seg), r * np.sin(2 * np.pi * j / n_seg), z))
+    for i in range(n_ring):
+        for j in range(n_seg):
+            a, b = i * n_seg + j, i * n_seg + (j + 1) % n_seg
+            faces.append((a, b, b + n_seg, a + n_seg))
+    me = make_mesh("smooth", verts, faces, smooth=lambda i: True, uv_layers=("A", "B"),
+                   render_uv=1)
+    compare("smooth", me)
+
+    # N-gons: a convex hexagon, a concave (L-shaped) hexagon, a pentagon, plus a quad; flat.
+    verts = [(0, 0, 0), (2, 0, 0), (3, 1, 0), (2, 2, 0), (0, 2, 0), (-1, 1, 0),
+             (4, 0, 0), (6, 0, 0), (6, 1, 0), (5, 1, 0), (5, 3, 0), (4, 3, 0),
+             (7, 0, 0), (8, 0, 0), (8.5, 1, 0), (7.5, 2, 0), (6.8, 1, 0),
+             (9, 0, 0), (10, 0, 0), (10, 1, 0), (9, 1, 0)]
+    faces = [(0, 1, 2, 3, 4, 5), (6, 7, 8, 9, 10, 11), (12, 13, 14, 15, 16), (17, 18, 19, 20)]
+    me = make_mesh("ngons", verts, faces, smooth=lambda i: False, materials=(red, green))
+    compare("ngons", me)
+
+    # Custom split normals on a quad strip.
+    verts = [(x, y, 0.1 * x * x) for y in (0, 1) for x in range(4)]
+    faces = [(0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6)]
+    me = make_mesh("custom", verts, faces, smooth=lambda i: True)
+    me.use_auto_smooth = True
+    tilt = [(0.3 * (k % 3) - 0.3, 0.2, 1.0) for k in range(len(me.loops))]
+    me.normals_split_custom_set([tuple(np.array(t) / np.linalg.norm(t)) for t in tilt])
+    me.update()
+    check(me.has_custom_normals, "custom normals set")
+    compare("custom", me)
+
+    # An evaluated mesh: subdivided cube (modifier applied by the depsgraph).
+    bpy.ops.mesh.primitive_cube_add()
+    cube = bpy.context.active_object
+    mod = cube.modifiers.new("subsurf", 'SUBSURF')
+    mod.levels = mod.render_levels = 1
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    evaluated = cube.evaluated_get(depsgraph).data
+    check(len(evaluated.polygons) == 24, "the evaluated cube has the modifier's 24 faces")
+    compare("evaluated", evaluated)
+
+
+main()
