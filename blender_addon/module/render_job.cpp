@@ -64,10 +64,10 @@ struct RenderJob::State {
   std::mutex mutex;
   std::condition_variable wake;
   RenderProgress progress;
-  bool pass_finished = false;  // a pass ended since the last poll
-  bool finished = false;       // the worker returned
+  bool finished = false;  // the worker returned
   bool want_snapshot = false;
   bool snapshot_ready = false;
+  bool snapshot_news = false;  // a snapshot was taken since the poll loop last woke
   FilmPasses snapshot;
   std::atomic<bool> cancel{false};
   std::exception_ptr error;
@@ -86,14 +86,14 @@ void RenderJob::render(const py::function& poll, double poll_interval) {
   auto on_pass = [this, &st](const RenderProgress& p) {
     std::lock_guard lock(st.mutex);
     st.progress = p;
-    st.pass_finished = true;
     if (st.want_snapshot) {
       // The film is only consistent between passes: copy it now (a few memcpy-sized loops).
       st.snapshot.read(session_->film(), p.samples_done);
       st.want_snapshot = false;
       st.snapshot_ready = true;
+      st.snapshot_news = true;
+      st.wake.notify_all();
     }
-    st.wake.notify_all();
   };
 
   std::thread worker;
@@ -120,8 +120,11 @@ void RenderJob::render(const py::function& poll, double poll_interval) {
     {
       py::gil_scoped_release no_gil;
       std::unique_lock lock(st.mutex);
-      st.wake.wait_for(lock, interval, [&] { return st.finished || st.pass_finished; });
-      st.pass_finished = false;
+      // Woken by the interval, a snapshot or the end, not by every pass: with small passes
+      // (1 spp of a small frame takes milliseconds) a wake-up per pass ran the Python callback
+      // hundreds of times per second, on one of the cores the render threads use.
+      st.wake.wait_for(lock, interval, [&] { return st.finished || st.snapshot_news; });
+      st.snapshot_news = false;
       progress = st.progress;
       finished = st.finished;
       ready = st.snapshot_ready;

@@ -3,7 +3,8 @@
 // Blender's RenderEngine API (test_break, update_result, update_stats) must be called from the
 // thread that runs render(). The core's RenderSession::render() blocks, so it runs on a worker
 // thread while the calling thread waits with the GIL released and wakes every `poll_interval`
-// seconds (and after each finished pass) to call the Python `poll` callback with the GIL held.
+// seconds (and when a requested snapshot is ready) to call the Python `poll` callback with the GIL
+// held; it does not wake per pass, which at small frames would run Python every few milliseconds.
 // That keeps Esc responsive (within poll_interval, not one pass) and keeps every Blender call on
 // Blender's thread.
 //
