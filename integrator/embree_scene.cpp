@@ -358,6 +358,10 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
     const Vec3f n = mesh.corner_normals[corner] * w + mesh.corner_normals[corner + 1] * u +
                     mesh.corner_normals[corner + 2] * v;
     hit.shading_normal = safe_normalize(to_world_normal(n), ng);
+  } else if (!mesh.vertex_normals.empty()) {
+    const Vec3f* N = mesh.vertex_normals.data();
+    const Vec3f n = N[idx[0]] * w + N[idx[1]] * u + N[idx[2]] * v;
+    hit.shading_normal = safe_normalize(to_world_normal(n), ng);
   } else {
     hit.shading_normal = ng;
   }

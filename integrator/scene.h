@@ -13,13 +13,18 @@
 
 namespace gdpt {
 
-// Triangle mesh in object space. Attributes are per triangle corner (Blender loop triangles).
+// Triangle mesh in object space. Attributes are per triangle corner (Blender loop triangles),
+// except vertex_normals.
 struct Mesh {
   std::vector<Vec3f> positions;        // vertices
   std::vector<uint32_t> indices;       // 3 per triangle, into positions
   std::vector<Vec3f> corner_normals;   // 3 per triangle (split normals); empty = flat shading
   std::vector<Vec2f> corner_uvs;       // 3 per triangle; empty = no UVs (uv = 0)
   std::vector<int32_t> material_slot;  // per triangle; empty = slot 0
+  // Per-vertex shading normals, used when corner_normals is empty: what a smooth mesh without
+  // split normals has, in a sixth of the memory (a 1M-triangle smooth mesh: 6 MB instead of the
+  // 36 MB of corner normals). Both empty = flat shading.
+  std::vector<Vec3f> vertex_normals;
   size_t triangle_count() const { return indices.size() / 3; }
 };
 

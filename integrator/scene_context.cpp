@@ -26,6 +26,8 @@ void validate(const Scene& scene, std::vector<std::string>& warnings) {
     const size_t tris = mesh.triangle_count();
     if (!mesh.corner_normals.empty() && mesh.corner_normals.size() != 3 * tris)
       throw std::invalid_argument(name + ": corner_normals must have 3 entries per triangle");
+    if (!mesh.vertex_normals.empty() && mesh.vertex_normals.size() != mesh.positions.size())
+      throw std::invalid_argument(name + ": vertex_normals must have 1 entry per vertex");
     if (!mesh.corner_uvs.empty() && mesh.corner_uvs.size() != 3 * tris)
       throw std::invalid_argument(name + ": corner_uvs must have 3 entries per triangle");
     if (!mesh.material_slot.empty() && mesh.material_slot.size() != tris)

@@ -252,28 +252,26 @@ Mesh gather_mesh(const CornerSource& src, size_t triangles, bool with_material,
   std::memcpy(static_cast<void*>(mesh.positions.data()), src.positions,
               src.vertex_count * sizeof(Vec3f));
   reserve_fresh(mesh.indices, corner_count);
-  if (src.normals) reserve_fresh(mesh.corner_normals, corner_count);
+  if (src.normals && src.normals_per_loop) reserve_fresh(mesh.corner_normals, corner_count);
   if (src.loop_uvs) reserve_fresh(mesh.corner_uvs, corner_count);
   if (with_material) reserve_fresh(mesh.material_slot, triangles);
   // One loop per output array: each streams through its own buffer.
   corners([&](int32_t loop) { mesh.indices.push_back(uint32_t(src.loop_vertex[loop])); },
           [](int32_t) {});
-  if (src.normals) {
+  if (src.normals && src.normals_per_loop) {
     const float* n = src.normals;
-    if (src.normals_per_loop)
-      corners(
-          [&](int32_t loop) {
-            const size_t i = 3 * size_t(loop);
-            mesh.corner_normals.emplace_back(n[i], n[i + 1], n[i + 2]);
-          },
-          [](int32_t) {});
-    else
-      corners(
-          [&](int32_t loop) {
-            const size_t i = 3 * size_t(src.loop_vertex[loop]);
-            mesh.corner_normals.emplace_back(n[i], n[i + 1], n[i + 2]);
-          },
-          [](int32_t) {});
+    corners(
+        [&](int32_t loop) {
+          const size_t i = 3 * size_t(loop);
+          mesh.corner_normals.emplace_back(n[i], n[i + 1], n[i + 2]);
+        },
+        [](int32_t) {});
+  } else if (src.normals) {
+    // Vertex normals stay per vertex (Mesh::vertex_normals): no per-corner copy.
+    reserve_fresh(mesh.vertex_normals, src.vertex_count);
+    mesh.vertex_normals.resize(src.vertex_count);
+    std::memcpy(static_cast<void*>(mesh.vertex_normals.data()), src.normals,
+                src.vertex_count * sizeof(Vec3f));
   }
   if (src.loop_uvs) {
     const float* uv = src.loop_uvs;
@@ -429,6 +427,7 @@ py::dict SceneBuilder::mesh_arrays(int index) const {
   py::dict d;
   d["positions"] = copy(m.positions, {py::ssize_t(m.positions.size()), 3}, 0.0f);
   d["indices"] = copy(m.indices, {t, 3}, uint32_t(0));
+  d["vertex_normals"] = copy(m.vertex_normals, {py::ssize_t(m.vertex_normals.size()), 3}, 0.0f);
   d["corner_normals"] = copy(m.corner_normals, {m.corner_normals.empty() ? 0 : t, 3, 3}, 0.0f);
   d["corner_uvs"] = copy(m.corner_uvs, {m.corner_uvs.empty() ? 0 : t, 3, 2}, 0.0f);
   d["material_slot"] = copy(m.material_slot, {py::ssize_t(m.material_slot.size())}, int32_t(0));

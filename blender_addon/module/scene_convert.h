@@ -51,8 +51,9 @@ class SceneBuilder {
                const std::optional<IntArray>& material_slot);
   // The same mesh from Blender's own arrays, gathered per triangle corner here (memory-bound
   // loops, much faster than numpy fancy indexing): corner_loops (3 per triangle) index
-  // loop_vertex; normals are per vertex (normals_per_loop false) or per loop, or empty; loop_uvs
-  // (2 per loop) may be empty.
+  // loop_vertex; normals are per vertex (normals_per_loop false: kept per vertex, as
+  // Mesh::vertex_normals) or per loop (gathered per corner), or empty; loop_uvs (2 per loop) may
+  // be empty.
   int add_mesh_loops(const FloatArray& positions, const IntArray& loop_vertex,
                      const IntArray& corner_loops, const FloatArray& normals, bool normals_per_loop,
                      const FloatArray& loop_uvs, const IntArray& material_slot);
@@ -74,8 +75,8 @@ class SceneBuilder {
   void set_world(const py::dict& world);
 
   // The arrays of mesh `index` as the core holds them (copies), for the export tests:
-  // positions (n, 3), indices (m, 3), corner_normals (m, 3, 3) or empty, corner_uvs (m, 3, 2) or
-  // empty, material_slot (m,) or empty.
+  // positions (n, 3), indices (m, 3), corner_normals (m, 3, 3) or empty, vertex_normals (n, 3) or
+  // empty, corner_uvs (m, 3, 2) or empty, material_slot (m,) or empty.
   py::dict mesh_arrays(int index) const;
   size_t mesh_count() const { return scene_.meshes.size(); }
   size_t instance_count() const { return scene_.instances.size(); }

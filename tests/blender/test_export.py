@@ -75,6 +75,8 @@ def compare(name, mesh):
     builder = _gdpt.SceneBuilder()
     index = export_mesh.add_mesh(builder, mesh)
     got = builder.mesh_arrays(index)
+    print(f"{name}: normals per " + ("corner" if got["corner_normals"].size else "vertex" if
+                                     got["vertex_normals"].size else "- (flat)"))
     ref = reference(mesh)
     check(np.array_equal(got["positions"], ref["positions"]), f"{name}: positions")
     check(got["indices"].shape == ref["indices"].shape,
@@ -88,10 +90,13 @@ def compare(name, mesh):
     check(all(same[t] or degenerate[t] for t in range(len(same))),
           f"{name}: the same vertices at every corner, in Blender's order ({int(same.sum())} of "
           f"{len(same)} triangles; the others in quads with two corners at one position)")
+    normals = got["corner_normals"]
+    if normals.size == 0 and got["vertex_normals"].size:  # kept per vertex (all smooth)
+        normals = got["vertex_normals"][got["indices"]]
     if ref["normals"] is None:
-        check(got["corner_normals"].size == 0, f"{name}: all flat, no shading normals")
+        check(normals.size == 0, f"{name}: all flat, no shading normals")
     else:
-        err = float(np.abs(got["corner_normals"][same] - ref["normals"][same]).max())
+        err = float(np.abs(normals[same] - ref["normals"][same]).max())
         check(err < 1e-5, f"{name}: corner normals are Blender's split normals (max error {err})")
     if ref["uvs"] is None:
         check(got["corner_uvs"].size == 0, f"{name}: no UV map, no UVs")

@@ -113,6 +113,39 @@ TEST(EmbreeScene, NormalsTransformByInverseTranspose) {
   }
 }
 
+TEST(EmbreeScene, VertexNormalsShadeAsTheSameCornerNormals) {
+  // Per-vertex normals give exactly the shading normals of the equivalent per-corner array, for
+  // a flattened and for an instanced placement.
+  Mesh a;
+  a.positions = {{-1, -1, 0}, {1, -1, 0.3f}, {1, 1, 0}, {-1, 1, -0.2f}};
+  a.indices = {0, 1, 2, 0, 2, 3};
+  a.vertex_normals = {normalize(Vec3f(-0.3f, -0.2f, 1)), normalize(Vec3f(0.4f, -0.1f, 1)),
+                      normalize(Vec3f(0.2f, 0.5f, 1)), normalize(Vec3f(-0.1f, 0.3f, 1))};
+  Mesh b = a;
+  b.vertex_normals.clear();
+  for (uint32_t i : a.indices) b.corner_normals.push_back(a.vertex_normals[i]);
+  for (int copies : {1, 2}) {
+    Scene sa, sb;
+    sa.meshes.push_back(a);
+    sb.meshes.push_back(b);
+    for (int c = 0; c < copies; ++c) {
+      Instance inst;
+      inst.object_to_world = translate_scale({0, 0, -3.0f * float(c)}, {1.5f, 1, 1});
+      sa.instances.push_back(inst);
+      sb.instances.push_back(inst);
+    }
+    EmbreeScene ba(sa, 0), bb(sb, 0);
+    for (float x : {-0.9f, -0.3f, 0.2f, 0.8f})
+      for (float y : {-0.7f, 0.1f, 0.6f}) {
+        SurfaceHit ha, hb;
+        ASSERT_TRUE(ba.intersect(down(x, y), ha));
+        ASSERT_TRUE(bb.intersect(down(x, y), hb));
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(ha.shading_normal[c], hb.shading_normal[c]);
+        EXPECT_GT(length(ha.shading_normal - ha.geometric_normal), 1e-3f);
+      }
+  }
+}
+
 TEST(EmbreeScene, DegenerateTrianglesNeverGiveNaN) {
   Scene scene;
   Mesh m;
