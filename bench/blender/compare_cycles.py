@@ -14,6 +14,21 @@ RES = tuple(int(v) for v in os.environ.get("GDPT_BENCH_RES", "96x72").split("x")
 SAMPLES = int(os.environ.get("GDPT_BENCH_SAMPLES", "32"))
 REF_SAMPLES = int(os.environ.get("GDPT_BENCH_REF_SAMPLES", "512"))
 BOUNCES = int(os.environ.get("GDPT_BENCH_BOUNCES", "4"))
+# Russian roulette depth of the core for this benchmark only (the add-on has no setting for it;
+# unset = the core's default). For comparing termination policies with Cycles, which applies
+# roulette from the second bounce on (path_state_continuation_probability).
+RR_DEPTH = os.environ.get("GDPT_BENCH_RR_DEPTH")
+
+
+def _with_rr_depth():
+    import gdpt.properties as properties
+    settings_dict = properties.settings_dict
+
+    def patched(scene):
+        d = settings_dict(scene)
+        d["rr_depth"] = int(RR_DEPTH)
+        return d
+    properties.settings_dict = patched
 
 
 def cornell(scene):
@@ -54,9 +69,17 @@ def compare(name, build, out):
     scene = S.clear()
     build(scene)
     row = {}
+    # A 1-spp render per engine first: one-time costs of the first render of a scene in the
+    # process (OpenColorIO config and processors, Cycles' device and kernels) are not per-render
+    # costs, and would otherwise land in the fixed cost of the 32-spp render below.
+    first = {eng: render(scene, eng, 1, os.path.join(out, f"{name}_{eng}_warm.exr"))[0]
+             for eng in ('GDPT', 'CYCLES')}
+    rays = 0.0
     for eng in ('GDPT', 'CYCLES'):
         t, img = render(scene, eng, SAMPLES, os.path.join(out, f"{name}_{eng}_{SAMPLES}.exr"))
         render_only = engine.LAST_RENDER["render"] if eng == 'GDPT' else t
+        if eng == 'GDPT':
+            rays = engine.LAST_RENDER["rays"] / (RES[0] * RES[1] * SAMPLES)
         t_ref, ref = render(scene, eng, REF_SAMPLES,
                             os.path.join(out, f"{name}_{eng}_ref.exr"))
         row[eng] = (t, render_only, S.rel_mse(img, ref), ref, t_ref)
@@ -65,7 +88,8 @@ def compare(name, build, out):
     cross = S.rel_mse(g[3], c[3])
     print(f"BENCH {name}: {RES[0]}x{RES[1]}, {SAMPLES} spp, {BOUNCES} bounces")
     print(f"  GDPT PT : {g[0]:.2f} s wall ({g[1]:.2f} s render) = {pixels / g[0] / 1e6:.3f} "
-          f"Msamples/s wall; relMSE vs own {REF_SAMPLES} spp: {g[2]:.5f}")
+          f"Msamples/s wall; relMSE vs own {REF_SAMPLES} spp: {g[2]:.5f}; {rays:.2f} rays per "
+          f"sample (camera, extension and shadow rays)")
     print(f"  Cycles  : {c[0]:.2f} s wall = {pixels / c[0] / 1e6:.3f} Msamples/s; relMSE vs "
           f"own {REF_SAMPLES} spp: {c[2]:.5f}")
     print(f"  samples/s ratio GDPT/Cycles (wall): {c[0] / g[0]:.2f}x; relMSE ratio "
@@ -75,10 +99,16 @@ def compare(name, build, out):
     # counts each engine rendered cancels them: the throughput of the sampling itself.
     extra = RES[0] * RES[1] * (REF_SAMPLES - SAMPLES)
     mg, mc = extra / max(g[4] - g[0], 1e-9), extra / max(c[4] - c[0], 1e-9)
+    # Work-normalised noise: relMSE x time per sample (marginal), lower is better. Unlike the
+    # samples/s ratio it does not depend on how much work each engine puts into one sample
+    # (e.g. where Russian roulette starts).
+    efficiency = (c[2] / mc) / max(g[2] / mg, 1e-30)
     print(f"  marginal samples/s ({SAMPLES} -> {REF_SAMPLES} spp): GDPT {mg / 1e6:.3f} M, "
           f"Cycles {mc / 1e6:.3f} M: ratio {mg / mc:.2f}x; fixed cost per render GDPT "
           f"{g[0] - RES[0] * RES[1] * SAMPLES / mg:.2f} s, Cycles "
-          f"{c[0] - RES[0] * RES[1] * SAMPLES / mc:.2f} s")
+          f"{c[0] - RES[0] * RES[1] * SAMPLES / mc:.2f} s (first 1-spp render of the scene: "
+          f"GDPT {first['GDPT']:.2f} s, Cycles {first['CYCLES']:.2f} s)")
+    print(f"  efficiency 1 / (relMSE x marginal time per sample), GDPT/Cycles: {efficiency:.2f}x")
 
 
 def export_and_overhead(out):
@@ -97,7 +127,7 @@ def export_and_overhead(out):
     wall = time.perf_counter() - t0
     info = engine.LAST_RENDER
     print(f"BENCH export: {info['triangles']} triangles exported in {info['export']:.3f} s "
-          f"(target < 0.5 s)")
+          f"(target < 0.5 s; CPU time of Blender's thread {info['export_cpu']:.3f} s)")
     print(f"  render() total {info['total']:.3f} s: export {info['export']:.3f} s, core scene "
           f"setup (BVH, lights) {info['setup']:.3f} s, 1 spp {info['render']:.3f} s, "
           f"reconstruct {info['reconstruct']:.3f} s, "
@@ -118,6 +148,9 @@ def export_and_overhead(out):
 
 
 def main():
+    if RR_DEPTH is not None:
+        _with_rr_depth()
+        print(f"BENCH note: GDPT rr_depth = {RR_DEPTH} (GDPT_BENCH_RR_DEPTH)")
     out = S.args()["out"]
     os.makedirs(out, exist_ok=True)
     compare("cornell", cornell, out)

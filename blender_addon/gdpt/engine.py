@@ -200,9 +200,11 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         LAST_RENDER.clear()
         LAST_RENDER.update(
             view_layer=view_layer.name, status=status, samples=film["samples"], width=width,
-            height=height, export=stats.seconds, setup=session_seconds, render=t_done - t_render,
+            height=height, export=stats.seconds, export_cpu=stats.cpu_seconds,
+            setup=session_seconds, render=t_done - t_render,
             reconstruct=t_reconstruct - t_done, write=t_end - t_reconstruct,
-            total=t_end - t_start, triangles=stats.triangles, warnings=sorted(self._warned))
+            total=t_end - t_start, triangles=stats.triangles, rays=job.rays_traced(),
+            warnings=sorted(self._warned))
         print(f"{MARKER} view layer '{view_layer.name}' {status}: {film['samples']}/"
               f"{settings.samples} samples, {width}x{height}, mode {settings.mode}, "
               f"reconstruction {norm}; export {stats.seconds:.3f} s, scene setup "

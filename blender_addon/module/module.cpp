@@ -106,6 +106,7 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("snapshot", &RenderJob::snapshot)
       .def("passes", &RenderJob::passes)
       .def("features_summary", &RenderJob::features_summary)
+      .def("rays_traced", &RenderJob::rays_traced)
       .def("warnings", &RenderJob::warnings);
 
   m.def("empty", &empty_array, py::arg("count"), py::arg("dtype"),

@@ -170,6 +170,10 @@ py::dict RenderJob::passes() {
   return p.to_python();
 }
 
+uint64_t RenderJob::rays_traced() const {
+  return session_->rays_traced();
+}
+
 std::string RenderJob::features_summary() const {
   return session_->features_summary();
 }

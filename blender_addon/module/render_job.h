@@ -42,6 +42,7 @@ class RenderJob {
   py::dict snapshot();  // last snapshot taken (after poll saw snapshot_ready)
   py::dict passes();    // the film after render() returned
   std::string features_summary() const;
+  uint64_t rays_traced() const;  // camera, extension and shadow rays so far
   py::list warnings() const;
 
  private:
