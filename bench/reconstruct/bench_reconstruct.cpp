@@ -1,6 +1,6 @@
 // bench_reconstruct: cost of the reconstruction solvers at 1920x1080 RGB on 1 and 2 threads.
 //
-//   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep]
+//   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] [--l2-only]
 //
 // Reports, per thread count:
 //   - one bare FFTW forward + inverse 2-D DCT of the 3 planes (double, the same cached plans the
@@ -10,7 +10,8 @@
 //     primal, w = 1 / (|e|_RGB + reg), reg = 0.05 halving (target >= 2.5x at equal or better
 //     objective);
 //   - Weighted time, iterations, exit residual and objective.
-// --sweep also prints the L1 objective and time for a grid of (reweightings, CG steps).
+// --sweep also prints the L1 objective and time for a grid of (reweightings, CG steps);
+// --l2-only stops after the DCT pair and the L2 solve (for quick runs while tuning L2).
 // Synthetic data: a smooth image with edges; primal noise sigma 0.2 (0.05 in the right half),
 // gradient noise sigma 0.02 plus 1% outliers of +-2 (fireflies); variances match the noise.
 #include <algorithm>
@@ -94,7 +95,7 @@ Data make_data(int w, int h) {
 
 int main(int argc, char** argv) {
   int width = 1920, height = 1080, only_threads = 0;
-  bool sweep = false;
+  bool sweep = false, l2_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--width" && i + 1 < argc)
@@ -105,9 +106,12 @@ int main(int argc, char** argv) {
       only_threads = std::atoi(argv[++i]);
     else if (a == "--sweep")
       sweep = true;
+    else if (a == "--l2-only")
+      l2_only = true;
     else {
       std::fprintf(stderr,
-                   "usage: bench_reconstruct [--width W] [--height H] [--threads N] [--sweep]\n");
+                   "usage: bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] "
+                   "[--l2-only]\n");
       return 2;
     }
   }
@@ -167,6 +171,7 @@ int main(int argc, char** argv) {
         "L2 solve (reconstruct(), incl. I/O passes): %8.1f ms = %.2fx the double DCT pair, "
         "objective %.6g\n",
         1e3 * t_l2, t_l2 / t_dct, r2.objective);
+    if (l2_only) continue;
 
     // --- L1: ours vs L1D.
     s.norm = gdpt::ReconstructionNorm::L1;
