@@ -193,6 +193,7 @@ int main(int argc, char** argv) {
 
     gdpt::ReconstructionSettings settings = o.settings;
     settings.progress = [&](float f) { progress.stage("solve", f); };
+    settings.compute_objective = true;  // printed in the summary line
     gdpt::ReconstructionReport report;
     const std::vector<float> image = gdpt::reconstruct(input, settings, &report);
 

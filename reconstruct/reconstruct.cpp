@@ -359,7 +359,8 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
         rep.relative_residual = cg.relative_residual;
       }
     }
-    if (gradients) rep.objective = objective(pr, settings.norm, alpha, input.variance, x.data());
+    if (gradients && settings.compute_objective)
+      rep.objective = objective(pr, settings.norm, alpha, input.variance, x.data());
 
     // Output = solution + very-direct emission; nothing non-finite leaves this function.
     parallel_rows(H, [&](int y0, int y1) {

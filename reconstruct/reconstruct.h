@@ -43,6 +43,9 @@ struct ReconstructionSettings {
   // FFTW_MEASURE plans (kept as wisdom in ~/.cache/gdpt/fftw-wisdom): worth it when the same size
   // is solved repeatedly in one process (the add-on); FFTW_ESTIMATE otherwise.
   bool fft_measure = false;
+  // Fill ReconstructionReport::objective (one more pass over all buffers). Off by default: the
+  // engine and the compositor node never read it; the CLI prints it, tests and benchmarks check it.
+  bool compute_objective = false;
   // Called with the completed fraction in [0, 1] (from the calling thread).
   std::function<void(float)> progress;
 };
@@ -58,7 +61,7 @@ struct ReconstructionInput {
 
 struct ReconstructionReport {
   int iterations = 0;      // total inner iterations
-  double objective = 0.0;  // final value of the objective for the chosen norm
+  double objective = 0.0;  // objective of the chosen norm (0 unless settings.compute_objective)
   double seconds = 0.0;
   double relative_residual = 0.0;  // CG exit residual |b - A I| / |b| (0 for the direct solve)
   int missing_values = 0;          // non-finite input terms treated as missing

@@ -89,6 +89,13 @@ TEST(L2, ExactRecoveryFromTrueGradients) {
   EXPECT_LT(relative_error(out, truth), 1e-4);
   EXPECT_GT(relative_error(primal, truth), 0.05);  // the primal alone is far off
   EXPECT_EQ(report.iterations, 0);                 // direct solve
+  EXPECT_EQ(report.objective, 0.0);                // not requested
+  s.compute_objective = true;
+  const auto again = reconstruct(in, s, &report);
+  EXPECT_EQ(again, out);
+  EXPECT_NEAR(report.objective,
+              reconstruction_objective(in, ReconstructionNorm::L2, s.alpha, out.data()),
+              1e-9 * report.objective);
 }
 
 // The DCT solve and plain CG from zero on the same uniform system agree: two independent solvers
@@ -154,6 +161,7 @@ TEST(L1, BeatsL2OnSparseOutlierGradients) {
   const auto l2 = reconstruct(in, s2);
   ReconstructionSettings s1;
   s1.norm = ReconstructionNorm::L1;
+  s1.compute_objective = true;
   ReconstructionReport r1;
   const auto l1 = reconstruct(in, s1, &r1);
 
