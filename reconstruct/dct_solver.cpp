@@ -1,7 +1,11 @@
 #include "reconstruct/dct_solver.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -10,18 +14,45 @@
 
 #include <fftw3.h>
 
+#include "reconstruct/huge_pages.h"
 #include "reconstruct/parallel.h"
 
 namespace gdpt::detail {
 
-void FftwFree::operator()(double* p) const {
-  fftw_free(p);
+void DctFree::operator()(double* p) const {
+  std::free(p);
 }
 
 DctBuffer dct_alloc(size_t count) {
-  auto* p = static_cast<double*>(fftw_malloc(sizeof(double) * std::max<size_t>(count, 1)));
+  constexpr size_t kAlign = size_t(2) << 20;  // a huge page
+  const size_t bytes = sizeof(double) * std::max<size_t>(count, 1);
+  auto* p =
+      static_cast<double*>(std::aligned_alloc(kAlign, (bytes + kAlign - 1) / kAlign * kAlign));
   if (!p) throw std::bad_alloc();
+  advise_huge_pages(p, bytes);
   return DctBuffer(p);
+}
+
+namespace {
+std::mutex g_buffer_mutex;
+DctBuffer g_buffer;
+size_t g_buffer_count = 0;
+}  // namespace
+
+CachedDctBuffer::CachedDctBuffer(size_t count) : count_(count) {
+  {
+    std::lock_guard lock(g_buffer_mutex);
+    if (g_buffer && g_buffer_count == count) buffer_ = std::move(g_buffer);
+  }
+  if (!buffer_) buffer_ = dct_alloc(count);
+}
+
+CachedDctBuffer::~CachedDctBuffer() {
+  DctBuffer old;  // freed outside the lock
+  std::lock_guard lock(g_buffer_mutex);
+  old = std::move(g_buffer);
+  g_buffer = std::move(buffer_);
+  g_buffer_count = count_;
 }
 
 std::string fftw_wisdom_path() {
@@ -94,48 +125,98 @@ void dct_round_trip(int width, int height, double* planes, int threads, bool mea
   fftw_execute_r2r(p.inverse, planes, planes);
 }
 
-void solve_l2_dct(int width, int height, double alpha, const float* primal, const float* gradient_x,
+namespace {
+
+// 1 when v is NaN or +-Inf (exponent all ones); integer compares, so the loops vectorise.
+inline uint32_t not_finite(float v) {
+  uint32_t u;
+  std::memcpy(&u, &v, sizeof u);
+  return uint32_t(int32_t(u & 0x7fffffffu) > 0x7f7fffff);
+}
+
+// b = alpha^2 primal + Dx^T dx + Dy^T dy of one row, interleaved RGB in `b` (3 * width values).
+// (Dx^T g)(x) = g(x - 1) - g(x), where g(-1) and g(W - 1) are not part of the objective (zero);
+// the same for rows: kBelow says row y - 1 exists (its dy enters with +), kAbove that row y + 1
+// does (this row's dy enters with -). The boundary columns are peeled off, so the middle loop is
+// branch-free over contiguous values; the operations are in the same order for every value.
+template <bool kBelow, bool kAbove>
+void rhs_row(int width, double alpha2, const float* p, const float* gx, const float* gy,
+             const float* gy_below, double* b) {
+  auto value = [&](int k, bool left, bool right) {
+    double v = alpha2 * p[k];
+    if (right) v -= gx[k];
+    if (left) v += gx[k - 3];
+    if constexpr (kAbove) v -= gy[k];
+    if constexpr (kBelow) v += gy_below[k];
+    return v;
+  };
+  const int n = 3 * width;
+  if (width == 1) {
+    for (int k = 0; k < 3; ++k) b[k] = value(k, false, false);
+    return;
+  }
+  for (int k = 0; k < 3; ++k) b[k] = value(k, false, true);
+  for (int k = 3; k < n - 3; ++k) b[k] = value(k, true, true);
+  for (int k = n - 3; k < n; ++k) b[k] = value(k, true, false);
+}
+
+}  // namespace
+
+bool solve_l2_dct(int width, int height, double alpha, const float* primal, const float* gradient_x,
                   const float* gradient_y, double* planes, int threads, bool measure) {
   const PlanPair& plans = plans_for(width, height, threads, measure);
   const size_t plane = size_t(width) * height;
   const double alpha2 = alpha * alpha;
+  const int n = 3 * width;
 
-  // --- Right-hand side b = alpha^2 primal + Dx^T dx + Dy^T dy, deinterleaved into planes.
-  // (Dx^T g)(x) = g(x - 1) - g(x), where g(-1) and g(W - 1) are not part of the objective (zero).
-  parallel_rows(height, [&](int y0, int y1) {
+  // --- Right-hand side, deinterleaved into planes, and the finiteness check of every input, in
+  // one pass over the inputs.
+  const auto bad = parallel_rows_sum<1>(height, [&](int y0, int y1, std::array<double, 1>& s) {
+    std::vector<double> b(static_cast<size_t>(n));
+    uint32_t flags = 0;
     for (int y = y0; y < y1; ++y) {
       const size_t row = size_t(y) * width;
-      for (int x = 0; x < width; ++x) {
-        const size_t i = row + x;
-        for (int c = 0; c < 3; ++c) {
-          double b = alpha2 * primal[3 * i + c];
-          if (x < width - 1) b -= gradient_x[3 * i + c];
-          if (x > 0) b += gradient_x[3 * (i - 1) + c];
-          if (y < height - 1) b -= gradient_y[3 * i + c];
-          if (y > 0) b += gradient_y[3 * (i - width) + c];
-          planes[c * plane + i] = b;
-        }
+      const float *p = primal + 3 * row, *gx = gradient_x + 3 * row, *gy = gradient_y + 3 * row;
+      for (int k = 0; k < n; ++k) flags |= not_finite(p[k]) | not_finite(gx[k]) | not_finite(gy[k]);
+      const float* below = y > 0 ? gy - n : nullptr;
+      if (y > 0 && y < height - 1)
+        rhs_row<true, true>(width, alpha2, p, gx, gy, below, b.data());
+      else if (y > 0)
+        rhs_row<true, false>(width, alpha2, p, gx, gy, below, b.data());
+      else if (y < height - 1)
+        rhs_row<false, true>(width, alpha2, p, gx, gy, below, b.data());
+      else
+        rhs_row<false, false>(width, alpha2, p, gx, gy, below, b.data());
+      for (int c = 0; c < 3; ++c) {
+        double* out = planes + c * plane + row;
+        for (int x = 0; x < width; ++x) out[x] = b[3 * x + c];
       }
     }
+    s[0] += flags;
   });
+  if (bad[0] != 0) return false;
 
   fftw_execute_r2r(plans.forward, planes, planes);
 
   // --- Divide by the eigenvalues; 1 / (4 W H) undoes the unnormalised REDFT10 -> REDFT01 pair.
+  // The factor depends on (kx, ky) only: one division per coefficient, shared by the 3 planes.
   std::vector<double> lambda_x(width);
   for (int k = 0; k < width; ++k) lambda_x[k] = 2.0 - 2.0 * std::cos(M_PI * k / width);
   const double norm = 1.0 / (4.0 * double(width) * double(height));
   parallel_rows(height, [&](int y0, int y1) {
+    std::vector<double> factor(width);
     for (int y = y0; y < y1; ++y) {
       const double lambda_y = 2.0 - 2.0 * std::cos(M_PI * y / height) + alpha2;
+      for (int x = 0; x < width; ++x) factor[x] = norm / (lambda_x[x] + lambda_y);
       for (int c = 0; c < 3; ++c) {
         double* row = planes + c * plane + size_t(y) * width;
-        for (int x = 0; x < width; ++x) row[x] *= norm / (lambda_x[x] + lambda_y);
+        for (int x = 0; x < width; ++x) row[x] *= factor[x];
       }
     }
   });
 
   fftw_execute_r2r(plans.inverse, planes, planes);
+  return true;
 }
 
 }  // namespace gdpt::detail

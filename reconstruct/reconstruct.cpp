@@ -12,6 +12,7 @@
 #include <tbb/task_arena.h>
 
 #include "reconstruct/dct_solver.h"
+#include "reconstruct/huge_pages.h"
 #include "reconstruct/irls_reweight.h"
 #include "reconstruct/parallel.h"
 #include "reconstruct/weighted_cg.h"
@@ -51,13 +52,19 @@ bool finite3(const float* v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
 }
 
-Prepared prepare(const ReconstructionInput& in, bool need_gradients) {
+// The input as given, assumed finite (the L2 pass checks it; see reconstruct()).
+Prepared unchecked(const ReconstructionInput& in) {
   Prepared p;
   p.width = in.width;
   p.height = in.height;
   p.primal = in.primal;
   p.gradient_x = in.gradient_x;
   p.gradient_y = in.gradient_y;
+  return p;
+}
+
+Prepared prepare(const ReconstructionInput& in, bool need_gradients) {
+  Prepared p = unchecked(in);
   const int W = in.width;
   const auto count = parallel_rows_sum<1>(in.height, [&](int y0, int y1, std::array<double, 1>& s) {
     for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
@@ -125,7 +132,10 @@ double squared3(const float* e) {
 // Per-pixel weights of a quadratic problem (alpha^2 folded into w0).
 struct Weights {
   std::vector<float> w0, wx, wy;
-  explicit Weights(size_t n) : w0(n), wx(n), wy(n) {}
+  explicit Weights(size_t n)
+      : w0(detail::huge_vector<float>(n)),
+        wx(detail::huge_vector<float>(n)),
+        wy(detail::huge_vector<float>(n)) {}
 };
 
 Weights uniform_weights(const Prepared& pr, double alpha) {
@@ -247,17 +257,37 @@ void validate(const ReconstructionInput& in, ReconstructionNorm norm, float alph
     throw std::invalid_argument("reconstruct: the Weighted norm needs the variance buffer");
 }
 
-// The exact uniform L2 solution of the (sanitised) data, as interleaved float.
-std::vector<float> l2_solution(const Prepared& pr, double alpha, int threads, bool measure) {
+// The output rule: solution + emission where the emission is finite; non-finite values become 0.
+inline float finish_value(float v, const float* emission, size_t i) {
+  if (emission && std::isfinite(emission[i])) v += emission[i];
+  return std::isfinite(v) ? v : 0.f;
+}
+
+// The exact uniform L2 solution of `pr`, as interleaved float; with `finish` the output rule is
+// applied in the same pass (the result is then the final image). Returns an empty vector when
+// some input value is not finite: `pr` must then be sanitised (prepare()) and solved again.
+std::vector<float> l2_solution(const Prepared& pr, double alpha, int threads, bool measure,
+                               const float* emission, bool finish) {
   const int W = pr.width, H = pr.height;
   const size_t plane = size_t(W) * H;
-  detail::DctBuffer planes = detail::dct_alloc(3 * plane);
-  detail::solve_l2_dct(W, H, alpha, pr.primal, pr.gradient_x, pr.gradient_y, planes.get(), threads,
-                       measure);
-  std::vector<float> x(3 * plane);
+  const detail::CachedDctBuffer planes(3 * plane);
+  if (!detail::solve_l2_dct(W, H, alpha, pr.primal, pr.gradient_x, pr.gradient_y, planes.get(),
+                            threads, measure))
+    return {};
+  auto x = detail::huge_vector<float>(3 * plane);
   parallel_rows(H, [&](int y0, int y1) {
-    for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i)
-      for (int c = 0; c < 3; ++c) x[3 * i + c] = float(planes[c * plane + i]);
+    for (int y = y0; y < y1; ++y) {
+      const size_t row = size_t(y) * W;
+      for (int c = 0; c < 3; ++c) {
+        const double* src = planes.get() + c * plane + row;
+        float* dst = x.data() + 3 * row + c;
+        if (finish)
+          for (int i = 0; i < W; ++i)
+            dst[3 * i] = finish_value(float(src[i]), emission, 3 * (row + i) + c);
+        else
+          for (int i = 0; i < W; ++i) dst[3 * i] = float(src[i]);
+      }
+    }
   });
   return x;
 }
@@ -290,14 +320,26 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
   tbb::task_arena arena(threads);
   arena.execute([&] {
     const bool gradients = settings.norm != ReconstructionNorm::None;
-    const Prepared pr = prepare(input, gradients);
-    rep.missing_values = pr.missing;
     progress(0.f);
-
+    // L2 without missing data finishes the output in its last pass, unless the objective (of the
+    // solution without emission) is still to be computed.
+    const bool finish_in_l2 =
+        settings.norm == ReconstructionNorm::L2 && !(settings.compute_objective && input.emission);
+    bool finished = false;
+    Prepared pr;
     if (!gradients) {
+      pr = prepare(input, false);
       x.assign(input.primal, input.primal + 3 * n);  // non-finite values become 0 below
     } else {
-      x = l2_solution(pr, alpha, threads, settings.fft_measure);
+      // Inputs are nearly always finite: the DCT's right-hand side pass checks that, and only
+      // when it finds a non-finite value is the data sanitised (prepare) and solved again.
+      pr = unchecked(input);
+      x = l2_solution(pr, alpha, threads, settings.fft_measure, input.emission, finish_in_l2);
+      finished = finish_in_l2 && !x.empty();
+      if (x.empty()) {
+        pr = prepare(input, true);
+        x = l2_solution(pr, alpha, threads, settings.fft_measure, nullptr, false);
+      }
       detail::CgWorkspace ws;
       if (settings.norm == ReconstructionNorm::L2 && pr.missing > 0) {
         // Missing terms break the DCT's constant coefficients: finish with CG on the masked
@@ -316,7 +358,7 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
         // L1 objective. One pass forms the weights, the Jacobi diagonal and the CG's starting
         // residual (irls_reweight.h); the buffers live across the reweightings.
         Weights w(n);
-        std::vector<float> inv_diag(n);
+        auto inv_diag = detail::huge_vector<float>(n);
         ws.resize(3 * n);
         const detail::IrlsData data{W,
                                     H,
@@ -363,13 +405,12 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
       rep.objective = objective(pr, settings.norm, alpha, input.variance, x.data());
 
     // Output = solution + very-direct emission; nothing non-finite leaves this function.
-    parallel_rows(H, [&](int y0, int y1) {
-      for (size_t i = 3 * size_t(y0) * W; i < 3 * size_t(y1) * W; ++i) {
-        float v = x[i];
-        if (input.emission && std::isfinite(input.emission[i])) v += input.emission[i];
-        x[i] = std::isfinite(v) ? v : 0.f;
-      }
-    });
+    if (!finished)
+      parallel_rows(H, [&](int y0, int y1) {
+        for (size_t i = 3 * size_t(y0) * W; i < 3 * size_t(y1) * W; ++i)
+          x[i] = finish_value(x[i], input.emission, i);
+      });
+    rep.missing_values = pr.missing;
     progress(1.f);
   });
 

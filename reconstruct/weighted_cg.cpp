@@ -5,16 +5,17 @@
 #include <cmath>
 #include <vector>
 
+#include "reconstruct/huge_pages.h"
 #include "reconstruct/parallel.h"
 
 namespace gdpt::detail {
 
 void CgWorkspace::resize(size_t values) {
   if (r.size() == values) return;
-  r.resize(values);
-  p.resize(values);
-  p_next.resize(values);
-  q.resize(values);
+  resize_huge(r, values);
+  resize_huge(p, values);
+  resize_huge(p_next, values);
+  resize_huge(q, values);
 }
 
 namespace {
@@ -282,7 +283,7 @@ CgResult run_cg(const WeightedProblem& pb, float* x, const CgStart& start, int m
 
 std::vector<float> jacobi_inverse_diagonal(const WeightedProblem& pb) {
   const int W = pb.width, H = pb.height;
-  std::vector<float> d(size_t(W) * H);
+  auto d = huge_vector<float>(size_t(W) * H);
   parallel_rows(H, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < W; ++x) {
