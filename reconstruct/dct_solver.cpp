@@ -24,10 +24,10 @@ void DctFree::operator()(double* p) const {
 }
 
 DctBuffer dct_alloc(size_t count) {
-  constexpr size_t kAlign = size_t(2) << 20;  // a huge page
+  // Large buffers start on a huge page boundary; 64 bytes is more than any SIMD FFTW uses.
   const size_t bytes = sizeof(double) * std::max<size_t>(count, 1);
-  auto* p =
-      static_cast<double*>(std::aligned_alloc(kAlign, (bytes + kAlign - 1) / kAlign * kAlign));
+  const size_t align = bytes >= kHugePageMinBytes ? size_t(2) << 20 : 64;
+  auto* p = static_cast<double*>(std::aligned_alloc(align, (bytes + align - 1) / align * align));
   if (!p) throw std::bad_alloc();
   advise_huge_pages(p, bytes);
   return DctBuffer(p);

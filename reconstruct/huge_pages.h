@@ -17,12 +17,15 @@
 
 namespace gdpt::detail {
 
+// Buffers below this size are left alone.
+inline constexpr size_t kHugePageMinBytes = size_t(4) << 20;
+
 // Best effort: marks the whole 4 KiB pages inside [p, p + bytes) for huge pages. Call it before
-// the memory is first written (pages already faulted in stay small). Small buffers are skipped.
+// the memory is first written (pages already faulted in stay small).
 inline void advise_huge_pages(void* p, size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr uintptr_t kPage = 4096, kMinBytes = uintptr_t(4) << 20;
-  if (bytes < kMinBytes) return;
+  constexpr uintptr_t kPage = 4096;
+  if (bytes < kHugePageMinBytes) return;
   const uintptr_t begin = (uintptr_t(p) + kPage - 1) & ~(kPage - 1);
   const uintptr_t end = (uintptr_t(p) + bytes) & ~(kPage - 1);
   if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
