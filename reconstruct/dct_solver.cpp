@@ -13,6 +13,8 @@
 #include <vector>
 
 #include <fftw3.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "reconstruct/huge_pages.h"
 #include "reconstruct/parallel.h"
@@ -162,17 +164,81 @@ void rhs_row(int width, double alpha2, const float* p, const float* gx, const fl
 
 }  // namespace
 
-bool solve_l2_dct(int width, int height, double alpha, const float* primal, const float* gradient_x,
-                  const float* gradient_y, double* planes, int threads, bool measure) {
-  const PlanPair& plans = plans_for(width, height, threads, measure);
+namespace {
+
+// One-line 1-D plans (single-threaded; the passes run them in parallel from TBB): rows of
+// `width`, and blocks of kColumnBlock contiguous columns of `height`.
+constexpr int kColumnBlock = 8;
+
+struct LinePlans {
+  fftw_plan row_forward = nullptr, row_inverse = nullptr;
+  fftw_plan column_forward = nullptr, column_inverse = nullptr;
+};
+
+std::map<std::tuple<int, int, bool>, LinePlans> g_line_plans;
+
+const LinePlans& line_plans_for(int width, int height, bool measure) {
+  std::lock_guard lock(g_plan_mutex);
+  const auto key = std::make_tuple(width, height, measure);
+  if (auto it = g_line_plans.find(key); it != g_line_plans.end()) return it->second;
+  if (!g_threads_initialised) {
+    fftw_init_threads();
+    g_threads_initialised = true;
+  }
+  const std::string wisdom = fftw_wisdom_path();
+  if (measure && !g_wisdom_loaded && !wisdom.empty()) {
+    fftw_import_wisdom_from_filename(wisdom.c_str());
+    g_wisdom_loaded = true;
+  }
+  fftw_plan_with_nthreads(1);
+  const unsigned flags = measure ? FFTW_MEASURE : FFTW_ESTIMATE;
+  auto* scratch =
+      static_cast<double*>(fftw_malloc(sizeof(double) * std::max(width, kColumnBlock * height)));
+  if (!scratch) throw std::bad_alloc();
+  LinePlans p;
+  p.row_forward = fftw_plan_r2r_1d(width, scratch, scratch, FFTW_REDFT10, flags);
+  p.row_inverse = fftw_plan_r2r_1d(width, scratch, scratch, FFTW_REDFT01, flags);
+  const fftw_r2r_kind k10 = FFTW_REDFT10, k01 = FFTW_REDFT01;
+  p.column_forward = fftw_plan_many_r2r(1, &height, kColumnBlock, scratch, nullptr, 1, height,
+                                        scratch, nullptr, 1, height, &k10, flags);
+  p.column_inverse = fftw_plan_many_r2r(1, &height, kColumnBlock, scratch, nullptr, 1, height,
+                                        scratch, nullptr, 1, height, &k01, flags);
+  fftw_free(scratch);
+  if (!p.row_forward || !p.row_inverse || !p.column_forward || !p.column_inverse)
+    throw std::runtime_error("FFTW could not create a DCT plan");
+  if (measure && !wisdom.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(std::filesystem::path(wisdom).parent_path(), ec);
+    fftw_export_wisdom_to_filename(wisdom.c_str());
+  }
+  return g_line_plans.emplace(key, p).first->second;
+}
+
+struct FftwLine {
+  double* p;
+  explicit FftwLine(size_t n) : p(static_cast<double*>(fftw_malloc(sizeof(double) * n))) {
+    if (!p) throw std::bad_alloc();
+  }
+  ~FftwLine() { fftw_free(p); }
+  FftwLine(const FftwLine&) = delete;
+  FftwLine& operator=(const FftwLine&) = delete;
+};
+
+}  // namespace
+
+bool solve_l2_dct_rows(int width, int height, double alpha, const float* primal,
+                       const float* gradient_x, const float* gradient_y, double* planes,
+                       bool measure, const RowSink& sink) {
+  const LinePlans& plans = line_plans_for(width, height, measure);
   const size_t plane = size_t(width) * height;
   const double alpha2 = alpha * alpha;
   const int n = 3 * width;
 
-  // --- Right-hand side, deinterleaved into planes, and the finiteness check of every input, in
-  // one pass over the inputs.
+  // --- Pass 1, per row: the right-hand side b, the finiteness check of every input, and the
+  // forward DCT along the row, into the planes.
   const auto bad = parallel_rows_sum<1>(height, [&](int y0, int y1, std::array<double, 1>& s) {
     std::vector<double> b(static_cast<size_t>(n));
+    const FftwLine line(width);
     uint32_t flags = 0;
     for (int y = y0; y < y1; ++y) {
       const size_t row = size_t(y) * width;
@@ -188,35 +254,86 @@ bool solve_l2_dct(int width, int height, double alpha, const float* primal, cons
       else
         rhs_row<false, false>(width, alpha2, p, gx, gy, below, b.data());
       for (int c = 0; c < 3; ++c) {
-        double* out = planes + c * plane + row;
-        for (int x = 0; x < width; ++x) out[x] = b[3 * x + c];
+        for (int x = 0; x < width; ++x) line.p[x] = b[3 * x + c];
+        fftw_execute_r2r(plans.row_forward, line.p, line.p);
+        std::memcpy(planes + c * plane + row, line.p, sizeof(double) * width);
       }
     }
     s[0] += flags;
   });
   if (bad[0] != 0) return false;
 
-  fftw_execute_r2r(plans.forward, planes, planes);
-
-  // --- Divide by the eigenvalues; 1 / (4 W H) undoes the unnormalised REDFT10 -> REDFT01 pair.
-  // The factor depends on (kx, ky) only: one division per coefficient, shared by the 3 planes.
-  std::vector<double> lambda_x(width);
+  // --- Pass 2, per block of kColumnBlock columns: forward DCT along the columns, division by the
+  // eigenvalues (and by 4 W H, which undoes the unnormalised REDFT10 -> REDFT01 pair), inverse
+  // DCT along the columns. The factor is shared by the 3 planes.
+  std::vector<double> lambda_x(width), lambda_y(height);
   for (int k = 0; k < width; ++k) lambda_x[k] = 2.0 - 2.0 * std::cos(M_PI * k / width);
+  for (int k = 0; k < height; ++k) lambda_y[k] = 2.0 - 2.0 * std::cos(M_PI * k / height) + alpha2;
   const double norm = 1.0 / (4.0 * double(width) * double(height));
-  parallel_rows(height, [&](int y0, int y1) {
-    std::vector<double> factor(width);
-    for (int y = y0; y < y1; ++y) {
-      const double lambda_y = 2.0 - 2.0 * std::cos(M_PI * y / height) + alpha2;
-      for (int x = 0; x < width; ++x) factor[x] = norm / (lambda_x[x] + lambda_y);
+  const int blocks = (width + kColumnBlock - 1) / kColumnBlock;
+  const size_t block_values = size_t(kColumnBlock) * height;
+  tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 1), [&](const tbb::blocked_range<int>& r) {
+    const FlushDenormals ftz;
+    const FftwLine cols(3 * block_values);
+    for (int blk = r.begin(); blk != r.end(); ++blk) {
+      const int x0 = blk * kColumnBlock, m = std::min(kColumnBlock, width - x0);
       for (int c = 0; c < 3; ++c) {
-        double* row = planes + c * plane + size_t(y) * width;
-        for (int x = 0; x < width; ++x) row[x] *= factor[x];
+        double* col = cols.p + c * block_values;
+        for (int y = 0; y < height; ++y) {
+          const double* src = planes + c * plane + size_t(y) * width + x0;
+          for (int j = 0; j < m; ++j) col[j * height + y] = src[j];
+        }
+        for (int j = m; j < kColumnBlock; ++j) std::fill_n(col + j * height, height, 0.0);
+        fftw_execute_r2r(plans.column_forward, col, col);
+      }
+      for (int j = 0; j < m; ++j) {
+        double* c0 = cols.p + j * height;
+        double* c1 = c0 + block_values;
+        double* c2 = c1 + block_values;
+        const double lx = lambda_x[x0 + j];
+        for (int k = 0; k < height; ++k) {
+          const double f = norm / (lx + lambda_y[k]);
+          c0[k] *= f;
+          c1[k] *= f;
+          c2[k] *= f;
+        }
+      }
+      for (int c = 0; c < 3; ++c) {
+        double* col = cols.p + c * block_values;
+        fftw_execute_r2r(plans.column_inverse, col, col);
+        for (int y = 0; y < height; ++y) {
+          double* dst = planes + c * plane + size_t(y) * width + x0;
+          for (int j = 0; j < m; ++j) dst[j] = col[j * height + y];
+        }
       }
     }
   });
 
-  fftw_execute_r2r(plans.inverse, planes, planes);
+  // --- Pass 3, per row: inverse DCT along the row, handed to the sink.
+  parallel_rows(height, [&](int y0, int y1) {
+    const FftwLine lines(3 * size_t(width));
+    const double* rows[3] = {lines.p, lines.p + width, lines.p + 2 * width};
+    for (int y = y0; y < y1; ++y) {
+      for (int c = 0; c < 3; ++c) {
+        double* line = lines.p + c * width;
+        std::memcpy(line, planes + c * plane + size_t(y) * width, sizeof(double) * width);
+        fftw_execute_r2r(plans.row_inverse, line, line);
+      }
+      sink(y, rows);
+    }
+  });
   return true;
+}
+
+bool solve_l2_dct(int width, int height, double alpha, const float* primal, const float* gradient_x,
+                  const float* gradient_y, double* planes, bool measure) {
+  const size_t plane = size_t(width) * height;
+  return solve_l2_dct_rows(width, height, alpha, primal, gradient_x, gradient_y, planes, measure,
+                           [&](int y, const double* const* rows) {
+                             for (int c = 0; c < 3; ++c)
+                               std::memcpy(planes + c * plane + size_t(y) * width, rows[c],
+                                           sizeof(double) * width);
+                           });
 }
 
 }  // namespace gdpt::detail

@@ -8,12 +8,14 @@
 // dy. The solve runs in double precision: with alpha -> 1e-4 the DC term is alpha^2 * sum(primal)
 // next to O(1) divergence values, which float cannot hold.
 //
-// FFTW plans (REDFT10 forward, REDFT01 inverse, 3 contiguous planes at once) are created once per
-// (size, threads, effort) and cached for the life of the process; FFTW_MEASURE plans also load and
-// save FFTW wisdom in $XDG_CACHE_HOME/gdpt/fftw-wisdom (or ~/.cache/gdpt/fftw-wisdom).
+// FFTW plans (REDFT10 forward, REDFT01 inverse: single-threaded 1-D plans for the solve, 2-D
+// plans for the benchmark's reference) are created once per (size[, threads], effort) and cached
+// for the life of the process; FFTW_MEASURE plans also load and save FFTW wisdom in
+// $XDG_CACHE_HOME/gdpt/fftw-wisdom (or ~/.cache/gdpt/fftw-wisdom).
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -45,15 +47,30 @@ class CachedDctBuffer {
 };
 
 // Inputs are interleaved RGB floats. `planes` holds 3 planes of width * height doubles (from
-// dct_alloc) and receives the solution per channel. `threads` >= 1 is the FFTW thread count; the
-// row passes run in the caller's TBB arena. Returns false, with `planes` unspecified, when any
-// input value (including the ignored last column of dx and last row of dy) is not finite: the
+// dct_alloc) and receives the solution per channel. Returns false, with `planes` unspecified, when
+// any input value (including the ignored last column of dx and last row of dy) is not finite: the
 // finiteness check is part of the pass that forms the right-hand side.
+//
+// The 2-D transforms are done as 1-D FFTW transforms inside three passes over memory, run in the
+// caller's TBB arena (fixed blocks: the result does not depend on the thread count):
+//   1. per row: b, the finiteness check, forward DCT along the row;
+//   2. per block of 8 columns: forward DCT along the columns, division by the eigenvalues,
+//      inverse DCT along the columns;
+//   3. per row: inverse DCT along the row, then the row is handed on.
 bool solve_l2_dct(int width, int height, double alpha, const float* primal, const float* gradient_x,
-                  const float* gradient_y, double* planes, int threads, bool measure);
+                  const float* gradient_y, double* planes, bool measure);
 
-// One forward (REDFT10) and one inverse (REDFT01) transform of the 3 planes, unnormalised, through
-// the same cached plans as solve_l2_dct: the benchmark's reference cost.
+// The same solve, but each solution row y goes to sink(y, rows) (rows[c]: `width` doubles of
+// channel c) instead of back into `planes`, which is then only scratch. Called from the row
+// pass's threads, each row once.
+using RowSink = std::function<void(int y, const double* const* rows)>;
+bool solve_l2_dct_rows(int width, int height, double alpha, const float* primal,
+                       const float* gradient_x, const float* gradient_y, double* planes,
+                       bool measure, const RowSink& sink);
+
+// One forward (REDFT10) and one inverse (REDFT01) 2-D transform of the 3 planes, unnormalised,
+// through cached FFTW 2-D plans (3 planes per plan, `threads` FFTW threads): the benchmark's
+// reference cost.
 void dct_round_trip(int width, int height, double* planes, int threads, bool measure);
 
 // Path of the FFTW wisdom file used by FFTW_MEASURE plans.

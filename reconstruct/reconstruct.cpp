@@ -266,29 +266,27 @@ inline float finish_value(float v, const float* emission, size_t i) {
 // The exact uniform L2 solution of `pr`, as interleaved float; with `finish` the output rule is
 // applied in the same pass (the result is then the final image). Returns an empty vector when
 // some input value is not finite: `pr` must then be sanitised (prepare()) and solved again.
-std::vector<float> l2_solution(const Prepared& pr, double alpha, int threads, bool measure,
+std::vector<float> l2_solution(const Prepared& pr, double alpha, bool measure,
                                const float* emission, bool finish) {
   const int W = pr.width, H = pr.height;
   const size_t plane = size_t(W) * H;
   const detail::CachedDctBuffer planes(3 * plane);
-  if (!detail::solve_l2_dct(W, H, alpha, pr.primal, pr.gradient_x, pr.gradient_y, planes.get(),
-                            threads, measure))
-    return {};
   auto x = detail::huge_vector<float>(3 * plane);
-  parallel_rows(H, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y) {
-      const size_t row = size_t(y) * W;
-      for (int c = 0; c < 3; ++c) {
-        const double* src = planes.get() + c * plane + row;
-        float* dst = x.data() + 3 * row + c;
-        if (finish)
-          for (int i = 0; i < W; ++i)
-            dst[3 * i] = finish_value(float(src[i]), emission, 3 * (row + i) + c);
-        else
-          for (int i = 0; i < W; ++i) dst[3 * i] = float(src[i]);
-      }
-    }
-  });
+  const bool ok = detail::solve_l2_dct_rows(
+      W, H, alpha, pr.primal, pr.gradient_x, pr.gradient_y, planes.get(), measure,
+      [&](int y, const double* const* rows) {
+        const size_t row = size_t(y) * W;
+        for (int c = 0; c < 3; ++c) {
+          const double* src = rows[c];
+          float* dst = x.data() + 3 * row + c;
+          if (finish)
+            for (int i = 0; i < W; ++i)
+              dst[3 * i] = finish_value(float(src[i]), emission, 3 * (row + i) + c);
+          else
+            for (int i = 0; i < W; ++i) dst[3 * i] = float(src[i]);
+        }
+      });
+  if (!ok) return {};
   return x;
 }
 
@@ -334,11 +332,11 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
       // Inputs are nearly always finite: the DCT's right-hand side pass checks that, and only
       // when it finds a non-finite value is the data sanitised (prepare) and solved again.
       pr = unchecked(input);
-      x = l2_solution(pr, alpha, threads, settings.fft_measure, input.emission, finish_in_l2);
+      x = l2_solution(pr, alpha, settings.fft_measure, input.emission, finish_in_l2);
       finished = finish_in_l2 && !x.empty();
       if (x.empty()) {
         pr = prepare(input, true);
-        x = l2_solution(pr, alpha, threads, settings.fft_measure, nullptr, false);
+        x = l2_solution(pr, alpha, settings.fft_measure, nullptr, false);
       }
       detail::CgWorkspace ws;
       if (settings.norm == ReconstructionNorm::L2 && pr.missing > 0) {

@@ -62,7 +62,7 @@ TEST_P(L2NormalEquations, RelativeResidualBelow1em6) {
   const auto gy = random_values(n, 3, -1.f, 1.f);
   auto planes = detail::dct_alloc(n);
   ASSERT_TRUE(
-      detail::solve_l2_dct(w, h, alpha, p.data(), gx.data(), gy.data(), planes.get(), 1, false));
+      detail::solve_l2_dct(w, h, alpha, p.data(), gx.data(), gy.data(), planes.get(), false));
   EXPECT_LT(normal_equation_residual(w, h, alpha, p, gx, gy, planes.get()), 1e-6);
 }
 
