@@ -257,7 +257,7 @@ LightSample LightSampler::sample(Vec3f ref, float u_select, Vec2f u) const {
   LightSample s;
   if (I.entries.empty()) return s;
   // A single emitter (a Cornell box's lamp) needs no CDF search: its pmf is 1.
-  float pmf = I.entries.size() == 1 ? I.selection.pmf(0) : 0.0f;
+  float pmf = I.entries.size() == 1 ? 1.0f : 0.0f;
   const Entry e =
       I.entries.size() == 1 ? I.entries[0] : I.entries[I.selection.sample_discrete(u_select, &pmf)];
   if (!(pmf > 0.0f)) return s;

@@ -55,8 +55,12 @@ struct AreaLight {
     if (!orthogonal) return std::nullopt;
     const Vec3f to = ref - center;
     const float d2 = length_squared(to);
-    // area cos / d^2 >= threshold, with cos = dot(to, normal) / d, without the division.
-    if (area * dot(to, normal) < kSphericalSolidAngle * d2 * std::sqrt(d2)) return std::nullopt;
+    // area cos / d^2 >= threshold with cos = dot(to, normal) / d, squared: no square root or
+    // division in the test that most reference points fail.
+    const float a_cos_d = area * dot(to, normal);
+    if (!(a_cos_d > 0.0f) ||
+        a_cos_d * a_cos_d < kSphericalSolidAngle * kSphericalSolidAngle * d2 * d2 * d2)
+      return std::nullopt;
     const SphericalRectangle r(ref, corner, unit_u, unit_v, len_u, len_v);
     if (!(r.solid_angle() >= kMinSphericalSolidAngle)) return std::nullopt;
     return r;
