@@ -20,7 +20,7 @@ namespace gdpt {
 
 struct Ray {
   Vec3f origin;
-  Vec3f direction;  // unit
+  Vec3f direction;  // unit, but for shadow rays to a finite point: the segment, t in [0, 1)
   float t_min = 0.0f;
   float t_max = 1e30f;
 };

@@ -240,12 +240,12 @@ class PathTracer final : public Integrator {
               // aiming from the offset origin: the offset shortens the path to a light surface
               // by up to offset / cos, which at grazing angles (a ceiling just above a panel)
               // exceeded the 1e-4 margin and made the emitter occlude itself.
+              // A finite light point is aimed at with the segment itself as the direction, t in
+              // [0, 1): no normalisation for an occlusion query.
               shadow.t_max = kInf;
               if (!ls.is_infinite) {
-                const Vec3f to = ls.position - shadow.origin;
-                const float len = length(to);
-                shadow.direction = to / len;
-                shadow.t_max = len * (1.0f - 1e-4f);
+                shadow.direction = ls.position - shadow.origin;
+                shadow.t_max = 1.0f - 1e-4f;
               }
               const Spectrum tr = transmittance(shadow, scratch, out.rays);
               if (!is_black(tr)) {
