@@ -62,7 +62,10 @@ struct Vertex {
   Frame frame;
   Vec3f ng;  // geometric normal on the side of the incoming ray
   Vec3f wi;  // local incoming direction
-  ClosureSet closures;
+  // The closures: a constant material's own set (no copy), else `own` filled by evaluate().
+  // A Vertex is never copied or moved (it lives in PathScratch), so `closures` may point into it.
+  const ClosureSet* closures = nullptr;
+  ClosureSet own;
   float roughness = 1.0f;  // ClosureSet::roughness(), 1 for a vertex without BSDF
   // A single Lambert lobe: eval() and pdf() depend on wi only through the sign of wi.z * wo.z,
   // so an offset sharing this vertex with another wi reuses the base's values (same_side()).
@@ -90,22 +93,60 @@ inline bool same_side(const Vertex& v, Vec3f wi_a, Vec3f wi_b, Vec3f wo) {
   return v.lambert && (wi_a.z * wo.z > 0.0f) == (wi_b.z * wo.z > 0.0f);
 }
 
+// What setup_vertex() needs of a material side whose closures do not vary over the surface
+// (Material::closures returns its cached set): the set itself, its roughness and whether it is a
+// single Lambert lobe, computed once per material and side. `set` is null for a material that
+// is evaluated per hit (textures).
+struct MaterialSide {
+  const ClosureSet* set = nullptr;
+  float roughness = 1.0f;
+  bool lambert = false;
+};
+
+float vertex_roughness(const ClosureSet& cs) {
+  return cs.has_bsdf() ? cs.roughness() : 1.0f;
+}
+bool single_lambert(const ClosureSet& cs) {
+  return cs.count() == 1 && cs[0].type == ClosureType::Lambert;
+}
+
+// Indexed by 2 * material + front_facing.
+std::vector<MaterialSide> material_sides(const SceneContext& ctx) {
+  std::vector<MaterialSide> sides(2 * ctx.materials().size());
+  ClosureSet scratch;
+  for (size_t m = 0; m < ctx.materials().size(); ++m)
+    for (int front = 0; front < 2; ++front) {
+      const ClosureSet& cs = ctx.materials()[m].closures(ShadingContext{{}, front == 1}, scratch);
+      if (&cs == &scratch) continue;  // evaluated per hit
+      sides[2 * m + size_t(front)] = {&cs, vertex_roughness(cs), single_lambert(cs)};
+    }
+  return sides;
+}
+
 // Sets up `v` at `hit` reached along `dir` (world, unit), as the path tracer does: Cycles-style
 // flipped normals for back faces, geometric-normal fallback for a shading normal that puts the
 // incoming direction below its horizon.
-void setup_vertex(const SceneContext& ctx, const SurfaceHit& hit, Vec3f dir, Vertex& v) {
+void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
+                  const SurfaceHit& hit, Vec3f dir, Vertex& v) {
   v.hit = hit;
-  const ShadingContext sc{hit.uv, hit.front_facing};
-  v.closures.clear();
-  ctx.materials()[size_t(hit.material)].evaluate(sc, v.closures);
+  const MaterialSide& side = sides[2 * size_t(hit.material) + (hit.front_facing ? 1 : 0)];
+  if (side.set) {
+    v.closures = side.set;
+    v.roughness = side.roughness;
+    v.lambert = side.lambert;
+  } else {
+    v.own.clear();
+    ctx.materials()[size_t(hit.material)].evaluate(ShadingContext{hit.uv, hit.front_facing}, v.own);
+    v.closures = &v.own;
+    v.roughness = vertex_roughness(v.own);
+    v.lambert = single_lambert(v.own);
+  }
   const Vec3f wi_world = -dir;
   v.ng = hit.front_facing ? hit.geometric_normal : -hit.geometric_normal;
   Vec3f ns = hit.front_facing ? hit.shading_normal : -hit.shading_normal;
   if (dot(ns, wi_world) <= 1e-4f) ns = v.ng;
   v.frame = Frame(ns);
   v.wi = v.frame.to_local(wi_world);
-  v.roughness = v.closures.has_bsdf() ? v.closures.roughness() : 1.0f;
-  v.lambert = v.closures.count() == 1 && v.closures[0].type == ClosureType::Lambert;
   v.origin_set = false;
 }
 
@@ -212,7 +253,8 @@ class GradientPathTracer final : public Integrator {
         settings_(settings),
         has_world_(ctx.lights().has_environment()),
         has_visible_lamps_(ctx.lights().has_camera_visible_lights()),
-        has_dof_(ctx.camera().has_dof()) {}
+        has_dof_(ctx.camera().has_dof()),
+        sides_(material_sides(ctx)) {}
 
   bool estimates_gradients() const override { return true; }
 
@@ -440,11 +482,11 @@ class GradientPathTracer final : public Integrator {
       o.ray = row.cam[k * kRow + i];
       // Base hits a surface, the offset the world: no shift.
       o.alive = row.cam_found[k * kRow + i];
-      if (o.alive) setup_vertex(ctx_, row.cam_hit[k * kRow + i], o.ray.direction, o.v);
+      if (o.alive) setup_vertex(ctx_, sides_, row.cam_hit[k * kRow + i], o.ray.direction, o.v);
     }
 
     int cur = 0;  // scratch.verts[cur] is the base vertex
-    setup_vertex(ctx_, hit, ray.direction, scratch.verts[cur]);
+    setup_vertex(ctx_, sides_, hit, ray.direction, scratch.verts[cur]);
     // Very direct light: emission seen by the camera, never shifted.
     out.emission += triangle_emission(ctx_, hit, ray.origin);
 
@@ -456,10 +498,10 @@ class GradientPathTracer final : public Integrator {
       if (bounce > max_bounces) break;
       const Vertex& base = scratch.verts[cur];
       Vertex& next_base = scratch.verts[cur ^ 1];
-      if (!base.closures.has_bsdf()) break;
+      if (!base.closures->has_bsdf()) break;
 
       const VertexType base_type = classify(base.roughness);
-      const ClosureSet& bc = base.closures;
+      const ClosureSet& bc = *base.closures;
 
       // Offsets arriving at a shared vertex see it from their own direction. `open` counts the
       // offsets with work of their own at this bounce (alive, not connected); connected and dead
@@ -475,7 +517,7 @@ class GradientPathTracer final : public Integrator {
         if (!o.active || !o.alive || o.link == Link::Connected) continue;
         if (o.link == Link::Recent) {
           o.wi_shared = base.frame.to_local(o.wi_world);
-        } else if (!o.v.closures.has_bsdf()) {
+        } else if (!o.v.closures->has_bsdf()) {
           o.alive = false;  // the offset ends on a surface without BSDF: it cannot follow
           continue;
         } else {
@@ -557,7 +599,7 @@ class GradientPathTracer final : public Integrator {
                        : shift::light_reconnection_jacobian(light_base, o.v.hit.position);
             fo[k] = Spectrum(0.0f);
             if (local_dir(o.v, lo[k].direction, wo_o[k])) {
-              fo[k] = o.v.closures.eval_pdf(o.v.wi, wo_o[k], pdf_fo[k]);
+              fo[k] = o.v.closures->eval_pdf(o.v.wi, wo_o[k], pdf_fo[k]);
               if (!is_black(fo[k]) && !is_black(lo[k].radiance)) {
                 test[k] = true;
                 shadow[k] = shadow_ray(o.v, lo[k].direction,
@@ -646,7 +688,7 @@ class GradientPathTracer final : public Integrator {
       const float t_hit = found ? next.t : kInf;
       LightHit lh;
       const bool light_hit = lights.intersect(ray.origin, ray.direction, t_hit, lh);
-      if (found) setup_vertex(ctx_, next, ray.direction, next_base);
+      if (found) setup_vertex(ctx_, sides_, next, ray.direction, next_base);
       const VertexType next_type = found ? classify(next_base.roughness) : VertexType::Diffuse;
 
       // --- Shift every offset over this segment ---
@@ -665,7 +707,7 @@ class GradientPathTracer final : public Integrator {
         if (open == 0) break;
         if (!o.active || !o.alive || o.link == Link::Connected) continue;
         if (!lobe_drawn && delta && o.link == Link::NotConnected &&
-            o.v.closures.uses_lobe_choice()) {
+            o.v.closures->uses_lobe_choice()) {
           st.u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
           lobe_drawn = true;
         }
@@ -851,7 +893,7 @@ class GradientPathTracer final : public Integrator {
           o.seg_pdf = bs.pdf;
         } else {
           float pdf = 0.0f;
-          o.seg_value = Vec3d(base.closures.eval_pdf(o.wi_shared, bs.wo, pdf));
+          o.seg_value = Vec3d(base.closures->eval_pdf(o.wi_shared, bs.wo, pdf));
           o.seg_pdf = pdf;
         }
         if (!(o.seg_pdf > 0.0)) o.shift = Shift::Failed;
@@ -863,7 +905,7 @@ class GradientPathTracer final : public Integrator {
 
     const Vertex& y = o.v;
     const VertexType yd_type =
-        bs.is_delta() && y.closures.has_delta() ? VertexType::Specular : classify(y.roughness);
+        bs.is_delta() && y.closures->has_delta() ? VertexType::Specular : classify(y.roughness);
 
     // --- Reconnection: x_d, y_d and x_{d+1} all diffuse ---
     if (xd_type == VertexType::Diffuse && yd_type == VertexType::Diffuse &&
@@ -887,7 +929,7 @@ class GradientPathTracer final : public Integrator {
         o.shift = Shift::Reconnect;
         o.seg_jacobian = r.jacobian;
         float pdf = 0.0f;
-        o.seg_value = Vec3d(y.closures.eval_pdf(y.wi, wo, pdf));
+        o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
         o.seg_pdf = pdf;
         // Visibility: traced with the other offsets' rays in one packet (seg_visible).
         o.vis_pending = true;
@@ -903,7 +945,7 @@ class GradientPathTracer final : public Integrator {
         }
         o.shift = Shift::ReconnectEnv;
         float pdf = 0.0f;
-        o.seg_value = Vec3d(y.closures.eval_pdf(y.wi, wo, pdf));
+        o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
         o.seg_pdf = pdf;
         o.vis_pending = true;
         o.vis_ray = shadow_ray(y, wo_world, kInf);
@@ -919,9 +961,9 @@ class GradientPathTracer final : public Integrator {
       // offset samples its own closures; when its random choice differs, the choice is forced
       // for a single-lobe closure set (the lobe's event is driven by u_lobe alone).
       const uint8_t want = bs.lobe & (kLobeReflection | kLobeTransmission);
-      BsdfSample so = y.closures.sample(y.wi, u_lobe, u_dir);
-      if (so.valid && (!so.is_delta() || (so.lobe & want) == 0) && y.closures.count() == 1)
-        so = y.closures.sample(y.wi, (want & kLobeReflection) ? 0.0f : 0.99999994f, u_dir);
+      BsdfSample so = y.closures->sample(y.wi, u_lobe, u_dir);
+      if (so.valid && (!so.is_delta() || (so.lobe & want) == 0) && y.closures->count() == 1)
+        so = y.closures->sample(y.wi, (want & kLobeReflection) ? 0.0f : 0.99999994f, u_dir);
       if (!so.valid || !so.is_delta() || (so.lobe & want) == 0 || !(so.pdf > 0.0f)) {
         o.shift = Shift::Failed;
         return;
@@ -941,7 +983,7 @@ class GradientPathTracer final : public Integrator {
       }
       wo = hv.wo.to_float();
       float pdf = 0.0f;
-      o.seg_value = Vec3d(y.closures.eval_pdf(y.wi, wo, pdf));
+      o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
       o.seg_pdf = pdf;
       o.seg_jacobian = hv.jacobian;
       if (!(o.seg_pdf > 0.0)) {
@@ -978,9 +1020,11 @@ class GradientPathTracer final : public Integrator {
   }
 
   float next_vertex_roughness(const SurfaceHit& h) const {
+    const MaterialSide& side = sides_[2 * size_t(h.material) + (h.front_facing ? 1 : 0)];
+    if (side.set) return side.roughness;
     ClosureSet cs;
     ctx_.materials()[size_t(h.material)].evaluate(ShadingContext{h.uv, h.front_facing}, cs);
-    return cs.has_bsdf() ? cs.roughness() : 1.0f;
+    return vertex_roughness(cs);
   }
 
   // (a) for a not-connected pair with x_d, y_d diffuse: the offset reconnects to the point the
@@ -993,7 +1037,7 @@ class GradientPathTracer final : public Integrator {
       Vec3f wo;
       if (!local_dir(y, base_dir, wo)) return;
       float pdf_o = 0.0f;
-      const Spectrum fo = y.closures.eval_pdf(y.wi, wo, pdf_o);
+      const Spectrum fo = y.closures->eval_pdf(y.wi, wo, pdf_o);
       const bool vis = !occluded(y, base_dir, kInf, rays);
       co = vis ? mul(mul(o.f, fo), lh.radiance) : Vec3d();
       d_off = shift::offset_densities(o.p, 1.0, pl_pair, vis ? pdf_o : 0.0f);
@@ -1013,7 +1057,7 @@ class GradientPathTracer final : public Integrator {
                          std::fabs(lo.distance - d) < 1e-3f * d &&
                          length_squared(lo.normal - lh.normal) <= kSameNormal2;
     float pdf_o = 0.0f;
-    const Spectrum fo = y.closures.eval_pdf(y.wi, wo, pdf_o);
+    const Spectrum fo = y.closures->eval_pdf(y.wi, wo, pdf_o);
     const bool vis = reaches && !occluded(y, dir, d * (1.0f - 1e-4f), rays);
     co = vis ? mul(mul(o.f, fo), lo.radiance) * r.jacobian : Vec3d();
     // Light sampling from y produces this point only where the light emits towards y (a spot's
@@ -1098,7 +1142,7 @@ class GradientPathTracer final : public Integrator {
         break;
       case Shift::HalfVector:
         if (o.killed) return kill();
-        if (o.next_found) setup_vertex(ctx_, o.next_hit, o.ray.direction, o.v);
+        if (o.next_found) setup_vertex(ctx_, sides_, o.next_hit, o.ray.direction, o.v);
         break;
       case Shift::Failed:
         return kill();
@@ -1113,6 +1157,7 @@ class GradientPathTracer final : public Integrator {
   bool has_world_ = false;
   bool has_visible_lamps_ = false;
   bool has_dof_ = false;
+  std::vector<MaterialSide> sides_;
 };
 
 }  // namespace
