@@ -352,7 +352,7 @@ class GradientPathTracer final : public Integrator {
 
   // The segment from vertex `v` along `dir` up to t_max, leaving the surface on the side of
   // `dir`.
-  static Ray shadow_ray(const Vertex& v, Vec3f dir, float t_max) {
+  static Ray shadow_ray(const Vertex& v, const Vec3f& dir, float t_max) {
     const Vec3f from = v.hit.position;
     Ray shadow;
     shadow.origin = ray_origin(v, dot(dir, v.ng) > 0.0f);
@@ -373,7 +373,7 @@ class GradientPathTracer final : public Integrator {
     return shadow;
   }
 
-  bool occluded(const Vertex& v, Vec3f dir, float t_max, uint32_t& rays) const {
+  bool occluded(const Vertex& v, const Vec3f& dir, float t_max, uint32_t& rays) const {
     ++rays;
     return ctx_.bvh().occluded(shadow_ray(v, dir, t_max));
   }
