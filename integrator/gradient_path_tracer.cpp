@@ -351,7 +351,7 @@ class GradientPathTracer final : public Integrator {
   }
 
   // The segment from vertex `v` along `dir` up to t_max, leaving the surface on the side of
-  // `dir`.
+  // `dir`: an occlusion query only (EmbreeScene::occluded / occluded4).
   static Ray shadow_ray(const Vertex& v, const Vec3f& dir, float t_max) {
     const Vec3f from = v.hit.position;
     Ray shadow;
@@ -362,12 +362,14 @@ class GradientPathTracer final : public Integrator {
     if (std::isfinite(t_max)) {
       // Aim at the same end point from the offset origin: the offset shortens the path to a
       // light surface by up to offset / cos, which at grazing angles exceeded the caller's
-      // 1e-4 margin and made an emitter occlude itself.
+      // 1e-4 margin and made an emitter occlude itself. The direction is that segment itself,
+      // not a unit vector, and t runs over [0, 1]: Embree accepts any direction length (t is
+      // measured in it), and an occlusion query needs no unit direction, which saves a square
+      // root and three divisions per ray.
       const Vec3f to = from + dir * t_max - shadow.origin;
-      const float len = length(to);
-      if (len > 0.0f) {
-        shadow.direction = to / len;
-        shadow.t_max = len;
+      if (length_squared(to) > 0.0f) {
+        shadow.direction = to;
+        shadow.t_max = 1.0f;
       }
     }
     return shadow;
