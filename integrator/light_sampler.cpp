@@ -224,6 +224,8 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
         break;
       case Kind::Area:
         I.areas[en.index].select_pmf = pmf;
+        if (I.areas[en.index].area > 0.0f)
+          I.areas[en.index].area_pdf = pmf / I.areas[en.index].area;
         break;
       case Kind::Sun:
         I.suns[en.index].select_pmf = pmf;

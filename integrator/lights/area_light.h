@@ -33,6 +33,7 @@ struct AreaLight {
   bool ellipse = false;
   Spectrum radiance;
   float select_pmf = 0.0f;      // filled by LightSampler
+  float area_pdf = 0.0f;        // select_pmf / area, filled by LightSampler (LightSample::area_pdf)
   bool camera_visible = false;  // filled by LightSampler
   // Dual basis of (axis_u, axis_v): local coordinates of a point in the plane are dot products.
   Vec3f dual_u, dual_v;
@@ -128,6 +129,7 @@ struct AreaLight {
     s.direction = dir;
     s.distance = d;
     s.pdf = sph ? 1.0f / sph->solid_angle() : d2 / (area * cos_l);
+    s.area_pdf = area_pdf;
     s.is_delta = false;
     s.is_infinite = false;
     s.valid = std::isfinite(s.pdf);
@@ -152,6 +154,7 @@ struct AreaLight {
     hit.position = o + d * t;
     hit.normal = normal;
     hit.radiance = radiance;
+    hit.area_pdf = area_pdf;
     const std::optional<SphericalRectangle> sph = spherical(o);
     hit.pdf = sph ? 1.0f / sph->solid_angle() : t * t / (area * -dot(d, normal));
   }
