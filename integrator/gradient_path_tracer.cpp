@@ -145,7 +145,7 @@ std::vector<MaterialSide> material_sides(const SceneContext& ctx) {
 // flipped normals for back faces, geometric-normal fallback for a shading normal that puts the
 // incoming direction below its horizon.
 void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
-                  const SurfaceHit& hit, Vec3f dir, Vertex& v) {
+                  const SurfaceHit& hit, const Vec3f& dir, Vertex& v) {
   v.hit = hit;
   const MaterialSide& side = sides[2 * size_t(hit.material) + (hit.front_facing ? 1 : 0)];
   if (side.set) {
@@ -511,10 +511,11 @@ class GradientPathTracer final : public Integrator {
       o.f = Vec3d(1.0, 1.0, 1.0);
       o.p = 1.0;
       o.grad = Vec3d();
-      o.ray = row.cam[k * kRow + i];
+      const Ray& cam = row.cam[k * kRow + i];
+      o.ray = cam;
       // Base hits a surface, the offset the world: no shift.
       o.alive = row.cam_found[k * kRow + i];
-      if (o.alive) setup_vertex(ctx_, sides_, row.cam_hit[k * kRow + i], o.ray.direction, o.v);
+      if (o.alive) setup_vertex(ctx_, sides_, row.cam_hit[k * kRow + i], cam.direction, o.v);
     }
 
     int cur = 0;  // scratch.verts[cur] is the base vertex
@@ -730,9 +731,21 @@ class GradientPathTracer final : public Integrator {
       // --- Shift every offset over this segment ---
       const Vec3d seg_b = Vec3d(bs.value);
       const float pdf_b = bs.pdf;
+      // Filled member by member: an aggregate assignment built a temporary with narrow stores and
+      // copied it with 16-byte loads across them (failed store-to-load forwarding; perf annotate
+      // put ~1% of the samples there).
       BaseStep st;
       if (open > 0) {
-        st = {&base, &bs, xd_type, next_type, wo_world, found, &next, u_lobe, u_dir, {}, false};
+        st.base = &base;
+        st.bs = &bs;
+        st.xd_type = xd_type;
+        st.next_type = next_type;
+        st.wo_world = wo_world;
+        st.found = found;
+        st.next = &next;
+        st.u_lobe = u_lobe;
+        st.u_dir = u_dir;
+        st.base_front = false;
         if (found) {
           st.target =
               shift::reconnection_base(base.hit.position, next.position, next.geometric_normal);
