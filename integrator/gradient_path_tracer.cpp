@@ -206,12 +206,13 @@ struct Offset {
   bool killed = false;  // the continuing path is not invertible / mismatched
 };
 
+// Filled completely by trace() (reused across pixels: zeroing it per pixel took a `rep stos`).
 struct SampleResult {
-  Spectrum primal{0.0f};
-  Spectrum emission{0.0f};
+  Spectrum primal;
+  Spectrum emission;
   Vec3d grad[kOffsets];
-  uint8_t attempts = 0, failures = 0;
-  uint32_t rays = 0;
+  uint8_t attempts, failures;
+  uint32_t rays;
 };
 
 // The base's segment x_d -> x_{d+1} as the offsets' shift_segment() calls see it.
@@ -248,6 +249,7 @@ struct CameraRow {
   SurfaceHit hit[kRow];
   // Offset k of pixel i at k * kRow + i, traced when the pixel's base ray found a surface.
   Ray cam[kOffsets * kRow];
+  Ray cam_pixel[kOffsets];  // generate_offset_rays()'s output for one pixel
   bool cam_valid[kOffsets * kRow], cam_found[kOffsets * kRow];
   SurfaceHit cam_hit[kOffsets * kRow];
 };
@@ -290,6 +292,7 @@ class GradientPathTracer final : public Integrator {
       sum2 += l * l;
     };
     CameraRow& row = scratch.row;
+    SampleResult r;
     const bool has_dof = has_dof_;
     for (uint32_t s = first_sample; s < first_sample + sample_count; ++s)
       for (int y = tile.y0; y < tile.y1; ++y)
@@ -317,7 +320,7 @@ class GradientPathTracer final : public Integrator {
             mask[kLeft] = x >= 1;
             mask[kDown] = y >= 1;
             const bool traced = row.valid[i] && row.found[i];
-            Ray cam[kOffsets];
+            Ray* cam = row.cam_pixel;
             if (traced) ctx_.camera().generate_offset_rays(row.raster[i], row.lens[i], mask, cam);
             for (int k = 0; k < kOffsets; ++k) {
               row.cam_valid[k * kRow + i] = traced && mask[k];
@@ -329,7 +332,10 @@ class GradientPathTracer final : public Integrator {
           for (int i = 0; i < n; ++i) {
             const int x = x0 + i;
             const bool* mask = row.mask[i];
-            SampleResult r;
+            // The pixel's accumulator (4 cache lines) is read after the path: fetch it now.
+            const char* acc_bytes = reinterpret_cast<const char*>(&film.pixel(x, y));
+            for (size_t b = 0; b < sizeof(Film::Accumulator); b += 64)
+              __builtin_prefetch(acc_bytes + b, 1);
             trace(row.sampler[i], i, scratch, r);
             rays += r.rays;
             // --- Primal, emission and statistics of the pixel's base path ---
@@ -480,20 +486,26 @@ class GradientPathTracer final : public Integrator {
     const CameraRow& row = scratch.row;
     const bool* mask = row.mask[i];
 
+    out.primal = Spectrum(0.0f);
+    out.emission = Spectrum(0.0f);
+    out.attempts = out.failures = 0;
+    out.rays = 1;
+
     // --- Camera rays (traced by render_tile) ---
-    Ray ray = row.ray[i];
+    const Ray& cam_ray = row.ray[i];
     const SurfaceHit& hit = row.hit[i];
-    ++out.rays;
     const bool camera_found = row.found[i];
     // Very direct light, never shifted: lamps visible to the camera, and the world.
     if (has_visible_lamps_) {
       LightHit lh;
-      if (lights.intersect(ray.origin, ray.direction, camera_found ? hit.t : ray.t_max, lh) &&
+      if (lights.intersect(cam_ray.origin, cam_ray.direction, camera_found ? hit.t : cam_ray.t_max,
+                           lh) &&
           lh.camera_visible)
         out.emission += lh.radiance;
     }
     if (!camera_found) {
-      if (has_world_) out.emission += lights.environment(ray.direction);
+      if (has_world_) out.emission += lights.environment(cam_ray.direction);
+      for (Vec3d& g : out.grad) g = Vec3d();
       return;
     }
 
@@ -519,9 +531,10 @@ class GradientPathTracer final : public Integrator {
     }
 
     int cur = 0;  // scratch.verts[cur] is the base vertex
-    setup_vertex(ctx_, sides_, hit, ray.direction, scratch.verts[cur]);
+    setup_vertex(ctx_, sides_, hit, cam_ray.direction, scratch.verts[cur]);
     // Very direct light: emission seen by the camera, never shifted.
-    out.emission += triangle_emission(ctx_, hit, ray.origin);
+    out.emission += triangle_emission(ctx_, hit, cam_ray.origin);
+    Ray ray;  // the base's current segment
 
     Spectrum beta(1.0f);  // f / p of the base, for the primal (PT estimator)
     Vec3d fb(1.0, 1.0, 1.0);
