@@ -352,6 +352,7 @@ bool LightSampler::intersect(Vec3f origin, Vec3f direction, float t_max, LightHi
   if (area) {
     area->fill_hit(origin, direction, best, hit);
     hit.pdf *= area->select_pmf;
+    hit.area_pdf = area->area_pdf;
     hit.camera_visible = area->camera_visible;
     return true;
   }

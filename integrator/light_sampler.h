@@ -22,22 +22,22 @@ struct LightSample {
   Vec3f direction;     // unit, from the reference point towards the light
   float distance = 0;  // to position; +inf for sun and world
   float pdf = 0;       // solid-angle density incl. light selection; discrete prob. if is_delta
+  bool is_delta = false;     // cannot be hit by BSDF sampling (no MIS)
+  bool is_infinite = false;  // sun or world
+  bool valid = false;
   // Area lights only (0 for the others): selection pmf / area, the density per unit area of
   // uniform area sampling. G-PT weighs its techniques with the area-sampling density
   // area_pdf d^2 / cos of a light point, the same function from every reference point.
   float area_pdf = 0;
-  bool is_delta = false;     // cannot be hit by BSDF sampling (no MIS)
-  bool is_infinite = false;  // sun or world
-  bool valid = false;
 };
 
 struct LightHit {
   Spectrum radiance;  // emitted towards the ray origin
   float distance = 0;
-  float pdf = 0;       // density sample() would have produced this direction from the ray origin
-  float area_pdf = 0;  // area lights: selection pmf / area (LightSample::area_pdf), else 0
+  float pdf = 0;  // density sample() would have produced this direction from the ray origin
   Vec3f position, normal;
   bool camera_visible = false;  // the lamp shows to camera rays (Light::camera_visible)
+  float area_pdf = 0;           // area lights: selection pmf / area (LightSample::area_pdf)
 };
 
 class LightSampler {

@@ -33,13 +33,13 @@ struct AreaLight {
   bool ellipse = false;
   Spectrum radiance;
   float select_pmf = 0.0f;      // filled by LightSampler
-  float area_pdf = 0.0f;        // select_pmf / area, filled by LightSampler (LightSample::area_pdf)
   bool camera_visible = false;  // filled by LightSampler
   // Dual basis of (axis_u, axis_v): local coordinates of a point in the plane are dot products.
   Vec3f dual_u, dual_v;
   bool orthogonal = false;  // rectangle with orthogonal axes: spherical sampling possible
   Vec3f corner, unit_u, unit_v;
   float len_u = 0.0f, len_v = 0.0f;
+  float area_pdf = 0.0f;  // select_pmf / area, filled by LightSampler (LightSample::area_pdf)
 
   static constexpr float kMinSphericalSolidAngle = 1e-3f;
   // Spherical sampling only where the rectangle subtends at least this much, estimated as
@@ -154,7 +154,6 @@ struct AreaLight {
     hit.position = o + d * t;
     hit.normal = normal;
     hit.radiance = radiance;
-    hit.area_pdf = area_pdf;
     const std::optional<SphericalRectangle> sph = spherical(o);
     hit.pdf = sph ? 1.0f / sph->solid_angle() : t * t / (area * -dot(d, normal));
   }
