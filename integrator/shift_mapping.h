@@ -251,6 +251,11 @@ inline HalfVectorShift half_vector_shift(Vec3d base_wi, Vec3d base_wo, Vec3d off
 // f, the offset term f' J and the gradient f' J - f. A failed shift has q = 0.
 // When next-event estimation is not shifted for a pair, both sides drop their light terms:
 // pass p_L = p'_L = 0 for the BSDF technique, and the light technique is not used.
+// The weights of a pair's four techniques sum to one for any density used in place of p_L, p'_L
+// as long as all four see the same function of the light point and its vertex: the integrator
+// weighs area lights with their area-sampling density (mis_light_pdf in
+// gradient_path_tracer.cpp) and passes p_mis^2 / pdf as the light technique's `technique_pdf`,
+// so that the base term stays divided by the density it was sampled with.
 // ---------------------------------------------------------------------------------------------
 struct PathDensities {
   double path = 0.0;   // p (base) or J * p' (offset, Jacobian included)
