@@ -162,122 +162,58 @@ EmbreeScene::~EmbreeScene() {
   if (device_) rtcReleaseDevice(device_);
 }
 
-bool EmbreeScene::intersect(const Ray& ray, SurfaceHit& hit) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  RTCRayHit rh;
-  rh.ray.org_x = ray.origin.x;
-  rh.ray.org_y = ray.origin.y;
-  rh.ray.org_z = ray.origin.z;
-  rh.ray.dir_x = ray.direction.x;
-  rh.ray.dir_y = ray.direction.y;
-  rh.ray.dir_z = ray.direction.z;
-  rh.ray.tnear = ray.t_min;
-  rh.ray.tfar = ray.t_max;
-  rh.ray.time = 0.0f;
-  rh.ray.mask = 0xffffffffu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(top_, &ctx, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  hit.t = rh.ray.tfar;
-  // Instanced meshes report the top-level id in instID[0], flattened ones in geomID.
-  const unsigned top_id =
-      rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
-  complete_hit(top_id, rh.hit.primID, rh.hit.u, rh.hit.v, ray.direction, hit);
-  return true;
-}
+namespace {
 
-bool EmbreeScene::occluded(const Ray& ray) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  RTCRay r;
+// Embree's single-ray layout of `ray` (tnear > tfar marks an inactive ray of a stream).
+void to_embree(const Ray& ray, bool active, RTCRay& r) {
   r.org_x = ray.origin.x;
   r.org_y = ray.origin.y;
   r.org_z = ray.origin.z;
   r.dir_x = ray.direction.x;
   r.dir_y = ray.direction.y;
   r.dir_z = ray.direction.z;
-  r.tnear = ray.t_min;
-  r.tfar = ray.t_max;
+  r.tnear = active ? ray.t_min : 1.0f;
+  r.tfar = active ? ray.t_max : 0.0f;
   r.time = 0.0f;
   r.mask = 0xffffffffu;
   r.id = 0;
   r.flags = 0;
-  rtcOccluded1(top_, &ctx, &r);
-  return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
 
-namespace {
-
-// Fills lane i of a packet ray from `ray` (a lane that is not valid is left untouched by Embree).
-template <typename Packet>
-void set_lane(Packet& r, int i, const Ray& ray) {
-  r.org_x[i] = ray.origin.x;
-  r.org_y[i] = ray.origin.y;
-  r.org_z[i] = ray.origin.z;
-  r.dir_x[i] = ray.direction.x;
-  r.dir_y[i] = ray.direction.y;
-  r.dir_z[i] = ray.direction.z;
-  r.tnear[i] = ray.t_min;
-  r.tfar[i] = ray.t_max;
-  r.time[i] = 0.0f;
-  r.mask[i] = 0xffffffffu;
-  r.id[i] = unsigned(i);
-  r.flags[i] = 0;
+void to_embree(const Ray& ray, bool active, RTCRayHit& rh) {
+  to_embree(ray, active, rh.ray);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
 }  // namespace
 
-void EmbreeScene::intersect4(const Ray rays[4], const bool valid[4], bool found[4],
-                             SurfaceHit hits[4]) const {
-  // An empty packet costs a call; a single ray is faster on its own.
-  const int n = int(valid[0]) + int(valid[1]) + int(valid[2]) + int(valid[3]);
-  if (n <= 1) {
-    for (int i = 0; i < 4; ++i) found[i] = valid[i] && intersect(rays[i], hits[i]);
-    return;
-  }
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  alignas(16) int lanes[4];
-  alignas(16) RTCRayHit4 rh;
-  for (int i = 0; i < 4; ++i) {
-    lanes[i] = valid[i] ? -1 : 0;
-    set_lane(rh.ray, i, valid[i] ? rays[i] : Ray{});
-    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-  }
-  rtcIntersect4(lanes, top_, &ctx, &rh);
-  for (int i = 0; i < 4; ++i) {
-    found[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-    if (!found[i]) continue;
-    hits[i].t = rh.ray.tfar[i];
-    const unsigned top_id =
-        rh.hit.instID[0][i] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0][i] : rh.hit.geomID[i];
-    complete_hit(top_id, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], rays[i].direction, hits[i]);
-  }
+inline bool EmbreeScene::read_hit(const RTCRayHit& rh, Vec3f dir, SurfaceHit& hit) const {
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  hit.t = rh.ray.tfar;
+  // Instanced meshes report the top-level id in instID[0], flattened ones in geomID.
+  const unsigned top_id =
+      rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
+  complete_hit(top_id, rh.hit.primID, rh.hit.u, rh.hit.v, dir, hit);
+  return true;
 }
 
-void EmbreeScene::occluded4(const Ray rays[4], const bool valid[4], bool blocked[4]) const {
-  const int n = int(valid[0]) + int(valid[1]) + int(valid[2]) + int(valid[3]);
-  if (n <= 1) {
-    for (int i = 0; i < 4; ++i) blocked[i] = valid[i] && occluded(rays[i]);
-    return;
-  }
+bool EmbreeScene::intersect(const Ray& ray, SurfaceHit& hit) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  alignas(16) int lanes[4];
-  alignas(16) RTCRay4 r;
-  for (int i = 0; i < 4; ++i) {
-    lanes[i] = valid[i] ? -1 : 0;
-    set_lane(r, i, valid[i] ? rays[i] : Ray{});
-  }
-  rtcOccluded4(lanes, top_, &ctx, &r);
-  for (int i = 0; i < 4; ++i) blocked[i] = valid[i] && r.tfar[i] < 0.0f;  // -inf on a hit
+  RTCRayHit rh;
+  to_embree(ray, true, rh);
+  rtcIntersect1(top_, &ctx, &rh);
+  return read_hit(rh, ray.direction, hit);
+}
+
+bool EmbreeScene::occluded(const Ray& ray) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRay r;
+  to_embree(ray, true, r);
+  rtcOccluded1(top_, &ctx, &r);
+  return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
 
 void EmbreeScene::intersect_stream(const Ray* rays, const bool* valid, int n, bool* found,
@@ -289,35 +225,11 @@ void EmbreeScene::intersect_stream(const Ray* rays, const bool* valid, int n, bo
   alignas(16) RTCRayHit rh[kChunk];
   for (int first = 0; first < n; first += kChunk) {
     const int m = std::min(kChunk, n - first);
-    for (int j = 0; j < m; ++j) {
-      const Ray& ray = rays[first + j];
-      RTCRayHit& r = rh[j];
-      r.ray.org_x = ray.origin.x;
-      r.ray.org_y = ray.origin.y;
-      r.ray.org_z = ray.origin.z;
-      r.ray.dir_x = ray.direction.x;
-      r.ray.dir_y = ray.direction.y;
-      r.ray.dir_z = ray.direction.z;
-      // An inactive ray of a stream has tnear > tfar.
-      r.ray.tnear = valid[first + j] ? ray.t_min : 1.0f;
-      r.ray.tfar = valid[first + j] ? ray.t_max : 0.0f;
-      r.ray.time = 0.0f;
-      r.ray.mask = 0xffffffffu;
-      r.ray.id = unsigned(j);
-      r.ray.flags = 0;
-      r.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      r.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    }
+    for (int j = 0; j < m; ++j) to_embree(rays[first + j], valid[first + j], rh[j]);
     rtcIntersect1M(top_, &ctx, rh, unsigned(m), sizeof(RTCRayHit));
     for (int j = 0; j < m; ++j) {
       const int i = first + j;
-      const RTCRayHit& r = rh[j];
-      found[i] = valid[i] && r.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-      if (!found[i]) continue;
-      hits[i].t = r.ray.tfar;
-      const unsigned top_id =
-          r.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? r.hit.instID[0] : r.hit.geomID;
-      complete_hit(top_id, r.hit.primID, r.hit.u, r.hit.v, rays[i].direction, hits[i]);
+      found[i] = valid[i] && read_hit(rh[j], rays[i].direction, hits[i]);
     }
   }
 }

@@ -48,11 +48,6 @@ class EmbreeScene {
   bool intersect(const Ray& ray, SurfaceHit& hit) const;
   // True when something blocks the segment (t_min, t_max).
   bool occluded(const Ray& ray) const;
-  // Four rays at once (Embree ray packets, rtcIntersect4 / rtcOccluded4, coherent context): ray i
-  // is traced only when valid[i]; results as above (found/blocked false for invalid rays). For
-  // the G-PT offsets, whose four rays start at neighbouring pixels.
-  void intersect4(const Ray rays[4], const bool valid[4], bool found[4], SurfaceHit hits[4]) const;
-  void occluded4(const Ray rays[4], const bool valid[4], bool blocked[4]) const;
   // A stream of n rays (Embree rtcIntersect1M, coherent context: Embree groups consecutive rays
   // into packets of its native width, on any ISA). Ray i is traced only when valid[i]; results as
   // intersect(). For G-PT's camera rays of a row of pixels (consecutive rays start at neighbouring
@@ -67,6 +62,9 @@ class EmbreeScene {
                     SurfaceHit& hit) const;
 
  private:
+  // Fills `hit` from Embree's result; false when nothing was hit.
+  bool read_hit(const RTCRayHit& rh, Vec3f dir, SurfaceHit& hit) const;
+
   struct InstanceData {
     const Mesh* mesh = nullptr;
     const Instance* instance = nullptr;

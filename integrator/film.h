@@ -45,6 +45,24 @@ class Film {
     // then hold the G_right / G_up halves; both are zero in PT mode.
     double dx_left[3] = {0, 0, 0}, dx_left2 = 0;
     double dy_down[3] = {0, 0, 0}, dy_down2 = 0;
+
+    // One camera sample's primal and camera-visible emission, as every integrator adds them: a
+    // non-finite value would poison the pixel forever and is dropped (counted as black); with
+    // clamp > 0 the primal is scaled so its largest component is at most clamp.
+    void add_path(Spectrum primal_sample, Spectrum emission_sample, float clamp) {
+      if (!is_finite(primal_sample)) primal_sample = Spectrum(0.0f);
+      if (!is_finite(emission_sample)) emission_sample = Spectrum(0.0f);
+      if (clamp > 0.0f) {
+        const float m = max_component(primal_sample);
+        if (m > clamp) primal_sample *= clamp / m;
+      }
+      const double lum = luminance(primal_sample);
+      for (int c = 0; c < 3; ++c) {
+        primal[c] += primal_sample[c];
+        emission[c] += emission_sample[c];
+      }
+      primal2 += lum * lum;
+    }
   };
   Accumulator& pixel(int x, int y) { return acc_[size_t(y) * width_ + x]; }
   const Accumulator& pixel(int x, int y) const { return acc_[size_t(y) * width_ + x]; }

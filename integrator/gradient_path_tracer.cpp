@@ -339,19 +339,8 @@ class GradientPathTracer final : public Integrator {
             trace(row.sampler[i], i, scratch, r);
             rays += r.rays;
             // --- Primal, emission and statistics of the pixel's base path ---
-            if (!is_finite(r.primal)) r.primal = Spectrum(0.0f);
-            if (!is_finite(r.emission)) r.emission = Spectrum(0.0f);
-            if (clamp > 0.0f) {
-              const float m = max_component(r.primal);
-              if (m > clamp) r.primal *= clamp / m;
-            }
             Film::Accumulator& acc = film.pixel(x, y);
-            const double lum = luminance(r.primal);
-            for (int c = 0; c < 3; ++c) {
-              acc.primal[c] += r.primal[c];
-              acc.emission[c] += r.emission[c];
-            }
-            acc.primal2 += lum * lum;
+            acc.add_path(r.primal, r.emission, clamp);
             acc.shift_attempts += r.attempts;
             acc.shift_failures += r.failures;
             // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---

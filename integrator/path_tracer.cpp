@@ -63,21 +63,9 @@ class PathTracer final : public Integrator {
         Film::Accumulator& acc = film.pixel(x, y);
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
           sampler.start(settings_.seed, x, y, s);
-          PathResult r = trace(sampler, x, y, closures, scratch);
+          const PathResult r = trace(sampler, x, y, closures, scratch);
           rays += r.rays;
-          // A non-finite sample would poison the pixel forever: drop it (counted as black).
-          if (!is_finite(r.primal)) r.primal = Spectrum(0.0f);
-          if (!is_finite(r.emission)) r.emission = Spectrum(0.0f);
-          if (clamp > 0.0f) {
-            const float m = max_component(r.primal);
-            if (m > clamp) r.primal *= clamp / m;
-          }
-          const double lum = luminance(r.primal);
-          for (int c = 0; c < 3; ++c) {
-            acc.primal[c] += r.primal[c];
-            acc.emission[c] += r.emission[c];
-          }
-          acc.primal2 += lum * lum;
+          acc.add_path(r.primal, r.emission, clamp);
         }
         film.add_sample_count(x, y, sample_count);
       }
