@@ -1,18 +1,48 @@
 // Statistical proofs of the G-PT integrator against a converged PT reference on the same scene:
-//  - E[dx], E[dy] equal the finite differences of the PT reference within 4 sigma per pixel
-//    (sigma from the variance buffers of both renders), including the border pixels, and the
-//    image-wide sum of the differences is within 4 sigma of zero (power against small systematic
-//    bias, e.g. a factor on one technique);
-//  - the G-PT primal equals PT within noise;
+//  - E[dx], E[dy] equal the finite differences of the PT reference per pixel (rule below),
+//    including the border pixels, and the image-wide sum of the differences is within 4 sigma of
+//    zero (power against small systematic bias);
+//  - the G-PT primal equals PT within noise (same rule);
 //  - the last column / row hold the Neumann zeros;
 //  - the film is bit-identical with 1 and 2 threads.
 // Scenes: diffuse Cornell box, GGX glossy object (rough = reconnection, very smooth = half-vector
-// copy), smooth glass (delta refraction with TIR), constant environment light. All renders use
-// fixed seeds, so the outcome is deterministic.
+// copy), smooth glass (delta refraction with TIR), constant environment light, mixed and spot
+// lights, thin lens, multi-lobe materials, hard cases. All renders use fixed seeds, so the
+// outcome is deterministic; GDPT_GRADIENT_TEST_SEED_OFFSET adds an offset to every seed of these
+// statistical tests (calibration only).
+//
+// Per-pixel rule (check()): z = diff / sigma with sigma^2 = max(own variance, mean of the
+// variances of the 3x3 neighbourhood on the same image border); |z| <= 4, except one pixel per
+// buffer in (4, 5]; none beyond 5. Budgets: G-PT 1024 spp against PT 4096 spp (hard cases 512
+// against 2048; the heavy-tailed near-threshold and dense-glass cases 2048 / 1024).
+//
+// Why: the per-pixel sample variances of near-specular paths are heavy-tailed. A pixel whose
+// samples missed the rare, large caustic paths has a deficient mean *and* a sample variance up to
+// 100x too small, so diff / own sigma reaches 6-10 without any bias. A sample variance is an
+// unbiased estimate of the variance, but its median lies far below it in such tails; the mean
+// over a pixel's 3x3 neighbourhood (which shares the caustic) keeps the unbiasedness and averages
+// over nine pixels' rare events. The sampler is Owen-scrambled Sobol, whose per-sample variance
+// overestimates the variance of the mean of smooth integrands (Cornell box: 0.7% of |z| > 2
+// instead of 4.6%), so the rule stays conservative where the tail is light.
+//
+// Calibration (2026-12-01; 40 seed pairs, every seed + 0, 100, ..., 3900): the previous rule
+// (own variance only, G-PT 512 / hard cases 256 spp) failed without any bias in 19 of 800 runs
+// (20 cases x 40): glossy-smooth 5, smooth glass 8, glass-tir 2, rough-glass-tir 4 of 40 (max
+// |z| 9.70). This rule: 0 of 800, max |z| 4.16, 2 pixels beyond 4 in all 800 runs, none beyond 5,
+// max |global z| 2.43; still 0 of 800 with the thresholds lowered to 3.5 / 4.5 (global 3.5).
+// Power (bias injections into a local copy of the integrator, never committed; this file's
+// seeds): every injected bias that failed the previous tests fails these, in a superset of the
+// tests: the +x offset's next-event contribution x1.03: 5 -> 6 failing tests; both offsets'
+// x1.1: 1 -> 1, x1.3: 5 -> 6; merged-event terms x1.1: 1 -> 3, x1.3: 10 -> 12; reconnection
+// Jacobian x1.3: 1 -> 2. Symmetric 3% errors and a missing invertibility kill fail neither.
+// Full table and method: docs/gradient.md, "Unbiasedness tests: rule and calibration".
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <vector>
 
 #include "gradient_scenes.h"
 #include "integrator/camera.h"
@@ -20,31 +50,81 @@
 namespace gdpt::gradient_test {
 namespace {
 
-// Per-pixel rule: |z| <= 4 for every pixel, except that one pixel per buffer may lie in (4, 5]
-// (with ~240 Gaussian z values, P(two beyond 4) ~ 1e-4; Monte Carlo sample variances of
-// glossy paths are heavy-tailed, and the test must stay deterministic-and-passing when another
-// component changes the random realisation). Nothing may exceed 5 sigma.
+// Seeds of the statistical tests are the defaults below plus GDPT_GRADIENT_TEST_SEED_OFFSET
+// (unset: 0). Only for calibration runs (see the header and docs/gradient.md); CI never sets it.
+uint32_t seed_offset() {
+  static const uint32_t off = [] {
+    const char* s = std::getenv("GDPT_GRADIENT_TEST_SEED_OFFSET");
+    return s ? uint32_t(std::strtoul(s, nullptr, 10)) : 0u;
+  }();
+  return off;
+}
+
+// One compared buffer (dx, dy or primal) on the pixel grid: G-PT minus the reference and the
+// variance of that difference (from both renders' variance buffers) for every tested pixel.
+struct Buffer {
+  int w = 0, h = 0;
+  std::vector<double> diff, var;
+  std::vector<char> tested;
+  Buffer(int w_, int h_)
+      : w(w_), h(h_), diff(size_t(w * h)), var(size_t(w * h)), tested(size_t(w * h)) {}
+  void set(int x, int y, double d, double v) {
+    const size_t i = size_t(y * w + x);
+    diff[i] = d;
+    var[i] = v;
+    tested[i] = 1;
+  }
+  // 0 on the first row / column, 2 on the last, 1 inside.
+  static int side(int v, int n) { return v == 0 ? 0 : (v == n - 1 ? 2 : 1); }
+  // Mean of the variances of the tested pixels of the 3x3 neighbourhood of (x, y), the pixel
+  // included, that lie on the same image border as (x, y): a border pixel's outward offsets are
+  // not traced, so its estimator (and variance) differs from its inner neighbours' (in
+  // all-half-vector, the first column's dx variance is 16-19x below its 3x3 mean). Interior
+  // pixels pool with interior ones, an edge pixel along its edge, a corner pixel with itself.
+  double neighbourhood_var(int x, int y) const {
+    double sum = 0.0;
+    int n = 0;
+    for (int j = std::max(y - 1, 0); j <= std::min(y + 1, h - 1); ++j)
+      for (int i = std::max(x - 1, 0); i <= std::min(x + 1, w - 1); ++i)
+        if (tested[size_t(j * w + i)] && side(i, w) == side(x, w) && side(j, h) == side(y, h)) {
+          sum += var[size_t(j * w + i)];
+          ++n;
+        }
+    return sum / n;
+  }
+};
+
+// The per-pixel rule of the header: the own variance, raised to the mean of its 3x3
+// neighbourhood (same border). The image-wide z uses the sum of the own variances.
 struct Check {
   int tested = 0, outliers = 0, severe = 0;
-  double max_z = 0.0;
+  double max_z = 0.0, max_z_own = 0.0;  // pooled sigma, own sigma only (printed for reference)
   double sum_diff = 0.0, sum_var = 0.0;
   double global_z() const { return sum_var > 0.0 ? sum_diff / std::sqrt(sum_var) : 0.0; }
 };
 
-void add(Check& c, double value, double expected, double var) {
-  ++c.tested;
-  const double diff = value - expected;
-  c.sum_diff += diff;
-  c.sum_var += var;
-  if (!(var > 0.0)) {
-    // No variance on either side (e.g. nothing but black): the values must agree exactly-ish.
-    if (std::fabs(diff) > 1e-6) ++c.severe;
-    return;
-  }
-  const double z = std::fabs(diff) / std::sqrt(var);
-  c.max_z = std::max(c.max_z, z);
-  if (z > 4.0) ++c.outliers;
-  if (z > 5.0) ++c.severe;
+Check check(const Buffer& b) {
+  Check c;
+  for (int y = 0; y < b.h; ++y)
+    for (int x = 0; x < b.w; ++x) {
+      const size_t i = size_t(y * b.w + x);
+      if (!b.tested[i]) continue;
+      ++c.tested;
+      const double diff = b.diff[i], var = b.var[i];
+      c.sum_diff += diff;
+      c.sum_var += var;
+      if (!(var > 0.0)) {
+        // No variance on either side (e.g. nothing but black): the values must agree exactly-ish.
+        if (std::fabs(diff) > 1e-6) ++c.severe;
+        continue;
+      }
+      c.max_z_own = std::max(c.max_z_own, std::fabs(diff) / std::sqrt(var));
+      const double z = std::fabs(diff) / std::sqrt(std::max(var, b.neighbourhood_var(x, y)));
+      c.max_z = std::max(c.max_z, z);
+      if (z > 4.0) ++c.outliers;
+      if (z > 5.0) ++c.severe;
+    }
+  return c;
 }
 
 void expect_within_4_sigma(const Check& c, const char* name, const char* buffer) {
@@ -57,40 +137,52 @@ struct Comparison {
 };
 
 Comparison compare(const Passes& ref, const Passes& g) {
-  Comparison r;
+  Buffer dx(g.w, g.h), dy(g.w, g.h), primal(g.w, g.h);
   for (int y = 0; y < g.h; ++y)
     for (int x = 0; x < g.w; ++x) {
-      add(r.primal, g.lum(g.primal, x, y), ref.lum(ref.primal, x, y),
-          g.var(x, y, 0) + ref.var(x, y, 0));
+      primal.set(x, y, g.lum(g.primal, x, y) - ref.lum(ref.primal, x, y),
+                 g.var(x, y, 0) + ref.var(x, y, 0));
       if (x + 1 < g.w) {
         const double e = ref.lum(ref.primal, x + 1, y) - ref.lum(ref.primal, x, y);
-        add(r.dx, g.lum(g.dx, x, y), e, g.var(x, y, 1) + ref.var(x, y, 0) + ref.var(x + 1, y, 0));
+        dx.set(x, y, g.lum(g.dx, x, y) - e,
+               g.var(x, y, 1) + ref.var(x, y, 0) + ref.var(x + 1, y, 0));
       } else {
         EXPECT_EQ(g.lum(g.dx, x, y), 0.0) << "Neumann column";
       }
       if (y + 1 < g.h) {
         const double e = ref.lum(ref.primal, x, y + 1) - ref.lum(ref.primal, x, y);
-        add(r.dy, g.lum(g.dy, x, y), e, g.var(x, y, 2) + ref.var(x, y, 0) + ref.var(x, y + 1, 0));
+        dy.set(x, y, g.lum(g.dy, x, y) - e,
+               g.var(x, y, 2) + ref.var(x, y, 0) + ref.var(x, y + 1, 0));
       } else {
         EXPECT_EQ(g.lum(g.dy, x, y), 0.0) << "Neumann row";
       }
     }
-  return r;
+  return {check(dx), check(dy), check(primal)};
+}
+
+// Max |z| (with the own variance alone in parentheses), outliers beyond 4 and image-wide z.
+void print_comparison(const char* name, const Comparison& c, bool primal) {
+  auto one = [](const char* buffer, const Check& k) {
+    std::printf(" | %s: max z %.2f (own %.2f), outliers %d/%d, global z %.2f", buffer, k.max_z,
+                k.max_z_own, k.outliers, k.tested, k.global_z());
+  };
+  std::printf("[%s]", name);
+  one("dx", c.dx);
+  one("dy", c.dy);
+  if (primal) one("primal", c.primal);
+  std::printf("\n");
 }
 
 void expect_unbiased(const char* name, const Scene& scene, int ref_spp, int gpt_spp,
                      float max_failure_rate = 1.0f) {
-  const Passes ref = render(scene, settings(RenderSettings::Mode::PT, ref_spp, 7));
-  const Passes g = render(scene, settings(RenderSettings::Mode::GPT, gpt_spp, 11));
+  const Passes ref = render(scene, settings(RenderSettings::Mode::PT, ref_spp, 7 + seed_offset()));
+  const Passes g = render(scene, settings(RenderSettings::Mode::GPT, gpt_spp, 11 + seed_offset()));
   const Comparison c = compare(ref, g);
   double failures = 0.0;
   for (float f : g.failures) failures += f;
   failures /= double(g.failures.size());
-  std::printf(
-      "[%s] dx: max z %.2f, outliers %d/%d, global z %.2f | dy: max z %.2f, outliers %d/%d, "
-      "global z %.2f | primal: max z %.2f, outliers %d/%d | shift failure rate %.3f\n",
-      name, c.dx.max_z, c.dx.outliers, c.dx.tested, c.dx.global_z(), c.dy.max_z, c.dy.outliers,
-      c.dy.tested, c.dy.global_z(), c.primal.max_z, c.primal.outliers, c.primal.tested, failures);
+  print_comparison(name, c, true);
+  std::printf("[%s] shift failure rate %.3f\n", name, failures);
   expect_within_4_sigma(c.dx, name, "dx");
   expect_within_4_sigma(c.dy, name, "dy");
   expect_within_4_sigma(c.primal, name, "primal");
@@ -106,27 +198,27 @@ void expect_unbiased(const char* name, const Scene& scene, int ref_spp, int gpt_
 }
 
 TEST(GradientUnbiased, DiffuseCornellBox) {
-  expect_unbiased("cornell", make_scene(SceneKind::CornellDiffuse, 16), 4096, 512, 0.5f);
+  expect_unbiased("cornell", make_scene(SceneKind::CornellDiffuse, 16), 4096, 1024, 0.5f);
 }
 
 TEST(GradientUnbiased, GlossyReconnectedAndHalfVector) {
   // roughness 0.3 -> alpha 0.09: reconnection; roughness 0.02 -> alpha 4e-4: half-vector copy.
-  expect_unbiased("glossy-rough", make_scene(SceneKind::CornellGlossy, 16, 0.3f), 4096, 512);
-  expect_unbiased("glossy-smooth", make_scene(SceneKind::CornellGlossy, 16, 0.02f), 4096, 512);
+  expect_unbiased("glossy-rough", make_scene(SceneKind::CornellGlossy, 16, 0.3f), 4096, 1024);
+  expect_unbiased("glossy-smooth", make_scene(SceneKind::CornellGlossy, 16, 0.02f), 4096, 1024);
 }
 
 TEST(GradientUnbiased, SmoothGlass) {
-  expect_unbiased("glass", make_scene(SceneKind::CornellGlass, 16, 0.0f), 4096, 512);
+  expect_unbiased("glass", make_scene(SceneKind::CornellGlass, 16, 0.0f), 4096, 1024);
 }
 
 TEST(GradientUnbiased, EnvironmentLight) {
-  expect_unbiased("environment", make_scene(SceneKind::Environment, 16), 4096, 512);
+  expect_unbiased("environment", make_scene(SceneKind::Environment, 16), 4096, 1024);
 }
 
 TEST(GradientUnbiased, MixedLights) {
   // Emissive triangles (offset light samples by resampling), a point light (delta), a sphere light
   // (evaluated by intersection) and a soft sun (infinite): every shifted-NEE path.
-  expect_unbiased("mixed-lights", make_scene(SceneKind::MixedLights, 16), 4096, 512);
+  expect_unbiased("mixed-lights", make_scene(SceneKind::MixedLights, 16), 4096, 1024);
 }
 
 // The Cornell box lit by one spot light under the ceiling pointing down, its cone edge (with
@@ -155,9 +247,9 @@ Scene spot_scene(float radius, float blend) {
 TEST(GradientUnbiased, SpotLight) {
   // The hard cone edge makes a wrongly weighted pair (an offset outside the cone keeping a light
   // density) a strong, coherent bias in dy: before the fix 108/240 outliers, global z -44.
-  expect_unbiased("spot-point", spot_scene(0.0f, 0.3f), 4096, 512);
-  expect_unbiased("spot-radius", spot_scene(0.08f, 0.3f), 4096, 512);
-  expect_unbiased("spot-radius-hard", spot_scene(0.08f, 0.0f), 4096, 512);
+  expect_unbiased("spot-point", spot_scene(0.0f, 0.3f), 4096, 1024);
+  expect_unbiased("spot-radius", spot_scene(0.08f, 0.3f), 4096, 1024);
+  expect_unbiased("spot-radius-hard", spot_scene(0.08f, 0.0f), 4096, 1024);
 }
 
 // A diffuse ceiling 0.1 m / 0.3 m above a two-sided emissive 1.2 m panel (the Blender mesh_light
@@ -212,20 +304,19 @@ TEST(GradientUnbiased, ThinLensDepthOfField) {
   Scene scene = make_scene(SceneKind::CornellDiffuse, 16);
   scene.camera.aperture_radius = 0.08f;
   scene.camera.focus_distance = 3.0f;
-  expect_unbiased("depth-of-field", scene, 4096, 512);
+  expect_unbiased("depth-of-field", scene, 4096, 1024);
 }
 
 TEST(GradientUnbiased, EveryVertexHalfVector) {
   // Threshold above every roughness: all vertices (Lambert included) take the half-vector copy,
   // light sampling is never shifted; exercises kills, failed shifts and offset-only light hits.
   Scene scene = make_scene(SceneKind::CornellDiffuse, 16);
-  const Passes ref = render(scene, settings(RenderSettings::Mode::PT, 4096, 7));
-  RenderSettings s = settings(RenderSettings::Mode::GPT, 512, 11);
+  const Passes ref = render(scene, settings(RenderSettings::Mode::PT, 4096, 7 + seed_offset()));
+  RenderSettings s = settings(RenderSettings::Mode::GPT, 1024, 11 + seed_offset());
   s.shift_roughness_threshold = 2.0f;
   const Passes g = render(scene, s);
   const Comparison c = compare(ref, g);
-  std::printf("[all-half-vector] dx: max z %.2f global z %.2f | dy: max z %.2f global z %.2f\n",
-              c.dx.max_z, c.dx.global_z(), c.dy.max_z, c.dy.global_z());
+  print_comparison("all-half-vector", c, false);
   expect_within_4_sigma(c.dx, "all-half-vector", "dx");
   expect_within_4_sigma(c.dy, "all-half-vector", "dy");
   EXPECT_LT(std::fabs(c.dx.global_z()), 4.0);
@@ -240,13 +331,12 @@ bool all_finite(const Passes& p) {
   return true;
 }
 
-void expect_hard_case(const char* name, const Scene& scene, int gpt_spp = 256) {
-  const Passes g = render(scene, settings(RenderSettings::Mode::GPT, gpt_spp, 5));
+void expect_hard_case(const char* name, const Scene& scene, int gpt_spp = 512) {
+  const Passes g = render(scene, settings(RenderSettings::Mode::GPT, gpt_spp, 5 + seed_offset()));
   EXPECT_TRUE(all_finite(g)) << name;
-  const Passes ref = render(scene, settings(RenderSettings::Mode::PT, 2048, 9));
+  const Passes ref = render(scene, settings(RenderSettings::Mode::PT, 2048, 9 + seed_offset()));
   const Comparison c = compare(ref, g);
-  std::printf("[%s] dx: max z %.2f global z %.2f | dy: max z %.2f global z %.2f\n", name,
-              c.dx.max_z, c.dx.global_z(), c.dy.max_z, c.dy.global_z());
+  print_comparison(name, c, false);
   expect_within_4_sigma(c.dx, name, "dx");
   expect_within_4_sigma(c.dy, name, "dy");
   EXPECT_LT(std::fabs(c.dx.global_z()), 4.0) << name;
@@ -266,7 +356,7 @@ TEST(GradientHardCases, RoughnessAroundThreshold) {
   // GGX alpha = roughness^2 just below (9.5e-4) and just above (1.05e-3) the 1e-3 threshold.
   // Near-delta lobes are heavy-tailed: more samples so that the sample variance is reliable.
   expect_hard_case("below-threshold", make_scene(SceneKind::CornellGlossy, 16, std::sqrt(0.00095f)),
-                   1024);
+                   2048);
   expect_hard_case("above-threshold",
                    make_scene(SceneKind::CornellGlossy, 16, std::sqrt(0.00105f)));
 }
@@ -275,11 +365,13 @@ TEST(GradientHardCases, GlassWithTotalInternalReflection) {
   // Dense smooth glass (ior 2.4): rays inside the sphere reflect totally beyond 24.6 degrees.
   Scene scene = make_scene(SceneKind::CornellGlass, 16, 0.0f);
   scene.materials[3] = glass(0.0f, 2.4f);
-  expect_hard_case("glass-tir", scene);
+  // Caustics through dense glass are the heaviest tails of these tests: twice the default
+  // samples (calibration: with the default, max |z| 4.65 in 31 seed pairs; with 1024, 3.45).
+  expect_hard_case("glass-tir", scene, 1024);
   // Rough glass below the threshold: half-vector refraction with TIR mismatches.
   Scene rough = make_scene(SceneKind::CornellGlass, 16, 0.0f);
   rough.materials[3] = glass(0.025f, 2.4f);
-  expect_hard_case("rough-glass-tir", rough);
+  expect_hard_case("rough-glass-tir", rough, 1024);
 }
 
 // Materials whose closure set mixes a delta lobe with rough ones: the base picks one lobe per
@@ -302,16 +394,16 @@ MaterialDesc mix_of(MaterialDesc a, MaterialDesc b, float fac) {
 TEST(GradientUnbiased, MultiLobeMaterialsWithADeltaLobe) {
   Scene diffuse_glass = make_scene(SceneKind::CornellDiffuse, 16);
   diffuse_glass.materials[3] = mix_of(diffuse({0.5f, 0.5f, 0.8f}), glass(0.0f), 0.5f);
-  expect_unbiased("mix-diffuse-smooth-glass", diffuse_glass, 4096, 512);
+  expect_unbiased("mix-diffuse-smooth-glass", diffuse_glass, 4096, 1024);
   Scene diffuse_mirror = make_scene(SceneKind::CornellDiffuse, 16);
   diffuse_mirror.materials[3] =
       mix_of(diffuse({0.5f, 0.5f, 0.8f}), glossy({0.9f, 0.9f, 0.9f}, 0.0f), 0.5f);
-  expect_unbiased("mix-diffuse-mirror", diffuse_mirror, 4096, 512);
+  expect_unbiased("mix-diffuse-mirror", diffuse_mirror, 4096, 1024);
   // Principled v1 with half transmission at roughness 0: diffuse, specular and smooth glass.
   Scene principled = make_scene(SceneKind::CornellDiffuse, 16);
   principled.materials[3] = single_node(ShaderNodeKind::Principled, {0.8f, 0.6f, 0.5f}, 0.0f);
   principled.materials[3].nodes[0].transmission = FloatInput(0.5f);
-  expect_unbiased("principled-transmission", principled, 4096, 512);
+  expect_unbiased("principled-transmission", principled, 4096, 1024);
 }
 
 TEST(GradientIntegrator, DeterministicAcrossThreadCounts) {
