@@ -38,8 +38,15 @@ inline uint32_t hash_u32(uint32_t x) {
   x ^= x >> 15;
   return x;
 }
-inline uint32_t hash_combine(uint32_t seed, uint32_t v) {
-  return hash_u32(seed ^ (v + 0x9e3779b9u + (seed << 6) + (seed >> 2)));
+// 64-bit finaliser (MurmurHash3's fmix64): full avalanche, so one call per dimension yields the
+// three 32-bit scramble seeds of a 2D sample.
+inline uint64_t mix64(uint64_t z) {
+  z ^= z >> 33;
+  z *= 0xff51afd7ed558ccdull;
+  z ^= z >> 33;
+  z *= 0xc4ceb9fe1a85ec53ull;
+  z ^= z >> 33;
+  return z;
 }
 
 // Laine-Karras style permutation in reversed-bit order: each bit is flipped depending only on the
@@ -108,7 +115,8 @@ class Sampler {
   // Starts sample `index` of pixel (x, y) for a render with `seed`.
   void start(uint32_t seed, int x, int y, uint32_t index) {
     using namespace sampler_detail;
-    pixel_hash_ = hash_combine(hash_combine(hash_u32(seed), uint32_t(x)), uint32_t(y));
+    pixel_key_ = mix64((uint64_t(uint32_t(y)) << 32 | uint32_t(x)) ^
+                       uint64_t(hash_u32(seed)) * 0x9e3779b97f4a7c15ull);
     reversed_index_ = reverse_bits(index);
   }
 
@@ -119,25 +127,29 @@ class Sampler {
   // Written with the reversals folded: nested_uniform_scramble(v, s) =
   // reverse_bits(lk_permutation(reverse_bits(v), s)), Sobol dimension 0 is reverse_bits(i) and
   // the dimension-1 table already returns reversed bits.
+  // The seeds of the index shuffle and of the coordinate scrambles all come from one 64-bit hash
+  // of (pixel key, dim): its low and high halves, and for y the high half of a multiple of it.
   float get1d(uint32_t dim) const {
     using namespace sampler_detail;
-    const uint32_t h = hash_combine(pixel_hash_, dim);
-    const uint32_t i = reverse_bits(lk_permutation(reversed_index_, h));  // shuffled index
-    return to_unit_float(reverse_bits(lk_permutation(i, hash_u32(h ^ 0x5bd1e995u))));
+    const uint64_t h = mix64(pixel_key_ ^ dim);
+    const uint32_t i = reverse_bits(lk_permutation(reversed_index_, uint32_t(h)));  // shuffled
+    return to_unit_float(reverse_bits(lk_permutation(i, uint32_t(h >> 32))));
   }
 
-  Vec2f get2d(uint32_t dim) const {
+  // Out of line: inlined into the PT kernel it cost more instructions than the call (+41 per
+  // Cornell-box sample, register pressure in the path loop).
+  [[gnu::noinline]] Vec2f get2d(uint32_t dim) const {
     using namespace sampler_detail;
-    const uint32_t h = hash_combine(pixel_hash_, dim);
-    const uint32_t i = reverse_bits(lk_permutation(reversed_index_, h));  // shuffled index
-    const uint32_t x = reverse_bits(lk_permutation(i, hash_u32(h ^ 0x5bd1e995u)));
-    const uint32_t y =
-        reverse_bits(lk_permutation(reversed_sobol_dim1(i), hash_u32(h ^ 0x1b873593u)));
+    const uint64_t h = mix64(pixel_key_ ^ dim);
+    const uint32_t i = reverse_bits(lk_permutation(reversed_index_, uint32_t(h)));  // shuffled
+    const uint32_t x = reverse_bits(lk_permutation(i, uint32_t(h >> 32)));
+    const uint32_t y = reverse_bits(
+        lk_permutation(reversed_sobol_dim1(i), uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32)));
     return {to_unit_float(x), to_unit_float(y)};
   }
 
  private:
-  uint32_t pixel_hash_ = 0;
+  uint64_t pixel_key_ = 0;
   uint32_t reversed_index_ = 0;
 };
 
