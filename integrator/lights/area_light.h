@@ -19,9 +19,10 @@
 #include <cmath>
 #include <optional>
 
-#include "integrator/light_sampler.h"
+#include "integrator/lights/light_sample.h"
 #include "integrator/lights/spherical_rectangle.h"
 #include "integrator/lights/warp.h"
+#include "integrator/scene.h"
 
 namespace gdpt::lights {
 
