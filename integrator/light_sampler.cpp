@@ -212,6 +212,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
   }
 
   single_area_ = areas_.size() == 1 && points_.empty() && I.suns.empty();
+  only_area_ = single_area_ && I.entries.size() == 1;
 
   // --- Selection CDF, and each light's own probability for MIS --------------------------------
   I.selection = Distribution1D(weights);
@@ -253,7 +254,14 @@ bool LightSampler::has_environment() const {
   return impl_->world_enabled;
 }
 
-LightSample LightSampler::sample(Vec3f ref, float u_select, Vec2f u) const {
+LightSample LightSampler::sample_only_area(Vec3f ref, Vec2f u) const {
+  // Its pmf is 1 and its radiance finite (a non-finite one has non-finite power: not stored).
+  LightSample s;
+  if (!areas_[0].sample(ref, u, s)) s = LightSample{};
+  return s;
+}
+
+LightSample LightSampler::sample_any(Vec3f ref, float u_select, Vec2f u) const {
   const Impl& I = *impl_;
   LightSample s;
   if (I.entries.empty()) return s;

@@ -29,7 +29,11 @@ class LightSampler {
   // Whether sample() reads u_select: a scene with one emitter (a Cornell box's lamp) needs no
   // selection number, and integrators skip drawing it.
   bool needs_selection() const;
-  LightSample sample(Vec3f ref_position, float u_select, Vec2f u) const;
+  // The scene whose only emitter is one area lamp (a Cornell box) goes straight to a small
+  // function: no selection, no dispatch, no generic checks.
+  LightSample sample(Vec3f ref_position, float u_select, Vec2f u) const {
+    return only_area_ ? sample_only_area(ref_position, u) : sample_any(ref_position, u_select, u);
+  }
   // Density of sample() choosing the point hit on emissive triangle (instance, primitive).
   float pdf_triangle(uint32_t instance, uint32_t primitive, Vec3f ref_position,
                      Vec3f light_position, Vec3f light_normal) const;
@@ -60,12 +64,15 @@ class LightSampler {
                        LightHit& hit);
   static void fill_hit(const lights::AreaLight& l, Vec3f origin, Vec3f direction, float t,
                        LightHit& hit);
+  LightSample sample_only_area(Vec3f ref_position, Vec2f u) const;
+  LightSample sample_any(Vec3f ref_position, float u_select, Vec2f u) const;
   bool intersect_any(Vec3f origin, Vec3f direction, float t_max, LightHit& hit) const;
 
   // Analytic lamps with a surface, here rather than in Impl for the in-line intersect().
   std::vector<lights::PointLight> points_;
   std::vector<lights::AreaLight> areas_;
   bool single_area_ = false;  // one area lamp is the only analytic light (no point, spot, sun)
+  bool only_area_ = false;    // ... and the only emitter (no emissive triangle, no world)
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
