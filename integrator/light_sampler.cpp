@@ -213,6 +213,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
 
   single_area_ = areas_.size() == 1 && points_.empty() && I.suns.empty();
   only_area_ = single_area_ && I.entries.size() == 1;
+  emitters_ = I.entries.size();
 
   // --- Selection CDF, and each light's own probability for MIS --------------------------------
   I.selection = Distribution1D(weights);
@@ -241,14 +242,6 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
 }
 
 LightSampler::~LightSampler() = default;
-
-bool LightSampler::empty() const {
-  return impl_->entries.empty();
-}
-
-bool LightSampler::needs_selection() const {
-  return impl_->entries.size() > 1;
-}
 
 bool LightSampler::has_environment() const {
   return impl_->world_enabled;

@@ -25,10 +25,10 @@ class LightSampler {
                std::span<const Texture> textures);
   ~LightSampler();
 
-  bool empty() const;
+  bool empty() const { return emitters_ == 0; }
   // Whether sample() reads u_select: a scene with one emitter (a Cornell box's lamp) needs no
   // selection number, and integrators skip drawing it.
-  bool needs_selection() const;
+  bool needs_selection() const { return emitters_ > 1; }
   // The scene whose only emitter is one area lamp (a Cornell box) goes straight to a small
   // function: no selection, no dispatch, no generic checks.
   LightSample sample(Vec3f ref_position, float u_select, Vec2f u) const {
@@ -73,6 +73,7 @@ class LightSampler {
   std::vector<lights::AreaLight> areas_;
   bool single_area_ = false;  // one area lamp is the only analytic light (no point, spot, sun)
   bool only_area_ = false;    // ... and the only emitter (no emissive triangle, no world)
+  size_t emitters_ = 0;       // entries of the selection CDF
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

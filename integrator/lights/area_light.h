@@ -161,8 +161,8 @@ struct AreaLight {
     s.valid = pdf > 0.0f && std::isfinite(pdf);
   }
 
+  // LightSampler stores no zero-area lamp (zero power), so area > 0 here.
   float intersect_t(Vec3f o, Vec3f d, float t_max) const {
-    if (area <= 0.0f) return -1.0f;
     const float denom = dot(d, normal);
     if (denom >= 0.0f) return -1.0f;  // one-sided: only rays travelling against the emission
     const float t = dot(center - o, normal) / denom;
