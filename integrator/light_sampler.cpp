@@ -70,8 +70,6 @@ float scene_radius(const Scene& scene) {
 
 struct LightSampler::Impl {
   std::span<const Material> materials;
-  std::vector<lights::PointLight> points;
-  std::vector<lights::AreaLight> areas;
   std::vector<lights::SunLight> suns;
   std::vector<lights::TriangleLight> triangles;
   std::vector<uint64_t> triangle_keys;  // sorted, parallel to `triangles`
@@ -108,8 +106,8 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
         s.camera_visible = l.camera_visible;
         const float p = s.power();
         if (!(p > 0.0f) || !std::isfinite(p)) break;
-        I.entries.push_back({Kind::Point, uint32_t(I.points.size())});
-        I.points.push_back(s);
+        I.entries.push_back({Kind::Point, uint32_t(points_.size())});
+        points_.push_back(s);
         weights.push_back(p);
         break;
       }
@@ -118,8 +116,8 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
         a.camera_visible = l.camera_visible;
         const float p = a.power();
         if (!(p > 0.0f) || !std::isfinite(p)) break;
-        I.entries.push_back({Kind::Area, uint32_t(I.areas.size())});
-        I.areas.push_back(a);
+        I.entries.push_back({Kind::Area, uint32_t(areas_.size())});
+        areas_.push_back(a);
         weights.push_back(p);
         break;
       }
@@ -213,6 +211,10 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
     }
   }
 
+  single_area_ = areas_.size() == 1 && points_.empty() && I.suns.empty();
+  only_area_ = single_area_ && I.entries.size() == 1;
+  emitters_ = I.entries.size();
+
   // --- Selection CDF, and each light's own probability for MIS --------------------------------
   I.selection = Distribution1D(weights);
   for (uint32_t e = 0; e < I.entries.size(); ++e) {
@@ -220,12 +222,11 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
     const Entry& en = I.entries[e];
     switch (en.kind) {
       case Kind::Point:
-        I.points[en.index].select_pmf = pmf;
+        points_[en.index].select_pmf = pmf;
         break;
       case Kind::Area:
-        I.areas[en.index].select_pmf = pmf;
-        if (I.areas[en.index].area > 0.0f)
-          I.areas[en.index].area_pdf = pmf / I.areas[en.index].area;
+        areas_[en.index].select_pmf = pmf;
+        if (areas_[en.index].area > 0.0f) areas_[en.index].area_pdf = pmf / areas_[en.index].area;
         break;
       case Kind::Sun:
         I.suns[en.index].select_pmf = pmf;
@@ -242,19 +243,18 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
 
 LightSampler::~LightSampler() = default;
 
-bool LightSampler::empty() const {
-  return impl_->entries.empty();
-}
-
-bool LightSampler::needs_selection() const {
-  return impl_->entries.size() > 1;
-}
-
 bool LightSampler::has_environment() const {
   return impl_->world_enabled;
 }
 
-LightSample LightSampler::sample(Vec3f ref, float u_select, Vec2f u) const {
+LightSample LightSampler::sample_only_area(Vec3f ref, Vec2f u) const {
+  // Its pmf is 1 and its radiance finite (a non-finite one has non-finite power: not stored).
+  LightSample s;
+  if (!areas_[0].sample(ref, u, s)) s = LightSample{};
+  return s;
+}
+
+LightSample LightSampler::sample_any(Vec3f ref, float u_select, Vec2f u) const {
   const Impl& I = *impl_;
   LightSample s;
   if (I.entries.empty()) return s;
@@ -266,10 +266,10 @@ LightSample LightSampler::sample(Vec3f ref, float u_select, Vec2f u) const {
   bool ok = false;
   switch (e.kind) {
     case Kind::Point:
-      ok = I.points[e.index].sample(ref, u, s);
+      ok = points_[e.index].sample(ref, u, s);
       break;
     case Kind::Area:
-      ok = I.areas[e.index].sample(ref, u, s);
+      ok = areas_[e.index].sample(ref, u, s);
       break;
     case Kind::Sun:
       ok = I.suns[e.index].sample(ref, u, s);
@@ -322,20 +322,33 @@ float LightSampler::pdf_triangle(uint32_t instance, uint32_t primitive, Vec3f re
   return std::isfinite(pdf) ? pdf : 0.0f;
 }
 
-bool LightSampler::intersect(Vec3f origin, Vec3f direction, float t_max, LightHit& hit) const {
-  const Impl& I = *impl_;
+void LightSampler::fill_hit(const lights::PointLight& l, Vec3f origin, Vec3f direction, float t,
+                            LightHit& hit) {
+  l.fill_hit(origin, direction, t, hit);
+  hit.pdf *= l.select_pmf;
+  hit.camera_visible = l.camera_visible;
+}
+
+void LightSampler::fill_hit(const lights::AreaLight& l, Vec3f origin, Vec3f direction, float t,
+                            LightHit& hit) {
+  l.fill_hit(origin, direction, t, hit);
+  hit.pdf *= l.select_pmf;
+  hit.area_pdf = l.area_pdf;
+  hit.camera_visible = l.camera_visible;
+}
+
+bool LightSampler::intersect_any(Vec3f origin, Vec3f direction, float t_max, LightHit& hit) const {
   float best = t_max;
   const lights::PointLight* point = nullptr;
   const lights::AreaLight* area = nullptr;
-  for (const lights::PointLight& s : I.points) {
+  for (const lights::PointLight& s : points_) {
     const float t = s.intersect_t(origin, direction, best);
     if (t > 0.0f) {
       best = t;
       point = &s;
-      area = nullptr;
     }
   }
-  for (const lights::AreaLight& a : I.areas) {
+  for (const lights::AreaLight& a : areas_) {
     const float t = a.intersect_t(origin, direction, best);
     if (t > 0.0f) {
       best = t;
@@ -344,22 +357,17 @@ bool LightSampler::intersect(Vec3f origin, Vec3f direction, float t_max, LightHi
     }
   }
   if (point) {
-    point->fill_hit(origin, direction, best, hit);
-    hit.pdf *= point->select_pmf;
-    hit.camera_visible = point->camera_visible;
+    fill_hit(*point, origin, direction, best, hit);
     return true;
   }
   if (area) {
-    area->fill_hit(origin, direction, best, hit);
-    hit.pdf *= area->select_pmf;
-    hit.area_pdf = area->area_pdf;
-    hit.camera_visible = area->camera_visible;
+    fill_hit(*area, origin, direction, best, hit);
     return true;
   }
   // Sun discs sit at infinity: only rays that escape the scene reach them, i.e. rays whose
   // t_max is still unbounded (Ray::t_max defaults to 1e30, or +inf).
   if (t_max >= 1e30f) {
-    for (const lights::SunLight& s : I.suns) {
+    for (const lights::SunLight& s : impl_->suns) {
       if (s.hit(direction)) {
         s.fill_hit(origin, direction, hit);
         hit.pdf *= s.select_pmf;
@@ -384,8 +392,8 @@ float LightSampler::pdf_environment(Vec3f direction) const {
 bool LightSampler::has_camera_visible_lights() const {
   const Impl& I = *impl_;
   const auto visible = [](const auto& l) { return l.camera_visible; };
-  return std::any_of(I.points.begin(), I.points.end(), visible) ||
-         std::any_of(I.areas.begin(), I.areas.end(), visible) ||
+  return std::any_of(points_.begin(), points_.end(), visible) ||
+         std::any_of(areas_.begin(), areas_.end(), visible) ||
          std::any_of(I.suns.begin(), I.suns.end(), visible);
 }
 

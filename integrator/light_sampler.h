@@ -1,13 +1,17 @@
 // All light sources of a scene behind one interface: point (radius: disc), spot, sun, area lights,
 // emissive triangles (sampled by power) and the world (constant or importance-sampled image).
-// Units and looks as Cycles: area radiance = P / (pi A), point/spot intensity = P / (4 pi) per
-// steradian, sun = irradiance in W/m^2.
+// Units and looks as Cycles 3.4: area radiance = P / (4 A), point/spot intensity = P / (4 pi) per
+// steradian, sun = irradiance in W/m^2 (docs/lights.md).
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <vector>
 
+#include "integrator/lights/area_light.h"
+#include "integrator/lights/light_sample.h"
+#include "integrator/lights/point_light.h"
 #include "integrator/math/vec.h"
 #include "integrator/scene.h"
 #include "shaders/material.h"
@@ -15,49 +19,39 @@
 
 namespace gdpt {
 
-struct LightSample {
-  Spectrum radiance;   // emitted radiance arriving at the reference point (unoccluded), not / pdf
-  Vec3f position;      // point on the light (finite lights); reference + direction for infinite
-  Vec3f normal;        // light surface normal at position (zero for point-like lights)
-  Vec3f direction;     // unit, from the reference point towards the light
-  float distance = 0;  // to position; +inf for sun and world
-  float pdf = 0;       // solid-angle density incl. light selection; discrete prob. if is_delta
-  bool is_delta = false;     // cannot be hit by BSDF sampling (no MIS)
-  bool is_infinite = false;  // sun or world
-  bool valid = false;
-  // Area lights only (0 for the others): selection pmf / area, the density per unit area of
-  // uniform area sampling. G-PT weighs its techniques with the area-sampling density
-  // area_pdf d^2 / cos of a light point, the same function from every reference point.
-  float area_pdf = 0;
-};
-
-struct LightHit {
-  Spectrum radiance;  // emitted towards the ray origin
-  float distance = 0;
-  float pdf = 0;  // density sample() would have produced this direction from the ray origin
-  Vec3f position, normal;
-  bool camera_visible = false;  // the lamp shows to camera rays (Light::camera_visible)
-  float area_pdf = 0;           // area lights: selection pmf / area (LightSample::area_pdf)
-};
-
 class LightSampler {
  public:
   LightSampler(const Scene& scene, std::span<const Material> materials,
                std::span<const Texture> textures);
   ~LightSampler();
 
-  bool empty() const;
+  bool empty() const { return emitters_ == 0; }
   // Whether sample() reads u_select: a scene with one emitter (a Cornell box's lamp) needs no
   // selection number, and integrators skip drawing it.
-  bool needs_selection() const;
-  LightSample sample(Vec3f ref_position, float u_select, Vec2f u) const;
+  bool needs_selection() const { return emitters_ > 1; }
+  // The scene whose only emitter is one area lamp (a Cornell box) goes straight to a small
+  // function: no selection, no dispatch, no generic checks.
+  LightSample sample(Vec3f ref_position, float u_select, Vec2f u) const {
+    return only_area_ ? sample_only_area(ref_position, u) : sample_any(ref_position, u_select, u);
+  }
   // Density of sample() choosing the point hit on emissive triangle (instance, primitive).
   float pdf_triangle(uint32_t instance, uint32_t primitive, Vec3f ref_position,
                      Vec3f light_position, Vec3f light_normal) const;
   // Closest analytic light (point/spot disc, area, sun disc) along the ray with t < t_max.
   // Sun discs are at infinity: reported only for unbounded rays (t_max >= 1e30, Ray's default,
   // or +inf), i.e. rays that escaped the geometry. Emissive triangles are geometry, not here.
-  bool intersect(Vec3f origin, Vec3f direction, float t_max, LightHit& hit) const;
+  // It runs for every ray (a Blender lamp is not geometry) and almost always misses: the common
+  // scene with one area lamp and nothing else is tested in line, without a call.
+  [[gnu::always_inline]] bool intersect(Vec3f origin, Vec3f direction, float t_max,
+                                        LightHit& hit) const {
+    if (single_area_) {
+      const float t = areas_[0].intersect_t(origin, direction, t_max);
+      if (!(t > 0.0f)) return false;
+      fill_hit(areas_[0], origin, direction, t, hit);
+      return true;
+    }
+    return intersect_any(origin, direction, t_max, hit);
+  }
   // Radiance of the world along an escaping ray (sun discs excluded: see intersect) and its pdf.
   Spectrum environment(Vec3f direction) const;
   float pdf_environment(Vec3f direction) const;
@@ -66,6 +60,20 @@ class LightSampler {
   bool has_camera_visible_lights() const;  // world is non-black
 
  private:
+  static void fill_hit(const lights::PointLight& l, Vec3f origin, Vec3f direction, float t,
+                       LightHit& hit);
+  static void fill_hit(const lights::AreaLight& l, Vec3f origin, Vec3f direction, float t,
+                       LightHit& hit);
+  LightSample sample_only_area(Vec3f ref_position, Vec2f u) const;
+  LightSample sample_any(Vec3f ref_position, float u_select, Vec2f u) const;
+  bool intersect_any(Vec3f origin, Vec3f direction, float t_max, LightHit& hit) const;
+
+  // Analytic lamps with a surface, here rather than in Impl for the in-line intersect().
+  std::vector<lights::PointLight> points_;
+  std::vector<lights::AreaLight> areas_;
+  bool single_area_ = false;  // one area lamp is the only analytic light (no point, spot, sun)
+  bool only_area_ = false;    // ... and the only emitter (no emissive triangle, no world)
+  size_t emitters_ = 0;       // entries of the selection CDF
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

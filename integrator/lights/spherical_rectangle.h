@@ -47,6 +47,7 @@ class SphericalRectangle {
     const float g23 = angle_sum(x0_ * y1_, l01, -x0_ * y0_, l00);  // g2 + g3
     b0_ = -y0_ / std::sqrt(z2 + y0_ * y0_);                        // n0.z
     b1_ = y1_ / std::sqrt(z2 + y1_ * y1_);                         // n2.z
+    b0m1_ = -z2 / (z2 + y0_ * y0_);  // b0^2 - 1 without cancellation (grazing: b0^2 near 1)
     k_ = 2.0f * kPi - g23;
     solid_angle_ = g01 - k_;
   }
@@ -60,17 +61,20 @@ class SphericalRectangle {
     float sin_au, cos_au;
     sincos_fast(au, &sin_au, &cos_au);
     const float fu = (cos_au * b0_ - b1_) / sin_au;
-    float cu = std::copysign(1.0f, fu) / std::sqrt(fu * fu + b0_ * b0_);
-    cu = std::clamp(cu, -1.0f, 1.0f);
-    float xu = -(cu * z0_) / std::sqrt(std::max(1e-12f, 1.0f - cu * cu));
+    // The paper's cu = sign(fu) / sqrt(fu^2 + b0^2) and xu = -cu z0 / sqrt(1 - cu^2) fold into
+    // xu = sign(fu) |z0| / sqrt(fu^2 + b0^2 - 1): one square root and one division on this
+    // latency chain instead of two each (the shadow ray waits for the point).
+    const float q = fu * fu + b0m1_;
+    float xu = std::copysign(std::fabs(z0_), fu) / std::sqrt(std::max(q, 1e-30f));
     xu = std::clamp(xu, x0_, x1_);
-    // 2. Pick y uniformly in the projected height h = y / sqrt(d^2 + y^2) along that line.
-    const float dist = std::sqrt(xu * xu + z0_ * z0_);
-    const float h0 = y0_ / std::sqrt(dist * dist + y0_ * y0_);
-    const float h1 = y1_ / std::sqrt(dist * dist + y1_ * y1_);
+    // 2. Pick y uniformly in the projected height h = y / sqrt(d^2 + y^2) along that line
+    // (d^2 = xu^2 + z0^2; y = h d / sqrt(1 - h^2) as one root of a quotient).
+    const float dist2 = xu * xu + z0_ * z0_;
+    const float h0 = y0_ / std::sqrt(dist2 + y0_ * y0_);
+    const float h1 = y1_ / std::sqrt(dist2 + y1_ * y1_);
     const float hv = h0 + u.y * (h1 - h0);
     const float hv2 = hv * hv;
-    const float yv = hv2 < 1.0f - 1e-6f ? (hv * dist) / std::sqrt(1.0f - hv2) : y1_;
+    const float yv = hv2 < 1.0f - 1e-6f ? hv * std::sqrt(dist2 / (1.0f - hv2)) : y1_;
     return o_ + x_ * xu + y_ * std::clamp(yv, y0_, y1_) + z_ * z0_;
   }
 
@@ -84,7 +88,7 @@ class SphericalRectangle {
 
   Vec3f o_, x_, y_, z_;
   float x0_, y0_, z0_, x1_, y1_;
-  float b0_, b1_, k_, solid_angle_;
+  float b0_, b1_, b0m1_, k_, solid_angle_;
 };
 
 }  // namespace gdpt::lights

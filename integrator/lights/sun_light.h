@@ -17,9 +17,10 @@
 #include <cmath>
 #include <limits>
 
-#include "integrator/light_sampler.h"
+#include "integrator/lights/light_sample.h"
 #include "integrator/lights/warp.h"
 #include "integrator/math/frame.h"
+#include "integrator/scene.h"
 
 namespace gdpt::lights {
 

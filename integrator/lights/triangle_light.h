@@ -10,9 +10,10 @@
 #include <cstdint>
 #include <optional>
 
-#include "integrator/light_sampler.h"
+#include "integrator/lights/light_sample.h"
 #include "integrator/lights/spherical_triangle.h"
 #include "integrator/lights/warp.h"
+#include "integrator/scene.h"
 #include "shaders/material.h"
 
 namespace gdpt::lights {
