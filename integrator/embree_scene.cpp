@@ -1,9 +1,11 @@
 #include "integrator/embree_scene.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -19,9 +21,10 @@ constexpr float kOriginRegion = 1.0f / 32.0f;
 constexpr float kFloatScale = 1.0f / 65536.0f;
 constexpr float kIntScale = 256.0f;
 
-Vec3f safe_normalize(Vec3f v, Vec3f fallback) {
+Vec3f safe_normalize(const Vec3f& v, const Vec3f& fallback) {
   const float l2 = length_squared(v);
-  if (!(l2 > 0.0f) || !std::isfinite(l2)) return fallback;
+  // 0 < l2 < inf: fails for zero, infinite and NaN lengths.
+  if (!(l2 > 0.0f && l2 < std::numeric_limits<float>::infinity())) return fallback;
   return v / std::sqrt(l2);
 }
 
@@ -136,12 +139,39 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     rtcReleaseGeometry(geom);
     if (id >= instances_.size()) instances_.resize(id + 1);
     InstanceData& d = instances_[id];
-    d.mesh = &mesh;
-    d.instance = &inst;
     d.index = uint32_t(i);
-    d.to_world = T;
-    d.world_positions = world_positions;
+    d.world_space = world_positions != nullptr;
     d.winding = det < 0.0f ? -1.0f : 1.0f;
+    d.positions = world_positions ? world_positions : mesh.positions.data();
+    d.indices = mesh.indices.data();
+    const size_t tris = mesh.triangle_count();
+    if (!mesh.corner_normals.empty()) {
+      d.corner_normals = mesh.corner_normals.data();
+      d.corner_normal_tris = uint32_t(std::min(mesh.corner_normals.size() / 3, tris));
+    }
+    if (!mesh.vertex_normals.empty()) d.vertex_normals = mesh.vertex_normals.data();
+    if (!mesh.corner_uvs.empty()) {
+      d.corner_uvs = mesh.corner_uvs.data();
+      d.corner_uv_tris = uint32_t(std::min(mesh.corner_uvs.size() / 3, tris));
+    }
+    // Slot -> material with the default applied (-1 and out-of-range indices).
+    auto resolve = [&](int32_t mat) {
+      return (mat >= 0 && mat < default_material_) ? mat : default_material_;
+    };
+    for (int32_t m : inst.slot_material) d.slot_materials.push_back(resolve(m));
+    auto material_of = [&](size_t prim) {
+      const int32_t slot = prim < mesh.material_slot.size() ? mesh.material_slot[prim] : 0;
+      return slot >= 0 && size_t(slot) < d.slot_materials.size() ? d.slot_materials[size_t(slot)]
+                                                                 : default_material_;
+    };
+    d.uniform_material = material_of(0);
+    for (size_t prim = 1; prim < tris && d.uniform_material >= 0; ++prim)
+      if (material_of(prim) != d.uniform_material) d.uniform_material = -1;
+    if (d.uniform_material < 0) {
+      d.material_slot = mesh.material_slot.data();
+      d.material_slot_count = uint32_t(mesh.material_slot.size());
+    }
+    d.to_world = T;
     const Transform inv = T.inverse();
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) d.normal_matrix[r][c] = inv.m[c][r];
@@ -188,7 +218,7 @@ void to_embree(const Ray& ray, bool active, RTCRayHit& rh) {
 
 }  // namespace
 
-inline bool EmbreeScene::read_hit(const RTCRayHit& rh, Vec3f dir, SurfaceHit& hit) const {
+inline bool EmbreeScene::read_hit(const RTCRayHit& rh, const Vec3f& dir, SurfaceHit& hit) const {
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.t = rh.ray.tfar;
   // Instanced meshes report the top-level id in instID[0], flattened ones in geomID.
@@ -234,11 +264,10 @@ void EmbreeScene::intersect_stream(const Ray* rays, const bool* valid, int n, bo
   }
 }
 
-void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v, Vec3f dir,
-                               SurfaceHit& hit) const {
+void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v,
+                               const Vec3f& dir, SurfaceHit& hit) const {
   const InstanceData& d = instances_[top_id];
-  const Mesh& mesh = *d.mesh;
-  const uint32_t* idx = &mesh.indices[size_t(primitive) * 3];
+  const uint32_t* idx = d.indices + size_t(primitive) * 3;
   const float w = 1.0f - u - v;
   hit.instance = d.index;
   hit.primitive = primitive;
@@ -250,46 +279,44 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
                  M[2][0] * n.x + M[2][1] * n.y + M[2][2] * n.z);
   };
   // Degenerate triangles have no normal: face the ray so shading stays finite.
+  const Vec3f p0 = d.positions[idx[0]], p1 = d.positions[idx[1]], p2 = d.positions[idx[2]];
   Vec3f ng;
-  if (d.world_positions) {
-    const Vec3f* P = d.world_positions;
-    const Vec3f p0 = P[idx[0]], p1 = P[idx[1]], p2 = P[idx[2]];
+  if (d.world_space) {
     hit.position = p0 * w + p1 * u + p2 * v;
     ng = safe_normalize(cross(p1 - p0, p2 - p0) * d.winding, -dir);
   } else {
-    const Vec3f* P = mesh.positions.data();
-    const Vec3f p0 = P[idx[0]], p1 = P[idx[1]], p2 = P[idx[2]];
     hit.position = d.to_world.point(p0 * w + p1 * u + p2 * v);
     ng = safe_normalize(to_world_normal(cross(p1 - p0, p2 - p0)), -dir);
   }
   hit.geometric_normal = ng;
   hit.front_facing = dot(dir, ng) < 0.0f;
 
-  const size_t corner = size_t(primitive) * 3;
-  if (!mesh.corner_normals.empty() && mesh.corner_normals.size() >= corner + 3) {
-    const Vec3f n = mesh.corner_normals[corner] * w + mesh.corner_normals[corner + 1] * u +
-                    mesh.corner_normals[corner + 2] * v;
+  if (primitive < d.corner_normal_tris) {
+    const Vec3f* N = d.corner_normals + size_t(primitive) * 3;
+    const Vec3f n = N[0] * w + N[1] * u + N[2] * v;
     hit.shading_normal = safe_normalize(to_world_normal(n), ng);
-  } else if (!mesh.vertex_normals.empty()) {
-    const Vec3f* N = mesh.vertex_normals.data();
+  } else if (d.vertex_normals) {
+    const Vec3f* N = d.vertex_normals;
     const Vec3f n = N[idx[0]] * w + N[idx[1]] * u + N[idx[2]] * v;
     hit.shading_normal = safe_normalize(to_world_normal(n), ng);
   } else {
     hit.shading_normal = ng;
   }
-  if (!mesh.corner_uvs.empty() && mesh.corner_uvs.size() >= corner + 3) {
-    hit.uv = mesh.corner_uvs[corner] * w + mesh.corner_uvs[corner + 1] * u +
-             mesh.corner_uvs[corner + 2] * v;
+  if (primitive < d.corner_uv_tris) {
+    const Vec2f* T = d.corner_uvs + size_t(primitive) * 3;
+    hit.uv = T[0] * w + T[1] * u + T[2] * v;
   } else {
     hit.uv = Vec2f(0.0f, 0.0f);
   }
 
-  int32_t slot = 0;
-  if (primitive < mesh.material_slot.size()) slot = mesh.material_slot[primitive];
-  int32_t mat = -1;
-  const auto& slots = d.instance->slot_material;
-  if (slot >= 0 && size_t(slot) < slots.size()) mat = slots[size_t(slot)];
-  hit.material = (mat >= 0 && mat < default_material_) ? mat : default_material_;
+  if (d.uniform_material >= 0) {
+    hit.material = d.uniform_material;
+  } else {
+    const int32_t slot = primitive < d.material_slot_count ? d.material_slot[primitive] : 0;
+    hit.material = slot >= 0 && size_t(slot) < d.slot_materials.size()
+                       ? d.slot_materials[size_t(slot)]
+                       : default_material_;
+  }
 }
 
 }  // namespace gdpt

@@ -58,24 +58,42 @@ class EmbreeScene {
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
   size_t instanced_triangle_count() const { return instanced_triangles_; }
   // Fills the rest of a hit from (top-level geometry id, primitive, barycentrics).
-  void complete_hit(uint32_t top_id, uint32_t primitive, float u, float v, Vec3f dir,
+  void complete_hit(uint32_t top_id, uint32_t primitive, float u, float v, const Vec3f& dir,
                     SurfaceHit& hit) const;
 
  private:
   // Fills `hit` from Embree's result; false when nothing was hit.
-  bool read_hit(const RTCRayHit& rh, Vec3f dir, SurfaceHit& hit) const;
+  bool read_hit(const RTCRayHit& rh, const Vec3f& dir, SurfaceHit& hit) const;
 
+  // Everything complete_hit() reads, resolved at build time (raw pointers into the Scene's
+  // meshes, slot -> material table with the default applied): a hit costs no vector bounds or
+  // emptiness checks and no chasing of Mesh / Instance pointers.
   struct InstanceData {
-    const Mesh* mesh = nullptr;
-    const Instance* instance = nullptr;
     uint32_t index = 0;  // in Scene::instances
-    Transform to_world;
-    float normal_matrix[3][3];  // inverse transpose of the linear part
-    // Flattened (world-space) meshes: Embree's own vertex buffer, so hits need no transform.
-    const Vec3f* world_positions = nullptr;
+    // Flattened (world-space) meshes: Embree's own vertex buffer, so hits need no transform;
+    // instanced meshes: the Mesh's object-space positions.
+    bool world_space = false;
     // -1 for mirroring transforms: a world-space cross product then points against the
     // transformed object-space normal, whose orientation front_facing is defined by (as Cycles).
     float winding = 1.0f;
+    const Vec3f* positions = nullptr;
+    const uint32_t* indices = nullptr;
+    // Shading normals: corner normals for primitives < corner_normal_tris, else vertex normals
+    // when present, else flat.
+    const Vec3f* corner_normals = nullptr;
+    uint32_t corner_normal_tris = 0;
+    const Vec3f* vertex_normals = nullptr;
+    const Vec2f* corner_uvs = nullptr;  // for primitives < corner_uv_tris; else uv = 0
+    uint32_t corner_uv_tris = 0;
+    // Material: `uniform_material` when every triangle resolves to one (the common case), else
+    // slot_materials[material_slot[primitive]] (slot 0 past material_slot_count, default
+    // material for slots outside the table).
+    int32_t uniform_material = -1;
+    const int32_t* material_slot = nullptr;
+    uint32_t material_slot_count = 0;
+    std::vector<int32_t> slot_materials;
+    Transform to_world;
+    float normal_matrix[3][3];  // inverse transpose of the linear part
   };
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;
