@@ -9,17 +9,9 @@
 #include <stdexcept>
 #include <string>
 
-#include <emmintrin.h>
-
 namespace gdpt {
 
 namespace {
-
-// Integer-ULP offset scale and the absolute fallback near the origin (positions whose magnitude is
-// below kOriginRegion have too few ULPs to step by integers meaningfully).
-constexpr float kOriginRegion = 1.0f / 32.0f;
-constexpr float kFloatScale = 1.0f / 65536.0f;
-constexpr float kIntScale = 256.0f;
 
 Vec3f safe_normalize(const Vec3f& v, const Vec3f& fallback) {
   const float l2 = length_squared(v);
@@ -29,27 +21,6 @@ Vec3f safe_normalize(const Vec3f& v, const Vec3f& fallback) {
 }
 
 }  // namespace
-
-// The three components at once in SSE2 lanes (branch-free; the scalar form cost ~60
-// instructions a call, with a data-dependent branch per component).
-Vec3f offset_ray_origin(Vec3f p, Vec3f n) {
-  const __m128 P = _mm_setr_ps(p.x, p.y, p.z, 0.0f), N = _mm_setr_ps(n.x, n.y, n.z, 0.0f);
-  // Integer ULP steps, away from zero: add kIntScale * n ULPs to |p|'s bits, i.e. subtract for
-  // negative p (sign = -1 there: (of ^ sign) - sign negates).
-  const __m128i of = _mm_cvttps_epi32(_mm_mul_ps(N, _mm_set1_ps(kIntScale)));
-  const __m128i bits = _mm_castps_si128(P);
-  const __m128i sign = _mm_srai_epi32(bits, 31);
-  const __m128 stepped =
-      _mm_castsi128_ps(_mm_add_epi32(bits, _mm_sub_epi32(_mm_xor_si128(of, sign), sign)));
-  // Near the origin an absolute step.
-  const __m128 absolute = _mm_add_ps(P, _mm_mul_ps(N, _mm_set1_ps(kFloatScale)));
-  const __m128 abs_p = _mm_andnot_ps(_mm_set1_ps(-0.0f), P);
-  const __m128 near = _mm_cmplt_ps(abs_p, _mm_set1_ps(kOriginRegion));
-  const __m128 r = _mm_or_ps(_mm_and_ps(near, absolute), _mm_andnot_ps(near, stepped));
-  alignas(16) float out[4];
-  _mm_store_ps(out, r);
-  return {out[0], out[1], out[2]};
-}
 
 EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     : default_material_(default_material) {
@@ -192,60 +163,6 @@ EmbreeScene::~EmbreeScene() {
   if (device_) rtcReleaseDevice(device_);
 }
 
-namespace {
-
-// Embree's single-ray layout of `ray` (tnear > tfar marks an inactive ray of a stream).
-void to_embree(const Ray& ray, bool active, RTCRay& r) {
-  r.org_x = ray.origin.x;
-  r.org_y = ray.origin.y;
-  r.org_z = ray.origin.z;
-  r.dir_x = ray.direction.x;
-  r.dir_y = ray.direction.y;
-  r.dir_z = ray.direction.z;
-  r.tnear = active ? ray.t_min : 1.0f;
-  r.tfar = active ? ray.t_max : 0.0f;
-  r.time = 0.0f;
-  r.mask = 0xffffffffu;
-  r.id = 0;
-  r.flags = 0;
-}
-
-void to_embree(const Ray& ray, bool active, RTCRayHit& rh) {
-  to_embree(ray, active, rh.ray);
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-}
-
-}  // namespace
-
-inline bool EmbreeScene::read_hit(const RTCRayHit& rh, const Vec3f& dir, SurfaceHit& hit) const {
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  hit.t = rh.ray.tfar;
-  // Instanced meshes report the top-level id in instID[0], flattened ones in geomID.
-  const unsigned top_id =
-      rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
-  complete_hit(top_id, rh.hit.primID, rh.hit.u, rh.hit.v, dir, hit);
-  return true;
-}
-
-bool EmbreeScene::intersect(const Ray& ray, SurfaceHit& hit) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  RTCRayHit rh;
-  to_embree(ray, true, rh);
-  rtcIntersect1(top_, &ctx, &rh);
-  return read_hit(rh, ray.direction, hit);
-}
-
-bool EmbreeScene::occluded(const Ray& ray) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  RTCRay r;
-  to_embree(ray, true, r);
-  rtcOccluded1(top_, &ctx, &r);
-  return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
-}
-
 void EmbreeScene::intersect_stream(const Ray* rays, const bool* valid, int n, bool* found,
                                    SurfaceHit* hits) const {
   RTCIntersectContext ctx;
@@ -255,7 +172,7 @@ void EmbreeScene::intersect_stream(const Ray* rays, const bool* valid, int n, bo
   alignas(16) RTCRayHit rh[kChunk];
   for (int first = 0; first < n; first += kChunk) {
     const int m = std::min(kChunk, n - first);
-    for (int j = 0; j < m; ++j) to_embree(rays[first + j], valid[first + j], rh[j]);
+    for (int j = 0; j < m; ++j) detail::to_embree(rays[first + j], valid[first + j], rh[j]);
     rtcIntersect1M(top_, &ctx, rh, unsigned(m), sizeof(RTCRayHit));
     for (int j = 0; j < m; ++j) {
       const int i = first + j;
