@@ -1,5 +1,6 @@
 #include "integrator/embree_scene.h"
 
+#include <xmmintrin.h>
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -11,16 +12,7 @@
 
 namespace gdpt {
 
-namespace {
-
-Vec3f safe_normalize(const Vec3f& v, const Vec3f& fallback) {
-  const float l2 = length_squared(v);
-  // 0 < l2 < inf: fails for zero, infinite and NaN lengths.
-  if (!(l2 > 0.0f && l2 < std::numeric_limits<float>::infinity())) return fallback;
-  return v / std::sqrt(l2);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     : default_material_(default_material) {
@@ -142,10 +134,13 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
       d.material_slot = mesh.material_slot.data();
       d.material_slot_count = uint32_t(mesh.material_slot.size());
     }
-    d.to_world = T;
     const Transform inv = T.inverse();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) d.normal_matrix[r][c] = inv.m[c][r];
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 3; ++r) {
+        d.to_world_cols[c][r] = T.m[r][c];
+        // The inverse transpose's column c = the inverse's row c.
+        if (c < 3) d.normal_cols[c][r] = inv.m[c][r];
+      }
     instanced_triangles_ += mesh.triangle_count();
   }
   rtcSetSceneBuildQuality(top_, RTC_BUILD_QUALITY_MEDIUM);
@@ -181,6 +176,58 @@ void EmbreeScene::intersect_stream(const Ray* rays, const bool* valid, int n, bo
   }
 }
 
+namespace {
+
+// complete_hit()'s vector work in SSE2 lanes (x, y, z; w = 0). Each lane does the scalar code's
+// operations in the same order (no FMA contraction on the x86-64 baseline), so hits are
+// bit-identical to the Vec3f form, which GCC half-vectorised with shuffles and spills (~190
+// instructions a hit on the Cornell box).
+inline __m128 load3(const Vec3f& v) {
+  const __m128 xy = _mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(&v.x));
+  return _mm_movelh_ps(xy, _mm_load_ss(&v.z));
+}
+inline __m128 load2(const Vec2f& v) {
+  return _mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(&v.x));
+}
+inline void store3(Vec3f& out, __m128 a) {
+  _mm_storel_pi(reinterpret_cast<__m64*>(&out.x), a);
+  _mm_store_ss(&out.z, _mm_movehl_ps(a, a));
+}
+// (a.x b.x + a.y b.y) + a.z b.z, as dot().
+inline float dot3(__m128 a, __m128 b) {
+  const __m128 m = _mm_mul_ps(a, b);
+  const __m128 y = _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 1, 1, 1));
+  return _mm_cvtss_f32(_mm_add_ss(_mm_add_ss(m, y), _mm_movehl_ps(m, m)));
+}
+inline __m128 cross3(__m128 a, __m128 b) {
+  const __m128 a_yzx = _mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 0, 2, 1));
+  const __m128 b_zxy = _mm_shuffle_ps(b, b, _MM_SHUFFLE(3, 1, 0, 2));
+  const __m128 a_zxy = _mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 1, 0, 2));
+  const __m128 b_yzx = _mm_shuffle_ps(b, b, _MM_SHUFFLE(3, 0, 2, 1));
+  return _mm_sub_ps(_mm_mul_ps(a_yzx, b_zxy), _mm_mul_ps(a_zxy, b_yzx));
+}
+// (a w + b u) + c v: barycentric interpolation in the order of the scalar code.
+inline __m128 interpolate(__m128 a, __m128 b, __m128 c, __m128 w, __m128 u, __m128 v) {
+  return _mm_add_ps(_mm_add_ps(_mm_mul_ps(a, w), _mm_mul_ps(b, u)), _mm_mul_ps(c, v));
+}
+// Row r: (M[r][0] x + M[r][1] y) + M[r][2] z, from M's columns.
+inline __m128 linear3(const float (*cols)[4], __m128 v) {
+  const __m128 x = _mm_shuffle_ps(v, v, _MM_SHUFFLE(0, 0, 0, 0));
+  const __m128 y = _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 1, 1, 1));
+  const __m128 z = _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 2, 2, 2));
+  return _mm_add_ps(
+      _mm_add_ps(_mm_mul_ps(_mm_load_ps(cols[0]), x), _mm_mul_ps(_mm_load_ps(cols[1]), y)),
+      _mm_mul_ps(_mm_load_ps(cols[2]), z));
+}
+inline __m128 normalize_or(__m128 v, __m128 fallback) {
+  const float l2 = dot3(v, v);
+  // 0 < l2 < inf: fails for zero, infinite and NaN lengths.
+  if (!(l2 > 0.0f && l2 < std::numeric_limits<float>::infinity())) return fallback;
+  return _mm_div_ps(v, _mm_set1_ps(std::sqrt(l2)));
+}
+
+}  // namespace
+
 void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v,
                                const Vec3f& dir, SurfaceHit& hit) const {
   const InstanceData& d = instances_[top_id];
@@ -188,43 +235,44 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
   const float w = 1.0f - u - v;
   hit.instance = d.index;
   hit.primitive = primitive;
+  const __m128 W = _mm_set1_ps(w), U = _mm_set1_ps(u), V = _mm_set1_ps(v);
 
-  auto to_world_normal = [&](Vec3f n) {
-    const auto& M = d.normal_matrix;
-    return Vec3f(M[0][0] * n.x + M[0][1] * n.y + M[0][2] * n.z,
-                 M[1][0] * n.x + M[1][1] * n.y + M[1][2] * n.z,
-                 M[2][0] * n.x + M[2][1] * n.y + M[2][2] * n.z);
-  };
+  const __m128 p0 = load3(d.positions[idx[0]]), p1 = load3(d.positions[idx[1]]),
+               p2 = load3(d.positions[idx[2]]);
+  const __m128 D = load3(dir);
   // Degenerate triangles have no normal: face the ray so shading stays finite.
-  const Vec3f p0 = d.positions[idx[0]], p1 = d.positions[idx[1]], p2 = d.positions[idx[2]];
-  Vec3f ng;
+  const __m128 minus_dir = _mm_xor_ps(D, _mm_set1_ps(-0.0f));
+  const __m128 e = cross3(_mm_sub_ps(p1, p0), _mm_sub_ps(p2, p0));
+  __m128 position, ng;
   if (d.world_space) {
-    hit.position = p0 * w + p1 * u + p2 * v;
-    ng = safe_normalize(cross(p1 - p0, p2 - p0) * d.winding, -dir);
+    position = interpolate(p0, p1, p2, W, U, V);
+    ng = normalize_or(_mm_mul_ps(e, _mm_set1_ps(d.winding)), minus_dir);
   } else {
-    hit.position = d.to_world.point(p0 * w + p1 * u + p2 * v);
-    ng = safe_normalize(to_world_normal(cross(p1 - p0, p2 - p0)), -dir);
+    const __m128 p = interpolate(p0, p1, p2, W, U, V);
+    position = _mm_add_ps(linear3(d.to_world_cols, p), _mm_load_ps(d.to_world_cols[3]));
+    ng = normalize_or(linear3(d.normal_cols, e), minus_dir);
   }
-  hit.geometric_normal = ng;
-  hit.front_facing = dot(dir, ng) < 0.0f;
+  store3(hit.position, position);
+  store3(hit.geometric_normal, ng);
+  hit.front_facing = dot3(D, ng) < 0.0f;
 
+  __m128 ns = ng;
   if (primitive < d.corner_normal_tris) {
     const Vec3f* N = d.corner_normals + size_t(primitive) * 3;
-    const Vec3f n = N[0] * w + N[1] * u + N[2] * v;
-    hit.shading_normal = safe_normalize(to_world_normal(n), ng);
+    const __m128 n = interpolate(load3(N[0]), load3(N[1]), load3(N[2]), W, U, V);
+    ns = normalize_or(linear3(d.normal_cols, n), ng);
   } else if (d.vertex_normals) {
     const Vec3f* N = d.vertex_normals;
-    const Vec3f n = N[idx[0]] * w + N[idx[1]] * u + N[idx[2]] * v;
-    hit.shading_normal = safe_normalize(to_world_normal(n), ng);
-  } else {
-    hit.shading_normal = ng;
+    const __m128 n = interpolate(load3(N[idx[0]]), load3(N[idx[1]]), load3(N[idx[2]]), W, U, V);
+    ns = normalize_or(linear3(d.normal_cols, n), ng);
   }
+  store3(hit.shading_normal, ns);
+  __m128 uv = _mm_setzero_ps();
   if (primitive < d.corner_uv_tris) {
     const Vec2f* T = d.corner_uvs + size_t(primitive) * 3;
-    hit.uv = T[0] * w + T[1] * u + T[2] * v;
-  } else {
-    hit.uv = Vec2f(0.0f, 0.0f);
+    uv = interpolate(load2(T[0]), load2(T[1]), load2(T[2]), W, U, V);
   }
+  _mm_storel_pi(reinterpret_cast<__m64*>(&hit.uv.x), uv);
 
   if (d.uniform_material >= 0) {
     hit.material = d.uniform_material;

@@ -167,8 +167,10 @@ class EmbreeScene {
     const int32_t* material_slot = nullptr;
     uint32_t material_slot_count = 0;
     std::vector<int32_t> slot_materials;
-    Transform to_world;
-    float normal_matrix[3][3];  // inverse transpose of the linear part
+    // Columns of the object-to-world transform (the fourth: translation) and of the normal
+    // matrix (inverse transpose of its linear part), as SSE lanes (w = 0).
+    alignas(16) float to_world_cols[4][4] = {};
+    alignas(16) float normal_cols[3][4] = {};
   };
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;
