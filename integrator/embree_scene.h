@@ -106,6 +106,17 @@ class EmbreeScene {
     rtcIntersect1(top_, &ctx, &rh);
     return read_hit(rh, ray.direction, hit);
   }
+  // Closest hit distance only, without the hit record: for rays whose hit can only end the path.
+  bool intersect_distance(const Ray& ray, float& t) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    detail::to_embree(ray, true, rh);
+    rtcIntersect1(top_, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    t = rh.ray.tfar;
+    return true;
+  }
   // True when something blocks the segment (t_min, t_max).
   [[gnu::always_inline]] bool occluded(const Ray& ray) const {
     RTCIntersectContext ctx;

@@ -127,7 +127,11 @@ class PathTracer final : public Integrator {
 
     // `vertex` numbers every surface interaction (sampler dimensions); `bounce` follows Cycles.
     for (int vertex = 0;; ++vertex) {
-      const bool found = bvh.intersect(ray, hit);
+      // Past the bounce limits a vertex only ends the path: without emissive triangles its hit
+      // needs no record, only the distance (analytic lights in front of it, the world behind).
+      const bool last = bounce > max_bounces || transparent > kMaxTransparentBounces;
+      const bool found =
+          !kEmissive && last ? bvh.intersect_distance(ray, hit.t) : bvh.intersect(ray, hit);
       ++out.rays;
       const float t_hit = found ? hit.t : ray.t_max;
 
@@ -171,6 +175,8 @@ class PathTracer final : public Integrator {
         break;
       }
 
+      if (!kEmissive && last) break;
+
       // --- Shading point ---
       const ShadingContext sc{hit.uv, hit.front_facing};
       const Material& material = materials[size_t(hit.material)];
@@ -189,7 +195,7 @@ class PathTracer final : public Integrator {
           }
         }
       }
-      if (bounce > max_bounces || transparent > kMaxTransparentBounces) break;
+      if (last) break;
       const ClosureSet& closures = material.closures(sc, closure_scratch);
       if (!closures.has_bsdf()) break;
 
