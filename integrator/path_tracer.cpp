@@ -57,13 +57,14 @@ class PathTracer final : public Integrator {
     uint64_t rays = 0;
     Sampler sampler;
     ClosureSet closures, scratch;  // ~0.5 KB each: initialised once per tile, not per sample
+    SurfaceHit hit;                // likewise: every intersect() overwrites what is read after it
     const float clamp = settings_.clamp;
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x) {
         Film::Accumulator& acc = film.pixel(x, y);
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
           sampler.start(settings_.seed, x, y, s);
-          const PathResult r = trace(sampler, x, y, closures, scratch);
+          const PathResult r = trace(sampler, x, y, closures, scratch, hit);
           rays += r.rays;
           acc.add_path(r.primal, r.emission, clamp);
         }
@@ -100,7 +101,7 @@ class PathTracer final : public Integrator {
   }
 
   PathResult trace(const Sampler& sampler, int px, int py, ClosureSet& closure_scratch,
-                   ClosureSet& scratch) const {
+                   ClosureSet& scratch, SurfaceHit& hit) const {
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
     const auto& materials = ctx_.materials();
@@ -118,7 +119,6 @@ class PathTracer final : public Integrator {
     float prev_pdf = 0.0f;   // solid-angle pdf of the BSDF sample that spawned `ray`
     bool prev_delta = true;  // no MIS for camera rays and delta lobes
     Vec3f prev_position = ray.origin;
-    SurfaceHit hit;
 
     int bounce = 0;           // Cycles' bounce count: scattering events, transparent ones excluded
     int transparent = 0;      // transparent crossings (Cycles' transparent bounces)
