@@ -223,7 +223,9 @@ inline __m128 normalize_or(__m128 v, __m128 fallback) {
   const float l2 = dot3(v, v);
   // 0 < l2 < inf: fails for zero, infinite and NaN lengths.
   if (!(l2 > 0.0f && l2 < std::numeric_limits<float>::infinity())) return fallback;
-  return _mm_div_ps(v, _mm_set1_ps(std::sqrt(l2)));
+  // sqrtps, not std::sqrt: the same value without the errno fallback call, whose presence made
+  // complete_hit() save registers and spill.
+  return _mm_div_ps(v, _mm_sqrt_ps(_mm_set1_ps(l2)));
 }
 
 }  // namespace
