@@ -78,17 +78,7 @@ CameraModel::CameraModel(const Camera& cam) {
   }
 }
 
-Ray CameraModel::generate_ray(Vec2f raster, Vec2f lens) const {
-  if (pinhole_) {
-    const Vec3f w = w0_ + wx_ * raster.x + wy_ * raster.y;
-    const float len = length(w);
-    Ray ray;
-    ray.origin = pinhole_origin_;
-    ray.direction = w / len;
-    ray.t_min = clip_start_ * len;
-    ray.t_max = clip_end_ * len;
-    return ray;
-  }
+Ray CameraModel::generate_ray_general(Vec2f raster, Vec2f lens) const {
   const Vec2f s = raster_to_screen(raster);
   Vec3f origin, dir;
   float z_scale;  // distance along the ray per unit of view depth

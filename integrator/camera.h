@@ -33,7 +33,19 @@ class CameraModel {
   // Ray through raster position `raster` (pixel units, y up) and lens sample `lens` in [0,1)^2
   // (ignored without depth of field). Shifting `raster` by +-1 with the same `lens` is how G-PT
   // builds its offset paths.
-  Ray generate_ray(Vec2f raster, Vec2f lens) const;
+  // Inline (forced: GCC keeps it out of the path tracer's large trace loop): the pinhole case,
+  // one per sample, is a handful of operations next to the call.
+  [[gnu::always_inline]] Ray generate_ray(Vec2f raster, Vec2f lens) const {
+    if (!pinhole_) return generate_ray_general(raster, lens);
+    const Vec3f w = w0_ + wx_ * raster.x + wy_ * raster.y;
+    const float len = length(w);
+    Ray ray;
+    ray.origin = pinhole_origin_;
+    ray.direction = w / len;
+    ray.t_min = clip_start_ * len;
+    ray.t_max = clip_end_ * len;
+    return ray;
+  }
 
   // G-PT's offset rays: the rays through raster + (+1, 0), (0, +1), (-1, 0), (0, -1) (in that
   // order, where `mask` is set) with the same lens sample, equal to generate_ray() up to
@@ -51,6 +63,7 @@ class CameraModel {
   Vec3f position() const { return camera_to_world_.translation(); }
 
  private:
+  Ray generate_ray_general(Vec2f raster, Vec2f lens) const;  // orthographic, depth of field
   // Raster -> screen (viewplane) coordinates.
   Vec2f raster_to_screen(Vec2f raster) const {
     return {left_ + (right_ - left_) * raster.x * inv_width_,

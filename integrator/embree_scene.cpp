@@ -1,52 +1,18 @@
 #include "integrator/embree_scene.h"
 
+#include <xmmintrin.h>
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
-#include <emmintrin.h>
-
 namespace gdpt {
 
-namespace {
-
-// Integer-ULP offset scale and the absolute fallback near the origin (positions whose magnitude is
-// below kOriginRegion have too few ULPs to step by integers meaningfully).
-constexpr float kOriginRegion = 1.0f / 32.0f;
-constexpr float kFloatScale = 1.0f / 65536.0f;
-constexpr float kIntScale = 256.0f;
-
-Vec3f safe_normalize(Vec3f v, Vec3f fallback) {
-  const float l2 = length_squared(v);
-  if (!(l2 > 0.0f) || !std::isfinite(l2)) return fallback;
-  return v / std::sqrt(l2);
-}
-
-}  // namespace
-
-// The three components at once in SSE2 lanes (branch-free; the scalar form cost ~60
-// instructions a call, with a data-dependent branch per component).
-Vec3f offset_ray_origin(Vec3f p, Vec3f n) {
-  const __m128 P = _mm_setr_ps(p.x, p.y, p.z, 0.0f), N = _mm_setr_ps(n.x, n.y, n.z, 0.0f);
-  // Integer ULP steps, away from zero: add kIntScale * n ULPs to |p|'s bits, i.e. subtract for
-  // negative p (sign = -1 there: (of ^ sign) - sign negates).
-  const __m128i of = _mm_cvttps_epi32(_mm_mul_ps(N, _mm_set1_ps(kIntScale)));
-  const __m128i bits = _mm_castps_si128(P);
-  const __m128i sign = _mm_srai_epi32(bits, 31);
-  const __m128 stepped =
-      _mm_castsi128_ps(_mm_add_epi32(bits, _mm_sub_epi32(_mm_xor_si128(of, sign), sign)));
-  // Near the origin an absolute step.
-  const __m128 absolute = _mm_add_ps(P, _mm_mul_ps(N, _mm_set1_ps(kFloatScale)));
-  const __m128 abs_p = _mm_andnot_ps(_mm_set1_ps(-0.0f), P);
-  const __m128 near = _mm_cmplt_ps(abs_p, _mm_set1_ps(kOriginRegion));
-  const __m128 r = _mm_or_ps(_mm_and_ps(near, absolute), _mm_andnot_ps(near, stepped));
-  alignas(16) float out[4];
-  _mm_store_ps(out, r);
-  return {out[0], out[1], out[2]};
-}
+namespace {}  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     : default_material_(default_material) {
@@ -136,15 +102,45 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     rtcReleaseGeometry(geom);
     if (id >= instances_.size()) instances_.resize(id + 1);
     InstanceData& d = instances_[id];
-    d.mesh = &mesh;
-    d.instance = &inst;
     d.index = uint32_t(i);
-    d.to_world = T;
-    d.world_positions = world_positions;
+    d.world_space = world_positions != nullptr;
     d.winding = det < 0.0f ? -1.0f : 1.0f;
+    d.positions = world_positions ? world_positions : mesh.positions.data();
+    d.indices = mesh.indices.data();
+    const size_t tris = mesh.triangle_count();
+    if (!mesh.corner_normals.empty()) {
+      d.corner_normals = mesh.corner_normals.data();
+      d.corner_normal_tris = uint32_t(std::min(mesh.corner_normals.size() / 3, tris));
+    }
+    if (!mesh.vertex_normals.empty()) d.vertex_normals = mesh.vertex_normals.data();
+    if (!mesh.corner_uvs.empty()) {
+      d.corner_uvs = mesh.corner_uvs.data();
+      d.corner_uv_tris = uint32_t(std::min(mesh.corner_uvs.size() / 3, tris));
+    }
+    // Slot -> material with the default applied (-1 and out-of-range indices).
+    auto resolve = [&](int32_t mat) {
+      return (mat >= 0 && mat < default_material_) ? mat : default_material_;
+    };
+    for (int32_t m : inst.slot_material) d.slot_materials.push_back(resolve(m));
+    auto material_of = [&](size_t prim) {
+      const int32_t slot = prim < mesh.material_slot.size() ? mesh.material_slot[prim] : 0;
+      return slot >= 0 && size_t(slot) < d.slot_materials.size() ? d.slot_materials[size_t(slot)]
+                                                                 : default_material_;
+    };
+    d.uniform_material = material_of(0);
+    for (size_t prim = 1; prim < tris && d.uniform_material >= 0; ++prim)
+      if (material_of(prim) != d.uniform_material) d.uniform_material = -1;
+    if (d.uniform_material < 0) {
+      d.material_slot = mesh.material_slot.data();
+      d.material_slot_count = uint32_t(mesh.material_slot.size());
+    }
     const Transform inv = T.inverse();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) d.normal_matrix[r][c] = inv.m[c][r];
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 3; ++r) {
+        d.to_world_cols[c][r] = T.m[r][c];
+        // The inverse transpose's column c = the inverse's row c.
+        if (c < 3) d.normal_cols[c][r] = inv.m[c][r];
+      }
     instanced_triangles_ += mesh.triangle_count();
   }
   rtcSetSceneBuildQuality(top_, RTC_BUILD_QUALITY_MEDIUM);
@@ -162,60 +158,6 @@ EmbreeScene::~EmbreeScene() {
   if (device_) rtcReleaseDevice(device_);
 }
 
-namespace {
-
-// Embree's single-ray layout of `ray` (tnear > tfar marks an inactive ray of a stream).
-void to_embree(const Ray& ray, bool active, RTCRay& r) {
-  r.org_x = ray.origin.x;
-  r.org_y = ray.origin.y;
-  r.org_z = ray.origin.z;
-  r.dir_x = ray.direction.x;
-  r.dir_y = ray.direction.y;
-  r.dir_z = ray.direction.z;
-  r.tnear = active ? ray.t_min : 1.0f;
-  r.tfar = active ? ray.t_max : 0.0f;
-  r.time = 0.0f;
-  r.mask = 0xffffffffu;
-  r.id = 0;
-  r.flags = 0;
-}
-
-void to_embree(const Ray& ray, bool active, RTCRayHit& rh) {
-  to_embree(ray, active, rh.ray);
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-}
-
-}  // namespace
-
-inline bool EmbreeScene::read_hit(const RTCRayHit& rh, Vec3f dir, SurfaceHit& hit) const {
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  hit.t = rh.ray.tfar;
-  // Instanced meshes report the top-level id in instID[0], flattened ones in geomID.
-  const unsigned top_id =
-      rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
-  complete_hit(top_id, rh.hit.primID, rh.hit.u, rh.hit.v, dir, hit);
-  return true;
-}
-
-bool EmbreeScene::intersect(const Ray& ray, SurfaceHit& hit) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  RTCRayHit rh;
-  to_embree(ray, true, rh);
-  rtcIntersect1(top_, &ctx, &rh);
-  return read_hit(rh, ray.direction, hit);
-}
-
-bool EmbreeScene::occluded(const Ray& ray) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  RTCRay r;
-  to_embree(ray, true, r);
-  rtcOccluded1(top_, &ctx, &r);
-  return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
-}
-
 void EmbreeScene::intersect_stream(const Ray* rays, const bool* valid, int n, bool* found,
                                    SurfaceHit* hits) const {
   RTCIntersectContext ctx;
@@ -225,7 +167,7 @@ void EmbreeScene::intersect_stream(const Ray* rays, const bool* valid, int n, bo
   alignas(16) RTCRayHit rh[kChunk];
   for (int first = 0; first < n; first += kChunk) {
     const int m = std::min(kChunk, n - first);
-    for (int j = 0; j < m; ++j) to_embree(rays[first + j], valid[first + j], rh[j]);
+    for (int j = 0; j < m; ++j) detail::to_embree(rays[first + j], valid[first + j], rh[j]);
     rtcIntersect1M(top_, &ctx, rh, unsigned(m), sizeof(RTCRayHit));
     for (int j = 0; j < m; ++j) {
       const int i = first + j;
@@ -234,62 +176,114 @@ void EmbreeScene::intersect_stream(const Ray* rays, const bool* valid, int n, bo
   }
 }
 
-void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v, Vec3f dir,
-                               SurfaceHit& hit) const {
+namespace {
+
+// complete_hit()'s vector work in SSE2 lanes (x, y, z; w = 0). Each lane does the scalar code's
+// operations in the same order (no FMA contraction on the x86-64 baseline), so hits are
+// bit-identical to the Vec3f form, which GCC half-vectorised with shuffles and spills (~190
+// instructions a hit on the Cornell box).
+inline __m128 load3(const Vec3f& v) {
+  const __m128 xy = _mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(&v.x));
+  return _mm_movelh_ps(xy, _mm_load_ss(&v.z));
+}
+inline __m128 load2(const Vec2f& v) {
+  return _mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(&v.x));
+}
+inline void store3(Vec3f& out, __m128 a) {
+  _mm_storel_pi(reinterpret_cast<__m64*>(&out.x), a);
+  _mm_store_ss(&out.z, _mm_movehl_ps(a, a));
+}
+// (a.x b.x + a.y b.y) + a.z b.z, as dot().
+inline float dot3(__m128 a, __m128 b) {
+  const __m128 m = _mm_mul_ps(a, b);
+  const __m128 y = _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 1, 1, 1));
+  return _mm_cvtss_f32(_mm_add_ss(_mm_add_ss(m, y), _mm_movehl_ps(m, m)));
+}
+inline __m128 cross3(__m128 a, __m128 b) {
+  const __m128 a_yzx = _mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 0, 2, 1));
+  const __m128 b_zxy = _mm_shuffle_ps(b, b, _MM_SHUFFLE(3, 1, 0, 2));
+  const __m128 a_zxy = _mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 1, 0, 2));
+  const __m128 b_yzx = _mm_shuffle_ps(b, b, _MM_SHUFFLE(3, 0, 2, 1));
+  return _mm_sub_ps(_mm_mul_ps(a_yzx, b_zxy), _mm_mul_ps(a_zxy, b_yzx));
+}
+// (a w + b u) + c v: barycentric interpolation in the order of the scalar code.
+inline __m128 interpolate(__m128 a, __m128 b, __m128 c, __m128 w, __m128 u, __m128 v) {
+  return _mm_add_ps(_mm_add_ps(_mm_mul_ps(a, w), _mm_mul_ps(b, u)), _mm_mul_ps(c, v));
+}
+// Row r: (M[r][0] x + M[r][1] y) + M[r][2] z, from M's columns.
+inline __m128 linear3(const float (*cols)[4], __m128 v) {
+  const __m128 x = _mm_shuffle_ps(v, v, _MM_SHUFFLE(0, 0, 0, 0));
+  const __m128 y = _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 1, 1, 1));
+  const __m128 z = _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 2, 2, 2));
+  return _mm_add_ps(
+      _mm_add_ps(_mm_mul_ps(_mm_load_ps(cols[0]), x), _mm_mul_ps(_mm_load_ps(cols[1]), y)),
+      _mm_mul_ps(_mm_load_ps(cols[2]), z));
+}
+inline __m128 normalize_or(__m128 v, __m128 fallback) {
+  const float l2 = dot3(v, v);
+  // 0 < l2 < inf: fails for zero, infinite and NaN lengths.
+  if (!(l2 > 0.0f && l2 < std::numeric_limits<float>::infinity())) return fallback;
+  // sqrtps, not std::sqrt: the same value without the errno fallback call, whose presence made
+  // complete_hit() save registers and spill.
+  return _mm_div_ps(v, _mm_sqrt_ps(_mm_set1_ps(l2)));
+}
+
+}  // namespace
+
+void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v,
+                               const Vec3f& dir, SurfaceHit& hit) const {
   const InstanceData& d = instances_[top_id];
-  const Mesh& mesh = *d.mesh;
-  const uint32_t* idx = &mesh.indices[size_t(primitive) * 3];
+  const uint32_t* idx = d.indices + size_t(primitive) * 3;
   const float w = 1.0f - u - v;
   hit.instance = d.index;
   hit.primitive = primitive;
+  const __m128 W = _mm_set1_ps(w), U = _mm_set1_ps(u), V = _mm_set1_ps(v);
 
-  auto to_world_normal = [&](Vec3f n) {
-    const auto& M = d.normal_matrix;
-    return Vec3f(M[0][0] * n.x + M[0][1] * n.y + M[0][2] * n.z,
-                 M[1][0] * n.x + M[1][1] * n.y + M[1][2] * n.z,
-                 M[2][0] * n.x + M[2][1] * n.y + M[2][2] * n.z);
-  };
+  const __m128 p0 = load3(d.positions[idx[0]]), p1 = load3(d.positions[idx[1]]),
+               p2 = load3(d.positions[idx[2]]);
+  const __m128 D = load3(dir);
   // Degenerate triangles have no normal: face the ray so shading stays finite.
-  Vec3f ng;
-  if (d.world_positions) {
-    const Vec3f* P = d.world_positions;
-    const Vec3f p0 = P[idx[0]], p1 = P[idx[1]], p2 = P[idx[2]];
-    hit.position = p0 * w + p1 * u + p2 * v;
-    ng = safe_normalize(cross(p1 - p0, p2 - p0) * d.winding, -dir);
+  const __m128 minus_dir = _mm_xor_ps(D, _mm_set1_ps(-0.0f));
+  const __m128 e = cross3(_mm_sub_ps(p1, p0), _mm_sub_ps(p2, p0));
+  __m128 position, ng;
+  if (d.world_space) {
+    position = interpolate(p0, p1, p2, W, U, V);
+    ng = normalize_or(_mm_mul_ps(e, _mm_set1_ps(d.winding)), minus_dir);
   } else {
-    const Vec3f* P = mesh.positions.data();
-    const Vec3f p0 = P[idx[0]], p1 = P[idx[1]], p2 = P[idx[2]];
-    hit.position = d.to_world.point(p0 * w + p1 * u + p2 * v);
-    ng = safe_normalize(to_world_normal(cross(p1 - p0, p2 - p0)), -dir);
+    const __m128 p = interpolate(p0, p1, p2, W, U, V);
+    position = _mm_add_ps(linear3(d.to_world_cols, p), _mm_load_ps(d.to_world_cols[3]));
+    ng = normalize_or(linear3(d.normal_cols, e), minus_dir);
   }
-  hit.geometric_normal = ng;
-  hit.front_facing = dot(dir, ng) < 0.0f;
+  store3(hit.position, position);
+  store3(hit.geometric_normal, ng);
+  hit.front_facing = dot3(D, ng) < 0.0f;
 
-  const size_t corner = size_t(primitive) * 3;
-  if (!mesh.corner_normals.empty() && mesh.corner_normals.size() >= corner + 3) {
-    const Vec3f n = mesh.corner_normals[corner] * w + mesh.corner_normals[corner + 1] * u +
-                    mesh.corner_normals[corner + 2] * v;
-    hit.shading_normal = safe_normalize(to_world_normal(n), ng);
-  } else if (!mesh.vertex_normals.empty()) {
-    const Vec3f* N = mesh.vertex_normals.data();
-    const Vec3f n = N[idx[0]] * w + N[idx[1]] * u + N[idx[2]] * v;
-    hit.shading_normal = safe_normalize(to_world_normal(n), ng);
-  } else {
-    hit.shading_normal = ng;
+  __m128 ns = ng;
+  if (primitive < d.corner_normal_tris) {
+    const Vec3f* N = d.corner_normals + size_t(primitive) * 3;
+    const __m128 n = interpolate(load3(N[0]), load3(N[1]), load3(N[2]), W, U, V);
+    ns = normalize_or(linear3(d.normal_cols, n), ng);
+  } else if (d.vertex_normals) {
+    const Vec3f* N = d.vertex_normals;
+    const __m128 n = interpolate(load3(N[idx[0]]), load3(N[idx[1]]), load3(N[idx[2]]), W, U, V);
+    ns = normalize_or(linear3(d.normal_cols, n), ng);
   }
-  if (!mesh.corner_uvs.empty() && mesh.corner_uvs.size() >= corner + 3) {
-    hit.uv = mesh.corner_uvs[corner] * w + mesh.corner_uvs[corner + 1] * u +
-             mesh.corner_uvs[corner + 2] * v;
-  } else {
-    hit.uv = Vec2f(0.0f, 0.0f);
+  store3(hit.shading_normal, ns);
+  __m128 uv = _mm_setzero_ps();
+  if (primitive < d.corner_uv_tris) {
+    const Vec2f* T = d.corner_uvs + size_t(primitive) * 3;
+    uv = interpolate(load2(T[0]), load2(T[1]), load2(T[2]), W, U, V);
   }
+  _mm_storel_pi(reinterpret_cast<__m64*>(&hit.uv.x), uv);
 
-  int32_t slot = 0;
-  if (primitive < mesh.material_slot.size()) slot = mesh.material_slot[primitive];
-  int32_t mat = -1;
-  const auto& slots = d.instance->slot_material;
-  if (slot >= 0 && size_t(slot) < slots.size()) mat = slots[size_t(slot)];
-  hit.material = (mat >= 0 && mat < default_material_) ? mat : default_material_;
+  if (d.uniform_material >= 0) {
+    hit.material = d.uniform_material;
+  } else {
+    const int32_t slot = primitive < d.material_slot_count ? d.material_slot[primitive] : 0;
+    hit.material = slot >= 0 && size_t(slot) < d.slot_materials.size()
+                       ? d.slot_materials[size_t(slot)]
+                       : default_material_;
+  }
 }
 
 }  // namespace gdpt

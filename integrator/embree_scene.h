@@ -9,6 +9,7 @@
 #pragma once
 
 #include <embree3/rtcore.h>
+#include <emmintrin.h>
 
 #include <cstdint>
 #include <vector>
@@ -34,7 +35,58 @@ struct SurfaceHit {
 // Moves p off the surface along n (the side the new ray leaves to) by an amount proportional to
 // the floating-point spacing at p, in the spirit of Wächter & Binder (Ray Tracing Gems, ch. 6):
 // integer ULP steps away from the origin, a small absolute step near it.
-Vec3f offset_ray_origin(Vec3f p, Vec3f n);
+// The three components at once in SSE2 lanes (branch-free; the scalar form cost ~60
+// instructions a call, with a data-dependent branch per component); inline, since the call
+// itself (Vec3f arguments split over registers, a stack round trip for the result) cost as much.
+[[gnu::always_inline]] inline Vec3f offset_ray_origin(const Vec3f& p, const Vec3f& n) {
+  // Integer-ULP offset scale and the absolute fallback near the origin (positions whose magnitude
+  // is below kOriginRegion have too few ULPs to step by integers meaningfully).
+  constexpr float kOriginRegion = 1.0f / 32.0f;
+  constexpr float kFloatScale = 1.0f / 65536.0f;
+  constexpr float kIntScale = 256.0f;
+  const __m128 P = _mm_setr_ps(p.x, p.y, p.z, 0.0f), N = _mm_setr_ps(n.x, n.y, n.z, 0.0f);
+  // Integer ULP steps, away from zero: add kIntScale * n ULPs to |p|'s bits, i.e. subtract for
+  // negative p (sign = -1 there: (of ^ sign) - sign negates).
+  const __m128i of = _mm_cvttps_epi32(_mm_mul_ps(N, _mm_set1_ps(kIntScale)));
+  const __m128i bits = _mm_castps_si128(P);
+  const __m128i sign = _mm_srai_epi32(bits, 31);
+  const __m128 stepped =
+      _mm_castsi128_ps(_mm_add_epi32(bits, _mm_sub_epi32(_mm_xor_si128(of, sign), sign)));
+  // Near the origin an absolute step.
+  const __m128 absolute = _mm_add_ps(P, _mm_mul_ps(N, _mm_set1_ps(kFloatScale)));
+  const __m128 abs_p = _mm_andnot_ps(_mm_set1_ps(-0.0f), P);
+  const __m128 near = _mm_cmplt_ps(abs_p, _mm_set1_ps(kOriginRegion));
+  const __m128 r = _mm_or_ps(_mm_and_ps(near, absolute), _mm_andnot_ps(near, stepped));
+  alignas(16) float out[4];
+  _mm_store_ps(out, r);
+  return {out[0], out[1], out[2]};
+}
+
+namespace detail {
+
+// Embree's single-ray layout of `ray` (tnear > tfar marks an inactive ray of a stream).
+inline void to_embree(const Ray& ray, bool active, RTCRay& r) {
+  r.org_x = ray.origin.x;
+  r.org_y = ray.origin.y;
+  r.org_z = ray.origin.z;
+  r.dir_x = ray.direction.x;
+  r.dir_y = ray.direction.y;
+  r.dir_z = ray.direction.z;
+  r.tnear = active ? ray.t_min : 1.0f;
+  r.tfar = active ? ray.t_max : 0.0f;
+  r.time = 0.0f;
+  r.mask = 0xffffffffu;
+  r.id = 0;
+  r.flags = 0;
+}
+
+inline void to_embree(const Ray& ray, bool active, RTCRayHit& rh) {
+  to_embree(ray, active, rh.ray);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+}  // namespace detail
 
 class EmbreeScene {
  public:
@@ -44,10 +96,36 @@ class EmbreeScene {
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
 
-  // Closest hit in (t_min, t_max). Fills `hit` when true.
-  bool intersect(const Ray& ray, SurfaceHit& hit) const;
+  // Closest hit in (t_min, t_max). Fills `hit` when true. Inline (as occluded()): the wrappers
+  // around Embree's calls are on every ray.
+  bool intersect(const Ray& ray, SurfaceHit& hit) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    detail::to_embree(ray, true, rh);
+    rtcIntersect1(top_, &ctx, &rh);
+    return read_hit(rh, ray.direction, hit);
+  }
+  // Closest hit distance only, without the hit record: for rays whose hit can only end the path.
+  bool intersect_distance(const Ray& ray, float& t) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    detail::to_embree(ray, true, rh);
+    rtcIntersect1(top_, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    t = rh.ray.tfar;
+    return true;
+  }
   // True when something blocks the segment (t_min, t_max).
-  bool occluded(const Ray& ray) const;
+  [[gnu::always_inline]] bool occluded(const Ray& ray) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay r;
+    detail::to_embree(ray, true, r);
+    rtcOccluded1(top_, &ctx, &r);
+    return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
+  }
   // A stream of n rays (Embree rtcIntersect1M, coherent context: Embree groups consecutive rays
   // into packets of its native width, on any ISA). Ray i is traced only when valid[i]; results as
   // intersect(). For G-PT's camera rays of a row of pixels (consecutive rays start at neighbouring
@@ -58,24 +136,52 @@ class EmbreeScene {
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
   size_t instanced_triangle_count() const { return instanced_triangles_; }
   // Fills the rest of a hit from (top-level geometry id, primitive, barycentrics).
-  void complete_hit(uint32_t top_id, uint32_t primitive, float u, float v, Vec3f dir,
+  void complete_hit(uint32_t top_id, uint32_t primitive, float u, float v, const Vec3f& dir,
                     SurfaceHit& hit) const;
 
  private:
   // Fills `hit` from Embree's result; false when nothing was hit.
-  bool read_hit(const RTCRayHit& rh, Vec3f dir, SurfaceHit& hit) const;
+  bool read_hit(const RTCRayHit& rh, const Vec3f& dir, SurfaceHit& hit) const {
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    hit.t = rh.ray.tfar;
+    // Instanced meshes report the top-level id in instID[0], flattened ones in geomID.
+    const unsigned top_id =
+        rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
+    complete_hit(top_id, rh.hit.primID, rh.hit.u, rh.hit.v, dir, hit);
+    return true;
+  }
 
+  // Everything complete_hit() reads, resolved at build time (raw pointers into the Scene's
+  // meshes, slot -> material table with the default applied): a hit costs no vector bounds or
+  // emptiness checks and no chasing of Mesh / Instance pointers.
   struct InstanceData {
-    const Mesh* mesh = nullptr;
-    const Instance* instance = nullptr;
     uint32_t index = 0;  // in Scene::instances
-    Transform to_world;
-    float normal_matrix[3][3];  // inverse transpose of the linear part
-    // Flattened (world-space) meshes: Embree's own vertex buffer, so hits need no transform.
-    const Vec3f* world_positions = nullptr;
+    // Flattened (world-space) meshes: Embree's own vertex buffer, so hits need no transform;
+    // instanced meshes: the Mesh's object-space positions.
+    bool world_space = false;
     // -1 for mirroring transforms: a world-space cross product then points against the
     // transformed object-space normal, whose orientation front_facing is defined by (as Cycles).
     float winding = 1.0f;
+    const Vec3f* positions = nullptr;
+    const uint32_t* indices = nullptr;
+    // Shading normals: corner normals for primitives < corner_normal_tris, else vertex normals
+    // when present, else flat.
+    const Vec3f* corner_normals = nullptr;
+    uint32_t corner_normal_tris = 0;
+    const Vec3f* vertex_normals = nullptr;
+    const Vec2f* corner_uvs = nullptr;  // for primitives < corner_uv_tris; else uv = 0
+    uint32_t corner_uv_tris = 0;
+    // Material: `uniform_material` when every triangle resolves to one (the common case), else
+    // slot_materials[material_slot[primitive]] (slot 0 past material_slot_count, default
+    // material for slots outside the table).
+    int32_t uniform_material = -1;
+    const int32_t* material_slot = nullptr;
+    uint32_t material_slot_count = 0;
+    std::vector<int32_t> slot_materials;
+    // Columns of the object-to-world transform (the fourth: translation) and of the normal
+    // matrix (inverse transpose of its linear part), as SSE lanes (w = 0).
+    alignas(16) float to_world_cols[4][4] = {};
+    alignas(16) float normal_cols[3][4] = {};
   };
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;

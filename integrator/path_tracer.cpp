@@ -57,13 +57,14 @@ class PathTracer final : public Integrator {
     uint64_t rays = 0;
     Sampler sampler;
     ClosureSet closures, scratch;  // ~0.5 KB each: initialised once per tile, not per sample
+    SurfaceHit hit;                // likewise: every intersect() overwrites what is read after it
     const float clamp = settings_.clamp;
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x) {
         Film::Accumulator& acc = film.pixel(x, y);
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
           sampler.start(settings_.seed, x, y, s);
-          const PathResult r = trace(sampler, x, y, closures, scratch);
+          const PathResult r = trace(sampler, x, y, closures, scratch, hit);
           rays += r.rays;
           acc.add_path(r.primal, r.emission, clamp);
         }
@@ -100,7 +101,7 @@ class PathTracer final : public Integrator {
   }
 
   PathResult trace(const Sampler& sampler, int px, int py, ClosureSet& closure_scratch,
-                   ClosureSet& scratch) const {
+                   ClosureSet& scratch, SurfaceHit& hit) const {
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
     const auto& materials = ctx_.materials();
@@ -118,7 +119,6 @@ class PathTracer final : public Integrator {
     float prev_pdf = 0.0f;   // solid-angle pdf of the BSDF sample that spawned `ray`
     bool prev_delta = true;  // no MIS for camera rays and delta lobes
     Vec3f prev_position = ray.origin;
-    SurfaceHit hit;
 
     int bounce = 0;           // Cycles' bounce count: scattering events, transparent ones excluded
     int transparent = 0;      // transparent crossings (Cycles' transparent bounces)
@@ -127,7 +127,11 @@ class PathTracer final : public Integrator {
 
     // `vertex` numbers every surface interaction (sampler dimensions); `bounce` follows Cycles.
     for (int vertex = 0;; ++vertex) {
-      const bool found = bvh.intersect(ray, hit);
+      // Past the bounce limits a vertex only ends the path: without emissive triangles its hit
+      // needs no record, only the distance (analytic lights in front of it, the world behind).
+      const bool last = bounce > max_bounces || transparent > kMaxTransparentBounces;
+      const bool found =
+          !kEmissive && last ? bvh.intersect_distance(ray, hit.t) : bvh.intersect(ray, hit);
       ++out.rays;
       const float t_hit = found ? hit.t : ray.t_max;
 
@@ -171,6 +175,8 @@ class PathTracer final : public Integrator {
         break;
       }
 
+      if (!kEmissive && last) break;
+
       // --- Shading point ---
       const ShadingContext sc{hit.uv, hit.front_facing};
       const Material& material = materials[size_t(hit.material)];
@@ -189,7 +195,7 @@ class PathTracer final : public Integrator {
           }
         }
       }
-      if (bounce > max_bounces || transparent > kMaxTransparentBounces) break;
+      if (last) break;
       const ClosureSet& closures = material.closures(sc, closure_scratch);
       if (!closures.has_bsdf()) break;
 

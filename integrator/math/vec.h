@@ -100,8 +100,10 @@ constexpr float max_component(Vec3f v) {
 constexpr float min_component(Vec3f v) {
   return std::min(v.x, std::min(v.y, v.z));
 }
-inline bool is_finite(Vec3f v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+// Branch-free: 0 * x is +-0 for finite x and NaN for infinite or NaN x, so the sum is 0 exactly
+// when all three are finite (the film tests every path's radiance).
+constexpr bool is_finite(Vec3f v) {
+  return v.x * 0.0f + v.y * 0.0f + v.z * 0.0f == 0.0f;
 }
 constexpr Vec3f lerp(Vec3f a, Vec3f b, float t) {
   return a * (1.0f - t) + b * t;
