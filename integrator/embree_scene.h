@@ -99,20 +99,14 @@ class EmbreeScene {
   // Closest hit in (t_min, t_max). Fills `hit` when true. Inline (as occluded()): the wrappers
   // around Embree's calls are on every ray.
   bool intersect(const Ray& ray, SurfaceHit& hit) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
-    detail::to_embree(ray, true, rh);
-    rtcIntersect1(top_, &ctx, &rh);
+    closest(ray, rh);
     return read_hit(rh, ray.direction, hit);
   }
   // Closest hit distance only, without the hit record: for rays whose hit can only end the path.
   bool intersect_distance(const Ray& ray, float& t) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
-    detail::to_embree(ray, true, rh);
-    rtcIntersect1(top_, &ctx, &rh);
+    closest(ray, rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     t = rh.ray.tfar;
     return true;
@@ -140,6 +134,13 @@ class EmbreeScene {
                     SurfaceHit& hit) const;
 
  private:
+  // Embree's closest-hit query for one ray, shared by intersect() and intersect_distance().
+  [[gnu::always_inline]] void closest(const Ray& ray, RTCRayHit& rh) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    detail::to_embree(ray, true, rh);
+    rtcIntersect1(top_, &ctx, &rh);
+  }
   // Fills `hit` from Embree's result; false when nothing was hit.
   bool read_hit(const RTCRayHit& rh, const Vec3f& dir, SurfaceHit& hit) const {
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
