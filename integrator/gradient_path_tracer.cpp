@@ -141,12 +141,13 @@ std::vector<MaterialSide> material_sides(const SceneContext& ctx) {
   return sides;
 }
 
-// Sets up `v` at `hit` reached along `dir` (world, unit), as the path tracer does: Cycles-style
-// flipped normals for back faces, geometric-normal fallback for a shading normal that puts the
-// incoming direction below its horizon.
-void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
-                  const SurfaceHit& hit, const Vec3f& dir, Vertex& v) {
-  v.hit = hit;
+// Sets up `v` at its hit v.hit reached along `dir` (world, unit), as the path tracer does:
+// Cycles-style flipped normals for back faces, geometric-normal fallback for a shading normal
+// that puts the incoming direction below its horizon. (The base's next hit is traced into v.hit
+// directly: no copy.)
+void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides, const Vec3f& dir,
+                   Vertex& v) {
+  const SurfaceHit& hit = v.hit;
   const MaterialSide& side = sides[2 * size_t(hit.material) + (hit.front_facing ? 1 : 0)];
   if (side.set) {
     v.closures = side.set;
@@ -166,6 +167,13 @@ void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   v.frame = Frame(ns);
   v.wi = v.frame.to_local(wi_world);
   v.origin_set = false;
+}
+
+// The same at a copy of `hit`.
+void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
+                  const SurfaceHit& hit, const Vec3f& dir, Vertex& v) {
+  v.hit = hit;
+  finish_vertex(ctx, sides, dir, v);
 }
 
 // Emitted radiance of an emissive triangle at `hit` towards the point `from`.
@@ -271,6 +279,7 @@ class GradientPathTracer final : public Integrator {
         has_world_(ctx.lights().has_environment()),
         has_visible_lamps_(ctx.lights().has_camera_visible_lights()),
         has_dof_(ctx.camera().has_dof()),
+        has_emissive_((ctx.features() & kSceneEmissiveTriangles) != 0),
         sides_(material_sides(ctx)) {}
 
   bool estimates_gradients() const override { return true; }
@@ -513,7 +522,6 @@ class GradientPathTracer final : public Integrator {
       o.p = 1.0;
       o.grad = Vec3d();
       const Ray& cam = row.cam[k * kRow + i];
-      o.ray = cam;
       // Base hits a surface, the offset the world: no shift.
       o.alive = row.cam_found[k * kRow + i];
       if (o.alive) setup_vertex(ctx_, sides_, row.cam_hit[k * kRow + i], cam.direction, o.v);
@@ -522,7 +530,7 @@ class GradientPathTracer final : public Integrator {
     int cur = 0;  // scratch.verts[cur] is the base vertex
     setup_vertex(ctx_, sides_, hit, cam_ray.direction, scratch.verts[cur]);
     // Very direct light: emission seen by the camera, never shifted.
-    out.emission += triangle_emission(ctx_, hit, cam_ray.origin);
+    out.emission += triangle_le(hit, cam_ray.origin);
     Ray ray;  // the base's current segment
 
     Spectrum beta(1.0f);  // f / p of the base, for the primal (PT estimator)
@@ -721,14 +729,25 @@ class GradientPathTracer final : public Integrator {
       ray.direction = normalize(wo_world);
       ray.t_min = 0.0f;
       ray.t_max = kInf;
-      SurfaceHit next;
-      const bool found = bvh.intersect(ray, next);
+      // The hit goes straight into the next vertex. Its end point only ends the path at the last
+      // bounce: no vertex set-up there (the offsets' shifts need its classification alone), and
+      // no hit record either when no offset shifts and no triangle emits (as PT).
+      const bool last = bounce == max_bounces;
+      const SurfaceHit& next = next_base.hit;
+      const bool found = last && open == 0 && !has_emissive_
+                             ? bvh.intersect_distance(ray, next_base.hit.t)
+                             : bvh.intersect(ray, next_base.hit);
       ++out.rays;
       const float t_hit = found ? next.t : kInf;
       LightHit lh;
       const bool light_hit = lights.intersect(ray.origin, ray.direction, t_hit, lh);
-      if (found) setup_vertex(ctx_, sides_, next, ray.direction, next_base);
-      const VertexType next_type = found ? classify(next_base.roughness) : VertexType::Diffuse;
+      VertexType next_type = VertexType::Diffuse;
+      if (found && !last) {
+        finish_vertex(ctx_, sides_, ray.direction, next_base);
+        next_type = classify(next_base.roughness);
+      } else if (found && open > 0) {
+        next_type = classify(next_vertex_roughness(next));
+      }
 
       // --- Shift every offset over this segment ---
       const Vec3d seg_b = Vec3d(bs.value);
@@ -833,7 +852,7 @@ class GradientPathTracer final : public Integrator {
             if (!delta && !is_black(le)) pl = lights.pdf_environment(ray.direction);
           }
         } else {
-          le = triangle_emission(ctx_, next, base.hit.position);
+          le = triangle_le(next, base.hit.position);
           if (!delta && !is_black(le))
             pl = lights.pdf_triangle(next.instance, next.primitive, base.hit.position,
                                      next.position, next.geometric_normal);
@@ -871,7 +890,7 @@ class GradientPathTracer final : public Integrator {
           o.f = mul(o.f, seg_b);
           o.p *= pdf_b;
         } else {
-          advance(o, next_base);
+          advance(o, last);
         }
       }
       if (!found) break;
@@ -1057,6 +1076,11 @@ class GradientPathTracer final : public Integrator {
     }
   }
 
+  // Emission of an emissive triangle at `hit` towards `from`; none without emissive triangles.
+  Spectrum triangle_le(const SurfaceHit& hit, Vec3f from) const {
+    return has_emissive_ ? triangle_emission(ctx_, hit, from) : Spectrum(0.0f);
+  }
+
   float next_vertex_roughness(const SurfaceHit& h) const {
     const MaterialSide& side = sides_[2 * size_t(h.material) + (h.front_facing ? 1 : 0)];
     if (side.set) return side.roughness;
@@ -1124,7 +1148,7 @@ class GradientPathTracer final : public Integrator {
       case Shift::Reconnect: {
         // Same end point, reached from y_d. Occlusion zeroes the contribution and the BSDF
         // density, but light sampling from y_d could still have produced the path.
-        const Spectrum le_o = triangle_emission(ctx_, next, o.v.hit.position);
+        const Spectrum le_o = triangle_le(next, o.v.hit.position);
         const float pl_o =
             pl_pair > 0.0f ? lights.pdf_triangle(next.instance, next.primitive, o.v.hit.position,
                                                  next.position, next.geometric_normal)
@@ -1146,7 +1170,7 @@ class GradientPathTracer final : public Integrator {
           if (has_world_) le_o = lights.environment(o.ray.direction);
           if (nee_on && !is_black(le_o)) pl_o = lights.pdf_environment(o.ray.direction);
         } else {
-          le_o = triangle_emission(ctx_, o.next_hit, o.v.hit.position);
+          le_o = triangle_le(o.next_hit, o.v.hit.position);
           if (nee_on && !is_black(le_o))
             pl_o = lights.pdf_triangle(o.next_hit.instance, o.next_hit.primitive, o.v.hit.position,
                                        o.next_hit.position, o.next_hit.geometric_normal);
@@ -1160,8 +1184,8 @@ class GradientPathTracer final : public Integrator {
     }
   }
 
-  // Moves the offset to the end of the segment.
-  void advance(Offset& o, const Vertex& next_base) const {
+  // Moves the offset to the end of the segment (`last`: the path ends there, no vertex needed).
+  void advance(Offset& o, bool last) const {
     auto kill = [&] {
       o.alive = false;
       o.failed = true;
@@ -1183,12 +1207,11 @@ class GradientPathTracer final : public Integrator {
         break;
       case Shift::HalfVector:
         if (o.killed) return kill();
-        if (o.next_found) setup_vertex(ctx_, sides_, o.next_hit, o.ray.direction, o.v);
+        if (o.next_found && !last) setup_vertex(ctx_, sides_, o.next_hit, o.ray.direction, o.v);
         break;
       case Shift::Failed:
         return kill();
     }
-    (void)next_base;
     o.f = mul(o.f, o.seg_value) * o.seg_jacobian;
     o.p *= o.seg_pdf * o.seg_jacobian;
   }
@@ -1198,6 +1221,7 @@ class GradientPathTracer final : public Integrator {
   bool has_world_ = false;
   bool has_visible_lamps_ = false;
   bool has_dof_ = false;
+  bool has_emissive_ = false;
   std::vector<MaterialSide> sides_;
 };
 
