@@ -13,6 +13,7 @@
 #include "integrator/gradient_path_tracer.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -269,6 +270,10 @@ struct PathScratch {
   LightSample lo[kOffsets];
   Vec3f wo_o[kOffsets];
   Spectrum fo[kOffsets];
+  // Per bounce, here rather than locals: their ReconnectionBase members' default initialisers
+  // (eight doubles each) ran on every bounce. Each is read only after trace() has set it.
+  BaseStep step;
+  shift::ReconnectionBase light_base;
 };
 
 class GradientPathTracer final : public Integrator {
@@ -555,6 +560,7 @@ class GradientPathTracer final : public Integrator {
       // A dead offset leaves the base alone with both of its techniques: light sampling stays on
       // (nee_on, as for connected offsets).
       int open = 0;
+      unsigned open_mask = 0;  // bit k: offset k is open (the loops below visit only these)
       for (Offset& o : std::span(off, kOffsets)) {
         o.nee_on = true;
         if (!o.active || !o.alive || o.link == Link::Connected) continue;
@@ -568,6 +574,7 @@ class GradientPathTracer final : public Integrator {
               base_type == VertexType::Diffuse && classify(o.v.roughness) == VertexType::Diffuse;
         }
         ++open;
+        open_mask |= 1u << (&o - off);
       }
       if (has_lights) {
         // Dimensions are indexed, not streamed: skipping an unused one changes no other value
@@ -620,12 +627,12 @@ class GradientPathTracer final : public Integrator {
           float pdf_fo[kOffsets];
           bool test[kOffsets] = {false, false, false, false};
           bool blocked[kOffsets] = {false, false, false, false};
-          shift::ReconnectionBase light_base;  // the shared light point's base side, on demand
+          shift::ReconnectionBase& light_base = scratch.light_base;  // set on demand
           bool light_base_set = false;
-          for (int k = 0; k < kOffsets && open > 0; ++k) {
+          for (unsigned m = open_mask; m != 0; m &= m - 1) {
+            const int k = std::countr_zero(m);
             const Offset& o = off[k];
             nc[k] = NeeCase::Skip;
-            if (!o.active || !o.alive || o.link == Link::Connected) continue;  // merged
             if (o.link != Link::NotConnected) {
               nc[k] = NeeCase::Shared;
               continue;
@@ -658,7 +665,8 @@ class GradientPathTracer final : public Integrator {
             }
           }
           // Second pass: contributions and weights.
-          for (int k = 0; k < kOffsets && open > 0; ++k) {
+          for (unsigned m = open_mask; m != 0; m &= m - 1) {
+            const int k = std::countr_zero(m);
             Offset& o = off[k];
             Vec3d co;
             PathDensities d_off{0.0, 0.0, 0.0};
@@ -755,7 +763,7 @@ class GradientPathTracer final : public Integrator {
       // Filled member by member: an aggregate assignment built a temporary with narrow stores and
       // copied it with 16-byte loads across them (failed store-to-load forwarding; perf annotate
       // put ~1% of the samples there).
-      BaseStep st;
+      BaseStep& st = scratch.step;
       if (open > 0) {
         st.base = &base;
         st.bs = &bs;
@@ -767,15 +775,16 @@ class GradientPathTracer final : public Integrator {
         st.u_lobe = u_lobe;
         st.u_dir = u_dir;
         st.base_front = false;
-        if (found) {
+        // The reconnection target (a double square root and division) only where shift_segment()
+        // may reconnect: x_d and x_{d+1} diffuse.
+        if (found && xd_type == VertexType::Diffuse && next_type == VertexType::Diffuse) {
           st.target =
               shift::reconnection_base(base.hit.position, next.position, next.geometric_normal);
           st.base_front = dot(base.hit.position - next.position, next.geometric_normal) > 0;
         }
       }
-      for (Offset& o : std::span(off, kOffsets)) {
-        if (open == 0) break;
-        if (!o.active || !o.alive || o.link == Link::Connected) continue;
+      for (unsigned m = open_mask; m != 0; m &= m - 1) {
+        Offset& o = off[std::countr_zero(m)];
         if (!lobe_drawn && delta && o.link == Link::NotConnected &&
             o.v.closures->uses_lobe_choice()) {
           st.u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
@@ -804,9 +813,8 @@ class GradientPathTracer final : public Integrator {
                 : pl;
         const Vec3d cb = base_lit ? mul(mul(fb, seg_b), lh.radiance) : Vec3d();
         if (base_lit) emit_merged = connected_event(mul(seg_b, lh.radiance), pdf_b, pl_mis, pdf_b);
-        for (Offset& o : std::span(off, kOffsets)) {
-          if (open == 0) break;
-          if (!o.active || !o.alive || o.link == Link::Connected) continue;
+        for (unsigned m = open_mask; m != 0; m &= m - 1) {
+          Offset& o = off[std::countr_zero(m)];
           // Without a lit base only a half-vector offset's own ray can find a light.
           if (!base_lit && o.shift != Shift::HalfVector) continue;
           Vec3d co;
@@ -862,9 +870,8 @@ class GradientPathTracer final : public Integrator {
         const Vec3d cb = mul(mul(fb, seg_b), le);
         if (base_emits)
           emit_merged = emit_merged + connected_event(mul(seg_b, le), pdf_b, pl, pdf_b);
-        for (Offset& o : std::span(off, kOffsets)) {
-          if (open == 0) break;
-          if (!o.active || !o.alive || o.link == Link::Connected) continue;
+        for (unsigned m = open_mask; m != 0; m &= m - 1) {
+          Offset& o = off[std::countr_zero(m)];
           // Without emission at the base's end point only a half-vector offset's own end point
           // can have some (the other shifts end at the same point, seen from the same side).
           if (!base_emits && o.shift != Shift::HalfVector) continue;
