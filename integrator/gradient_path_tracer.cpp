@@ -13,6 +13,7 @@
 #include "integrator/gradient_path_tracer.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -141,12 +142,13 @@ std::vector<MaterialSide> material_sides(const SceneContext& ctx) {
   return sides;
 }
 
-// Sets up `v` at `hit` reached along `dir` (world, unit), as the path tracer does: Cycles-style
-// flipped normals for back faces, geometric-normal fallback for a shading normal that puts the
-// incoming direction below its horizon.
-void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
-                  const SurfaceHit& hit, const Vec3f& dir, Vertex& v) {
-  v.hit = hit;
+// Sets up `v` at its hit v.hit reached along `dir` (world, unit), as the path tracer does:
+// Cycles-style flipped normals for back faces, geometric-normal fallback for a shading normal
+// that puts the incoming direction below its horizon. (The base's next hit is traced into v.hit
+// directly: no copy.)
+void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides, const Vec3f& dir,
+                   Vertex& v) {
+  const SurfaceHit& hit = v.hit;
   const MaterialSide& side = sides[2 * size_t(hit.material) + (hit.front_facing ? 1 : 0)];
   if (side.set) {
     v.closures = side.set;
@@ -166,6 +168,13 @@ void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   v.frame = Frame(ns);
   v.wi = v.frame.to_local(wi_world);
   v.origin_set = false;
+}
+
+// The same at a copy of `hit`.
+void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
+                  const SurfaceHit& hit, const Vec3f& dir, Vertex& v) {
+  v.hit = hit;
+  finish_vertex(ctx, sides, dir, v);
 }
 
 // Emitted radiance of an emissive triangle at `hit` towards the point `from`.
@@ -261,6 +270,10 @@ struct PathScratch {
   LightSample lo[kOffsets];
   Vec3f wo_o[kOffsets];
   Spectrum fo[kOffsets];
+  // Per bounce, here rather than locals: their ReconnectionBase members' default initialisers
+  // (eight doubles each) ran on every bounce. Each is read only after trace() has set it.
+  BaseStep step;
+  shift::ReconnectionBase light_base;
 };
 
 class GradientPathTracer final : public Integrator {
@@ -271,6 +284,7 @@ class GradientPathTracer final : public Integrator {
         has_world_(ctx.lights().has_environment()),
         has_visible_lamps_(ctx.lights().has_camera_visible_lights()),
         has_dof_(ctx.camera().has_dof()),
+        has_emissive_((ctx.features() & kSceneEmissiveTriangles) != 0),
         sides_(material_sides(ctx)) {}
 
   bool estimates_gradients() const override { return true; }
@@ -513,7 +527,6 @@ class GradientPathTracer final : public Integrator {
       o.p = 1.0;
       o.grad = Vec3d();
       const Ray& cam = row.cam[k * kRow + i];
-      o.ray = cam;
       // Base hits a surface, the offset the world: no shift.
       o.alive = row.cam_found[k * kRow + i];
       if (o.alive) setup_vertex(ctx_, sides_, row.cam_hit[k * kRow + i], cam.direction, o.v);
@@ -522,7 +535,7 @@ class GradientPathTracer final : public Integrator {
     int cur = 0;  // scratch.verts[cur] is the base vertex
     setup_vertex(ctx_, sides_, hit, cam_ray.direction, scratch.verts[cur]);
     // Very direct light: emission seen by the camera, never shifted.
-    out.emission += triangle_emission(ctx_, hit, cam_ray.origin);
+    out.emission += triangle_le(hit, cam_ray.origin);
     Ray ray;  // the base's current segment
 
     Spectrum beta(1.0f);  // f / p of the base, for the primal (PT estimator)
@@ -547,6 +560,7 @@ class GradientPathTracer final : public Integrator {
       // A dead offset leaves the base alone with both of its techniques: light sampling stays on
       // (nee_on, as for connected offsets).
       int open = 0;
+      unsigned open_mask = 0;  // bit k: offset k is open (the loops below visit only these)
       for (Offset& o : std::span(off, kOffsets)) {
         o.nee_on = true;
         if (!o.active || !o.alive || o.link == Link::Connected) continue;
@@ -560,6 +574,7 @@ class GradientPathTracer final : public Integrator {
               base_type == VertexType::Diffuse && classify(o.v.roughness) == VertexType::Diffuse;
         }
         ++open;
+        open_mask |= 1u << (&o - off);
       }
       if (has_lights) {
         // Dimensions are indexed, not streamed: skipping an unused one changes no other value
@@ -612,12 +627,12 @@ class GradientPathTracer final : public Integrator {
           float pdf_fo[kOffsets];
           bool test[kOffsets] = {false, false, false, false};
           bool blocked[kOffsets] = {false, false, false, false};
-          shift::ReconnectionBase light_base;  // the shared light point's base side, on demand
+          shift::ReconnectionBase& light_base = scratch.light_base;  // set on demand
           bool light_base_set = false;
-          for (int k = 0; k < kOffsets && open > 0; ++k) {
+          for (unsigned m = open_mask; m != 0; m &= m - 1) {
+            const int k = std::countr_zero(m);
             const Offset& o = off[k];
             nc[k] = NeeCase::Skip;
-            if (!o.active || !o.alive || o.link == Link::Connected) continue;  // merged
             if (o.link != Link::NotConnected) {
               nc[k] = NeeCase::Shared;
               continue;
@@ -650,7 +665,8 @@ class GradientPathTracer final : public Integrator {
             }
           }
           // Second pass: contributions and weights.
-          for (int k = 0; k < kOffsets && open > 0; ++k) {
+          for (unsigned m = open_mask; m != 0; m &= m - 1) {
+            const int k = std::countr_zero(m);
             Offset& o = off[k];
             Vec3d co;
             PathDensities d_off{0.0, 0.0, 0.0};
@@ -721,14 +737,25 @@ class GradientPathTracer final : public Integrator {
       ray.direction = normalize(wo_world);
       ray.t_min = 0.0f;
       ray.t_max = kInf;
-      SurfaceHit next;
-      const bool found = bvh.intersect(ray, next);
+      // The hit goes straight into the next vertex. Its end point only ends the path at the last
+      // bounce: no vertex set-up there (the offsets' shifts need its classification alone), and
+      // no hit record either when no offset shifts and no triangle emits (as PT).
+      const bool last = bounce == max_bounces;
+      const SurfaceHit& next = next_base.hit;
+      const bool found = last && open == 0 && !has_emissive_
+                             ? bvh.intersect_distance(ray, next_base.hit.t)
+                             : bvh.intersect(ray, next_base.hit);
       ++out.rays;
       const float t_hit = found ? next.t : kInf;
       LightHit lh;
       const bool light_hit = lights.intersect(ray.origin, ray.direction, t_hit, lh);
-      if (found) setup_vertex(ctx_, sides_, next, ray.direction, next_base);
-      const VertexType next_type = found ? classify(next_base.roughness) : VertexType::Diffuse;
+      VertexType next_type = VertexType::Diffuse;
+      if (found && !last) {
+        finish_vertex(ctx_, sides_, ray.direction, next_base);
+        next_type = classify(next_base.roughness);
+      } else if (found && open > 0) {
+        next_type = classify(next_vertex_roughness(next));
+      }
 
       // --- Shift every offset over this segment ---
       const Vec3d seg_b = Vec3d(bs.value);
@@ -736,7 +763,7 @@ class GradientPathTracer final : public Integrator {
       // Filled member by member: an aggregate assignment built a temporary with narrow stores and
       // copied it with 16-byte loads across them (failed store-to-load forwarding; perf annotate
       // put ~1% of the samples there).
-      BaseStep st;
+      BaseStep& st = scratch.step;
       if (open > 0) {
         st.base = &base;
         st.bs = &bs;
@@ -748,15 +775,16 @@ class GradientPathTracer final : public Integrator {
         st.u_lobe = u_lobe;
         st.u_dir = u_dir;
         st.base_front = false;
-        if (found) {
+        // The reconnection target (a double square root and division) only where shift_segment()
+        // may reconnect: x_d and x_{d+1} diffuse.
+        if (found && xd_type == VertexType::Diffuse && next_type == VertexType::Diffuse) {
           st.target =
               shift::reconnection_base(base.hit.position, next.position, next.geometric_normal);
           st.base_front = dot(base.hit.position - next.position, next.geometric_normal) > 0;
         }
       }
-      for (Offset& o : std::span(off, kOffsets)) {
-        if (open == 0) break;
-        if (!o.active || !o.alive || o.link == Link::Connected) continue;
+      for (unsigned m = open_mask; m != 0; m &= m - 1) {
+        Offset& o = off[std::countr_zero(m)];
         if (!lobe_drawn && delta && o.link == Link::NotConnected &&
             o.v.closures->uses_lobe_choice()) {
           st.u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
@@ -785,9 +813,8 @@ class GradientPathTracer final : public Integrator {
                 : pl;
         const Vec3d cb = base_lit ? mul(mul(fb, seg_b), lh.radiance) : Vec3d();
         if (base_lit) emit_merged = connected_event(mul(seg_b, lh.radiance), pdf_b, pl_mis, pdf_b);
-        for (Offset& o : std::span(off, kOffsets)) {
-          if (open == 0) break;
-          if (!o.active || !o.alive || o.link == Link::Connected) continue;
+        for (unsigned m = open_mask; m != 0; m &= m - 1) {
+          Offset& o = off[std::countr_zero(m)];
           // Without a lit base only a half-vector offset's own ray can find a light.
           if (!base_lit && o.shift != Shift::HalfVector) continue;
           Vec3d co;
@@ -833,7 +860,7 @@ class GradientPathTracer final : public Integrator {
             if (!delta && !is_black(le)) pl = lights.pdf_environment(ray.direction);
           }
         } else {
-          le = triangle_emission(ctx_, next, base.hit.position);
+          le = triangle_le(next, base.hit.position);
           if (!delta && !is_black(le))
             pl = lights.pdf_triangle(next.instance, next.primitive, base.hit.position,
                                      next.position, next.geometric_normal);
@@ -843,9 +870,8 @@ class GradientPathTracer final : public Integrator {
         const Vec3d cb = mul(mul(fb, seg_b), le);
         if (base_emits)
           emit_merged = emit_merged + connected_event(mul(seg_b, le), pdf_b, pl, pdf_b);
-        for (Offset& o : std::span(off, kOffsets)) {
-          if (open == 0) break;
-          if (!o.active || !o.alive || o.link == Link::Connected) continue;
+        for (unsigned m = open_mask; m != 0; m &= m - 1) {
+          Offset& o = off[std::countr_zero(m)];
           // Without emission at the base's end point only a half-vector offset's own end point
           // can have some (the other shifts end at the same point, seen from the same side).
           if (!base_emits && o.shift != Shift::HalfVector) continue;
@@ -871,7 +897,7 @@ class GradientPathTracer final : public Integrator {
           o.f = mul(o.f, seg_b);
           o.p *= pdf_b;
         } else {
-          advance(o, next_base);
+          advance(o, last);
         }
       }
       if (!found) break;
@@ -1057,6 +1083,11 @@ class GradientPathTracer final : public Integrator {
     }
   }
 
+  // Emission of an emissive triangle at `hit` towards `from`; none without emissive triangles.
+  Spectrum triangle_le(const SurfaceHit& hit, Vec3f from) const {
+    return has_emissive_ ? triangle_emission(ctx_, hit, from) : Spectrum(0.0f);
+  }
+
   float next_vertex_roughness(const SurfaceHit& h) const {
     const MaterialSide& side = sides_[2 * size_t(h.material) + (h.front_facing ? 1 : 0)];
     if (side.set) return side.roughness;
@@ -1124,7 +1155,7 @@ class GradientPathTracer final : public Integrator {
       case Shift::Reconnect: {
         // Same end point, reached from y_d. Occlusion zeroes the contribution and the BSDF
         // density, but light sampling from y_d could still have produced the path.
-        const Spectrum le_o = triangle_emission(ctx_, next, o.v.hit.position);
+        const Spectrum le_o = triangle_le(next, o.v.hit.position);
         const float pl_o =
             pl_pair > 0.0f ? lights.pdf_triangle(next.instance, next.primitive, o.v.hit.position,
                                                  next.position, next.geometric_normal)
@@ -1146,7 +1177,7 @@ class GradientPathTracer final : public Integrator {
           if (has_world_) le_o = lights.environment(o.ray.direction);
           if (nee_on && !is_black(le_o)) pl_o = lights.pdf_environment(o.ray.direction);
         } else {
-          le_o = triangle_emission(ctx_, o.next_hit, o.v.hit.position);
+          le_o = triangle_le(o.next_hit, o.v.hit.position);
           if (nee_on && !is_black(le_o))
             pl_o = lights.pdf_triangle(o.next_hit.instance, o.next_hit.primitive, o.v.hit.position,
                                        o.next_hit.position, o.next_hit.geometric_normal);
@@ -1160,8 +1191,8 @@ class GradientPathTracer final : public Integrator {
     }
   }
 
-  // Moves the offset to the end of the segment.
-  void advance(Offset& o, const Vertex& next_base) const {
+  // Moves the offset to the end of the segment (`last`: the path ends there, no vertex needed).
+  void advance(Offset& o, bool last) const {
     auto kill = [&] {
       o.alive = false;
       o.failed = true;
@@ -1183,12 +1214,11 @@ class GradientPathTracer final : public Integrator {
         break;
       case Shift::HalfVector:
         if (o.killed) return kill();
-        if (o.next_found) setup_vertex(ctx_, sides_, o.next_hit, o.ray.direction, o.v);
+        if (o.next_found && !last) setup_vertex(ctx_, sides_, o.next_hit, o.ray.direction, o.v);
         break;
       case Shift::Failed:
         return kill();
     }
-    (void)next_base;
     o.f = mul(o.f, o.seg_value) * o.seg_jacobian;
     o.p *= o.seg_pdf * o.seg_jacobian;
   }
@@ -1198,6 +1228,7 @@ class GradientPathTracer final : public Integrator {
   bool has_world_ = false;
   bool has_visible_lamps_ = false;
   bool has_dof_ = false;
+  bool has_emissive_ = false;
   std::vector<MaterialSide> sides_;
 };
 
