@@ -18,6 +18,7 @@
 
 #include "reconstruct/huge_pages.h"
 #include "reconstruct/parallel.h"
+#include "reconstruct/real_fft_dct.h"
 
 namespace gdpt::detail {
 
@@ -170,9 +171,12 @@ namespace {
 // `width`, and blocks of kColumnBlock contiguous columns of `height`.
 constexpr int kColumnBlock = 8;
 
+// Row and column-block DCTs through real FFTs (real_fft_dct.h): about half the time of FFTW's
+// REDFT10 / REDFT01 plans of the same lines.
 struct LinePlans {
-  fftw_plan row_forward = nullptr, row_inverse = nullptr;
-  fftw_plan column_forward = nullptr, column_inverse = nullptr;
+  RealFftDct row, column;
+  LinePlans(int width, int height, unsigned flags)
+      : row(width, 1, flags), column(height, kColumnBlock, flags) {}
 };
 
 std::map<std::tuple<int, int, bool>, LinePlans> g_line_plans;
@@ -191,38 +195,16 @@ const LinePlans& line_plans_for(int width, int height, bool measure) {
     g_wisdom_loaded = true;
   }
   fftw_plan_with_nthreads(1);
-  const unsigned flags = measure ? FFTW_MEASURE : FFTW_ESTIMATE;
-  auto* scratch =
-      static_cast<double*>(fftw_malloc(sizeof(double) * std::max(width, kColumnBlock * height)));
-  if (!scratch) throw std::bad_alloc();
-  LinePlans p;
-  p.row_forward = fftw_plan_r2r_1d(width, scratch, scratch, FFTW_REDFT10, flags);
-  p.row_inverse = fftw_plan_r2r_1d(width, scratch, scratch, FFTW_REDFT01, flags);
-  const fftw_r2r_kind k10 = FFTW_REDFT10, k01 = FFTW_REDFT01;
-  p.column_forward = fftw_plan_many_r2r(1, &height, kColumnBlock, scratch, nullptr, 1, height,
-                                        scratch, nullptr, 1, height, &k10, flags);
-  p.column_inverse = fftw_plan_many_r2r(1, &height, kColumnBlock, scratch, nullptr, 1, height,
-                                        scratch, nullptr, 1, height, &k01, flags);
-  fftw_free(scratch);
-  if (!p.row_forward || !p.row_inverse || !p.column_forward || !p.column_inverse)
-    throw std::runtime_error("FFTW could not create a DCT plan");
+  const LinePlans& p =
+      g_line_plans.try_emplace(key, width, height, measure ? FFTW_MEASURE : FFTW_ESTIMATE)
+          .first->second;
   if (measure && !wisdom.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(std::filesystem::path(wisdom).parent_path(), ec);
     fftw_export_wisdom_to_filename(wisdom.c_str());
   }
-  return g_line_plans.emplace(key, p).first->second;
+  return p;
 }
-
-struct FftwLine {
-  double* p;
-  explicit FftwLine(size_t n) : p(static_cast<double*>(fftw_malloc(sizeof(double) * n))) {
-    if (!p) throw std::bad_alloc();
-  }
-  ~FftwLine() { fftw_free(p); }
-  FftwLine(const FftwLine&) = delete;
-  FftwLine& operator=(const FftwLine&) = delete;
-};
 
 }  // namespace
 
@@ -237,8 +219,8 @@ bool solve_l2_dct_rows(int width, int height, double alpha, const float* primal,
   // --- Pass 1, per row: the right-hand side b, the finiteness check of every input, and the
   // forward DCT along the row, into the planes.
   const auto bad = parallel_rows_sum<1>(height, [&](int y0, int y1, std::array<double, 1>& s) {
-    std::vector<double> b(static_cast<size_t>(n));
-    const FftwLine line(width);
+    std::vector<double> b(static_cast<size_t>(n)), line(static_cast<size_t>(width));
+    RealFftDct::Work work(plans.row);
     uint32_t flags = 0;
     for (int y = y0; y < y1; ++y) {
       const size_t row = size_t(y) * width;
@@ -254,9 +236,9 @@ bool solve_l2_dct_rows(int width, int height, double alpha, const float* primal,
       else
         rhs_row<false, false>(width, alpha2, p, gx, gy, below, b.data());
       for (int c = 0; c < 3; ++c) {
-        for (int x = 0; x < width; ++x) line.p[x] = b[3 * x + c];
-        fftw_execute_r2r(plans.row_forward, line.p, line.p);
-        std::memcpy(planes + c * plane + row, line.p, sizeof(double) * width);
+        for (int x = 0; x < width; ++x) line[size_t(x)] = b[3 * x + c];
+        plans.row.forward(line.data(), work);
+        std::memcpy(planes + c * plane + row, line.data(), sizeof(double) * width);
       }
     }
     s[0] += flags;
@@ -274,20 +256,21 @@ bool solve_l2_dct_rows(int width, int height, double alpha, const float* primal,
   const size_t block_values = size_t(kColumnBlock) * height;
   tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 1), [&](const tbb::blocked_range<int>& r) {
     const FlushDenormals ftz;
-    const FftwLine cols(3 * block_values);
+    std::vector<double> cols(3 * block_values);
+    RealFftDct::Work work(plans.column);
     for (int blk = r.begin(); blk != r.end(); ++blk) {
       const int x0 = blk * kColumnBlock, m = std::min(kColumnBlock, width - x0);
       for (int c = 0; c < 3; ++c) {
-        double* col = cols.p + c * block_values;
+        double* col = cols.data() + c * block_values;
         for (int y = 0; y < height; ++y) {
           const double* src = planes + c * plane + size_t(y) * width + x0;
           for (int j = 0; j < m; ++j) col[j * height + y] = src[j];
         }
         for (int j = m; j < kColumnBlock; ++j) std::fill_n(col + j * height, height, 0.0);
-        fftw_execute_r2r(plans.column_forward, col, col);
+        plans.column.forward(col, work);
       }
       for (int j = 0; j < m; ++j) {
-        double* c0 = cols.p + j * height;
+        double* c0 = cols.data() + j * height;
         double* c1 = c0 + block_values;
         double* c2 = c1 + block_values;
         const double lx = lambda_x[x0 + j];
@@ -299,8 +282,8 @@ bool solve_l2_dct_rows(int width, int height, double alpha, const float* primal,
         }
       }
       for (int c = 0; c < 3; ++c) {
-        double* col = cols.p + c * block_values;
-        fftw_execute_r2r(plans.column_inverse, col, col);
+        double* col = cols.data() + c * block_values;
+        plans.column.inverse(col, work);
         for (int y = 0; y < height; ++y) {
           double* dst = planes + c * plane + size_t(y) * width + x0;
           for (int j = 0; j < m; ++j) dst[j] = col[j * height + y];
@@ -311,13 +294,14 @@ bool solve_l2_dct_rows(int width, int height, double alpha, const float* primal,
 
   // --- Pass 3, per row: inverse DCT along the row, handed to the sink.
   parallel_rows(height, [&](int y0, int y1) {
-    const FftwLine lines(3 * size_t(width));
-    const double* rows[3] = {lines.p, lines.p + width, lines.p + 2 * width};
+    std::vector<double> lines(3 * size_t(width));
+    RealFftDct::Work work(plans.row);
+    const double* rows[3] = {lines.data(), lines.data() + width, lines.data() + 2 * width};
     for (int y = y0; y < y1; ++y) {
       for (int c = 0; c < 3; ++c) {
-        double* line = lines.p + c * width;
+        double* line = lines.data() + c * width;
         std::memcpy(line, planes + c * plane + size_t(y) * width, sizeof(double) * width);
-        fftw_execute_r2r(plans.row_inverse, line, line);
+        plans.row.inverse(line, work);
       }
       sink(y, rows);
     }

@@ -8,10 +8,10 @@
 // dy. The solve runs in double precision: with alpha -> 1e-4 the DC term is alpha^2 * sum(primal)
 // next to O(1) divergence values, which float cannot hold.
 //
-// FFTW plans (REDFT10 forward, REDFT01 inverse: single-threaded 1-D plans for the solve, 2-D
-// plans for the benchmark's reference) are created once per (size[, threads], effort) and cached
-// for the life of the process; FFTW_MEASURE plans also load and save FFTW wisdom in
-// $XDG_CACHE_HOME/gdpt/fftw-wisdom (or ~/.cache/gdpt/fftw-wisdom).
+// FFTW plans (for the solve: single-threaded 1-D real DFTs behind real_fft_dct.h's DCTs; for
+// the benchmark's reference: 2-D REDFT10 / REDFT01) are created once per (size[, threads],
+// effort) and cached for the life of the process; FFTW_MEASURE plans also load and save FFTW wisdom
+// in $XDG_CACHE_HOME/gdpt/fftw-wisdom (or ~/.cache/gdpt/fftw-wisdom).
 #pragma once
 
 #include <cstddef>
@@ -51,8 +51,8 @@ class CachedDctBuffer {
 // any input value (including the ignored last column of dx and last row of dy) is not finite: the
 // finiteness check is part of the pass that forms the right-hand side.
 //
-// The 2-D transforms are done as 1-D FFTW transforms inside three passes over memory, run in the
-// caller's TBB arena (fixed blocks: the result does not depend on the thread count):
+// The 2-D transforms are done as 1-D DCTs (real_fft_dct.h) inside three passes over memory, run in
+// the caller's TBB arena (fixed blocks: the result does not depend on the thread count):
 //   1. per row: b, the finiteness check, forward DCT along the row;
 //   2. per block of 8 columns: forward DCT along the columns, division by the eigenvalues,
 //      inverse DCT along the columns;
