@@ -81,6 +81,31 @@ std::map<std::tuple<int, int, int, bool>, PlanPair> g_plans;
 bool g_threads_initialised = false;
 bool g_wisdom_loaded = false;
 
+// Planner set-up shared by both plan caches (caller holds g_plan_mutex): FFTW's threads
+// initialised once, wisdom loaded before the first measured plan; returns the planner flags.
+unsigned begin_planning(bool measure, int threads) {
+  if (!g_threads_initialised) {
+    fftw_init_threads();
+    g_threads_initialised = true;
+  }
+  const std::string wisdom = fftw_wisdom_path();
+  if (measure && !g_wisdom_loaded && !wisdom.empty()) {
+    fftw_import_wisdom_from_filename(wisdom.c_str());  // a missing file is not an error
+    g_wisdom_loaded = true;
+  }
+  fftw_plan_with_nthreads(threads);
+  return measure ? FFTW_MEASURE : FFTW_ESTIMATE;
+}
+
+// After measured planning: save the wisdom (best effort: a read-only home is fine).
+void end_planning(bool measure) {
+  const std::string wisdom = fftw_wisdom_path();
+  if (!measure || wisdom.empty()) return;
+  std::error_code ec;
+  std::filesystem::create_directories(std::filesystem::path(wisdom).parent_path(), ec);
+  fftw_export_wisdom_to_filename(wisdom.c_str());
+}
+
 fftw_plan make_plan(int width, int height, fftw_r2r_kind kind, double* buffer, unsigned flags) {
   const int n[2] = {height, width};
   const fftw_r2r_kind kinds[2] = {kind, kind};
@@ -94,29 +119,15 @@ const PlanPair& plans_for(int width, int height, int threads, bool measure) {
   const auto key = std::make_tuple(width, height, threads, measure);
   if (auto it = g_plans.find(key); it != g_plans.end()) return it->second;
 
-  if (!g_threads_initialised) {
-    fftw_init_threads();
-    g_threads_initialised = true;
-  }
-  const std::string wisdom = fftw_wisdom_path();
-  if (measure && !g_wisdom_loaded && !wisdom.empty()) {
-    fftw_import_wisdom_from_filename(wisdom.c_str());  // a missing file is not an error
-    g_wisdom_loaded = true;
-  }
-  fftw_plan_with_nthreads(threads);
+  const unsigned flags = begin_planning(measure, threads);
   // FFTW_MEASURE overwrites the buffer while planning: plan on scratch memory. Execution later
   // uses other fftw_malloc buffers, which have the same alignment.
   DctBuffer scratch = dct_alloc(size_t(3) * width * height);
-  const unsigned flags = measure ? FFTW_MEASURE : FFTW_ESTIMATE;
   PlanPair pair;
   pair.forward = make_plan(width, height, FFTW_REDFT10, scratch.get(), flags);
   pair.inverse = make_plan(width, height, FFTW_REDFT01, scratch.get(), flags);
   if (!pair.forward || !pair.inverse) throw std::runtime_error("FFTW could not create a DCT plan");
-  if (measure && !wisdom.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(std::filesystem::path(wisdom).parent_path(), ec);
-    fftw_export_wisdom_to_filename(wisdom.c_str());  // best effort: a read-only home is fine
-  }
+  end_planning(measure);
   return g_plans.emplace(key, pair).first->second;
 }
 
@@ -185,24 +196,9 @@ const LinePlans& line_plans_for(int width, int height, bool measure) {
   std::lock_guard lock(g_plan_mutex);
   const auto key = std::make_tuple(width, height, measure);
   if (auto it = g_line_plans.find(key); it != g_line_plans.end()) return it->second;
-  if (!g_threads_initialised) {
-    fftw_init_threads();
-    g_threads_initialised = true;
-  }
-  const std::string wisdom = fftw_wisdom_path();
-  if (measure && !g_wisdom_loaded && !wisdom.empty()) {
-    fftw_import_wisdom_from_filename(wisdom.c_str());
-    g_wisdom_loaded = true;
-  }
-  fftw_plan_with_nthreads(1);
-  const LinePlans& p =
-      g_line_plans.try_emplace(key, width, height, measure ? FFTW_MEASURE : FFTW_ESTIMATE)
-          .first->second;
-  if (measure && !wisdom.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(std::filesystem::path(wisdom).parent_path(), ec);
-    fftw_export_wisdom_to_filename(wisdom.c_str());
-  }
+  const unsigned flags = begin_planning(measure, 1);
+  const LinePlans& p = g_line_plans.try_emplace(key, width, height, flags).first->second;
+  end_planning(measure);
   return p;
 }
 
