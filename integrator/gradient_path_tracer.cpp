@@ -22,6 +22,7 @@
 #include "integrator/features.h"
 #include "integrator/math/frame.h"
 #include "integrator/path_tracer.h"
+#include "integrator/russian_roulette.h"
 #include "integrator/sampler.h"
 #include "integrator/scene_context.h"
 #include "integrator/shift_mapping.h"
@@ -725,11 +726,13 @@ class GradientPathTracer final : public Integrator {
       beta *= bs.value / bs.pdf;
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
       if (bounce >= settings_.rr_depth) {
-        const float q = std::min(max_component(beta), 0.95f);
-        if (!(sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kRoulette)) < q)) break;
-        beta /= q;
-        pb *= q;
-        for (Offset& o : std::span(off, kOffsets)) o.p *= q;
+        const float q = roulette_continuation(beta);
+        if (q < 1.0f) {
+          if (!(sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kRoulette)) < q)) break;
+          beta /= q;
+          pb *= q;
+          for (Offset& o : std::span(off, kOffsets)) o.p *= q;
+        }
       }
 
       // --- Trace the base's next segment ---

@@ -7,6 +7,7 @@
 
 #include "integrator/features.h"
 #include "integrator/math/frame.h"
+#include "integrator/russian_roulette.h"
 #include "integrator/sampler.h"
 #include "integrator/scene_context.h"
 #include "shaders/shading_context.h"
@@ -281,9 +282,11 @@ class PathTracer final : public Integrator {
 
       // --- Russian roulette (real bounces only) ---
       if (!crossing && bounce - 1 >= settings_.rr_depth) {
-        const float q = std::min(max_component(beta), 0.95f);
-        if (!(sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kRoulette)) < q)) break;
-        beta /= q;
+        const float q = roulette_continuation(beta);
+        if (q < 1.0f) {
+          if (!(sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kRoulette)) < q)) break;
+          beta /= q;
+        }
       }
 
       ray.origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);

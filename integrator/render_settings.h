@@ -13,7 +13,7 @@ struct RenderSettings {
   uint32_t seed = 0;
   int threads = 0;                           // 0 = all cores
   float clamp = 0.0f;                        // max sample value, 0 = off
-  int rr_depth = 5;                          // Russian roulette from this depth on
+  int rr_depth = 3;                          // Russian roulette from this vertex on
   float shift_roughness_threshold = 0.001f;  // G-PT: GGX alpha below this = specular vertex
   int samples_per_pass = 1;  // progressive granularity (a pass = this many spp over the image)
   // Debug / benchmark: run the kernel with every feature path on (same image, slower), to measure

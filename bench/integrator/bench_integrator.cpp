@@ -15,8 +15,9 @@
 //     bench_integrator 0 cornell
 // gives instructions per sample = callgrind's total / the printed sample count; it also prints the
 // mean per-pixel variance and an image checksum (equal checksums: a bit-identical image).
-// GDPT_BENCH_THREADS (default 1) and GDPT_BENCH_SEED set the thread count and seed, and
-// GDPT_BENCH_REFERENCE=PREFIX compares the image with PREFIX.<case>.f32 (luminance MSE), or writes
+// GDPT_BENCH_THREADS (default 1), GDPT_BENCH_SEED and GDPT_BENCH_RR_DEPTH set the thread count,
+// seed and roulette depth, and GDPT_BENCH_REFERENCE=PREFIX compares the image with
+// PREFIX.<case>.f32 (luminance MSE and relMSE), or writes
 // that file when it is missing: e.g. a 4096-spp reference, then MSE at 16 spp over a few seeds,
 // for error-at-equal-cost comparisons of sampling techniques.
 #include <atomic>
@@ -399,6 +400,7 @@ int main(int argc, char** argv) {
       st.max_bounces = name == "blender" ? 4 : 8;
       st.threads = env_int("GDPT_BENCH_THREADS", 1);
       st.seed = uint32_t(env_int("GDPT_BENCH_SEED", int(st.seed)));
+      st.rr_depth = env_int("GDPT_BENCH_RR_DEPTH", st.rr_depth);
       RenderSession session(scene, st);
       std::atomic<bool> cancel{false};
       session.render(nullptr, cancel);
@@ -436,14 +438,19 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "%s: wrong size\n", path.c_str());
             return 1;
           }
-          double mse = 0.0;
+          double mse = 0.0, rel_mse = 0.0;
           for (size_t i = 0; i < primal.size(); i += 3) {
             const double d = luminance(Spectrum(primal[i], primal[i + 1], primal[i + 2])) -
                              luminance(Spectrum(ref[i], ref[i + 1], ref[i + 2]));
             mse += d * d;
+            for (size_t k = i; k < i + 3; ++k)
+              rel_mse += double(primal[k] - ref[k]) * double(primal[k] - ref[k]) /
+                         (double(ref[k]) * double(ref[k]) + 0.01);
           }
-          std::printf("%s: luminance MSE against %s: %.6g\n", c, path.c_str(),
-                      mse / double(primal.size() / 3));
+          // relMSE as bench_equal_time and the Blender benchmark define it: it weighs dark
+          // pixels (indirect light) as much as bright ones, which the luminance MSE does not.
+          std::printf("%s: luminance MSE against %s: %.6g, relMSE %.6g\n", c, path.c_str(),
+                      mse / double(primal.size() / 3), rel_mse / double(primal.size()));
         } else if (FILE* out = std::fopen(path.c_str(), "wb")) {
           std::fwrite(primal.data(), sizeof(float), primal.size(), out);
           std::fclose(out);

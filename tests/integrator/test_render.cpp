@@ -495,6 +495,53 @@ TEST(Render, MaxBouncesFollowsCycles) {
   }
 }
 
+// Russian roulette (q = min(sqrt(max throughput), 1)) keeps the estimate unbiased while it ends
+// paths early: the scene of MaxBouncesFollowsCycles with 64 bounces converges to the series
+// a Le / (1 - a b) = 2/3 whether roulette starts at the first vertex, at the default vertex (3)
+// or never; starting at the first vertex traces far fewer rays.
+TEST(Render, RussianRouletteIsUnbiasedAndShortensPaths) {
+  Scene scene;
+  scene.meshes.push_back(quad(400.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  MaterialDesc ceiling = emission(Spectrum(1.0f), 1.0f);
+  ShaderNode d;
+  d.kind = ShaderNodeKind::Diffuse;
+  d.color = ColorInput(Spectrum(0.5f));
+  ceiling.nodes.push_back(d);
+  ShaderNode add;
+  add.kind = ShaderNodeKind::Add;
+  add.a = 0;
+  add.b = 1;
+  ceiling.nodes.push_back(add);
+  ceiling.root = 2;
+  scene.materials.push_back(ceiling);
+  scene.instances.push_back(place(0, 0));
+  scene.instances.push_back(place(0, 1, rotation_x(kPi, {0, 0, 1})));
+  scene.world.color = Spectrum(0.0f);
+  scene.camera = top_camera(8, 0.5f, 0.5f);
+  const double expect = 0.5 / (1.0 - 0.25);
+  uint64_t rays[3] = {};
+  const int depths[3] = {0, RenderSettings{}.rr_depth, 64};
+  for (int i = 0; i < 3; ++i) {
+    RenderSettings s = pt(256);
+    s.max_bounces = 64;
+    s.rr_depth = depths[i];
+    RenderSession session(scene, s);
+    std::atomic<bool> cancel{false};
+    session.render(nullptr, cancel);
+    std::vector<float> primal(session.film().pixel_count() * 3);
+    session.film().primal_rgb(primal.data());
+    double sum = 0.0;
+    for (float v : primal) sum += v;
+    EXPECT_NEAR(sum / primal.size(), expect, 0.01 * expect) << "rr_depth " << depths[i];
+    rays[i] = session.rays_traced();
+  }
+  // Without roulette a path bounces until max_bounces (~130 rays); from the first vertex on,
+  // survival falls geometrically.
+  EXPECT_LT(double(rays[0]), 0.2 * double(rays[2]));
+  EXPECT_LT(rays[1], rays[2]);
+}
+
 // Thin lens: emissive stripes on the focus plane render as with a pinhole; moving the focus away
 // blurs them (the gradient energy of the stripes' edges drops; total variation would not).
 TEST(Render, DepthOfFieldFocusesOnTheFocusPlane) {
