@@ -16,6 +16,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -264,10 +265,44 @@ struct CameraRow {
   SurfaceHit cam_hit[kOffsets * kRow];
 };
 
+// Camera rays of a tile without depth of field: one jitter per sample index for the whole image,
+// so the offset of pixel p towards a neighbour q (same jitter, q's pixel) is exactly q's base
+// camera ray. The tile's rays and a one-pixel halo around it (the neighbours of its border pixels,
+// clipped to the image; the halo's corners are no one's neighbour) are traced once per sample and
+// every offset reads its neighbour's hit: ~1.3 camera rays per base path instead of 5.
+struct CameraGrid {
+  int x0 = 0, y0 = 0, w = 0, h = 0;  // the traced rectangle
+  std::vector<Ray> ray;
+  std::vector<SurfaceHit> hit;
+  std::unique_ptr<bool[]> valid, found;  // not vector<bool>: intersect_stream takes bool arrays
+  size_t capacity = 0;
+  void reserve(size_t n) {
+    if (n <= capacity) return;
+    ray.resize(n);
+    hit.resize(n);
+    valid.reset(new bool[n]);
+    found.reset(new bool[n]);
+    capacity = n;
+  }
+  int index(int x, int y) const { return (y - y0) * w + (x - x0); }
+};
+
+// What trace() needs of one base path's camera rays, wherever render_tile() traced them.
+struct CameraSample {
+  const Ray* ray;
+  const SurfaceHit* hit;
+  bool found;
+  const bool* mask;  // offsets whose target pixel is inside the image
+  const Ray* off_ray[kOffsets];
+  const SurfaceHit* off_hit[kOffsets];
+  bool off_found[kOffsets];
+};
+
 struct PathScratch {
   Offset off[kOffsets];
   Vertex verts[2];  // base vertex and the next one, swapped per bounce
   CameraRow row;
+  CameraGrid grid;
   LightSample lo[kOffsets];
   Vec3f wo_o[kOffsets];
   Spectrum fo[kOffsets];
@@ -306,65 +341,112 @@ class GradientPathTracer final : public Integrator {
       const double l = 0.2126 * g.x + 0.7152 * g.y + 0.0722 * g.z;
       sum2 += l * l;
     };
-    CameraRow& row = scratch.row;
     SampleResult r;
-    const bool has_dof = has_dof_;
-    for (uint32_t s = first_sample; s < first_sample + sample_count; ++s)
-      for (int y = tile.y0; y < tile.y1; ++y)
-        for (int x0 = tile.x0; x0 < tile.x1; x0 += kRow) {
-          const int n = std::min(kRow, tile.x1 - x0);
-          // --- Camera rays of the row: same jitter and lens sample for a base and its offsets ---
-          for (int i = 0; i < kRow; ++i) {
-            row.valid[i] = i < n;
-            if (!row.valid[i]) continue;
-            const int x = x0 + i;
-            row.sampler[i].start(settings_.seed, x, y, s);
-            const Vec2f jitter = row.sampler[i].get2d(Sampler::kDimCamera);
-            row.lens[i] = has_dof ? row.sampler[i].get2d(Sampler::kDimLens) : Vec2f(0.5f, 0.5f);
-            row.raster[i] = Vec2f(float(x) + jitter.x, float(y) + jitter.y);
-            row.ray[i] = ctx_.camera().generate_ray(row.raster[i], row.lens[i]);
-          }
-          ctx_.bvh().intersect_stream(row.ray, row.valid, kRow, row.found, row.hit);
-          for (int i = 0; i < kRow; ++i) {
-            const int x = x0 + i;
-            // Every offset whose target pixel is inside the image: the pixel's own halves of
-            // dx(x), dy(x), dx(x - 1) and dy(y - 1) (the latter two combined at read-out).
-            bool* mask = row.mask[i];
-            mask[kRight] = x + 1 < W;
-            mask[kUp] = y + 1 < H;
-            mask[kLeft] = x >= 1;
-            mask[kDown] = y >= 1;
-            const bool traced = row.valid[i] && row.found[i];
-            Ray* cam = row.cam_pixel;
-            if (traced) ctx_.camera().generate_offset_rays(row.raster[i], row.lens[i], mask, cam);
+    // Runs pixel (x, y)'s base path and adds it to the film.
+    auto run_path = [&](const Sampler& sampler, const CameraSample& cs, int x, int y) {
+      // The pixel's accumulator (4 cache lines) is read after the path: fetch it now.
+      const char* acc_bytes = reinterpret_cast<const char*>(&film.pixel(x, y));
+      for (size_t b = 0; b < sizeof(Film::Accumulator); b += 64)
+        __builtin_prefetch(acc_bytes + b, 1);
+      trace(sampler, cs, scratch, r);
+      rays += r.rays;
+      // --- Primal, emission and statistics of the pixel's base path ---
+      Film::Accumulator& acc = film.pixel(x, y);
+      acc.add_path(r.primal, r.emission, clamp);
+      acc.shift_attempts += r.attempts;
+      acc.shift_failures += r.failures;
+      // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
+      const bool* mask = cs.mask;
+      if (mask[kRight]) add_half(r.grad[kRight], acc.dx, acc.dx2);
+      if (mask[kUp]) add_half(r.grad[kUp], acc.dy, acc.dy2);
+      if (mask[kLeft]) add_half(r.grad[kLeft], acc.dx_left, acc.dx_left2);
+      if (mask[kDown]) add_half(r.grad[kDown], acc.dy_down, acc.dy_down2);
+    };
+    // Every offset whose target pixel is inside the image: the pixel's own halves of dx(x),
+    // dy(x), dx(x - 1) and dy(y - 1) (the latter two combined at read-out).
+    auto offset_mask = [W, H](int x, int y, bool* mask) {
+      mask[kRight] = x + 1 < W;
+      mask[kUp] = y + 1 < H;
+      mask[kLeft] = x >= 1;
+      mask[kDown] = y >= 1;
+    };
+    constexpr int kStepX[kOffsets] = {1, 0, -1, 0}, kStepY[kOffsets] = {0, 1, 0, -1};
+    static_assert(kRight == 0 && kUp == 1 && kLeft == 2 && kDown == 3);
+    CameraSample cs;
+    if (!has_dof_) {
+      CameraGrid& g = scratch.grid;
+      for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
+        rays += trace_camera_grid(tile, W, H, s, g);
+        bool mask[kOffsets];
+        cs.mask = mask;
+        for (int y = tile.y0; y < tile.y1; ++y)
+          for (int x = tile.x0; x < tile.x1; ++x) {
+            Sampler sampler;
+            sampler.start(settings_.seed, x, y, s);
+            offset_mask(x, y, mask);
+            const int c = g.index(x, y);
+            cs.ray = &g.ray[c];
+            cs.hit = &g.hit[c];
+            cs.found = g.found[c];
             for (int k = 0; k < kOffsets; ++k) {
-              row.cam_valid[k * kRow + i] = traced && mask[k];
-              if (row.cam_valid[k * kRow + i]) row.cam[k * kRow + i] = cam[k];
+              if (!mask[k]) continue;
+              const int n = g.index(x + kStepX[k], y + kStepY[k]);
+              cs.off_ray[k] = &g.ray[n];
+              cs.off_hit[k] = &g.hit[n];
+              cs.off_found[k] = g.found[n];
+            }
+            run_path(sampler, cs, x, y);
+          }
+      }
+    } else {
+      // Depth of field: every pixel keeps its own jitter and lens sample, so each offset traces
+      // its own camera ray (through the neighbour, with the base's jitter and lens sample).
+      CameraRow& row = scratch.row;
+      for (uint32_t s = first_sample; s < first_sample + sample_count; ++s)
+        for (int y = tile.y0; y < tile.y1; ++y)
+          for (int x0 = tile.x0; x0 < tile.x1; x0 += kRow) {
+            const int n = std::min(kRow, tile.x1 - x0);
+            // --- Camera rays of the row: same jitter and lens sample for a base and its offsets
+            for (int i = 0; i < kRow; ++i) {
+              row.valid[i] = i < n;
+              if (!row.valid[i]) continue;
+              const int x = x0 + i;
+              row.sampler[i].start(settings_.seed, x, y, s);
+              const Vec2f jitter = row.sampler[i].get2d(Sampler::kDimCamera);
+              row.lens[i] = row.sampler[i].get2d(Sampler::kDimLens);
+              row.raster[i] = Vec2f(float(x) + jitter.x, float(y) + jitter.y);
+              row.ray[i] = ctx_.camera().generate_ray(row.raster[i], row.lens[i]);
+            }
+            ctx_.bvh().intersect_stream(row.ray, row.valid, kRow, row.found, row.hit);
+            for (int i = 0; i < kRow; ++i) {
+              bool* mask = row.mask[i];
+              offset_mask(x0 + i, y, mask);
+              const bool traced = row.valid[i] && row.found[i];
+              Ray* cam = row.cam_pixel;
+              if (traced) ctx_.camera().generate_offset_rays(row.raster[i], row.lens[i], mask, cam);
+              for (int k = 0; k < kOffsets; ++k) {
+                row.cam_valid[k * kRow + i] = traced && mask[k];
+                if (row.cam_valid[k * kRow + i]) row.cam[k * kRow + i] = cam[k];
+              }
+            }
+            ctx_.bvh().intersect_stream(row.cam, row.cam_valid, kOffsets * kRow, row.cam_found,
+                                        row.cam_hit);
+            for (int i = 0; i < n; ++i) {
+              rays += 1;  // the base camera ray
+              cs.mask = row.mask[i];
+              cs.ray = &row.ray[i];
+              cs.hit = &row.hit[i];
+              cs.found = row.found[i];
+              for (int k = 0; k < kOffsets; ++k) {
+                cs.off_ray[k] = &row.cam[k * kRow + i];
+                cs.off_hit[k] = &row.cam_hit[k * kRow + i];
+                cs.off_found[k] = row.cam_found[k * kRow + i];
+                rays += row.cam_valid[k * kRow + i];
+              }
+              run_path(row.sampler[i], cs, x0 + i, y);
             }
           }
-          ctx_.bvh().intersect_stream(row.cam, row.cam_valid, kOffsets * kRow, row.cam_found,
-                                      row.cam_hit);
-          for (int i = 0; i < n; ++i) {
-            const int x = x0 + i;
-            const bool* mask = row.mask[i];
-            // The pixel's accumulator (4 cache lines) is read after the path: fetch it now.
-            const char* acc_bytes = reinterpret_cast<const char*>(&film.pixel(x, y));
-            for (size_t b = 0; b < sizeof(Film::Accumulator); b += 64)
-              __builtin_prefetch(acc_bytes + b, 1);
-            trace(row.sampler[i], i, scratch, r);
-            rays += r.rays;
-            // --- Primal, emission and statistics of the pixel's base path ---
-            Film::Accumulator& acc = film.pixel(x, y);
-            acc.add_path(r.primal, r.emission, clamp);
-            acc.shift_attempts += r.attempts;
-            acc.shift_failures += r.failures;
-            // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
-            if (mask[kRight]) add_half(r.grad[kRight], acc.dx, acc.dx2);
-            if (mask[kUp]) add_half(r.grad[kUp], acc.dy, acc.dy2);
-            if (mask[kLeft]) add_half(r.grad[kLeft], acc.dx_left, acc.dx_left2);
-            if (mask[kDown]) add_half(r.grad[kDown], acc.dy_down, acc.dy_down2);
-          }
-        }
+    }
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x) film.add_sample_count(x, y, sample_count);
     count_rays(rays);
@@ -480,25 +562,56 @@ class GradientPathTracer final : public Integrator {
     return out.valid && length_squared(out.position - ls.position) < 1e-8f * scale * scale;
   }
 
-  // Traces pixel `i` of scratch.row, whose camera rays render_tile() has traced.
-  void trace(const Sampler& sampler, int i, PathScratch& scratch, SampleResult& out) const {
+  // Traces the tile's camera rays and a one-pixel halo around it for sample `s` (CameraGrid),
+  // with the image-wide jitter of that sample: a sampler keyed to no pixel, (-1, -1). Returns
+  // the number of rays.
+  uint64_t trace_camera_grid(const Tile& tile, int W, int H, uint32_t s, CameraGrid& g) const {
+    Sampler image_wide;
+    image_wide.start(settings_.seed, -1, -1, s);
+    const Vec2f jitter = image_wide.get2d(Sampler::kDimCamera);
+    g.x0 = std::max(tile.x0 - 1, 0);
+    g.y0 = std::max(tile.y0 - 1, 0);
+    const int x1 = std::min(tile.x1 + 1, W), y1 = std::min(tile.y1 + 1, H);
+    g.w = x1 - g.x0;
+    g.h = y1 - g.y0;
+    g.reserve(size_t(g.w) * size_t(g.h));
+    uint64_t n = 0;
+    for (int y = g.y0; y < y1; ++y) {
+      const bool row_inside = y >= tile.y0 && y < tile.y1;
+      for (int x = g.x0; x < x1; ++x) {
+        const int c = g.index(x, y);
+        // The halo's corners are no tile pixel's neighbour.
+        g.valid[c] = row_inside || (x >= tile.x0 && x < tile.x1);
+        if (!g.valid[c]) continue;
+        g.ray[c] = ctx_.camera().generate_ray(Vec2f(float(x) + jitter.x, float(y) + jitter.y),
+                                              Vec2f(0.5f, 0.5f));
+        ++n;
+      }
+    }
+    ctx_.bvh().intersect_stream(g.ray.data(), g.valid.get(), g.w * g.h, g.found.get(),
+                                g.hit.data());
+    return n;
+  }
+
+  // Traces one base path and its offsets from camera rays render_tile() has traced.
+  void trace(const Sampler& sampler, const CameraSample& cs, PathScratch& scratch,
+             SampleResult& out) const {
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
     const int max_bounces = settings_.max_bounces;
     const bool has_lights = !lights.empty();
     const bool needs_selection = lights.needs_selection();
-    const CameraRow& row = scratch.row;
-    const bool* mask = row.mask[i];
+    const bool* mask = cs.mask;
 
     out.primal = Spectrum(0.0f);
     out.emission = Spectrum(0.0f);
     out.attempts = out.failures = 0;
-    out.rays = 1;
+    out.rays = 0;  // camera rays are counted by render_tile()
 
     // --- Camera rays (traced by render_tile) ---
-    const Ray& cam_ray = row.ray[i];
-    const SurfaceHit& hit = row.hit[i];
-    const bool camera_found = row.found[i];
+    const Ray& cam_ray = *cs.ray;
+    const SurfaceHit& hit = *cs.hit;
+    const bool camera_found = cs.found;
     // Very direct light, never shifted: lamps visible to the camera, and the world.
     if (has_visible_lamps_) {
       LightHit lh;
@@ -519,7 +632,6 @@ class GradientPathTracer final : public Integrator {
       o.active = mask[k];
       o.alive = false;
       if (!o.active) continue;
-      ++out.rays;
       ++out.attempts;
       o.failed = false;
       o.link = Link::NotConnected;
@@ -527,10 +639,9 @@ class GradientPathTracer final : public Integrator {
       o.f = Vec3d(1.0, 1.0, 1.0);
       o.p = 1.0;
       o.grad = Vec3d();
-      const Ray& cam = row.cam[k * kRow + i];
       // Base hits a surface, the offset the world: no shift.
-      o.alive = row.cam_found[k * kRow + i];
-      if (o.alive) setup_vertex(ctx_, sides_, row.cam_hit[k * kRow + i], cam.direction, o.v);
+      o.alive = cs.off_found[k];
+      if (o.alive) setup_vertex(ctx_, sides_, *cs.off_hit[k], cs.off_ray[k]->direction, o.v);
     }
 
     int cur = 0;  // scratch.verts[cur] is the base vertex
