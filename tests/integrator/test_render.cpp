@@ -458,11 +458,9 @@ TEST(Render, ClampBoundsPrimalSamples) {
   EXPECT_FLOAT_EQ(up.emission[0], 1.5f);
 }
 
-// Floor of albedo a under a ceiling that emits Le and reflects with albedo b (Add shader). Paths
-// floor -> ceiling (-> floor -> ceiling)^k carry a Le (a b)^k and need 2k + 1 bounces after the
-// camera ray, with Cycles' meaning of max_bounces (0 = direct light only): 0, 1 -> a Le;
-// 2, 3 -> a Le (1 + a b); 4 -> a Le (1 + a b + (a b)^2).
-TEST(Render, MaxBouncesFollowsCycles) {
+// Floor of albedo a = 0.5 under a ceiling at height 1 that emits Le = 1 and reflects with albedo
+// b = 0.5 (Add shader), seen from above by a `res`-pixel camera.
+Scene emitting_ceiling_over_floor(int res) {
   Scene scene;
   scene.meshes.push_back(quad(400.0f));
   scene.materials.push_back(diffuse(Spectrum(0.5f)));
@@ -481,7 +479,16 @@ TEST(Render, MaxBouncesFollowsCycles) {
   scene.instances.push_back(place(0, 0));
   scene.instances.push_back(place(0, 1, rotation_x(kPi, {0, 0, 1})));
   scene.world.color = Spectrum(0.0f);
-  scene.camera = top_camera(4, 0.5f, 0.5f);
+  scene.camera = top_camera(res, 0.5f, 0.5f);
+  return scene;
+}
+
+// Floor of albedo a under a ceiling that emits Le and reflects with albedo b (Add shader). Paths
+// floor -> ceiling (-> floor -> ceiling)^k carry a Le (a b)^k and need 2k + 1 bounces after the
+// camera ray, with Cycles' meaning of max_bounces (0 = direct light only): 0, 1 -> a Le;
+// 2, 3 -> a Le (1 + a b); 4 -> a Le (1 + a b + (a b)^2).
+TEST(Render, MaxBouncesFollowsCycles) {
+  const Scene scene = emitting_ceiling_over_floor(4);
   RenderSettings s = pt(64);
   const double ab = 0.25;
   const std::pair<int, double> cases[] = {
@@ -500,25 +507,7 @@ TEST(Render, MaxBouncesFollowsCycles) {
 // a Le / (1 - a b) = 2/3 whether roulette starts at the first vertex, at the default vertex (3)
 // or never; starting at the first vertex traces far fewer rays.
 TEST(Render, RussianRouletteIsUnbiasedAndShortensPaths) {
-  Scene scene;
-  scene.meshes.push_back(quad(400.0f));
-  scene.materials.push_back(diffuse(Spectrum(0.5f)));
-  MaterialDesc ceiling = emission(Spectrum(1.0f), 1.0f);
-  ShaderNode d;
-  d.kind = ShaderNodeKind::Diffuse;
-  d.color = ColorInput(Spectrum(0.5f));
-  ceiling.nodes.push_back(d);
-  ShaderNode add;
-  add.kind = ShaderNodeKind::Add;
-  add.a = 0;
-  add.b = 1;
-  ceiling.nodes.push_back(add);
-  ceiling.root = 2;
-  scene.materials.push_back(ceiling);
-  scene.instances.push_back(place(0, 0));
-  scene.instances.push_back(place(0, 1, rotation_x(kPi, {0, 0, 1})));
-  scene.world.color = Spectrum(0.0f);
-  scene.camera = top_camera(8, 0.5f, 0.5f);
+  const Scene scene = emitting_ceiling_over_floor(8);
   const double expect = 0.5 / (1.0 - 0.25);
   uint64_t rays[3] = {};
   const int depths[3] = {0, RenderSettings{}.rr_depth, 64};
