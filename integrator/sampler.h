@@ -10,7 +10,9 @@
 //
 // Dimension layout (Sampler::Dim): camera jitter 2D, lens 2D, then per bounce kDimsPerBounce
 // dimensions: light select 1D, light position 2D, BSDF lobe 1D, BSDF direction 2D, Russian
-// roulette 1D. G-PT uses the same layout for its base path.
+// roulette 1D. G-PT uses the same layout for its base path; without depth of field it takes the
+// camera jitter from a sampler keyed to no pixel, start(seed, -1, -1, index): one jitter per
+// sample index for the whole image (gradient_path_tracer.cpp, CameraGrid).
 #pragma once
 
 #include <cstdint>
