@@ -75,10 +75,6 @@ CameraModel::CameraModel(const Camera& cam) {
     w0_ = camera_to_world_.vector(Vec3f(left_ * tan_half_, bottom_ * tan_half_, -1.0f));
     wx_ = camera_to_world_.vector(Vec3f((right_ - left_) * inv_width_ * tan_half_, 0.0f, 0.0f));
     wy_ = camera_to_world_.vector(Vec3f(0.0f, (top_ - bottom_) * inv_height_ * tan_half_, 0.0f));
-    // As generate_offset_rays_general() computes them per call.
-    const float sx = (right_ - left_) * inv_width_, sy = (top_ - bottom_) * inv_height_;
-    offset_ax_ = camera_to_world_.column(0) * (sx * tan_half_);
-    offset_ay_ = camera_to_world_.column(1) * (sy * tan_half_);
   }
 }
 
@@ -122,8 +118,8 @@ Ray CameraModel::generate_ray_general(Vec2f raster, Vec2f lens) const {
   return ray;
 }
 
-void CameraModel::generate_offset_rays_general(Vec2f raster, Vec2f lens, const bool mask[4],
-                                               Ray out[4]) const {
+void CameraModel::generate_offset_rays(Vec2f raster, Vec2f lens, const bool mask[4],
+                                       Ray out[4]) const {
   // One raster unit moves the screen position by these amounts.
   const float sx = (right_ - left_) * inv_width_, sy = (top_ - bottom_) * inv_height_;
   const float step_x[4] = {1.0f, 0.0f, -1.0f, 0.0f}, step_y[4] = {0.0f, 1.0f, 0.0f, -1.0f};

@@ -12,8 +12,6 @@
 // Cross-engine comparisons therefore set Cycles' filter_width small (e.g. 0.01).
 #pragma once
 
-#include <algorithm>
-
 #include "integrator/math/transform.h"
 #include "integrator/math/vec.h"
 #include "integrator/scene.h"
@@ -53,25 +51,8 @@ class CameraModel {
   // order, where `mask` is set) with the same lens sample, equal to generate_ray() up to
   // rounding. The camera-space direction is affine in the raster position, so each ray costs one
   // step from the common part and a normalisation instead of a full generate_ray().
-  // The pinhole case in line (one call per G-PT pixel sample): generate_offset_rays_general()'s
-  // arithmetic without depth of field, operation for operation, so the same rays bit for bit.
-  [[gnu::always_inline]] void generate_offset_rays(Vec2f raster, Vec2f lens, const bool mask[4],
-                                                   Ray out[4]) const {
-    if (!pinhole_) return generate_offset_rays_general(raster, lens, mask, out);
-    const float step_x[4] = {1.0f, 0.0f, -1.0f, 0.0f}, step_y[4] = {0.0f, 1.0f, 0.0f, -1.0f};
-    const Vec2f s = raster_to_screen(raster);
-    const Vec3f w = camera_to_world_.vector(Vec3f(s.x * tan_half_, s.y * tan_half_, -1.0f));
-    for (int k = 0; k < 4; ++k) {
-      if (!mask[k]) continue;
-      const Vec3f wk = w + offset_ax_ * step_x[k] + offset_ay_ * step_y[k];
-      const float len = length(wk);
-      const float z_scale = len / std::max(1.0f, 1e-8f * len);  // view depth 1
-      out[k].origin = pinhole_origin_;
-      out[k].direction = wk / len;
-      out[k].t_min = clip_start_ * z_scale;
-      out[k].t_max = clip_end_ * z_scale;
-    }
-  }
+  // Used by G-PT only with depth of field (without it, offsets reuse neighbours' camera rays).
+  void generate_offset_rays(Vec2f raster, Vec2f lens, const bool mask[4], Ray out[4]) const;
 
   // World point -> raster position (pinhole); returns false behind the camera. For tests.
   bool project(Vec3f world, Vec2f& raster) const;
@@ -84,7 +65,6 @@ class CameraModel {
 
  private:
   Ray generate_ray_general(Vec2f raster, Vec2f lens) const;  // orthographic, depth of field
-  void generate_offset_rays_general(Vec2f raster, Vec2f lens, const bool mask[4], Ray out[4]) const;
   // Raster -> screen (viewplane) coordinates.
   Vec2f raster_to_screen(Vec2f raster) const {
     return {left_ + (right_ - left_) * raster.x * inv_width_,
@@ -107,8 +87,6 @@ class CameraModel {
   // ray per unit of view depth (clip distances scale by it).
   bool pinhole_ = false;
   Vec3f pinhole_origin_, w0_, wx_, wy_;
-  // generate_offset_rays(): the world direction's change per raster unit in x and in y.
-  Vec3f offset_ax_, offset_ay_;
 };
 
 }  // namespace gdpt

@@ -275,14 +275,12 @@ struct CameraGrid {
   std::vector<Ray> ray;
   std::vector<SurfaceHit> hit;
   std::unique_ptr<bool[]> valid, found;  // not vector<bool>: intersect_stream takes bool arrays
-  size_t capacity = 0;
-  void reserve(size_t n) {
-    if (n <= capacity) return;
+  void reserve(size_t n) {  // grows only: no allocation once the first tile has been seen
+    if (n <= ray.size()) return;
     ray.resize(n);
     hit.resize(n);
     valid.reset(new bool[n]);
     found.reset(new bool[n]);
-    capacity = n;
   }
   int index(int x, int y) const { return (y - y0) * w + (x - x0); }
 };
