@@ -14,19 +14,25 @@
 
 namespace gdpt {
 
-inline void sincos_fast(float x, float* sin_out, float* cos_out) {
-  const double q = std::nearbyint(double(x) * 0.6366197723675814);  // x / (pi / 2)
-  const float r = float(double(x) - q * 1.5707963267948966);
+// sin and cos of r in [-pi/4, pi/4]: the polynomials alone, for callers whose angle is already
+// in that range (the concentric disk map).
+inline void sincos_quarter(float r, float* sin_out, float* cos_out) {
   const float r2 = r * r;
   float s = -0.00019517300825100392f;
   s = s * r2 + 0.008332177996635437f;
   s = s * r2 - 0.16666655242443085f;
-  const float sin_r = r + r * (r2 * s);
+  *sin_out = r + r * (r2 * s);
   float c = 2.4390452381339855e-05f;
   c = c * r2 - 0.0013886763481423259f;
   c = c * r2 + 0.04166662320494652f;
   c = c * r2 - 0.5f;
-  const float cos_r = 1.0f + r2 * c;
+  *cos_out = 1.0f + r2 * c;
+}
+
+inline void sincos_fast(float x, float* sin_out, float* cos_out) {
+  const double q = std::nearbyint(double(x) * 0.6366197723675814);  // x / (pi / 2)
+  float sin_r, cos_r;
+  sincos_quarter(float(double(x) - q * 1.5707963267948966), &sin_r, &cos_r);
   const uint32_t quadrant = uint32_t(int64_t(q)) & 3u;
   const float a = (quadrant & 1u) ? cos_r : sin_r;  // sin(x) up to sign
   const float b = (quadrant & 1u) ? sin_r : cos_r;  // cos(x) up to sign

@@ -5,22 +5,24 @@
 
 #include <cmath>
 
+#include "integrator/math/sincos_fast.h"
 #include "integrator/math/vec.h"
 
 namespace gdpt {
 
+// The angle is pi/4 * t or pi/2 - pi/4 * t with t in [-1, 1]: sin and cos of pi/4 * t by the
+// polynomials alone (sincos_quarter), the second case by swapping them. libm's sincosf with its
+// range reduction was ~2.4% of a diffuse path tracer's time.
 inline Vec2f square_to_disk_concentric(Vec2f u) {
   const float a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
   if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f};
-  float r, phi;
+  float s, c;
   if (std::fabs(a) > std::fabs(b)) {
-    r = a;
-    phi = (kPi / 4.0f) * (b / a);
-  } else {
-    r = b;
-    phi = (kPi / 2.0f) - (kPi / 4.0f) * (a / b);
+    sincos_quarter((kPi / 4.0f) * (b / a), &s, &c);
+    return {a * c, a * s};
   }
-  return {r * std::cos(phi), r * std::sin(phi)};
+  sincos_quarter((kPi / 4.0f) * (a / b), &s, &c);
+  return {b * s, b * c};
 }
 
 }  // namespace gdpt
