@@ -1,5 +1,6 @@
 #include "integrator/path_tracer.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -53,24 +54,42 @@ class PathTracer final : public Integrator {
   PathTracer(const SceneContext& ctx, const RenderSettings& settings)
       : ctx_(ctx), settings_(settings) {}
 
+  // Camera rays go to Embree a row segment at a time (kStream pixels of one sample index) as one
+  // coherent stream, which traverses neighbouring rays together; each path then continues from
+  // its camera hit. Every pixel still takes its samples in index order: the image is the same as
+  // with one camera ray at a time, bit for bit.
   void render_tile(const Tile& tile, uint32_t first_sample, uint32_t sample_count,
                    Film& film) const override {
+    constexpr int kStream = 16;
     uint64_t rays = 0;
-    Sampler sampler;
+    Sampler samplers[kStream];
+    Ray camera_rays[kStream];
+    bool valid[kStream], found[kStream];
+    SurfaceHit hits[kStream];      // each path's working hit record, starting as its camera hit
     ClosureSet closures, scratch;  // ~0.5 KB each: initialised once per tile, not per sample
-    SurfaceHit hit;                // likewise: every intersect() overwrites what is read after it
     const float clamp = settings_.clamp;
-    for (int y = tile.y0; y < tile.y1; ++y)
-      for (int x = tile.x0; x < tile.x1; ++x) {
-        Film::Accumulator& acc = film.pixel(x, y);
+    std::fill(valid, valid + kStream, true);
+    for (int y = tile.y0; y < tile.y1; ++y) {
+      for (int x0 = tile.x0; x0 < tile.x1; x0 += kStream) {
+        const int n = std::min(kStream, tile.x1 - x0);
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
-          sampler.start(settings_.seed, x, y, s);
-          const PathResult r = trace(sampler, x, y, closures, scratch, hit);
-          rays += r.rays;
-          acc.add_path(r.primal, r.emission, clamp);
+          // --- Camera rays of the segment, traced together ---
+          for (int j = 0; j < n; ++j) {
+            samplers[j].start(settings_.seed, x0 + j, y, s);
+            camera_rays[j] = camera_ray(samplers[j], x0 + j, y);
+          }
+          ctx_.bvh().intersect_stream(camera_rays, valid, n, found, hits);
+          // --- The paths ---
+          for (int j = 0; j < n; ++j) {
+            const PathResult r =
+                trace(samplers[j], camera_rays[j], found[j], closures, scratch, hits[j]);
+            rays += r.rays;
+            film.pixel(x0 + j, y).add_path(r.primal, r.emission, clamp);
+          }
         }
-        film.add_sample_count(x, y, sample_count);
       }
+      for (int x = tile.x0; x < tile.x1; ++x) film.add_sample_count(x, y, sample_count);
+    }
     count_rays(rays);
   }
 
@@ -101,7 +120,15 @@ class PathTracer final : public Integrator {
     return Spectrum(0.0f);
   }
 
-  PathResult trace(const Sampler& sampler, int px, int py, ClosureSet& closure_scratch,
+  Ray camera_ray(const Sampler& sampler, int px, int py) const {
+    const Vec2f jitter = sampler.get2d(Sampler::kDimCamera);
+    const Vec2f lens = kDoF ? sampler.get2d(Sampler::kDimLens) : Vec2f(0.5f, 0.5f);
+    return ctx_.camera().generate_ray({float(px) + jitter.x, float(py) + jitter.y}, lens);
+  }
+
+  // The path of one camera sample, from its camera ray already traced (`camera_found`, and `hit`
+  // holding the hit when found); `hit` is the path's working hit record from there on.
+  PathResult trace(const Sampler& sampler, Ray ray, bool camera_found, ClosureSet& closure_scratch,
                    ClosureSet& scratch, SurfaceHit& hit) const {
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
@@ -111,11 +138,6 @@ class PathTracer final : public Integrator {
     const bool needs_selection = lights.needs_selection();
 
     PathResult out;
-    // --- Camera ray ---
-    const Vec2f jitter = sampler.get2d(Sampler::kDimCamera);
-    const Vec2f lens = kDoF ? sampler.get2d(Sampler::kDimLens) : Vec2f(0.5f, 0.5f);
-    Ray ray = ctx_.camera().generate_ray({float(px) + jitter.x, float(py) + jitter.y}, lens);
-
     Spectrum beta(1.0f);     // path throughput f / p
     float prev_pdf = 0.0f;   // solid-angle pdf of the BSDF sample that spawned `ray`
     bool prev_delta = true;  // no MIS for camera rays and delta lobes
@@ -131,8 +153,9 @@ class PathTracer final : public Integrator {
       // Past the bounce limits a vertex only ends the path: without emissive triangles its hit
       // needs no record, only the distance (analytic lights in front of it, the world behind).
       const bool last = bounce > max_bounces || transparent > kMaxTransparentBounces;
-      const bool found =
-          !kEmissive && last ? bvh.intersect_distance(ray, hit.t) : bvh.intersect(ray, hit);
+      const bool found = vertex == 0          ? camera_found
+                         : !kEmissive && last ? bvh.intersect_distance(ray, hit.t)
+                                              : bvh.intersect(ray, hit);
       ++out.rays;
       const float t_hit = found ? hit.t : ray.t_max;
 
