@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "integrator/math/warp_disk.h"
 
@@ -15,6 +17,17 @@ CameraModel::CameraModel(const Camera& cam) {
   height_ = std::max(cam.height, 1);
   inv_width_ = 1.0f / float(width_);
   inv_height_ = 1.0f / float(height_);
+  if (cam.has_region()) {
+    if (cam.region_x < 0 || cam.region_y < 0 || cam.region_x + cam.region_width > width_ ||
+        cam.region_y + cam.region_height > height_)
+      throw std::invalid_argument(
+          "camera: render region " + std::to_string(cam.region_width) + "x" +
+          std::to_string(cam.region_height) + " at (" + std::to_string(cam.region_x) + ", " +
+          std::to_string(cam.region_y) + ") is not inside the " + std::to_string(width_) + "x" +
+          std::to_string(height_) + " frame");
+    region_x_ = cam.region_x;
+    region_y_ = cam.region_y;
+  }
 
   // Viewplane as Cycles' blender_camera_viewplane(): the fitted dimension spans [-1, 1] before
   // scaling, the other one [-1/aspect, 1/aspect] after the division below.

@@ -57,6 +57,11 @@ class CameraModel {
   // World point -> raster position (pinhole); returns false behind the camera. For tests.
   bool project(Vec3f world, Vec2f& raster) const;
 
+  // Offset of the rendered image in the frame (Camera::region_x / region_y; 0 without a region):
+  // integrators add it to image pixel coordinates to get raster positions and sampler keys.
+  int region_x() const { return region_x_; }
+  int region_y() const { return region_y_; }
+
   bool has_dof() const { return aperture_radius_ > 0.0f; }
   bool orthographic() const { return ortho_; }
   int width() const { return width_; }
@@ -73,7 +78,8 @@ class CameraModel {
 
   Transform camera_to_world_, world_to_camera_;
   bool ortho_ = false;
-  int width_ = 1, height_ = 1;
+  int width_ = 1, height_ = 1;  // the frame
+  int region_x_ = 0, region_y_ = 0;
   float inv_width_ = 1.0f, inv_height_ = 1.0f;
   // Viewplane in screen units, after shift.
   float left_ = -1.0f, right_ = 1.0f, bottom_ = -1.0f, top_ = 1.0f;

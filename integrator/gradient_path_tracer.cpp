@@ -326,6 +326,8 @@ class GradientPathTracer final : public Integrator {
   void render_tile(const Tile& tile, uint32_t first_sample, uint32_t sample_count,
                    Film& film) const override {
     const int W = film.width(), H = film.height();
+    // Raster positions and sampler keys are the frame's (a render region samples as the frame).
+    const int rx = ctx_.camera().region_x(), ry = ctx_.camera().region_y();
     uint64_t rays = 0;
     thread_local PathScratch scratch;
     const float clamp = settings_.clamp;
@@ -380,7 +382,7 @@ class GradientPathTracer final : public Integrator {
         for (int y = tile.y0; y < tile.y1; ++y)
           for (int x = tile.x0; x < tile.x1; ++x) {
             Sampler sampler;
-            sampler.start(settings_.seed, x, y, s);
+            sampler.start(settings_.seed, x + rx, y + ry, s);
             offset_mask(x, y, mask);
             const int c = g.index(x, y);
             cs.ray = &g.ray[c];
@@ -409,10 +411,10 @@ class GradientPathTracer final : public Integrator {
               row.valid[i] = i < n;
               if (!row.valid[i]) continue;
               const int x = x0 + i;
-              row.sampler[i].start(settings_.seed, x, y, s);
+              row.sampler[i].start(settings_.seed, x + rx, y + ry, s);
               const Vec2f jitter = row.sampler[i].get2d(Sampler::kDimCamera);
               row.lens[i] = row.sampler[i].get2d(Sampler::kDimLens);
-              row.raster[i] = Vec2f(float(x) + jitter.x, float(y) + jitter.y);
+              row.raster[i] = Vec2f(float(x + rx) + jitter.x, float(y + ry) + jitter.y);
               row.ray[i] = ctx_.camera().generate_ray(row.raster[i], row.lens[i]);
             }
             ctx_.bvh().intersect_stream(row.ray, row.valid, kRow, row.found, row.hit);
@@ -581,7 +583,8 @@ class GradientPathTracer final : public Integrator {
         // The halo's corners are no tile pixel's neighbour.
         g.valid[c] = row_inside || (x >= tile.x0 && x < tile.x1);
         if (!g.valid[c]) continue;
-        g.ray[c] = ctx_.camera().generate_ray(Vec2f(float(x) + jitter.x, float(y) + jitter.y),
+        const int fx = x + ctx_.camera().region_x(), fy = y + ctx_.camera().region_y();
+        g.ray[c] = ctx_.camera().generate_ray(Vec2f(float(fx) + jitter.x, float(fy) + jitter.y),
                                               Vec2f(0.5f, 0.5f));
         ++n;
       }

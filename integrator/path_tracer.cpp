@@ -68,6 +68,8 @@ class PathTracer final : public Integrator {
     SurfaceHit hits[kStream];      // each path's working hit record, starting as its camera hit
     ClosureSet closures, scratch;  // ~0.5 KB each: initialised once per tile, not per sample
     const float clamp = settings_.clamp;
+    // Raster positions and sampler keys are the frame's (a render region samples as the frame).
+    const int rx = ctx_.camera().region_x(), ry = ctx_.camera().region_y();
     std::fill(valid, valid + kStream, true);
     for (int y = tile.y0; y < tile.y1; ++y) {
       for (int x0 = tile.x0; x0 < tile.x1; x0 += kStream) {
@@ -75,8 +77,8 @@ class PathTracer final : public Integrator {
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
           // --- Camera rays of the segment, traced together ---
           for (int j = 0; j < n; ++j) {
-            samplers[j].start(settings_.seed, x0 + j, y, s);
-            camera_rays[j] = camera_ray(samplers[j], x0 + j, y);
+            samplers[j].start(settings_.seed, x0 + j + rx, y + ry, s);
+            camera_rays[j] = camera_ray(samplers[j], x0 + j + rx, y + ry);
           }
           ctx_.bvh().intersect_stream(camera_rays, valid, n, found, hits);
           // --- The paths ---
@@ -120,6 +122,7 @@ class PathTracer final : public Integrator {
     return Spectrum(0.0f);
   }
 
+  // The camera ray of pixel (px, py) of the frame.
   Ray camera_ray(const Sampler& sampler, int px, int py) const {
     const Vec2f jitter = sampler.get2d(Sampler::kDimCamera);
     const Vec2f lens = kDoF ? sampler.get2d(Sampler::kDimLens) : Vec2f(0.5f, 0.5f);

@@ -58,7 +58,7 @@ RenderSession::RenderSession(Scene scene, RenderSettings settings)
   d.integrator = d.settings.mode == RenderSettings::Mode::GPT
                      ? make_gradient_path_tracer(*d.context, d.settings)
                      : make_path_tracer(*d.context, d.settings);
-  const int w = d.scene.camera.width, h = d.scene.camera.height;
+  const int w = d.scene.camera.image_width(), h = d.scene.camera.image_height();
   d.film = Film(w, h);
   d.pass_film = Film(w, h);
   d.film.set_gradients_from_primal(!d.integrator->estimates_gradients());

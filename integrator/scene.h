@@ -51,8 +51,17 @@ struct Camera {
   float clip_start = 0.1f, clip_end = 1000.0f;
   float aperture_radius = 0.0f;   // metres; 0 = pinhole (Blender: focal_length / (2 f-stop))
   float focus_distance = 10.0f;   // metres along -Z
-  int width = 640, height = 480;  // pixels after resolution percentage
+  int width = 640, height = 480;  // pixels after resolution percentage (the whole frame)
   float pixel_aspect = 1.0f;      // pixel_aspect_x / pixel_aspect_y
+  // Render region (Blender's border): the rendered image is the region_width x region_height
+  // block of the frame whose bottom-left pixel is (region_x, region_y); a pixel of it sees and
+  // samples exactly what the same pixel of the whole frame does. 0 x 0: the whole frame.
+  int region_x = 0, region_y = 0, region_width = 0, region_height = 0;
+
+  bool has_region() const { return region_width > 0 && region_height > 0; }
+  // Size of the rendered image (film, passes): the region, or the whole frame.
+  int image_width() const { return has_region() ? region_width : width; }
+  int image_height() const { return has_region() ? region_height : height; }
 };
 
 // Blender light object. Emission direction is the light's local -Z (spot, sun, area).

@@ -103,7 +103,8 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
                         "camera (Scene Properties > Camera)")
             return
         camera = scene.camera.evaluated_get(depsgraph)
-        width, height = export_camera.render_resolution(scene.render)
+        # The whole frame, or the Render Region (border): Blender's result has exactly this size.
+        width, height = export_camera.image_size(scene.render)
 
         self.update_stats("", "Synchronizing scene")
         try:
@@ -133,6 +134,13 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         for candidate in result.layers:
             if candidate.name == view_layer.name:
                 layer = candidate
+        combined_pass = layer.passes.get("Combined")
+        if combined_pass is not None and len(combined_pass.rect) != width * height:
+            # Writing anyway would scramble the image: refuse instead.
+            self.end_result(result, cancel=True)
+            self._error(f"Blender's render result has {len(combined_pass.rect)} pixels, Gradient "
+                        f"PT computed a {width}x{height} image (render region / resolution)")
+            return
 
         t_render = time.perf_counter()
         interval = settings.preview_interval

@@ -4,9 +4,33 @@ from mathutils import Vector
 
 
 def render_resolution(render):
-    """Pixel size after the resolution percentage, as Blender computes it."""
-    scale = render.resolution_percentage / 100.0
-    return max(1, int(render.resolution_x * scale)), max(1, int(render.resolution_y * scale))
+    """Pixel size of the frame after the resolution percentage, in Blender's integer arithmetic
+    (render_init_from_main: size * xsch / 100)."""
+    pct = render.resolution_percentage
+    return (max(1, render.resolution_x * pct // 100), max(1, render.resolution_y * pct // 100))
+
+
+def render_region(render):
+    """The render region (Render Region / border) as (x, y, width, height) in pixels of the frame,
+    y from the bottom, or None when the whole frame renders. Blender computes it in float32 and
+    truncates (render_init_from_main), and gives the engine a result of exactly that size."""
+    if not render.use_border:
+        return None
+    width, height = render_resolution(render)
+    f = np.float32
+    x0 = int(f(render.border_min_x) * f(width))
+    x1 = int(f(render.border_max_x) * f(width))
+    y0 = int(f(render.border_min_y) * f(height))
+    y1 = int(f(render.border_max_y) * f(height))
+    if (x0, y0, x1, y1) == (0, 0, width, height):
+        return None
+    return x0, y0, x1 - x0, y1 - y0
+
+
+def image_size(render):
+    """Size of the image the engine renders and writes: the render region, or the frame."""
+    region = render_region(render)
+    return (region[2], region[3]) if region else render_resolution(render)
 
 
 def _rigid_matrix12(m):
@@ -34,8 +58,6 @@ def camera_dict(scene, cam_obj, warn):
     width, height = render_resolution(render)
     if cam.type == 'PANO':
         warn("panoramic cameras are not supported by Gradient PT; rendering as perspective")
-    if render.use_border:
-        warn("render region (border) is ignored by Gradient PT; rendering the full frame")
     d = {
         "projection": 'ORTHO' if cam.type == 'ORTHO' else 'PERSP',
         "sensor_fit": cam.sensor_fit,
@@ -54,6 +76,9 @@ def camera_dict(scene, cam_obj, warn):
         "aperture_radius": 0.0,
         "focus_distance": _focus_distance(cam_obj, cam),
     }
+    region = render_region(render)
+    if region:
+        d["region_x"], d["region_y"], d["region_width"], d["region_height"] = region
     if cam.dof.use_dof:
         fstop = max(float(cam.dof.aperture_fstop), 1e-5)
         if cam.type == 'ORTHO':

@@ -589,6 +589,10 @@ void SceneBuilder::set_camera(const py::dict& d) {
   get(d, "width", c.width);
   get(d, "height", c.height);
   get(d, "pixel_aspect", c.pixel_aspect);
+  get(d, "region_x", c.region_x);
+  get(d, "region_y", c.region_y);
+  get(d, "region_width", c.region_width);
+  get(d, "region_height", c.region_height);
 }
 
 void SceneBuilder::set_world(const py::dict& d) {

@@ -418,6 +418,44 @@ TEST(GradientIntegrator, DeterministicAcrossThreadCounts) {
   EXPECT_EQ(a.failures, b.failures);
 }
 
+// A render region (Blender's border) renders the frame's pixels: away from the region's edges
+// (where offsets leave the image) primal, gradients, variance and shift failures are bit-identical
+// to the whole frame's, with and without depth of field (the two camera-ray schemes).
+TEST(GradientIntegrator, RenderRegionIsTheFramesPixels) {
+  for (const bool dof : {false, true}) {
+    Scene scene = make_scene(SceneKind::CornellGlossy, 24, 0.02f);
+    if (dof) {
+      scene.camera.aperture_radius = 0.05f;
+      scene.camera.focus_distance = 3.0f;
+    }
+    const RenderSettings s = settings(RenderSettings::Mode::GPT, 4, 5);
+    const Passes full = render(scene, s);
+    const int rx = 7, ry = 4, rw = 11, rh = 13;
+    scene.camera.region_x = rx;
+    scene.camera.region_y = ry;
+    scene.camera.region_width = rw;
+    scene.camera.region_height = rh;
+    const Passes region = render(scene, s);
+    ASSERT_EQ(region.w, rw);
+    ASSERT_EQ(region.h, rh);
+    int nonzero = 0;
+    for (int y = 1; y + 1 < rh; ++y)
+      for (int x = 1; x + 1 < rw; ++x) {
+        const size_t i = size_t(y * rw + x), j = size_t((y + ry) * full.w + x + rx);
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_EQ(region.primal[3 * i + c], full.primal[3 * j + c])
+              << dof << " " << x << " " << y;
+          ASSERT_EQ(region.dx[3 * i + c], full.dx[3 * j + c]) << dof << " " << x << " " << y;
+          ASSERT_EQ(region.dy[3 * i + c], full.dy[3 * j + c]) << dof << " " << x << " " << y;
+          ASSERT_EQ(region.variance[3 * i + c], full.variance[3 * j + c]);
+          nonzero += region.dx[3 * i + c] != 0.0f;
+        }
+        ASSERT_EQ(region.failures[i], full.failures[j]);
+      }
+    EXPECT_GT(nonzero, 50) << dof;
+  }
+}
+
 // The offsets' camera rays (CameraModel::generate_offset_rays, one affine step from the base's
 // raster position) are the rays generate_ray() gives at raster +-1, up to float rounding:
 // perspective with shift and pixel aspect, thin lens, orthographic with and without a lens,

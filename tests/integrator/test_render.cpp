@@ -657,6 +657,41 @@ TEST(Render, BitIdenticalAcrossThreadCountsAndTileOrder) {
   EXPECT_NE(other.primal, one.primal);
 }
 
+// A render region (Blender's border) is the same pixels as the whole frame's, bit for bit: its
+// rays and sampler keys are the frame's. Checked with and without depth of field, and a region
+// outside the frame is refused.
+TEST(Render, RenderRegionIsTheFramesPixels) {
+  for (const bool dof : {false, true}) {
+    Scene scene = cornell_like();
+    if (dof) {
+      scene.camera.aperture_radius = 0.05f;
+      scene.camera.focus_distance = 3.0f;
+    }
+    const RenderSettings s = pt(4, 7);
+    const Image full = render(scene, s);
+    scene.camera.region_x = 5;
+    scene.camera.region_y = 3;
+    scene.camera.region_width = 13;
+    scene.camera.region_height = 9;
+    const Image region = render(scene, s);
+    ASSERT_EQ(region.w, 13);
+    ASSERT_EQ(region.h, 9);
+    double sum = 0.0;
+    for (int y = 0; y < region.h; ++y)
+      for (int x = 0; x < region.w; ++x)
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_EQ(region.at(x, y, c), full.at(x + 5, y + 3, c)) << dof << " " << x << " " << y;
+          sum += region.at(x, y, c);
+        }
+    EXPECT_GT(sum, 0.0);
+  }
+  Scene scene = cornell_like();
+  scene.camera.region_x = 20;
+  scene.camera.region_width = 5;  // 20 + 5 > 24
+  scene.camera.region_height = 4;
+  EXPECT_THROW(render(scene, pt(1)), std::invalid_argument);
+}
+
 TEST(Render, NeverNaNOrInf) {
   Scene scene = cornell_like();
   // Degenerate triangles, zero-length and inverted shading normals, zero-roughness glossy,
