@@ -1,12 +1,19 @@
 # Render Region (Blender's border, Ctrl+B in the camera view): Gradient PT renders only the region,
 # and its pixels are the whole frame's pixels.
 #  - PT, region cropped (Crop to Render Region): the EXR is the region's size as Blender computes
-#    it, and its Primal pass equals the whole frame's Primal there, bit for bit (the core samples a
-#    region pixel exactly as the same pixel of the frame);
+#    it, and its Primal pass equals the whole frame's Primal there (the core samples a region
+#    pixel exactly as the same pixel of the frame: bit for bit in the C++ tests);
 #  - G-PT, cropped: Primal, Gradient X and Gradient Y equal the frame's away from the region's edges
 #    (at the edges the offsets that leave the region are missing, as at the frame's edges); the
 #    reconstruction of the region is close to the frame's there;
 #  - not cropped: a frame-sized image with the region in place (alpha 1 inside, 0 outside);
+#
+# "Equal" here allows last-bit differences in a few values: Embree builds the BVH on all threads,
+# and inside Blender that build is not bit-for-bit repeatable, so a ray hitting a shared triangle
+# edge exactly may report either triangle from one render to the next. Seen: 1-3 values of ~3800
+# off by one ulp (6e-8) in about a third of the renders; with Embree's build on one thread
+# (GDPT_EMBREE_CONFIG=threads=1) 40 of 40 were bit-identical. A wrong region offset changes
+# nearly every value.
 #  - a resolution percentage whose float product would round differently (29% of 100 px) still
 #    gives Blender's own size.
 import os
@@ -49,6 +56,12 @@ def render(scene, path, border, crop, multilayer=True):
     return path
 
 
+def same_pixels(a, b):
+    """Equal up to last-bit noise in at most 0.5% of the values (see the header)."""
+    off = np.abs(a - b) > 1e-5 * np.maximum(np.abs(b), 1.0)
+    return a.shape == b.shape and off.mean() <= 0.005, off.mean()
+
+
 def blender_region(width, height):
     # Blender's render_init_from_main: float32 products, truncated.
     f = np.float32
@@ -76,9 +89,8 @@ def main():
           f"cropped PT region is {part['Primal'].shape[1]}x{part['Primal'].shape[0]} "
           f"(Blender's region {w}x{h})")
     same = full["Primal"][y0:y0 + h, x0:x0 + w]
-    check(np.array_equal(part["Primal"], same),
-          f"PT region Primal equals the frame's (max |diff| "
-          f"{np.abs(part['Primal'] - same).max():.3g})")
+    ok, frac = same_pixels(part["Primal"], same)
+    check(ok, f"PT region Primal equals the frame's ({100 * frac:.2f}% of values differ)")
     check(same.mean() > 0.01, f"the region is lit (mean {same.mean():.3f})")
 
     # --- G-PT: interior pixels equal, reconstruction close ---
@@ -89,8 +101,9 @@ def main():
     for n in names:
         a = part[n][1:-1, 1:-1]
         b = full[n][y0 + 1:y0 + h - 1, x0 + 1:x0 + w - 1]
-        check(np.array_equal(a, b), f"G-PT region {n} equals the frame's away from the edges "
-              f"(max |diff| {np.abs(a - b).max():.3g})")
+        ok, frac = same_pixels(a, b)
+        check(ok, f"G-PT region {n} equals the frame's away from the edges ({100 * frac:.2f}% "
+              f"of values differ)")
     check(np.abs(part["Gradient X"]).max() > 0, "the region has gradients")
     ch_full = exr.read_exr(os.path.join(out, "gpt_full.exr"))
     ch_part = exr.read_exr(os.path.join(out, "gpt_region.exr"))
@@ -110,15 +123,19 @@ def main():
     check(np.all(alpha[inside] == 1.0) and np.all(alpha[~inside] == 0.0),
           "alpha is 1 in the region and 0 outside")
     rgb = np.stack([ch[c] for c in "RGB"], axis=-1)
-    check(np.array_equal(rgb[inside].reshape(h, w, 3), same),
-          "the uncropped region's pixels are the frame's")
+    ok, frac = same_pixels(rgb[inside].reshape(h, w, 3), same)
+    check(ok, f"the uncropped region's pixels are the frame's ({100 * frac:.2f}% differ)")
 
     # --- Resolution percentage in Blender's integer arithmetic ---
     scene.render.resolution_x, scene.render.resolution_y = 100, 100
     scene.render.resolution_percentage = 29  # 100 * 0.29 = 28.999999999999996 in double
     S.setup_gdpt(scene, 1, mode='PT', reconstruction='NONE')
     ch = exr.read_exr(render(scene, os.path.join(out, "pct.exr"), False, False, False))
-    check(ch["R"].shape == (29, 29), f"29% of 100 px renders {ch['R'].shape[1]} px wide (29)")
+    import gdpt.engine as engine
+    size = (engine.LAST_RENDER.get("width"), engine.LAST_RENDER.get("height"))
+    check(ch["R"].shape == (29, 29) and size == (29, 29),
+          f"29% of 100 px: Blender's image {ch['R'].shape[1]} px, Gradient PT's {size} (29)")
+    check(np.all(ch["A"] == 1.0) and np.all(np.isfinite(ch["R"])), "every pixel written")
     print("render region: all checks passed")
 
 
