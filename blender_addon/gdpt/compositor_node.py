@@ -40,7 +40,9 @@ REQUIRED = INPUTS[:3]
 FILM_KEYS = {"Primal": "primal", "Gradient X": "gradient_x", "Gradient Y": "gradient_y",
              "Emission": "emission"}
 
-# (scene name, view layer name) -> {film key: (height, width, 3) float32} of the last render.
+# (scene name, view layer name) -> {film key: (height, width, 3) float32} of the last render, and
+# under "placement" (frame width, frame height, x, y) when it rendered an uncropped Render Region:
+# the compositor then works on frame-sized buffers with the region in place.
 _CACHE = {}
 # node.as_pointer() -> (level, message): the last outcome, drawn on the node.
 _STATUS = {}
@@ -99,17 +101,22 @@ def node_image(node):
     return image_node.image if image_node is not None else None
 
 
-def _write_image(node, rgb):
-    """rgb: (height, width, 3) float32, rows bottom-up; written with alpha 1."""
+def _write_image(node, rgb, placement=None):
+    """rgb: (height, width, 3) float32, rows bottom-up; written with alpha 1. With a placement
+    (frame width, frame height, x, y) the image is the frame, rgb at (x, y), alpha 0 elsewhere."""
     image = node_image(node)
     if image is None:
         raise InputError("the node's internal image is missing (delete and re-add the node)")
     height, width = rgb.shape[:2]
+    x = y = 0
+    if placement is not None:
+        width, height, x, y = placement
     if tuple(image.size) != (width, height):
         # A generated image regenerates its buffer at the new size.
         image.generated_width, image.generated_height = width, height
-    rgba = np.ones((height, width, 4), dtype=np.float32)
-    rgba[..., :3] = rgb
+    rgba = np.zeros((height, width, 4), dtype=np.float32)
+    rgba[y:y + rgb.shape[0], x:x + rgb.shape[1], :3] = rgb
+    rgba[y:y + rgb.shape[0], x:x + rgb.shape[1], 3] = 1.0
     image.pixels.foreach_set(rgba.ravel())
     image.update()
 
@@ -230,7 +237,9 @@ def reconstruct_node(scene, node, threads=0):
         np.ascontiguousarray(arrays["Gradient Y"], dtype=np.float32), None,
         None if emission is None else np.ascontiguousarray(emission, dtype=np.float32),
         node.norm, float(node.alpha), int(threads))
-    _write_image(node, rgb)
+    placements = {_CACHE.get((src[1], src[2]), {}).get("placement")
+                  for src in srcs.values() if src[0] == 'LAYER'}
+    _write_image(node, rgb, placements.pop() if len(placements) == 1 else None)
     height, width = rgb.shape[:2]
     _say(node, 'INFO', f"{node.norm}, alpha {node.alpha:g}, {width}x{height}"
                        + ("" if emission is not None else ", no Emission input"))
@@ -256,17 +265,18 @@ def any_node():
     return any(nodes_in(s) for s in bpy.data.scenes)
 
 
-def fill_after_render(scene, view_layer_name, film, threads, warn):
+def fill_after_render(scene, view_layer_name, film, threads, warn, placement=None):
     """Called by the engine's render() with the final film of one view layer (scene: original
     datablock). Caches the passes while some scene has a Gradient Reconstruct node, then solves
     every node that reads this view layer; bad inputs of this scene's nodes are reported with
     warn(). (In PT mode the film's gradients are differences of the primal: the node then returns
-    the PT image + Emission whatever its settings.)"""
+    the PT image + Emission whatever its settings.) placement: see _CACHE."""
     if not any_node():
         _CACHE.clear()
         return
     key = (scene.name, view_layer_name)
     _CACHE[key] = {k: film[k] for k in FILM_KEYS.values()}
+    _CACHE[key]["placement"] = placement
     for owner in bpy.data.scenes:
         for node in nodes_in(owner):
             try:

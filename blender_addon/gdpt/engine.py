@@ -199,8 +199,12 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         # Gradient Reconstruct compositor nodes solve from this layer's passes now: Blender
         # composites after render() returns (compositor_node.py).
         try:
+            region = export_camera.render_region(scene.render)
+            placement = None
+            if region and not scene.render.use_crop_to_border:
+                placement = export_camera.render_resolution(scene.render) + region[:2]
             compositor_node.fill_after_render(scene.original, view_layer.name, film,
-                                              settings.threads, self._warn)
+                                              settings.threads, self._warn, placement)
         except Exception as e:  # the node must never cost the render
             self._warn(f"Gradient Reconstruct compositor nodes were not updated: {e}")
         t_end = time.perf_counter()

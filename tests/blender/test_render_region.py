@@ -14,6 +14,8 @@
 # off by one ulp (6e-8) in about a third of the renders; with Embree's build on one thread
 # (GDPT_EMBREE_CONFIG=threads=1) 40 of 40 were bit-identical. A wrong region offset changes
 # nearly every value.
+#  - the Gradient Reconstruct compositor node: its image is the cropped region, or the frame with
+#    the region in place, equal to the engine's Combined;
 #  - a resolution percentage whose float product would round differently (29% of 100 px) still
 #    gives Blender's own size.
 import os
@@ -125,6 +127,33 @@ def main():
     rgb = np.stack([ch[c] for c in "RGB"], axis=-1)
     ok, frac = same_pixels(rgb[inside].reshape(h, w, 3), same)
     check(ok, f"the uncropped region's pixels are the frame's ({100 * frac:.2f}% differ)")
+
+    # --- The Gradient Reconstruct compositor node on a region: cropped, its image is the
+    # region; uncropped, the frame with the region in place, as Blender's Render Layers buffers
+    # (before 2026-12-01 it wrote a region-sized image, which the compositor placed centred) ---
+    S.setup_gdpt(scene, 8, mode='GPT', reconstruction='L1')
+    scene.use_nodes = True
+    tree = scene.node_tree
+    for n in list(tree.nodes):
+        tree.nodes.remove(n)
+    rl = tree.nodes.new("CompositorNodeRLayers")
+    node = tree.nodes.new("CompositorNodeGDPTReconstruct")
+    node.norm, node.alpha = 'L1', scene.gdpt.alpha  # the engine's own solve: Combined
+    comp = tree.nodes.new("CompositorNodeComposite")
+    for k in ("Primal", "Gradient X", "Gradient Y", "Emission"):
+        tree.links.new(rl.outputs[k], node.inputs[k])
+    tree.links.new(node.outputs["Image"], comp.inputs["Image"])
+    for crop in (True, False):
+        ch = exr.read_exr(render(scene, os.path.join(out, f"node_{crop}.exr"), True, crop))
+        composite = exr.rgb(ch, "Composite.Combined.")
+        combined = exr.rgb(ch, "ViewLayer.Combined.")
+        expect = (h, w, 3) if crop else (height, width, 3)
+        check(composite.shape == expect and combined.shape == expect,
+              f"node on a {'cropped' if crop else 'uncropped'} region: {composite.shape}")
+        err = float(np.abs(composite - combined).max())
+        check(err < 1e-5, f"node on a {'cropped' if crop else 'uncropped'} region: Composite "
+              f"equals the engine's Combined (max |diff| {err:.3g})")
+    scene.use_nodes = False
 
     # --- Resolution percentage in Blender's integer arithmetic ---
     scene.render.resolution_x, scene.render.resolution_y = 100, 100
