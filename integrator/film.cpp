@@ -50,6 +50,7 @@ void Film::take_rows(Film& pass, int y0, int y1) {
     a.dx2 += b.dx2;
     a.dy2 += b.dy2;
     a.shift_attempts += b.shift_attempts;
+    a.alpha += b.alpha;
     a.shift_failures += b.shift_failures;
     samples_[i] += pass.samples_[i];
     b = Accumulator{};
@@ -67,6 +68,11 @@ void Film::primal_rgb(float* out) const {
     const double inv = samples_[i] ? 1.0 / samples_[i] : 0.0;
     for (int c = 0; c < 3; ++c) out[3 * i + c] = float(acc_[i].primal[c] * inv);
   }
+}
+
+void Film::alpha(float* out) const {
+  for (size_t i = 0; i < acc_.size(); ++i)
+    out[i] = samples_[i] ? float(acc_[i].alpha / samples_[i]) : 0.0f;
 }
 
 void Film::emission_rgb(float* out) const {

@@ -3,6 +3,7 @@
 // differences in those rows: dx(x, y) ~ I(x+1, y) - I(x, y), dy(x, y) ~ I(x, y+1) - I(x, y).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -29,6 +30,10 @@ class Film {
   // 3 per pixel: variance of the pixel mean of luminance(primal), luminance(dx), luminance(dy).
   void variance3(float* out) const;
   void shift_failures(float* out) const;  // 1 per pixel: fraction of failed shifts
+  // 1 per pixel: coverage, the mean of the samples' alphas (1 unless the background is
+  // transparent: then 0 for a camera ray that reaches the world, 1 - the transparency crossed on
+  // the way for one that reaches it through Transparent surfaces).
+  void alpha(float* out) const;
   uint32_t samples(int x, int y) const { return samples_[size_t(y) * width_ + x]; }
   uint32_t min_samples() const;
 
@@ -39,6 +44,7 @@ class Film {
     double dy[3] = {0, 0, 0}, dy2 = 0;
     double emission[3] = {0, 0, 0};
     double shift_attempts = 0, shift_failures = 0;
+    double alpha = 0;  // sum of the samples' alphas
     // G-PT: this pixel's one-sided halves G_left and G_down (sum, sum of squared luminance),
     // written only by the pixel's own tile and subtracted from the neighbours' dx(x - 1) and
     // dy(y - 1) at read-out, so that no tile has to trace its neighbours' base paths. dx and dy
@@ -48,8 +54,10 @@ class Film {
 
     // One camera sample's primal and camera-visible emission, as every integrator adds them: a
     // non-finite value would poison the pixel forever and is dropped (counted as black); with
-    // clamp > 0 the primal is scaled so its largest component is at most clamp.
-    void add_path(Spectrum primal_sample, Spectrum emission_sample, float clamp) {
+    // clamp > 0 the primal is scaled so its largest component is at most clamp. alpha: see
+    // Film::alpha().
+    void add_path(Spectrum primal_sample, Spectrum emission_sample, float clamp,
+                  float alpha_sample = 1.0f) {
       if (!is_finite(primal_sample)) primal_sample = Spectrum(0.0f);
       if (!is_finite(emission_sample)) emission_sample = Spectrum(0.0f);
       if (clamp > 0.0f) {
@@ -62,6 +70,7 @@ class Film {
         emission[c] += emission_sample[c];
       }
       primal2 += lum * lum;
+      alpha += std::isfinite(alpha_sample) ? alpha_sample : 1.0f;
     }
   };
   Accumulator& pixel(int x, int y) { return acc_[size_t(y) * width_ + x]; }

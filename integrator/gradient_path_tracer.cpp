@@ -222,6 +222,7 @@ struct SampleResult {
   Spectrum primal;
   Spectrum emission;
   Vec3d grad[kOffsets];
+  float alpha;  // Film::alpha(): 0 for a camera ray that reaches a transparent background
   uint8_t attempts, failures;
   uint32_t rays;
 };
@@ -352,7 +353,7 @@ class GradientPathTracer final : public Integrator {
       rays += r.rays;
       // --- Primal, emission and statistics of the pixel's base path ---
       Film::Accumulator& acc = film.pixel(x, y);
-      acc.add_path(r.primal, r.emission, clamp);
+      acc.add_path(r.primal, r.emission, clamp, r.alpha);
       acc.shift_attempts += r.attempts;
       acc.shift_failures += r.failures;
       // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
@@ -606,6 +607,7 @@ class GradientPathTracer final : public Integrator {
 
     out.primal = Spectrum(0.0f);
     out.emission = Spectrum(0.0f);
+    out.alpha = 1.0f;
     out.attempts = out.failures = 0;
     out.rays = 0;  // camera rays are counted by render_tile()
 
@@ -622,7 +624,10 @@ class GradientPathTracer final : public Integrator {
         out.emission += lh.radiance;
     }
     if (!camera_found) {
-      if (has_world_) out.emission += lights.environment(cam_ray.direction);
+      if (settings_.transparent_background)
+        out.alpha = 0.0f;
+      else if (has_world_)
+        out.emission += lights.environment(cam_ray.direction);
       for (Vec3d& g : out.grad) g = Vec3d();
       return;
     }

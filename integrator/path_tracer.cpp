@@ -39,6 +39,7 @@ inline Vec3f bend_shading_normal(Vec3f ns, Vec3f ng, Vec3f wi) {
 struct PathResult {
   Spectrum primal{0.0f};
   Spectrum emission{0.0f};  // camera-visible emission
+  float alpha = 1.0f;       // Film::alpha()
   uint32_t rays = 0;
 };
 
@@ -86,7 +87,7 @@ class PathTracer final : public Integrator {
             const PathResult r =
                 trace(samplers[j], camera_rays[j], found[j], closures, scratch, hits[j]);
             rays += r.rays;
-            film.pixel(x0 + j, y).add_path(r.primal, r.emission, clamp);
+            film.pixel(x0 + j, y).add_path(r.primal, r.emission, clamp, r.alpha);
           }
         }
       }
@@ -186,12 +187,15 @@ class PathTracer final : public Integrator {
         }
       }
 
-      // --- Escape: the world ---
+      // --- Escape: the world (with a transparent background, a camera path that gets here
+      // leaves it out and reports the transparency it crossed: Cycles' alpha) ---
       if (!found) {
+        if (camera_path && settings_.transparent_background)
+          out.alpha = 1.0f - std::clamp((beta.x + beta.y + beta.z) / 3.0f, 0.0f, 1.0f);
         if constexpr (kWorld) {
           const Spectrum le = lights.environment(ray.direction);
           if (camera_path) {
-            out.emission += beta * le;
+            if (!settings_.transparent_background) out.emission += beta * le;
           } else if (!is_black(le)) {
             const float w = prev_delta
                                 ? 1.0f

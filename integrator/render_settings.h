@@ -15,6 +15,9 @@ struct RenderSettings {
   float clamp = 0.0f;                        // max sample value, 0 = off
   int rr_depth = 3;                          // Russian roulette from this vertex on
   float shift_roughness_threshold = 0.001f;  // G-PT: GGX alpha below this = specular vertex
+  // Blender's Film > Transparent: the world seen directly by the camera is left out of the image,
+  // and the film's alpha is the fraction of the pixel covered by surfaces (Film::alpha).
+  bool transparent_background = false;
   int samples_per_pass = 1;  // progressive granularity (a pass = this many spp over the image)
   // Debug / benchmark: run the kernel with every feature path on (same image, slower), to measure
   // what the per-scene specialisation buys.

@@ -101,8 +101,9 @@ def node_image(node):
     return image_node.image if image_node is not None else None
 
 
-def _write_image(node, rgb, placement=None):
-    """rgb: (height, width, 3) float32, rows bottom-up; written with alpha 1. With a placement
+def _write_image(node, rgb, placement=None, alpha=None):
+    """rgb: (height, width, 3) float32, rows bottom-up; written with alpha 1, or `alpha`
+    ((height, width[, 1]), the render's coverage with Film > Transparent). With a placement
     (frame width, frame height, x, y) the image is the frame, rgb at (x, y), alpha 0 elsewhere."""
     image = node_image(node)
     if image is None:
@@ -116,7 +117,8 @@ def _write_image(node, rgb, placement=None):
         image.generated_width, image.generated_height = width, height
     rgba = np.zeros((height, width, 4), dtype=np.float32)
     rgba[y:y + rgb.shape[0], x:x + rgb.shape[1], :3] = rgb
-    rgba[y:y + rgb.shape[0], x:x + rgb.shape[1], 3] = 1.0
+    rgba[y:y + rgb.shape[0], x:x + rgb.shape[1], 3] = (
+        1.0 if alpha is None else alpha.reshape(rgb.shape[:2]))
     image.pixels.foreach_set(rgba.ravel())
     image.update()
 
@@ -237,9 +239,12 @@ def reconstruct_node(scene, node, threads=0):
         np.ascontiguousarray(arrays["Gradient Y"], dtype=np.float32), None,
         None if emission is None else np.ascontiguousarray(emission, dtype=np.float32),
         node.norm, float(node.alpha), int(threads))
-    placements = {_CACHE.get((src[1], src[2]), {}).get("placement")
-                  for src in srcs.values() if src[0] == 'LAYER'}
-    _write_image(node, rgb, placements.pop() if len(placements) == 1 else None)
+    layers = {(src[1], src[2]) for src in srcs.values() if src[0] == 'LAYER'}
+    cached = _CACHE.get(layers.pop(), {}) if len(layers) == 1 else {}
+    alpha = cached.get("alpha")
+    if alpha is not None and alpha.shape[:2] != rgb.shape[:2]:
+        alpha = None
+    _write_image(node, rgb, cached.get("placement"), alpha)
     height, width = rgb.shape[:2]
     _say(node, 'INFO', f"{node.norm}, alpha {node.alpha:g}, {width}x{height}"
                        + ("" if emission is not None else ", no Emission input"))
@@ -277,6 +282,7 @@ def fill_after_render(scene, view_layer_name, film, threads, warn, placement=Non
     key = (scene.name, view_layer_name)
     _CACHE[key] = {k: film[k] for k in FILM_KEYS.values()}
     _CACHE[key]["placement"] = placement
+    _CACHE[key]["alpha"] = film.get("alpha")
     for owner in bpy.data.scenes:
         for node in nodes_in(owner):
             try:

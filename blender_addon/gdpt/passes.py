@@ -49,7 +49,8 @@ def layer_buffer(layer, film, combined_rgb):
         view = buffer[offset:offset + size].reshape(count, p.channels)
         if p.name == "Combined":
             view[:, :3] = combined_rgb.reshape(count, 3)
-            view[:, 3] = 1.0
+            # Coverage: 1 unless Film > Transparent leaves the background out.
+            view[:, 3] = film["alpha"].reshape(count) if "alpha" in film else 1.0
         elif p.name in _FILM_KEYS:
             data = film[_FILM_KEYS[p.name]].reshape(count, -1)
             view[:, :min(p.channels, data.shape[1])] = data[:, :p.channels]

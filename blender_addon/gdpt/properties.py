@@ -93,4 +93,6 @@ def settings_dict(scene):
         "threads": int(s.threads),
         "clamp": float(s.clamp),
         "shift_threshold": float(s.shift_threshold),
+        # Blender's Render Properties > Film > Transparent.
+        "transparent_background": bool(scene.render.film_transparent),
     }

@@ -44,6 +44,18 @@ class GDPT_PT_light_paths(_RenderPanel, Panel):
         layout.prop(context.scene.gdpt, "max_bounces")
 
 
+class GDPT_PT_film(_RenderPanel, Panel):
+    bl_label = "Film"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        # Blender's own setting (Cycles and EEVEE show it in their Film panels).
+        layout.prop(context.scene.render, "film_transparent", text="Transparent")
+
+
 class GDPT_PT_gradient_domain(_RenderPanel, Panel):
     bl_label = "Gradient Domain"
 
@@ -111,7 +123,7 @@ class GDPT_PT_passes(Panel):
         col.prop(s, "use_pass_shift_failures")
 
 
-_classes = (GDPT_PT_sampling, GDPT_PT_light_paths, GDPT_PT_gradient_domain,
+_classes = (GDPT_PT_sampling, GDPT_PT_light_paths, GDPT_PT_film, GDPT_PT_gradient_domain,
             GDPT_PT_reconstruction, GDPT_PT_performance, GDPT_PT_passes)
 
 # Blender's engine-agnostic panels carry 'BLENDER_RENDER' in COMPAT_ENGINES (the convention of

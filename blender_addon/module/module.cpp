@@ -38,6 +38,7 @@ RenderSettings settings_from_dict(const py::dict& d) {
   get("rr_depth", s.rr_depth);
   get("shift_threshold", s.shift_roughness_threshold);
   get("samples_per_pass", s.samples_per_pass);
+  get("transparent_background", s.transparent_background);
   return s;
 }
 

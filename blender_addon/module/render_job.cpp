@@ -36,6 +36,8 @@ void FilmPasses::read(const Film& film, int samples) {
   emission.resize(n * 3);
   variance.resize(n * 3);
   shift_failures.resize(n);
+  alpha.resize(n);
+  film.alpha(alpha.data());
   film.primal_rgb(primal.data());
   film.gradient_x_rgb(gradient_x.data());
   film.gradient_y_rgb(gradient_y.data());
@@ -56,6 +58,7 @@ py::dict FilmPasses::to_python() const {
   d["emission"] = to_numpy(std::move(copy.emission), height, width, 3);
   d["variance"] = to_numpy(std::move(copy.variance), height, width, 3);
   d["shift_failures"] = to_numpy(std::move(copy.shift_failures), height, width, 1);
+  d["alpha"] = to_numpy(std::move(copy.alpha), height, width, 1);
   return d;
 }
 

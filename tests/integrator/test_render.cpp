@@ -356,6 +356,63 @@ TEST(Render, EmissionSeenThroughTransparentSurfacesIsCameraVisible) {
   }
 }
 
+// Film > Transparent: camera rays that reach the world leave it out (no Emission) and give alpha 0,
+// through a Transparent sheet alpha 1 - mean(sheet colour) (Cycles' alpha); surfaces keep alpha 1
+// and their light, the world still lighting them. Left half of the view: world (under a sheet in
+// the second case), right half: a floor.
+TEST(Render, TransparentBackgroundLeavesTheWorldOutAndGivesCoverage) {
+  for (const bool sheet : {false, true}) {
+    Scene scene;
+    scene.meshes.push_back(quad(1.0f));
+    scene.materials.push_back(diffuse(Spectrum(0.5f)));
+    scene.instances.push_back(place(0, 0, translation({1, 0, 0})));  // x in [0, 2]
+    if (sheet) {
+      MaterialDesc m;
+      ShaderNode t;
+      t.kind = ShaderNodeKind::Transparent;
+      t.color = ColorInput(Spectrum(0.5f, 0.25f, 1.0f));
+      m.nodes.push_back(t);
+      m.root = 0;
+      scene.materials.push_back(m);
+      scene.instances.push_back(place(0, 1, translation({-1, 0, 1})));  // x in [-2, 0]
+    }
+    scene.world.color = Spectrum(0.5f);
+    scene.camera = top_camera(4, 2.0f, 5.0f);
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      if (sheet && mode == RenderSettings::Mode::GPT) continue;  // PT only (docs: limitation)
+      RenderSettings s = pt(16);
+      s.mode = mode;
+      const Image opaque = render(scene, s);
+      s.transparent_background = true;
+      RenderSession session(scene, s);
+      std::atomic<bool> cancel{false};
+      session.render(nullptr, cancel);
+      std::vector<float> primal(48), emission(48), alpha(16);
+      session.film().primal_rgb(primal.data());
+      session.film().emission_rgb(emission.data());
+      session.film().alpha(alpha.data());
+      const float world_alpha = sheet ? 1.0f - (0.5f + 0.25f + 1.0f) / 3.0f : 0.0f;
+      for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) {
+          const size_t i = size_t(y * 4 + x);
+          const bool floor = x >= 2;
+          EXPECT_NEAR(alpha[i], floor ? 1.0f : world_alpha, 1e-6f) << x << " " << y;
+          for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(emission[3 * i + c], 0.0f) << x << " " << y;
+            if (floor) {
+              EXPECT_EQ(primal[3 * i + c], opaque.primal[3 * i + c]);
+            } else if (!sheet) {
+              EXPECT_FLOAT_EQ(opaque.emission[3 * i + c], 0.5f);
+            }
+          }
+          if (floor) {
+            EXPECT_GT(primal[3 * i], 0.0f);
+          }
+        }
+    }
+  }
+}
+
 // --- Light-path semantics ---
 
 TEST(Render, CameraVisibleEmissionGoesToTheEmissionPass) {
