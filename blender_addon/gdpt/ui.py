@@ -6,6 +6,13 @@ from bpy.types import Panel
 ENGINE = "GDPT"
 
 
+def _split(layout):
+    """The layout of Blender's property panels: labels left, values right, no keyframe dots."""
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    return layout
+
+
 class _RenderPanel:
     bl_space_type = 'PROPERTIES'
     bl_region_type = 'WINDOW'
@@ -21,9 +28,7 @@ class GDPT_PT_sampling(_RenderPanel, Panel):
     bl_label = "Sampling"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = _split(self.layout)
         s = context.scene.gdpt
         col = layout.column(align=True)
         col.prop(s, "samples")
@@ -38,9 +43,7 @@ class GDPT_PT_light_paths(_RenderPanel, Panel):
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = _split(self.layout)
         layout.prop(context.scene.gdpt, "max_bounces")
 
 
@@ -49,9 +52,7 @@ class GDPT_PT_film(_RenderPanel, Panel):
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = _split(self.layout)
         # Blender's own setting (Cycles and EEVEE show it in their Film panels).
         layout.prop(context.scene.render, "film_transparent", text="Transparent")
 
@@ -60,9 +61,7 @@ class GDPT_PT_gradient_domain(_RenderPanel, Panel):
     bl_label = "Gradient Domain"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = _split(self.layout)
         s = context.scene.gdpt
         layout.prop(s, "mode")
         col = layout.column()
@@ -74,9 +73,7 @@ class GDPT_PT_reconstruction(_RenderPanel, Panel):
     bl_label = "Reconstruction"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = _split(self.layout)
         s = context.scene.gdpt
         col = layout.column()
         col.active = s.mode == 'GPT'
@@ -91,9 +88,7 @@ class GDPT_PT_performance(_RenderPanel, Panel):
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = _split(self.layout)
         s = context.scene.gdpt
         layout.prop(s, "threads")
         layout.prop(s, "preview_interval")
@@ -111,9 +106,7 @@ class GDPT_PT_passes(Panel):
         return context.engine in cls.COMPAT_ENGINES
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = _split(self.layout)
         s = context.view_layer.gdpt
         col = layout.column(heading="Include", align=True)
         col.prop(s, "use_pass_primal")

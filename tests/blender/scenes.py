@@ -232,6 +232,23 @@ def setup_cycles(scene, samples, bounces=4, seed=1):
     scene.render.use_persistent_data = False
 
 
+def reconstruct_tree(scene, norm='L1', alpha=0.2):
+    """Compositor: Render Layers (Primal, Gradients, Emission) -> Gradient Reconstruct -> Composite
+    (the engine must be GDPT for the Render Layers node to show its passes). Returns the node."""
+    scene.use_nodes = True
+    tree = scene.node_tree
+    for n in list(tree.nodes):
+        tree.nodes.remove(n)
+    rl = tree.nodes.new("CompositorNodeRLayers")
+    node = tree.nodes.new("CompositorNodeGDPTReconstruct")
+    node.norm, node.alpha = norm, alpha
+    comp = tree.nodes.new("CompositorNodeComposite")
+    for k in ("Primal", "Gradient X", "Gradient Y", "Emission"):
+        tree.links.new(rl.outputs[k], node.inputs[k])
+    tree.links.new(node.outputs["Image"], comp.inputs["Image"])
+    return node
+
+
 def render(scene, path, multilayer=False):
     """Renders the current frame to `path` (.exr) like `-f`, returns the path."""
     s = scene.render.image_settings

@@ -76,17 +76,7 @@ def main():
 
     # --- G-PT + L1, with the compositor node ---
     S.setup_gdpt(scene, 32, mode='GPT', reconstruction='L1')  # Render Layers shows GDPT's passes
-    scene.use_nodes = True
-    tree = scene.node_tree
-    for n in list(tree.nodes):
-        tree.nodes.remove(n)
-    rl = tree.nodes.new("CompositorNodeRLayers")
-    node = tree.nodes.new("CompositorNodeGDPTReconstruct")
-    node.norm, node.alpha = 'L1', 0.2
-    comp = tree.nodes.new("CompositorNodeComposite")
-    for k in ("Primal", "Gradient X", "Gradient Y", "Emission"):
-        tree.links.new(rl.outputs[k], node.inputs[k])
-    tree.links.new(node.outputs["Image"], comp.inputs["Image"])
+    S.reconstruct_tree(scene, 'L1', scene.gdpt.alpha)
     path = render(scene, "gpt_clear", True, mode='GPT', reconstruction='L1')
     gpt = rgba(path, "ViewLayer.Combined.")
     composite = rgba(path, "Composite.Combined.")

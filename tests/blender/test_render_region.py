@@ -132,17 +132,7 @@ def main():
     # region; uncropped, the frame with the region in place, as Blender's Render Layers buffers
     # (before 2026-12-01 it wrote a region-sized image, which the compositor placed centred) ---
     S.setup_gdpt(scene, 8, mode='GPT', reconstruction='L1')
-    scene.use_nodes = True
-    tree = scene.node_tree
-    for n in list(tree.nodes):
-        tree.nodes.remove(n)
-    rl = tree.nodes.new("CompositorNodeRLayers")
-    node = tree.nodes.new("CompositorNodeGDPTReconstruct")
-    node.norm, node.alpha = 'L1', scene.gdpt.alpha  # the engine's own solve: Combined
-    comp = tree.nodes.new("CompositorNodeComposite")
-    for k in ("Primal", "Gradient X", "Gradient Y", "Emission"):
-        tree.links.new(rl.outputs[k], node.inputs[k])
-    tree.links.new(node.outputs["Image"], comp.inputs["Image"])
+    S.reconstruct_tree(scene, 'L1', scene.gdpt.alpha)  # the engine's own solve: Combined
     for crop in (True, False):
         ch = exr.read_exr(render(scene, os.path.join(out, f"node_{crop}.exr"), True, crop))
         composite = exr.rgb(ch, "Composite.Combined.")

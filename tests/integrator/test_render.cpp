@@ -268,17 +268,15 @@ TEST(Render, DiskAreaLightMisMatchesTheAnalyticIrradiance) {
 // the sheet: light crosses it twice, L = albedo E cos / pi * T^2 (Cycles' transparent shadows).
 // Transparent crossings are not bounces: max_bounces = 0 gives the same image, and with a soft
 // sun the BSDF paths through the sheet are MIS-weighted against NEE from the floor.
+MaterialDesc transparent(Spectrum color) {
+  return test::single_node(ShaderNodeKind::Transparent, color, 0.0f);
+}
+
 Scene transparent_sheet_scene(float sun_angle) {
   Scene scene;
   scene.meshes.push_back(quad(50.0f));
   scene.materials.push_back(diffuse(Spectrum(0.5f)));
-  MaterialDesc sheet;
-  ShaderNode t;
-  t.kind = ShaderNodeKind::Transparent;
-  t.color = ColorInput(Spectrum(0.5f, 0.25f, 1.0f));
-  sheet.nodes.push_back(t);
-  sheet.root = 0;
-  scene.materials.push_back(sheet);
+  scene.materials.push_back(transparent(Spectrum(0.5f, 0.25f, 1.0f)));
   scene.instances.push_back(place(0, 0));
   scene.instances.push_back(place(0, 1, translation({0, 0, 1})));
   scene.world.color = Spectrum(0.0f);
@@ -367,13 +365,7 @@ TEST(Render, TransparentBackgroundLeavesTheWorldOutAndGivesCoverage) {
     scene.materials.push_back(diffuse(Spectrum(0.5f)));
     scene.instances.push_back(place(0, 0, translation({1, 0, 0})));  // x in [0, 2]
     if (sheet) {
-      MaterialDesc m;
-      ShaderNode t;
-      t.kind = ShaderNodeKind::Transparent;
-      t.color = ColorInput(Spectrum(0.5f, 0.25f, 1.0f));
-      m.nodes.push_back(t);
-      m.root = 0;
-      scene.materials.push_back(m);
+      scene.materials.push_back(transparent(Spectrum(0.5f, 0.25f, 1.0f)));
       scene.instances.push_back(place(0, 1, translation({-1, 0, 1})));  // x in [-2, 0]
     }
     scene.world.color = Spectrum(0.5f);
