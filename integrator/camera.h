@@ -54,6 +54,9 @@ class CameraModel {
   // Used by G-PT only with depth of field (without it, offsets reuse neighbours' camera rays).
   void generate_offset_rays(Vec2f raster, Vec2f lens, const bool mask[4], Ray out[4]) const;
 
+  // Distance of a world point in front of the camera along its view axis (Blender's Depth pass).
+  float view_depth(Vec3f world) const { return -world_to_camera_.point(world).z; }
+
   // World point -> raster position (pinhole); returns false behind the camera. For tests.
   bool project(Vec3f world, Vec2f& raster) const;
 

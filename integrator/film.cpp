@@ -25,11 +25,13 @@ Film::Film(int width, int height)
     : width_(std::max(width, 0)),
       height_(std::max(height, 0)),
       acc_(size_t(width_) * size_t(height_)),
-      samples_(size_t(width_) * size_t(height_), 0u) {}
+      samples_(size_t(width_) * size_t(height_), 0u),
+      depth_(size_t(width_) * size_t(height_), 0.0f) {}
 
 void Film::clear() {
   std::fill(acc_.begin(), acc_.end(), Accumulator{});
   std::fill(samples_.begin(), samples_.end(), 0u);
+  std::fill(depth_.begin(), depth_.end(), 0.0f);
 }
 
 void Film::take_rows(Film& pass, int y0, int y1) {
@@ -53,6 +55,8 @@ void Film::take_rows(Film& pass, int y0, int y1) {
     a.alpha += b.alpha;
     a.shift_failures += b.shift_failures;
     samples_[i] += pass.samples_[i];
+    if (pass.depth_[i] != 0.0f) depth_[i] = pass.depth_[i];
+    pass.depth_[i] = 0.0f;
     b = Accumulator{};
     pass.samples_[i] = 0;
   }
@@ -73,6 +77,10 @@ void Film::primal_rgb(float* out) const {
 void Film::alpha(float* out) const {
   for (size_t i = 0; i < acc_.size(); ++i)
     out[i] = samples_[i] ? float(acc_[i].alpha / samples_[i]) : 0.0f;
+}
+
+void Film::depth(float* out) const {
+  for (size_t i = 0; i < depth_.size(); ++i) out[i] = depth_[i] > 0.0f ? depth_[i] : 1e10f;
 }
 
 void Film::emission_rgb(float* out) const {

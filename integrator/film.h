@@ -34,6 +34,9 @@ class Film {
   // transparent: then 0 for a camera ray that reaches the world, 1 - the transparency crossed on
   // the way for one that reaches it through Transparent surfaces).
   void alpha(float* out) const;
+  // 1 per pixel: Blender's Depth (Z) pass as Cycles fills it: the view-axis distance of the
+  // camera ray's first hit in the pixel's sample 0, 1e10 where that ray saw no surface.
+  void depth(float* out) const;
   uint32_t samples(int x, int y) const { return samples_[size_t(y) * width_ + x]; }
   uint32_t min_samples() const;
 
@@ -76,6 +79,8 @@ class Film {
   Accumulator& pixel(int x, int y) { return acc_[size_t(y) * width_ + x]; }
   const Accumulator& pixel(int x, int y) const { return acc_[size_t(y) * width_ + x]; }
   void add_sample_count(int x, int y, uint32_t n = 1) { samples_[size_t(y) * width_ + x] += n; }
+  // Sample 0's camera hit (view-axis distance > 0); integrators call it for that sample only.
+  void set_depth(int x, int y, float d) { depth_[size_t(y) * width_ + x] = d; }
 
   // --- Bookkeeping (RenderSession) ---
   // PT mode: the integrator does not estimate gradients; gradient_x/y_rgb() then return forward
@@ -96,6 +101,7 @@ class Film {
   int width_ = 0, height_ = 0;
   std::vector<Accumulator> acc_;
   std::vector<uint32_t> samples_;
+  std::vector<float> depth_;  // 0: no surface (yet)
   bool gradients_from_primal_ = false;
 };
 

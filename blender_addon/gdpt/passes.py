@@ -24,6 +24,7 @@ _FILM_KEYS = {
     "Emission": "emission",
     "Variance": "variance",
     "Shift Failures": "shift_failures",
+    "Depth": "depth",
 }
 
 
@@ -33,6 +34,9 @@ def register_passes(engine, scene, view_layer):
     for name, channels, chan_id, kind, toggle in PASSES:
         if settings is None or getattr(settings, toggle):
             engine.register_pass(scene, view_layer, name, channels, chan_id, kind)
+    # Blender's own Z toggle (View Layer > Passes > Data > Z, as for Cycles).
+    if view_layer.use_pass_z:
+        engine.register_pass(scene, view_layer, "Depth", 1, "Z", 'VALUE')
 
 
 def layer_buffer(layer, film, combined_rgb):

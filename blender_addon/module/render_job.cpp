@@ -38,6 +38,8 @@ void FilmPasses::read(const Film& film, int samples) {
   shift_failures.resize(n);
   alpha.resize(n);
   film.alpha(alpha.data());
+  depth.resize(n);
+  film.depth(depth.data());
   film.primal_rgb(primal.data());
   film.gradient_x_rgb(gradient_x.data());
   film.gradient_y_rgb(gradient_y.data());
@@ -59,6 +61,7 @@ py::dict FilmPasses::to_python() const {
   d["variance"] = to_numpy(std::move(copy.variance), height, width, 3);
   d["shift_failures"] = to_numpy(std::move(copy.shift_failures), height, width, 1);
   d["alpha"] = to_numpy(std::move(copy.alpha), height, width, 1);
+  d["depth"] = to_numpy(std::move(copy.depth), height, width, 1);
   return d;
 }
 

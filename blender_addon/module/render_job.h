@@ -25,7 +25,8 @@ namespace gdpt::python {
 // The film passes as float32 images, row 0 at the bottom, interleaved.
 struct FilmPasses {
   int width = 0, height = 0, samples_done = 0;
-  std::vector<float> primal, gradient_x, gradient_y, emission, variance, shift_failures, alpha;
+  std::vector<float> primal, gradient_x, gradient_y, emission, variance, shift_failures, alpha,
+      depth;
   void read(const Film& film, int samples);
   py::dict to_python() const;  // numpy views owning copies of the vectors
 };

@@ -405,6 +405,41 @@ TEST(Render, TransparentBackgroundLeavesTheWorldOutAndGivesCoverage) {
   }
 }
 
+// Depth pass: the view-axis distance of sample 0's camera hit (Cycles), 1e10 without one; kept
+// across passes (one sample per pass here), PT and G-PT, perspective and orthographic.
+TEST(Render, DepthPassIsSampleZerosViewAxisDistance) {
+  Scene scene;
+  scene.meshes.push_back(quad(1.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  scene.instances.push_back(place(0, 0, translation({1, 0, 0})));  // right half of the view
+  scene.world.color = Spectrum(0.5f);
+  for (const bool ortho : {true, false}) {
+    scene.camera = top_camera(4, 2.0f, 7.0f);
+    if (!ortho) scene.camera.projection = Camera::Projection::Perspective;
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      RenderSettings s = pt(3);
+      s.mode = mode;
+      s.samples_per_pass = 1;
+      RenderSession session(scene, s);
+      std::atomic<bool> cancel{false};
+      session.render(nullptr, cancel);
+      std::vector<float> depth(16);
+      session.film().depth(depth.data());
+      int floor = 0;
+      for (int i = 0; i < 16; ++i) {
+        if (depth[size_t(i)] < 1e9f) {
+          ++floor;
+          EXPECT_NEAR(depth[size_t(i)], 7.0f, 1e-5f) << i;
+        } else {
+          EXPECT_EQ(depth[size_t(i)], 1e10f) << i;
+        }
+      }
+      EXPECT_GE(floor, ortho ? 8 : 2) << ortho;  // ortho: exactly the right half
+      EXPECT_LT(floor, 16) << ortho;
+    }
+  }
+}
+
 // --- Light-path semantics ---
 
 TEST(Render, CameraVisibleEmissionGoesToTheEmissionPass) {
