@@ -232,6 +232,21 @@ def setup_cycles(scene, samples, bounces=4, seed=1):
     scene.render.use_persistent_data = False
 
 
+def render_engine(scene, name, engine, samples, **gdpt_settings):
+    """Renders `name`.exr (multilayer) in the test's output folder with GDPT (setup_gdpt with
+    `gdpt_settings`, and checks that Gradient PT really rendered) or Cycles; returns the path."""
+    import gdpt.engine as engine_module
+    if engine == 'GDPT':
+        setup_gdpt(scene, samples, **gdpt_settings)
+        engine_module.LAST_RENDER.clear()
+    else:
+        setup_cycles(scene, samples)
+    path = render(scene, os.path.join(args()["out"], name + ".exr"), multilayer=True)
+    if engine == 'GDPT':
+        check(engine_module.LAST_RENDER.get("status") == "finished", f"Gradient PT rendered {name}")
+    return path
+
+
 def reconstruct_tree(scene, norm='L1', alpha=0.2):
     """Compositor: Render Layers (Primal, Gradients, Emission) -> Gradient Reconstruct -> Composite
     (the engine must be GDPT for the Render Layers node to show its passes). Returns the node."""

@@ -23,17 +23,8 @@ check = S.check
 
 
 def depth(scene, name, engine, **kw):
-    import gdpt.engine as engine_module
     scene.view_layers[0].use_pass_z = True
-    if engine == 'GDPT':
-        S.setup_gdpt(scene, 4, **kw)
-        engine_module.LAST_RENDER.clear()
-    else:
-        S.setup_cycles(scene, 4)
-    path = S.render(scene, os.path.join(S.args()["out"], name + ".exr"), multilayer=True)
-    if engine == 'GDPT':
-        check(engine_module.LAST_RENDER.get("status") == "finished", f"Gradient PT rendered {name}")
-    ch = exr.read_exr(path)
+    ch = exr.read_exr(S.render_engine(scene, name, engine, 4, **kw))
     check("ViewLayer.Depth.Z" in ch, f"{name}: the EXR has ViewLayer.Depth.Z")
     return ch["ViewLayer.Depth.Z"]
 

@@ -34,17 +34,8 @@ def rgba(path, prefix):
 
 
 def render(scene, name, transparent, engine='GDPT', **kw):
-    import gdpt.engine as engine_module
     scene.render.film_transparent = transparent
-    if engine == 'GDPT':
-        S.setup_gdpt(scene, 32, **kw)
-        engine_module.LAST_RENDER.clear()
-    else:
-        S.setup_cycles(scene, 32)
-    path = S.render(scene, os.path.join(S.args()["out"], name + ".exr"), multilayer=True)
-    if engine == 'GDPT':
-        check(engine_module.LAST_RENDER.get("status") == "finished", f"Gradient PT rendered {name}")
-    return path
+    return S.render_engine(scene, name, engine, 32, **kw)
 
 
 def main():
