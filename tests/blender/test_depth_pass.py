@@ -12,7 +12,6 @@ import math
 import os
 import sys
 
-import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))

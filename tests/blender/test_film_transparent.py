@@ -8,7 +8,6 @@
 import os
 import sys
 
-import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
