@@ -34,9 +34,12 @@ class Film {
   // transparent: then 0 for a camera ray that reaches the world, 1 - the transparency crossed on
   // the way for one that reaches it through Transparent surfaces).
   void alpha(float* out) const;
-  // 1 per pixel: Blender's Depth (Z) pass as Cycles fills it: the view-axis distance of the
-  // camera ray's first hit in the pixel's sample 0, 1e10 where that ray saw no surface.
+  // 1 per pixel, as Cycles fills these passes from the camera ray of the pixel's sample 0: Depth
+  // (Z), the view-axis distance of its first hit, 1e10 where it saw no surface; the object's and
+  // the material's pass index there (IndexOB, IndexMA), 0 where it saw no surface.
   void depth(float* out) const;
+  void object_index(float* out) const;
+  void material_index(float* out) const;
   uint32_t samples(int x, int y) const { return samples_[size_t(y) * width_ + x]; }
   uint32_t min_samples() const;
 
@@ -79,8 +82,14 @@ class Film {
   Accumulator& pixel(int x, int y) { return acc_[size_t(y) * width_ + x]; }
   const Accumulator& pixel(int x, int y) const { return acc_[size_t(y) * width_ + x]; }
   void add_sample_count(int x, int y, uint32_t n = 1) { samples_[size_t(y) * width_ + x] += n; }
-  // Sample 0's camera hit (view-axis distance > 0); integrators call it for that sample only.
-  void set_depth(int x, int y, float d) { depth_[size_t(y) * width_ + x] = d; }
+  // Sample 0's camera hit (view-axis distance > 0, pass indices); integrators call it for that
+  // sample only.
+  void set_first_hit(int x, int y, float depth, float object_index, float material_index) {
+    const size_t i = size_t(y) * width_ + x;
+    depth_[i] = depth;
+    object_index_[i] = object_index;
+    material_index_[i] = material_index;
+  }
 
   // --- Bookkeeping (RenderSession) ---
   // PT mode: the integrator does not estimate gradients; gradient_x/y_rgb() then return forward
@@ -102,6 +111,7 @@ class Film {
   std::vector<Accumulator> acc_;
   std::vector<uint32_t> samples_;
   std::vector<float> depth_;  // 0: no surface (yet)
+  std::vector<float> object_index_, material_index_;
   bool gradients_from_primal_ = false;
 };
 

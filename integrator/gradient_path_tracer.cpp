@@ -386,8 +386,8 @@ class GradientPathTracer final : public Integrator {
             sampler.start(settings_.seed, x + rx, y + ry, s);
             offset_mask(x, y, mask);
             const int c = g.index(x, y);
-            if (s == 0 && g.found[c])  // Depth pass: sample 0's camera hit, as Cycles
-              film.set_depth(x, y, ctx_.camera().view_depth(g.hit[c].position));
+            if (s == 0 && g.found[c])  // Depth and index passes: sample 0's camera hit, as Cycles
+              ctx_.record_first_hit(film, x, y, g.hit[c]);
             cs.ray = &g.ray[c];
             cs.hit = &g.hit[c];
             cs.found = g.found[c];
@@ -421,10 +421,9 @@ class GradientPathTracer final : public Integrator {
               row.ray[i] = ctx_.camera().generate_ray(row.raster[i], row.lens[i]);
             }
             ctx_.bvh().intersect_stream(row.ray, row.valid, kRow, row.found, row.hit);
-            if (s == 0)  // Depth pass: sample 0's camera hit, as Cycles
+            if (s == 0)  // Depth and index passes: sample 0's camera hit, as Cycles
               for (int i = 0; i < n; ++i)
-                if (row.found[i])
-                  film.set_depth(x0 + i, y, ctx_.camera().view_depth(row.hit[i].position));
+                if (row.found[i]) ctx_.record_first_hit(film, x0 + i, y, row.hit[i]);
             for (int i = 0; i < kRow; ++i) {
               bool* mask = row.mask[i];
               offset_mask(x0 + i, y, mask);

@@ -82,9 +82,9 @@ class PathTracer final : public Integrator {
             camera_rays[j] = camera_ray(samplers[j], x0 + j + rx, y + ry);
           }
           ctx_.bvh().intersect_stream(camera_rays, valid, n, found, hits);
-          if (s == 0)  // Depth pass: sample 0's camera hit, as Cycles
+          if (s == 0)  // Depth and index passes: sample 0's camera hit, as Cycles
             for (int j = 0; j < n; ++j)
-              if (found[j]) film.set_depth(x0 + j, y, ctx_.camera().view_depth(hits[j].position));
+              if (found[j]) ctx_.record_first_hit(film, x0 + j, y, hits[j]);
           // --- The paths ---
           for (int j = 0; j < n; ++j) {
             const PathResult r =

@@ -33,6 +33,7 @@ struct Instance {
   uint32_t mesh = 0;
   Transform object_to_world;
   std::vector<int32_t> slot_material;  // slot -> index in Scene::materials (-1 = default)
+  float pass_index = 0.0f;  // Blender's Object > Relations > Pass Index (the IndexOB pass)
 };
 
 // Blender camera. Looks down its local -Z with +Y up, like Blender.

@@ -9,6 +9,7 @@
 
 #include "integrator/camera.h"
 #include "integrator/embree_scene.h"
+#include "integrator/film.h"
 #include "integrator/light_sampler.h"
 #include "integrator/render_settings.h"
 #include "integrator/scene.h"
@@ -25,6 +26,16 @@ class SceneContext {
   ~SceneContext();
 
   const Scene& scene() const { return scene_; }
+  // The data passes of pixel (x, y) from the camera hit of its sample 0 (Film::set_first_hit):
+  // view-axis depth, the instance's and the material's pass index (the default material has 0).
+  void record_first_hit(Film& film, int x, int y, const SurfaceHit& hit) const {
+    const float object =
+        hit.instance < scene_.instances.size() ? scene_.instances[hit.instance].pass_index : 0.0f;
+    const float material = hit.material >= 0 && size_t(hit.material) < scene_.materials.size()
+                               ? scene_.materials[size_t(hit.material)].pass_index
+                               : 0.0f;
+    film.set_first_hit(x, y, camera_.view_depth(hit.position), object, material);
+  }
   const EmbreeScene& bvh() const { return *bvh_; }
   const CameraModel& camera() const { return camera_; }
   const LightSampler& lights() const { return *lights_; }

@@ -69,7 +69,8 @@ struct ShaderNode {
 struct MaterialDesc {
   std::string name;
   std::vector<ShaderNode> nodes;
-  int32_t root = -1;  // -1: Blender's default grey diffuse (0.8)
+  int32_t root = -1;        // -1: Blender's default grey diffuse (0.8)
+  float pass_index = 0.0f;  // Blender's Material > Settings > Pass Index (the IndexMA pass)
 };
 
 // Image pixels in scene-linear RGBA float (the loader converts from the file's colour space via

@@ -269,7 +269,15 @@ def _output_node(tree):
 
 
 def translate_material(material, images, warn):
-    """MaterialDesc dict for a Blender material (root -1 = Blender's default grey)."""
+    """MaterialDesc dict for a Blender material (root -1 = Blender's default grey), with the
+    material's Pass Index (IndexMA pass)."""
+    d = _translate_surface(material, images, warn)
+    if material is not None:
+        d["pass_index"] = material.pass_index
+    return d
+
+
+def _translate_surface(material, images, warn):
     if material is None:
         return {"name": "", "nodes": [], "root": -1}
     if not material.use_nodes or material.node_tree is None:

@@ -194,4 +194,4 @@ class GeometryExporter:
         if mesh < 0:
             return
         slots = [self.materials.get(slot.material) for slot in obj.material_slots]
-        self.builder.add_instance(mesh, _matrix12(matrix), slots)
+        self.builder.add_instance(mesh, _matrix12(matrix), slots, obj.pass_index)

@@ -25,6 +25,8 @@ _FILM_KEYS = {
     "Variance": "variance",
     "Shift Failures": "shift_failures",
     "Depth": "depth",
+    "IndexOB": "object_index",
+    "IndexMA": "material_index",
 }
 
 
@@ -34,9 +36,13 @@ def register_passes(engine, scene, view_layer):
     for name, channels, chan_id, kind, toggle in PASSES:
         if settings is None or getattr(settings, toggle):
             engine.register_pass(scene, view_layer, name, channels, chan_id, kind)
-    # Blender's own Z toggle (View Layer > Passes > Data > Z, as for Cycles).
+    # Blender's own data-pass toggles (View Layer > Passes > Data, as for Cycles).
     if view_layer.use_pass_z:
         engine.register_pass(scene, view_layer, "Depth", 1, "Z", 'VALUE')
+    if view_layer.use_pass_object_index:
+        engine.register_pass(scene, view_layer, "IndexOB", 1, "X", 'VALUE')
+    if view_layer.use_pass_material_index:
+        engine.register_pass(scene, view_layer, "IndexMA", 1, "X", 'VALUE')
 
 
 def layer_buffer(layer, film, combined_rgb):

@@ -116,6 +116,8 @@ class GDPT_PT_passes(Panel):
         col.prop(s, "use_pass_shift_failures")
         col = layout.column(heading="Data", align=True)
         col.prop(context.view_layer, "use_pass_z")
+        col.prop(context.view_layer, "use_pass_object_index")
+        col.prop(context.view_layer, "use_pass_material_index")
 
 
 _classes = (GDPT_PT_sampling, GDPT_PT_light_paths, GDPT_PT_film, GDPT_PT_gradient_domain,

@@ -40,6 +40,10 @@ void FilmPasses::read(const Film& film, int samples) {
   film.alpha(alpha.data());
   depth.resize(n);
   film.depth(depth.data());
+  object_index.resize(n);
+  film.object_index(object_index.data());
+  material_index.resize(n);
+  film.material_index(material_index.data());
   film.primal_rgb(primal.data());
   film.gradient_x_rgb(gradient_x.data());
   film.gradient_y_rgb(gradient_y.data());
@@ -62,6 +66,8 @@ py::dict FilmPasses::to_python() const {
   d["shift_failures"] = to_numpy(std::move(copy.shift_failures), height, width, 1);
   d["alpha"] = to_numpy(std::move(copy.alpha), height, width, 1);
   d["depth"] = to_numpy(std::move(copy.depth), height, width, 1);
+  d["object_index"] = to_numpy(std::move(copy.object_index), height, width, 1);
+  d["material_index"] = to_numpy(std::move(copy.material_index), height, width, 1);
   return d;
 }
 

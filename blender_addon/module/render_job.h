@@ -26,7 +26,7 @@ namespace gdpt::python {
 struct FilmPasses {
   int width = 0, height = 0, samples_done = 0;
   std::vector<float> primal, gradient_x, gradient_y, emission, variance, shift_failures, alpha,
-      depth;
+      depth, object_index, material_index;
   void read(const Film& film, int samples);
   py::dict to_python() const;  // numpy views owning copies of the vectors
 };

@@ -434,12 +434,14 @@ py::dict SceneBuilder::mesh_arrays(int index) const {
   return d;
 }
 
-void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material) {
+void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
+                                int pass_index) {
   if (mesh < 0 || size_t(mesh) >= scene_.meshes.size())
     throw std::invalid_argument("add_instance: mesh index out of range");
   Instance inst;
   inst.mesh = uint32_t(mesh);
   inst.object_to_world = to_transform(matrix, "instance");
+  inst.pass_index = float(pass_index);
   inst.slot_material.reserve(py::len(slot_material));
   for (const auto& m : slot_material) {
     const int32_t index = m.cast<int32_t>();
@@ -462,6 +464,7 @@ int SceneBuilder::add_material(const py::dict& material) {
   MaterialDesc desc;
   desc.name = get_str(material, "name", "");
   get(material, "root", desc.root);
+  get(material, "pass_index", desc.pass_index);
   if (material.contains("nodes")) {
     for (const auto& item : material["nodes"].cast<py::list>()) {
       const auto d = item.cast<py::dict>();

@@ -64,7 +64,9 @@ class SceneBuilder {
                      const IntArray& loop_start, const IntArray& loop_total,
                      const FloatArray& normals, bool normals_per_loop, const FloatArray& loop_uvs,
                      const IntArray& poly_material);
-  void add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material);
+  // pass_index: the object's Pass Index (IndexOB pass).
+  void add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
+                    int pass_index = 0);
   int add_material(const py::dict& material);
   // rgba: (h, w, 4) or flat, row 0 at the bottom; converted to scene linear from `colorspace`
   // unless it is empty (already scene linear).

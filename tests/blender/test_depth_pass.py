@@ -1,17 +1,20 @@
-# The Depth (Z) pass (View Layer > Passes > Data > Z) with Gradient PT, filled as Cycles fills it:
-# the view-axis distance of the first surface the camera ray of a pixel's first sample meets,
-# 1e10 where it meets none.
+# The Depth (Z), IndexOB and IndexMA passes (View Layer > Passes > Data) with Gradient PT, filled as
+# Cycles fills them: the view-axis distance of the first surface the camera ray of a pixel's first
+# sample meets (1e10 where it meets none), and that object's and material's Pass Index (0).
 #  - analytic: a camera facing a wall 5 m away along its axis gives 5.0 everywhere (PT and G-PT,
 #    perspective and orthographic), the sky beside the wall 1e10;
 #  - against Cycles on a scene with a floor, a sphere and sky (PT: per-pixel jitter like Cycles'):
 #    the same pixels are sky, and on the others the depths agree without bias (median relative
 #    difference within 0.3%; single pixels differ by ~1% on the sloped floor because each engine's
 #    sample 0 lands elsewhere in the pixel). G-PT's sample 0 has one jitter for the whole image, so
-#    its Depth pass sits at one sub-pixel position (a constant offset of under a pixel).
+#    its Depth pass sits at one sub-pixel position (a constant offset of under a pixel);
+#  - IndexOB / IndexMA on the same scene (object and material pass indices 2/7 and 4/9): the same
+#    values as Cycles on more than 98% of the pixels (the rest: silhouettes, sample 0 elsewhere).
 import math
 import os
 import sys
 
+import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
@@ -21,11 +24,17 @@ import scenes as S  # noqa: E402
 check = S.check
 
 
-def depth(scene, name, engine, **kw):
-    scene.view_layers[0].use_pass_z = True
+def depth(scene, name, engine, indices=False, **kw):
+    """The Depth pass, and with indices=True also the IndexOB and IndexMA passes."""
+    layer = scene.view_layers[0]
+    layer.use_pass_z = True
+    layer.use_pass_object_index = layer.use_pass_material_index = indices
     ch = exr.read_exr(S.render_engine(scene, name, engine, 4, **kw))
-    check("ViewLayer.Depth.Z" in ch, f"{name}: the EXR has ViewLayer.Depth.Z")
-    return ch["ViewLayer.Depth.Z"]
+    names = ["ViewLayer.Depth.Z"] + (["ViewLayer.IndexOB.X", "ViewLayer.IndexMA.X"]
+                                     if indices else [])
+    for n in names:
+        check(n in ch, f"{name}: the EXR has {n}")
+    return [ch[n] for n in names] if indices else ch[names[0]]
 
 
 def main():
@@ -56,8 +65,16 @@ def main():
     S.camera((0, -6, 1.5), (0, 0, 1.2), lens=35)
     S.light('SUN', (0, 0, 5), 2.0)
     scene.render.resolution_x, scene.render.resolution_y = 64, 48
-    g = depth(scene, "gdpt", 'GDPT', mode='PT', reconstruction='NONE')
-    c = depth(scene, "cycles", 'CYCLES')
+    bpy.data.objects["floor"].pass_index, bpy.data.objects["ball"].pass_index = 2, 7
+    bpy.data.materials["floor"].pass_index, bpy.data.materials["ball"].pass_index = 4, 9
+    g, g_ob, g_ma = depth(scene, "gdpt", 'GDPT', indices=True, mode='PT', reconstruction='NONE')
+    c, c_ob, c_ma = depth(scene, "cycles", 'CYCLES', indices=True)
+    for what, a, b, values in (("IndexOB", g_ob, c_ob, {0, 2, 7}),
+                               ("IndexMA", g_ma, c_ma, {0, 4, 9})):
+        seen = set(np.unique(a).tolist())
+        same = float((a == b).mean())
+        check(seen == values and same > 0.98,
+              f"{what}: values {sorted(seen)}, equal to Cycles' on {100 * same:.1f}% of the pixels")
     sky_g, sky_c = g >= 1e9, c >= 1e9
     disagree = int((sky_g != sky_c).sum())
     check(sky_g.sum() > 200 and disagree <= 0.02 * g.size,

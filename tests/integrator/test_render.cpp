@@ -405,13 +405,16 @@ TEST(Render, TransparentBackgroundLeavesTheWorldOutAndGivesCoverage) {
   }
 }
 
-// Depth pass: the view-axis distance of sample 0's camera hit (Cycles), 1e10 without one; kept
-// across passes (one sample per pass here), PT and G-PT, perspective and orthographic.
+// Depth pass: the view-axis distance of sample 0's camera hit (Cycles), 1e10 without one; the
+// object's and material's pass indices there (0 without a hit); kept across passes (one sample
+// per pass here), PT and G-PT, perspective and orthographic.
 TEST(Render, DepthPassIsSampleZerosViewAxisDistance) {
   Scene scene;
   scene.meshes.push_back(quad(1.0f));
   scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  scene.materials[0].pass_index = 5.0f;
   scene.instances.push_back(place(0, 0, translation({1, 0, 0})));  // right half of the view
+  scene.instances[0].pass_index = 3.0f;
   scene.world.color = Spectrum(0.5f);
   for (const bool ortho : {true, false}) {
     scene.camera = top_camera(4, 2.0f, 7.0f);
@@ -423,16 +426,21 @@ TEST(Render, DepthPassIsSampleZerosViewAxisDistance) {
       RenderSession session(scene, s);
       std::atomic<bool> cancel{false};
       session.render(nullptr, cancel);
-      std::vector<float> depth(16);
+      std::vector<float> depth(16), object(16), material(16);
       session.film().depth(depth.data());
+      session.film().object_index(object.data());
+      session.film().material_index(material.data());
       int floor = 0;
-      for (int i = 0; i < 16; ++i) {
-        if (depth[size_t(i)] < 1e9f) {
-          ++floor;
-          EXPECT_NEAR(depth[size_t(i)], 7.0f, 1e-5f) << i;
+      for (size_t i = 0; i < 16; ++i) {
+        const bool hit = depth[i] < 1e9f;
+        floor += hit;
+        if (hit) {
+          EXPECT_NEAR(depth[i], 7.0f, 1e-5f) << i;
         } else {
-          EXPECT_EQ(depth[size_t(i)], 1e10f) << i;
+          EXPECT_EQ(depth[i], 1e10f) << i;
         }
+        EXPECT_EQ(object[i], hit ? 3.0f : 0.0f) << i;
+        EXPECT_EQ(material[i], hit ? 5.0f : 0.0f) << i;
       }
       EXPECT_GE(floor, ortho ? 8 : 2) << ortho;  // ortho: exactly the right half
       EXPECT_LT(floor, 16) << ortho;
