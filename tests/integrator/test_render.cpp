@@ -101,6 +101,7 @@ Camera top_camera(int res, float scale, float height = 10.0f) {
 struct Image {
   int w = 0, h = 0;
   std::vector<float> primal, emission;
+  std::vector<float> alpha, depth, object_index, material_index;  // 1 per pixel
   uint32_t min_samples = 0;
   float at(int x, int y, int c = 0) const { return primal[size_t(y * w + x) * 3 + c]; }
 };
@@ -116,6 +117,12 @@ Image render(const Scene& scene, RenderSettings s, std::string* summary = nullpt
   img.emission.resize(session.film().pixel_count() * 3);
   session.film().primal_rgb(img.primal.data());
   session.film().emission_rgb(img.emission.data());
+  for (auto* v : {&img.alpha, &img.depth, &img.object_index, &img.material_index})
+    v->resize(session.film().pixel_count());
+  session.film().alpha(img.alpha.data());
+  session.film().depth(img.depth.data());
+  session.film().object_index(img.object_index.data());
+  session.film().material_index(img.material_index.data());
   img.min_samples = session.film().min_samples();
   if (summary) *summary = session.features_summary();
   return img;
@@ -376,13 +383,9 @@ TEST(Render, TransparentBackgroundLeavesTheWorldOutAndGivesCoverage) {
       s.mode = mode;
       const Image opaque = render(scene, s);
       s.transparent_background = true;
-      RenderSession session(scene, s);
-      std::atomic<bool> cancel{false};
-      session.render(nullptr, cancel);
-      std::vector<float> primal(48), emission(48), alpha(16);
-      session.film().primal_rgb(primal.data());
-      session.film().emission_rgb(emission.data());
-      session.film().alpha(alpha.data());
+      const Image clear = render(scene, s);
+      const std::vector<float>&primal = clear.primal, &emission = clear.emission,
+            &alpha = clear.alpha;
       const float world_alpha = sheet ? 1.0f - (0.5f + 0.25f + 1.0f) / 3.0f : 0.0f;
       for (int y = 0; y < 4; ++y)
         for (int x = 0; x < 4; ++x) {
@@ -423,13 +426,9 @@ TEST(Render, DepthPassIsSampleZerosViewAxisDistance) {
       RenderSettings s = pt(3);
       s.mode = mode;
       s.samples_per_pass = 1;
-      RenderSession session(scene, s);
-      std::atomic<bool> cancel{false};
-      session.render(nullptr, cancel);
-      std::vector<float> depth(16), object(16), material(16);
-      session.film().depth(depth.data());
-      session.film().object_index(object.data());
-      session.film().material_index(material.data());
+      const Image img = render(scene, s);
+      const std::vector<float>&depth = img.depth, &object = img.object_index,
+            &material = img.material_index;
       int floor = 0;
       for (size_t i = 0; i < 16; ++i) {
         const bool hit = depth[i] < 1e9f;
