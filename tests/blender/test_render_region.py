@@ -8,12 +8,11 @@
 #    reconstruction of the region is close to the frame's there;
 #  - not cropped: a frame-sized image with the region in place (alpha 1 inside, 0 outside);
 #
-# "Equal" here allows last-bit differences in a few values: Embree builds the BVH on all threads,
-# and inside Blender that build is not bit-for-bit repeatable, so a ray hitting a shared triangle
-# edge exactly may report either triangle from one render to the next. Seen: 1-3 values of ~3800
-# off by one ulp (6e-8) in about a third of the renders; with Embree's build on one thread
-# (GDPT_EMBREE_CONFIG=threads=1) 40 of 40 were bit-identical. A wrong region offset changes
-# nearly every value.
+# "Equal" here allows last-bit differences in a few values: inside Blender, renders of the same
+# scene are not bit-for-bit repeatable (1-3 values of ~3800 off by one ulp, 6e-8, in about a third
+# of the renders; cause not isolated, docs/integrator.md "Known limitations"), while outside
+# Blender they are (the C++ region tests compare exactly). A wrong region offset changes nearly
+# every value.
 #  - the Gradient Reconstruct compositor node: its image is the cropped region, or the frame with
 #    the region in place, equal to the engine's Combined;
 #  - a resolution percentage whose float product would round differently (29% of 100 px) still
