@@ -26,16 +26,12 @@ Film::Film(int width, int height)
       height_(std::max(height, 0)),
       acc_(size_t(width_) * size_t(height_)),
       samples_(size_t(width_) * size_t(height_), 0u),
-      depth_(size_t(width_) * size_t(height_), 0.0f),
-      object_index_(depth_.size(), 0.0f),
-      material_index_(depth_.size(), 0.0f) {}
+      first_hit_(size_t(width_) * size_t(height_)) {}
 
 void Film::clear() {
   std::fill(acc_.begin(), acc_.end(), Accumulator{});
   std::fill(samples_.begin(), samples_.end(), 0u);
-  std::fill(depth_.begin(), depth_.end(), 0.0f);
-  std::fill(object_index_.begin(), object_index_.end(), 0.0f);
-  std::fill(material_index_.begin(), material_index_.end(), 0.0f);
+  std::fill(first_hit_.begin(), first_hit_.end(), FirstHit{});
 }
 
 void Film::take_rows(Film& pass, int y0, int y1) {
@@ -59,12 +55,9 @@ void Film::take_rows(Film& pass, int y0, int y1) {
     a.alpha += b.alpha;
     a.shift_failures += b.shift_failures;
     samples_[i] += pass.samples_[i];
-    if (pass.depth_[i] != 0.0f) {  // sample 0 was in this pass and hit a surface
-      depth_[i] = pass.depth_[i];
-      object_index_[i] = pass.object_index_[i];
-      material_index_[i] = pass.material_index_[i];
-    }
-    pass.depth_[i] = pass.object_index_[i] = pass.material_index_[i] = 0.0f;
+    // Sample 0 was in this pass and hit a surface.
+    if (pass.first_hit_[i].depth != 0.0f) first_hit_[i] = pass.first_hit_[i];
+    pass.first_hit_[i] = FirstHit{};
     b = Accumulator{};
     pass.samples_[i] = 0;
   }
@@ -88,15 +81,16 @@ void Film::alpha(float* out) const {
 }
 
 void Film::depth(float* out) const {
-  for (size_t i = 0; i < depth_.size(); ++i) out[i] = depth_[i] > 0.0f ? depth_[i] : 1e10f;
+  for (size_t i = 0; i < first_hit_.size(); ++i)
+    out[i] = first_hit_[i].depth > 0.0f ? first_hit_[i].depth : 1e10f;
 }
 
 void Film::object_index(float* out) const {
-  std::copy(object_index_.begin(), object_index_.end(), out);
+  for (size_t i = 0; i < first_hit_.size(); ++i) out[i] = first_hit_[i].object_index;
 }
 
 void Film::material_index(float* out) const {
-  std::copy(material_index_.begin(), material_index_.end(), out);
+  for (size_t i = 0; i < first_hit_.size(); ++i) out[i] = first_hit_[i].material_index;
 }
 
 void Film::emission_rgb(float* out) const {

@@ -85,10 +85,7 @@ class Film {
   // Sample 0's camera hit (view-axis distance > 0, pass indices); integrators call it for that
   // sample only.
   void set_first_hit(int x, int y, float depth, float object_index, float material_index) {
-    const size_t i = size_t(y) * width_ + x;
-    depth_[i] = depth;
-    object_index_[i] = object_index;
-    material_index_[i] = material_index;
+    first_hit_[size_t(y) * width_ + x] = {depth, object_index, material_index};
   }
 
   // --- Bookkeeping (RenderSession) ---
@@ -110,8 +107,11 @@ class Film {
   int width_ = 0, height_ = 0;
   std::vector<Accumulator> acc_;
   std::vector<uint32_t> samples_;
-  std::vector<float> depth_;  // 0: no surface (yet)
-  std::vector<float> object_index_, material_index_;
+  struct FirstHit {
+    float depth = 0.0f;  // 0: no surface (yet)
+    float object_index = 0.0f, material_index = 0.0f;
+  };
+  std::vector<FirstHit> first_hit_;
   bool gradients_from_primal_ = false;
 };
 

@@ -581,6 +581,7 @@ class GradientPathTracer final : public Integrator {
     g.w = x1 - g.x0;
     g.h = y1 - g.y0;
     g.reserve(size_t(g.w) * size_t(g.h));
+    const int rx = ctx_.camera().region_x(), ry = ctx_.camera().region_y();  // frame raster
     uint64_t n = 0;
     for (int y = g.y0; y < y1; ++y) {
       const bool row_inside = y >= tile.y0 && y < tile.y1;
@@ -589,9 +590,8 @@ class GradientPathTracer final : public Integrator {
         // The halo's corners are no tile pixel's neighbour.
         g.valid[c] = row_inside || (x >= tile.x0 && x < tile.x1);
         if (!g.valid[c]) continue;
-        const int fx = x + ctx_.camera().region_x(), fy = y + ctx_.camera().region_y();
-        g.ray[c] = ctx_.camera().generate_ray(Vec2f(float(fx) + jitter.x, float(fy) + jitter.y),
-                                              Vec2f(0.5f, 0.5f));
+        g.ray[c] = ctx_.camera().generate_ray(
+            Vec2f(float(x + rx) + jitter.x, float(y + ry) + jitter.y), Vec2f(0.5f, 0.5f));
         ++n;
       }
     }

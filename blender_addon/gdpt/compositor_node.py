@@ -32,6 +32,8 @@ from bpy.app.handlers import persistent
 from bpy.props import EnumProperty, FloatProperty
 from nodeitems_utils import NodeItem
 
+from . import export_camera
+
 NODE_IDNAME = "CompositorNodeGDPTReconstruct"
 MARKER = "GDPT:"
 INPUTS = ("Primal", "Gradient X", "Gradient Y", "Emission")
@@ -380,8 +382,7 @@ def _update_setting(node, context):
 
 def _init_node(node, context):
     r = context.scene.render if context and context.scene else None
-    size = (r.resolution_x * r.resolution_percentage // 100,
-            r.resolution_y * r.resolution_percentage // 100) if r else (64, 64)
+    size = export_camera.render_resolution(r) if r else (64, 64)
     node.node_tree = _new_group(_new_image(*size))
 
 

@@ -104,7 +104,8 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
             return
         camera = scene.camera.evaluated_get(depsgraph)
         # The whole frame, or the Render Region (border): Blender's result has exactly this size.
-        width, height = export_camera.image_size(scene.render)
+        region = export_camera.render_region(scene.render)
+        width, height = region[2:] if region else export_camera.render_resolution(scene.render)
 
         self.update_stats("", "Synchronizing scene")
         try:
@@ -199,7 +200,6 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         # Gradient Reconstruct compositor nodes solve from this layer's passes now: Blender
         # composites after render() returns (compositor_node.py).
         try:
-            region = export_camera.render_region(scene.render)
             placement = None
             if region and not scene.render.use_crop_to_border:
                 placement = export_camera.render_resolution(scene.render) + region[:2]

@@ -27,12 +27,6 @@ def render_region(render):
     return x0, y0, x1 - x0, y1 - y0
 
 
-def image_size(render):
-    """Size of the image the engine renders and writes: the render region, or the frame."""
-    region = render_region(render)
-    return (region[2], region[3]) if region else render_resolution(render)
-
-
 def _rigid_matrix12(m):
     # The camera's scale must not scale the image plane or the lens: keep rotation + position.
     loc, rot, _scale = m.decompose()
