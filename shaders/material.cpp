@@ -331,14 +331,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
   std::vector<Rgba> means(textures.size());
   for (size_t i = 0; i < textures.size(); ++i) {
     if (!uses_image[i]) continue;
-    const Texture& t = textures[i];
-    const size_t count = size_t(t.width()) * size_t(t.height());
-    double sum[4] = {0, 0, 0, 0};
-    for (size_t p = 0; p < count; ++p)
-      for (int ch = 0; ch < 4; ++ch) sum[ch] += t.rgba()[p * 4 + size_t(ch)];
-    const double inv = count > 0 ? 1.0 / double(count) : 0.0;
-    means[i] = {Spectrum(float(sum[0] * inv), float(sum[1] * inv), float(sum[2] * inv)),
-                float(sum[3] * inv)};
+    means[i] = textures[i].mean();
   }
   if (features_ & kFeatureEmission)
     average_emission_ = walk(nodes_, root_, AverageInputs{&means, true}, nullptr);

@@ -8,7 +8,10 @@
 //  - An empty image returns Blender's "missing texture" magenta.
 #include "shaders/texture.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -20,7 +23,57 @@ Texture::Texture(const ImageDesc& image) : width_(image.width), height_(image.he
     throw std::invalid_argument("image '" + image.name + "': " + std::to_string(width_) + "x" +
                                 std::to_string(height_) + " needs " + std::to_string(expected) +
                                 " floats, has " + std::to_string(image.rgba.size()));
-  rgba_ = image.rgba;
+  if (!encode(image.rgba)) rgba_ = image.rgba;
+  double sum[4] = {0, 0, 0, 0};
+  const size_t count = size_t(width_) * size_t(height_);
+  for (size_t p = 0; p < count; ++p)
+    for (int ch = 0; ch < 4; ++ch) sum[ch] += image.rgba[p * 4 + size_t(ch)];
+  const double inv = count > 0 ? 1.0 / double(count) : 0.0;
+  mean_ = {Spectrum(float(sum[0] * inv), float(sum[1] * inv), float(sum[2] * inv)),
+           float(sum[3] * inv)};
+}
+
+bool Texture::encode(const std::vector<float>& rgba) {
+  // Per channel, an open-addressing table from a value's bits to its code, sparse enough (4096
+  // slots for at most 256 values) that almost every texel is found in its first slot; more than
+  // 256 distinct values in any channel: keep floats.
+  constexpr uint32_t kSlots = 4096;
+  constexpr uint32_t kEmpty = 0xffffffffu;  // a NaN pattern no decode produces; checked below
+  struct Channel {
+    uint32_t bits[kSlots];
+    uint8_t code[kSlots];
+    int count = 0;
+  };
+  auto channels = std::make_unique<Channel[]>(4);
+  for (int ch = 0; ch < 4; ++ch) std::fill_n(channels[ch].bits, kSlots, kEmpty);
+  const size_t count = size_t(width_) * size_t(height_);
+  std::vector<uint32_t> codes;
+  codes.reserve(count);  // untouched memory until written: cheap to give up on float images
+  const uint32_t* in = reinterpret_cast<const uint32_t*>(rgba.data());
+  for (size_t p = 0; p < count; ++p) {
+    uint32_t packed = 0;
+    for (int ch = 0; ch < 4; ++ch) {
+      Channel& c = channels[ch];
+      const uint32_t bits = in[p * 4 + size_t(ch)];
+      if (bits == kEmpty) return false;
+      uint32_t slot = (bits * 0x9e3779b1u) >> 20;  // top 12 bits
+      while (c.bits[slot] != bits) {
+        if (c.bits[slot] == kEmpty) {  // new value
+          if (c.count == 256) return false;
+          c.bits[slot] = bits;
+          c.code[slot] = uint8_t(c.count);
+          std::memcpy(&decode_[ch][c.count], &bits, sizeof bits);
+          ++c.count;
+          break;
+        }
+        slot = (slot + 1) & (kSlots - 1);
+      }
+      packed |= uint32_t(c.code[slot]) << (8 * ch);
+    }
+    codes.push_back(packed);
+  }
+  codes_ = std::move(codes);
+  return true;
 }
 
 namespace {
@@ -71,8 +124,7 @@ Rgba Texture::lookup(Vec2f uv, TextureLookup::Interpolation interpolation,
 
   auto texel = [&](int x, int y) -> Rgba {
     if (x < 0 || y < 0) return {Spectrum(0.0f), 0.0f};
-    const float* p = rgba_.data() + (size_t(y) * size_t(width_) + size_t(x)) * 4;
-    return {Spectrum(p[0], p[1], p[2]), p[3]};
+    return this->texel(size_t(y) * size_t(width_) + size_t(x));
   };
 
   if (interpolation == TextureLookup::Interpolation::Closest) {

@@ -157,7 +157,7 @@ Scene cornell_box(int res) {
   return s;
 }
 
-// The Cornell box with a 256x256 colour grid (sRGB-decoded, bilinear, repeat) as the base colour
+// The Cornell box with a 256x256 8-bit colour grid (sRGB-decoded, bilinear, repeat) as the base colour
 // of the floor and the back wall: what an image texture costs per sample.
 Scene textured_cornell_box(int res) {
   Scene s = cornell_box(res);
@@ -167,7 +167,8 @@ Scene textured_cornell_box(int res) {
   for (int y = 0; y < 256; ++y)
     for (int x = 0; x < 256; ++x) {
       const bool line = x % 32 == 0 || y % 32 == 0;
-      const float r = line ? 0.9f : float(x) / 255.0f, g = line ? 0.9f : float(y) / 255.0f;
+      // 8-bit values, as from a PNG: the texture keeps 8-bit codes (texture.h).
+      const float r = float(line ? 230 : x) / 255.0f, g = float(line ? 230 : y) / 255.0f;
       img.rgba.insert(img.rgba.end(), {r * r, g * g, 0.2f, 1.0f});
     }
   s.images.push_back(std::move(img));

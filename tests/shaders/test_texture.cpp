@@ -2,6 +2,8 @@
 // the bottom row, closest / bilinear, repeat / extend / clip.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 #include "shaders/texture.h"
@@ -78,6 +80,50 @@ TEST(Texture, MissingImageIsMagentaAndBadSizesThrow) {
   bad.height = 2;
   bad.rgba.resize(12);
   EXPECT_THROW(Texture{bad}, std::invalid_argument);
+}
+
+// An 8-bit image decoded to linear (any per-channel function of the byte: here the square)
+// is stored as 8-bit codes; the same image with one extra value in one channel (257 distinct)
+// falls back to floats. Lookups away from that texel are bit-identical between the two.
+TEST(Texture, EightBitImagesAreCodedAndLookUpTheSameValues) {
+  const int n = 64;
+  ImageDesc img;
+  img.name = "bytes";
+  img.width = img.height = n;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const auto byte = [](int v) { return float(v & 255) / 255.0f; };
+      const float r = byte(x * 4 + y), g = byte(x * 4 + 3 * y), b = byte(255 - x);
+      img.rgba.insert(img.rgba.end(), {r * r, g * g, b * b, byte(x + 3 * y)});
+    }
+  img.rgba[2] = -0.0f;  // a value's bits are its identity: -0 gets its own code
+  const Texture coded(img);
+  EXPECT_TRUE(coded.coded());
+  ImageDesc floats = img;
+  // Green takes all 256 byte values; a 257th in the top-right texel.
+  floats.rgba[(size_t(n) * n - 1) * 4 + 1] = 0.123456f;
+  const Texture plain(floats);
+  EXPECT_FALSE(plain.coded());
+  uint32_t rng = 12345;
+  auto next = [&] {
+    rng = rng * 1664525u + 1013904223u;
+    return float(rng >> 8) * 0x1p-24f;
+  };
+  for (int i = 0; i < 2000; ++i) {
+    const Vec2f uv(next() * 0.9f, next() * 0.9f);  // away from the altered texel
+    for (I interp : {I::Linear, I::Closest})
+      for (E ext : {E::Repeat, E::Extend, E::Clip}) {
+        const Rgba a = coded.lookup(uv, interp, ext), b = plain.lookup(uv, interp, ext);
+        ASSERT_EQ(a.rgb.x, b.rgb.x);
+        ASSERT_EQ(a.rgb.y, b.rgb.y);
+        ASSERT_EQ(a.rgb.z, b.rgb.z);
+        ASSERT_EQ(a.a, b.a);
+      }
+  }
+  EXPECT_TRUE(std::signbit(coded.lookup({0.5f / n, 0.5f / n}, I::Closest, E::Repeat).rgb.z));
+  // The mean is over the stored values, whichever the storage.
+  EXPECT_NEAR(coded.mean().rgb.x, plain.mean().rgb.x, 1e-7f);
+  EXPECT_NEAR(coded.mean().a, plain.mean().a, 1e-7f);
 }
 
 }  // namespace
