@@ -665,6 +665,9 @@ class GradientPathTracer final : public Integrator {
     Vec3d fb(1.0, 1.0, 1.0);
     double pb = 1.0;
 
+    // Bounce 0's numbers; later bounces' are drawn before the segment to them is traced, to run
+    // alongside it (Sampler::vertex_numbers).
+    Sampler::VertexNumbers u = sampler.vertex_numbers(0, has_lights);
     for (int bounce = 0;; ++bounce) {
       if (bounce > max_bounces) break;
       const Vertex& base = scratch.verts[cur];
@@ -705,7 +708,7 @@ class GradientPathTracer final : public Integrator {
         const float u_select =
             needs_selection ? sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kLightSelect))
                             : 0.0f;
-        const Vec2f u_light = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kLightPoint));
+        const Vec2f u_light = u.light;
         const LightSample ls = lights.sample(base.hit.position, u_select, u_light);
         if (ls.valid && ls.pdf > 0.0f) {
           // --- Base ---
@@ -835,7 +838,7 @@ class GradientPathTracer final : public Integrator {
       bool lobe_drawn = bc.uses_lobe_choice();
       const float u_lobe =
           lobe_drawn ? sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe)) : 0.0f;
-      const Vec2f u_dir = sampler.get2d(Sampler::bounce_dim(bounce, Sampler::kBsdfDir));
+      const Vec2f u_dir = u.dir;
       const BsdfSample bs = bc.sample(base.wi, u_lobe, u_dir);
       if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;
       const Vec3f wo_world = base.frame.to_world(bs.wo);
@@ -866,6 +869,7 @@ class GradientPathTracer final : public Integrator {
       // bounce: no vertex set-up there (the offsets' shifts need its classification alone), and
       // no hit record either when no offset shifts and no triangle emits (as PT).
       const bool last = bounce == max_bounces;
+      if (!last) u = sampler.vertex_numbers(bounce + 1, has_lights);
       const SurfaceHit& next = next_base.hit;
       const bool found = last && open == 0 && !has_emissive_
                              ? bvh.intersect_distance(ray, next_base.hit.t)

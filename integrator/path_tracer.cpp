@@ -133,22 +133,6 @@ class PathTracer final : public Integrator {
     return ctx_.camera().generate_ray({float(px) + jitter.x, float(py) + jitter.y}, lens);
   }
 
-  // The 2D numbers a path vertex always uses (light point, BSDF direction). They are drawn
-  // before the vertex's ray is traced: each is a ~70-cycle chain of dependent multiplies that
-  // would stall the shading code waiting for it, while drawn early it runs alongside Embree's
-  // traversal (Blender bench scene: +4.5% samples/s). Dimensions are indexed: drawing one that
-  // ends up unused changes no other value.
-  struct VertexNumbers {
-    Vec2f light, dir;
-  };
-  VertexNumbers vertex_numbers(const Sampler& sampler, int vertex) const {
-    VertexNumbers u;
-    if (!ctx_.lights().empty())
-      u.light = sampler.get2d(Sampler::bounce_dim(vertex, Sampler::kLightPoint));
-    u.dir = sampler.get2d(Sampler::bounce_dim(vertex, Sampler::kBsdfDir));
-    return u;
-  }
-
   // The path of one camera sample, from its camera ray already traced (`camera_found`, and `hit`
   // holding the hit when found); `hit` is the path's working hit record from there on.
   PathResult trace(const Sampler& sampler, Ray ray, bool camera_found, ClosureSet& closure_scratch,
@@ -176,8 +160,9 @@ class PathTracer final : public Integrator {
       // Past the bounce limits a vertex only ends the path: without emissive triangles its hit
       // needs no record, only the distance (analytic lights in front of it, the world behind).
       const bool last = bounce > max_bounces || transparent > kMaxTransparentBounces;
-      VertexNumbers u;
-      if (!last) u = vertex_numbers(sampler, vertex);
+      // Drawn before the ray is traced, to run alongside it (Sampler::vertex_numbers).
+      Sampler::VertexNumbers u;
+      if (!last) u = sampler.vertex_numbers(vertex, has_lights);
       const bool found = vertex == 0          ? camera_found
                          : !kEmissive && last ? bvh.intersect_distance(ray, hit.t)
                                               : bvh.intersect(ray, hit);

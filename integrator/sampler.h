@@ -126,6 +126,21 @@ class Sampler {
     return kDimFirstBounce + uint32_t(bounce) * kDimsPerBounce + d;
   }
 
+  // The 2D numbers a path vertex always uses: light point (when the scene has lights) and BSDF
+  // direction. Integrators draw them before the vertex's ray is traced: each is a ~70-cycle
+  // chain of dependent multiplies that would stall the shading code waiting for it, while
+  // drawn early it runs alongside Embree's traversal. Dimensions are indexed: drawing one that
+  // ends up unused changes no other value.
+  struct VertexNumbers {
+    Vec2f light, dir;
+  };
+  VertexNumbers vertex_numbers(int vertex, bool lights) const {
+    VertexNumbers u;
+    if (lights) u.light = get2d(bounce_dim(vertex, kLightPoint));
+    u.dir = get2d(bounce_dim(vertex, kBsdfDir));
+    return u;
+  }
+
   // Written with the reversals folded: nested_uniform_scramble(v, s) =
   // reverse_bits(lk_permutation(reverse_bits(v), s)), Sobol dimension 0 is reverse_bits(i) and
   // the dimension-1 table already returns reversed bits.

@@ -24,6 +24,7 @@
 #include <cstring>
 #include <ctime>
 
+#include "bench/film_checksum.h"
 #include "integrator/render_session.h"
 #include "tests/gradient/gradient_scenes.h"
 
@@ -45,7 +46,7 @@ struct Cost {
 };
 
 Cost seconds_per_sample(const Scene& scene, RenderSettings::Mode mode, int spp, int threads,
-                        uint64_t* rays) {
+                        uint64_t* rays, uint64_t* checksum = nullptr) {
   RenderSettings s = settings(mode, spp, 1, threads);
   s.samples_per_pass = 1;
   RenderSession session(scene, s);
@@ -56,6 +57,7 @@ Cost seconds_per_sample(const Scene& scene, RenderSettings::Mode mode, int spp, 
   const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double c = cpu_seconds() - c0;
   if (rays) *rays = session.rays_traced();
+  if (checksum) *checksum = bench::film_checksum(session.film());
   const double n = double(scene.camera.width) * scene.camera.height * spp;
   return {t / n, c / n};
 }
@@ -72,12 +74,16 @@ void run_case(const char* name, const Scene& scene, int spp, int repeats, int th
              run_gpt = selected("GDPT_BENCH_MODE", "gpt");
   if (!run_pt || !run_gpt) {
     // Instruction-count mode: one render of one mode.
-    uint64_t rays = 0;
-    const Cost c = seconds_per_sample(
-        scene, run_pt ? RenderSettings::Mode::PT : RenderSettings::Mode::GPT, spp, threads, &rays);
+    uint64_t rays = 0, checksum = 0;
+    const Cost c =
+        seconds_per_sample(scene, run_pt ? RenderSettings::Mode::PT : RenderSettings::Mode::GPT,
+                           spp, threads, &rays, &checksum);
     const double n = double(scene.camera.width) * scene.camera.height * spp;
-    std::printf("%-12s %s %.0f samples, %.1f rays/sample, %.3f us/sample cpu\n", name,
-                run_pt ? "PT" : "G-PT", n, double(rays) / n, c.cpu * 1e6);
+    std::printf(
+        "%-12s %s %.0f samples, %.1f rays/sample, %.3f us/sample cpu, image checksum "
+        "%016llx\n",
+        name, run_pt ? "PT" : "G-PT", n, double(rays) / n, c.cpu * 1e6,
+        (unsigned long long)checksum);
     return;
   }
   Cost pt{1e30, 1e30}, gpt{1e30, 1e30};

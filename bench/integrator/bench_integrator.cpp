@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/film_checksum.h"
 #include "integrator/render_session.h"
 
 using namespace gdpt;
@@ -157,8 +158,8 @@ Scene cornell_box(int res) {
   return s;
 }
 
-// The Cornell box with a 256x256 8-bit colour grid (sRGB-decoded, bilinear, repeat) as the base colour
-// of the floor and the back wall: what an image texture costs per sample.
+// The Cornell box with a 256x256 8-bit colour grid (sRGB-decoded, bilinear, repeat) as the base
+// colour of the floor and the back wall: what an image texture costs per sample.
 Scene textured_cornell_box(int res) {
   Scene s = cornell_box(res);
   ImageDesc img;
@@ -412,24 +413,17 @@ int main(int argc, char** argv) {
       double mean_var = 0.0;
       for (size_t i = 0; i < session.film().pixel_count(); ++i) mean_var += var[3 * i];
       mean_var /= double(session.film().pixel_count());
-      // FNV-1a of the primal image's bits: equal checksums mean a bit-identical image.
-      std::vector<float> primal(3 * session.film().pixel_count());
-      session.film().primal_rgb(primal.data());
-      uint64_t checksum = 1469598103934665603ull;
-      for (float v : primal) {
-        uint32_t b;
-        std::memcpy(&b, &v, sizeof b);
-        checksum = (checksum ^ b) * 1099511628211ull;
-      }
       std::printf("%s: %.0f samples, %llu rays, mean pixel variance %.6g, image checksum %016llx\n",
                   c, double(session.film().pixel_count()) * session.film().min_samples(),
                   (unsigned long long)session.rays_traced(), mean_var,
-                  (unsigned long long)checksum);
+                  (unsigned long long)bench::film_checksum(session.film()));
       // Error against a converged image: the per-pixel variance above ignores the sampler's
       // stratification (it rates Owen-scrambled Sobol no better than independent numbers), so
       // sampling techniques are compared by the luminance MSE to a reference, averaged over
       // seeds (GDPT_BENCH_SEED). A missing reference file is written from this render.
       if (const char* ref_path = std::getenv("GDPT_BENCH_REFERENCE")) {
+        std::vector<float> primal(3 * session.film().pixel_count());
+        session.film().primal_rgb(primal.data());
         const std::string path = std::string(ref_path) + "." + name + ".f32";
         if (FILE* f = std::fopen(path.c_str(), "rb")) {
           std::vector<float> ref(primal.size());
