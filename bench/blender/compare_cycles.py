@@ -14,6 +14,10 @@ RES = tuple(int(v) for v in os.environ.get("GDPT_BENCH_RES", "96x72").split("x")
 SAMPLES = int(os.environ.get("GDPT_BENCH_SAMPLES", "32"))
 REF_SAMPLES = int(os.environ.get("GDPT_BENCH_REF_SAMPLES", "512"))
 BOUNCES = int(os.environ.get("GDPT_BENCH_BOUNCES", "4"))
+# The reference renders, whose timing gives the marginal rates, are repeated this many times
+# with the engines alternating; the median time counts. A single ~2 s render moved Cycles' rate
+# by +-12% between runs on this shared machine.
+REPEATS = int(os.environ.get("GDPT_BENCH_REPEATS", "3"))
 # Russian roulette depth of the core for this benchmark only (the add-on has no setting for it;
 # unset = the core's default). For comparing termination policies with Cycles, which applies
 # roulette from the second bounce on (path_state_continuation_probability).
@@ -75,14 +79,24 @@ def compare(name, build, out):
     first = {eng: render(scene, eng, 1, os.path.join(out, f"{name}_{eng}_warm.exr"))[0]
              for eng in ('GDPT', 'CYCLES')}
     rays = 0.0
+    low = {}
     for eng in ('GDPT', 'CYCLES'):
         t, img = render(scene, eng, SAMPLES, os.path.join(out, f"{name}_{eng}_{SAMPLES}.exr"))
         render_only = engine.LAST_RENDER["render"] if eng == 'GDPT' else t
         if eng == 'GDPT':
             rays = engine.LAST_RENDER["rays"] / (RES[0] * RES[1] * SAMPLES)
-        t_ref, ref = render(scene, eng, REF_SAMPLES,
-                            os.path.join(out, f"{name}_{eng}_ref.exr"))
-        row[eng] = (t, render_only, S.rel_mse(img, ref), ref, t_ref)
+        low[eng] = (t, render_only, img)
+    ref_times = {'GDPT': [], 'CYCLES': []}
+    refs = {}
+    for _ in range(max(1, REPEATS)):
+        for eng in ('GDPT', 'CYCLES'):
+            t_ref, refs[eng] = render(scene, eng, REF_SAMPLES,
+                                      os.path.join(out, f"{name}_{eng}_ref.exr"))
+            ref_times[eng].append(t_ref)
+    for eng in ('GDPT', 'CYCLES'):
+        t, render_only, img = low[eng]
+        t_ref = float(np.median(ref_times[eng]))
+        row[eng] = (t, render_only, S.rel_mse(img, refs[eng]), refs[eng], t_ref)
     pixels = RES[0] * RES[1] * SAMPLES
     g, c = row['GDPT'], row['CYCLES']
     cross = S.rel_mse(g[3], c[3])
@@ -103,6 +117,10 @@ def compare(name, build, out):
     # samples/s ratio it does not depend on how much work each engine puts into one sample
     # (e.g. where Russian roulette starts).
     efficiency = (c[2] / mc) / max(g[2] / mg, 1e-30)
+    spread = {e: (min(ts), max(ts)) for e, ts in ref_times.items()}
+    print(f"  {REF_SAMPLES}-spp render times, {len(ref_times['GDPT'])} alternating runs: GDPT "
+          f"{spread['GDPT'][0]:.2f}-{spread['GDPT'][1]:.2f} s, Cycles {spread['CYCLES'][0]:.2f}-"
+          f"{spread['CYCLES'][1]:.2f} s (medians used)")
     print(f"  marginal samples/s ({SAMPLES} -> {REF_SAMPLES} spp): GDPT {mg / 1e6:.3f} M, "
           f"Cycles {mc / 1e6:.3f} M: ratio {mg / mc:.2f}x; fixed cost per render GDPT "
           f"{g[0] - RES[0] * RES[1] * SAMPLES / mg:.2f} s, Cycles "

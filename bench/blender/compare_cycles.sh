@@ -4,7 +4,8 @@
 # Cornell box and a textured scene; export time of a 1M-triangle mesh; add-on overhead.
 #   bash bench/blender/compare_cycles.sh <build-dir>
 # Knobs (environment): GDPT_BENCH_RES (default 96x72), GDPT_BENCH_SAMPLES (32),
-# GDPT_BENCH_REF_SAMPLES (512), GDPT_BENCH_BOUNCES (4), GDPT_BENCH_RR_DEPTH (unset: the core's
+# GDPT_BENCH_REF_SAMPLES (512), GDPT_BENCH_REPEATS (3, reference renders per engine, median
+# time), GDPT_BENCH_BOUNCES (4), GDPT_BENCH_RR_DEPTH (unset: the core's
 # default Russian roulette depth).
 set -euo pipefail
 build=${1:-build}
