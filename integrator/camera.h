@@ -12,6 +12,8 @@
 // Cross-engine comparisons therefore set Cycles' filter_width small (e.g. 0.01).
 #pragma once
 
+#include <cmath>
+
 #include "integrator/math/transform.h"
 #include "integrator/math/vec.h"
 #include "integrator/scene.h"
@@ -56,6 +58,12 @@ class CameraModel {
 
   // Distance of a world point in front of the camera along its view axis (Blender's Depth pass).
   float view_depth(Vec3f world) const { return -world_to_camera_.point(world).z; }
+  // Distance of a world point from the camera as Cycles' mist measures it: from the camera's
+  // position (perspective), along the view axis (orthographic).
+  float camera_distance(Vec3f world) const {
+    const Vec3f c = world_to_camera_.point(world);
+    return ortho_ ? std::fabs(c.z) : length(c);
+  }
 
   // World point -> raster position (pinhole); returns false behind the camera. For tests.
   bool project(Vec3f world, Vec2f& raster) const;

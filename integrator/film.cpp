@@ -28,7 +28,14 @@ Film::Film(int width, int height)
       samples_(size_t(width_) * size_t(height_), 0u),
       first_hit_(size_t(width_) * size_t(height_)) {}
 
+void Film::enable_data_passes(bool normal, bool mist) {
+  normal_.assign(normal ? 3 * pixel_count() : 0, 0.0);
+  mist_.assign(mist ? pixel_count() : 0, 0.0);
+}
+
 void Film::clear() {
+  std::fill(normal_.begin(), normal_.end(), 0.0);
+  std::fill(mist_.begin(), mist_.end(), 0.0);
   std::fill(acc_.begin(), acc_.end(), Accumulator{});
   std::fill(samples_.begin(), samples_.end(), 0u);
   std::fill(first_hit_.begin(), first_hit_.end(), FirstHit{});
@@ -55,6 +62,15 @@ void Film::take_rows(Film& pass, int y0, int y1) {
     a.alpha += b.alpha;
     a.shift_failures += b.shift_failures;
     samples_[i] += pass.samples_[i];
+    if (!normal_.empty())
+      for (size_t c = 3 * i; c < 3 * i + 3; ++c) {
+        normal_[c] += pass.normal_[c];
+        pass.normal_[c] = 0.0;
+      }
+    if (!mist_.empty()) {
+      mist_[i] += pass.mist_[i];
+      pass.mist_[i] = 0.0;
+    }
     // Sample 0 was in this pass and hit a surface.
     if (pass.first_hit_[i].depth != 0.0f) first_hit_[i] = pass.first_hit_[i];
     pass.first_hit_[i] = FirstHit{};
@@ -91,6 +107,23 @@ void Film::object_index(float* out) const {
 
 void Film::material_index(float* out) const {
   for (size_t i = 0; i < first_hit_.size(); ++i) out[i] = first_hit_[i].material_index;
+}
+
+void Film::normal(float* out) const {
+  for (size_t i = 0; i < pixel_count(); ++i) {
+    const double inv = samples_[i] ? 1.0 / samples_[i] : 0.0;
+    for (size_t c = 0; c < 3; ++c)
+      out[3 * i + c] = normal_.empty() ? 0.0f : float(normal_[3 * i + c] * inv);
+  }
+}
+
+void Film::mist(float* out) const {
+  // Cycles accumulates 1 - mist weighted by coverage and outputs 1 - the mean: the background
+  // (no surface) reads 1, fully misted.
+  for (size_t i = 0; i < pixel_count(); ++i) {
+    const double inv = samples_[i] ? 1.0 / samples_[i] : 0.0;
+    out[i] = mist_.empty() ? 0.0f : std::clamp(float(1.0 - mist_[i] * inv), 0.0f, 1.0f);
+  }
 }
 
 void Film::emission_rgb(float* out) const {

@@ -40,6 +40,13 @@ class Film {
   void depth(float* out) const;
   void object_index(float* out) const;
   void material_index(float* out) const;
+  // Normal and Mist passes (enable_data_passes): 3 / 1 per pixel, Cycles' definitions
+  // (integrator/data_passes.h): the mean over samples of the normal at the first opaque surface
+  // (0 without one), and 1 - the mean of the samples' (1 - mist) x surface coverage.
+  void normal(float* out) const;
+  void mist(float* out) const;
+  bool has_normal() const { return !normal_.empty(); }
+  bool has_mist() const { return !mist_.empty(); }
   uint32_t samples(int x, int y) const { return samples_[size_t(y) * width_ + x]; }
   uint32_t min_samples() const;
 
@@ -87,6 +94,13 @@ class Film {
   void set_first_hit(int x, int y, float depth, float object_index, float material_index) {
     first_hit_[size_t(y) * width_ + x] = {depth, object_index, material_index};
   }
+  // One sample's normal-pass and mist-pass values (only for the passes enabled).
+  void add_data(int x, int y, Vec3f normal, float mist) {
+    const size_t i = size_t(y) * width_ + x;
+    if (!normal_.empty())
+      for (int c = 0; c < 3; ++c) normal_[3 * i + size_t(c)] += normal[c];
+    if (!mist_.empty()) mist_[i] += mist;
+  }
 
   // --- Bookkeeping (RenderSession) ---
   // PT mode: the integrator does not estimate gradients; gradient_x/y_rgb() then return forward
@@ -96,6 +110,8 @@ class Film {
   void set_gradients_from_primal(bool on) { gradients_from_primal_ = on; }
   bool gradients_from_primal() const { return gradients_from_primal_; }
   void clear();  // zero every accumulator and sample count
+  // Allocates the Normal / Mist sums (none by default: films without them cost nothing).
+  void enable_data_passes(bool normal, bool mist);
   // Adds rows [y0, y1) of `pass` (same size) into this film and zeroes them in `pass`: how a
   // completed pass is committed.
   void take_rows(Film& pass, int y0, int y1);
@@ -112,6 +128,7 @@ class Film {
     float object_index = 0.0f, material_index = 0.0f;
   };
   std::vector<FirstHit> first_hit_;
+  std::vector<double> normal_, mist_;  // sums; empty when the pass is off
   bool gradients_from_primal_ = false;
 };
 

@@ -11,6 +11,7 @@
 // world) with contribution C = f * segment, and the matching offset contribution C' (Jacobian
 // included), adds w (C' - C) to the gradient half of that offset, w = shift::mis_weight_over_pdf.
 #include "integrator/gradient_path_tracer.h"
+#include "integrator/data_passes.h"
 
 #include <algorithm>
 #include <bit>
@@ -225,6 +226,7 @@ struct SampleResult {
   float alpha;  // Film::alpha(): 0 for a camera ray that reaches a transparent background
   uint8_t attempts, failures;
   uint32_t rays;
+  DataSample data;  // Normal / Mist passes (DataPasses)
 };
 
 // The base's segment x_d -> x_{d+1} as the offsets' shift_segment() calls see it.
@@ -320,7 +322,8 @@ class GradientPathTracer final : public Integrator {
         has_visible_lamps_(ctx.lights().has_camera_visible_lights()),
         has_dof_(ctx.camera().has_dof()),
         has_emissive_((ctx.features() & kSceneEmissiveTriangles) != 0),
-        sides_(material_sides(ctx)) {}
+        sides_(material_sides(ctx)),
+        data_(settings, ctx.camera()) {}
 
   bool estimates_gradients() const override { return true; }
 
@@ -354,6 +357,7 @@ class GradientPathTracer final : public Integrator {
       // --- Primal, emission and statistics of the pixel's base path ---
       Film::Accumulator& acc = film.pixel(x, y);
       acc.add_path(r.primal, r.emission, clamp, r.alpha);
+      if (data_.active()) film.add_data(x, y, r.data.normal, r.data.mist);
       acc.shift_attempts += r.attempts;
       acc.shift_failures += r.failures;
       // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
@@ -615,6 +619,7 @@ class GradientPathTracer final : public Integrator {
     out.alpha = 1.0f;
     out.attempts = out.failures = 0;
     out.rays = 0;  // camera rays are counted by render_tile()
+    out.data = DataSample{};
 
     // --- Camera rays (traced by render_tile) ---
     const Ray& cam_ray = *cs.ray;
@@ -657,6 +662,8 @@ class GradientPathTracer final : public Integrator {
 
     int cur = 0;  // scratch.verts[cur] is the base vertex
     setup_vertex(ctx_, sides_, hit, cam_ray.direction, scratch.verts[cur]);
+    if (data_.active())
+      data_.at_surface(hit, *scratch.verts[cur].closures, Spectrum(1.0f), out.data);
     // Very direct light: emission seen by the camera, never shifted.
     out.emission += triangle_le(hit, cam_ray.origin);
     Ray ray;  // the base's current segment
@@ -1359,6 +1366,7 @@ class GradientPathTracer final : public Integrator {
   bool has_dof_ = false;
   bool has_emissive_ = false;
   std::vector<MaterialSide> sides_;
+  DataPasses data_;
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "integrator/data_passes.h"
 #include "integrator/features.h"
 #include "integrator/math/frame.h"
 #include "integrator/russian_roulette.h"
@@ -41,6 +42,7 @@ struct PathResult {
   Spectrum emission{0.0f};  // camera-visible emission
   float alpha = 1.0f;       // Film::alpha()
   uint32_t rays = 0;
+  DataSample data;  // Normal / Mist passes (DataPasses)
 };
 
 template <uint32_t kFeatures>
@@ -53,7 +55,7 @@ class PathTracer final : public Integrator {
 
  public:
   PathTracer(const SceneContext& ctx, const RenderSettings& settings)
-      : ctx_(ctx), settings_(settings) {}
+      : ctx_(ctx), settings_(settings), data_(settings, ctx.camera()) {}
 
   // Camera rays go to Embree a row segment at a time (kStream pixels of one sample index) as one
   // coherent stream, which traverses neighbouring rays together; each path then continues from
@@ -91,6 +93,7 @@ class PathTracer final : public Integrator {
                 trace(samplers[j], camera_rays[j], found[j], closures, scratch, hits[j]);
             rays += r.rays;
             film.pixel(x0 + j, y).add_path(r.primal, r.emission, clamp, r.alpha);
+            if (data_.active()) film.add_data(x0 + j, y, r.data.normal, r.data.mist);
           }
         }
       }
@@ -234,6 +237,7 @@ class PathTracer final : public Integrator {
       }
       if (last) break;
       const ClosureSet& closures = material.closures(sc, closure_scratch);
+      if (camera_path && data_.active()) data_.at_surface(hit, closures, beta, out.data);
       if (!closures.has_bsdf()) break;
 
       // Frame facing the incoming ray (Cycles flips N and Ng for back faces; materials learn the
@@ -333,6 +337,7 @@ class PathTracer final : public Integrator {
 
   const SceneContext& ctx_;
   RenderSettings settings_;
+  DataPasses data_;
 };
 
 // --- Dispatch: one instantiation per subset of kSpecialised, picked once per session ---

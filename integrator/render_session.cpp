@@ -62,6 +62,8 @@ RenderSession::RenderSession(Scene scene, RenderSettings settings)
   d.film = Film(w, h);
   d.pass_film = Film(w, h);
   d.film.set_gradients_from_primal(!d.integrator->estimates_gradients());
+  d.film.enable_data_passes(d.settings.normal_pass, d.settings.mist_pass);
+  d.pass_film.enable_data_passes(d.settings.normal_pass, d.settings.mist_pass);
   for (int y = 0; y < h; y += kTileSize)
     for (int x = 0; x < w; x += kTileSize)
       d.tiles.push_back({x, y, std::min(x + kTileSize, w), std::min(y + kTileSize, h)});

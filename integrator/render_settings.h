@@ -18,6 +18,12 @@ struct RenderSettings {
   // Blender's Film > Transparent: the world seen directly by the camera is left out of the image,
   // and the film's alpha is the fraction of the pixel covered by surfaces (Film::alpha).
   bool transparent_background = false;
+  // Blender's Normal and Mist data passes (View Layer > Passes > Data), as Cycles computes them
+  // (integrator/data_passes.h); off: no cost. Mist: World > Mist Pass start, depth (distances
+  // from the camera) and falloff exponent (2 quadratic, 1 linear, 0.5 inverse quadratic).
+  bool normal_pass = false;
+  bool mist_pass = false;
+  float mist_start = 5.0f, mist_depth = 25.0f, mist_falloff = 2.0f;
   int samples_per_pass = 1;  // progressive granularity (a pass = this many spp over the image)
   // Debug / benchmark: run the kernel with every feature path on (same image, slower), to measure
   // what the per-scene specialisation buys.

@@ -121,6 +121,7 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         t_session = time.perf_counter()
         try:
             render_settings = properties.settings_dict(scene)
+            render_settings.update(passes.data_pass_settings(scene, view_layer))
             render_settings["samples_per_pass"] = samples_per_pass(width * height, settings)
             job = module.RenderJob(builder, render_settings)  # BVH, lights
         except ValueError as e:

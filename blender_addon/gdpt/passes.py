@@ -27,6 +27,8 @@ _FILM_KEYS = {
     "Depth": "depth",
     "IndexOB": "object_index",
     "IndexMA": "material_index",
+    "Normal": "normal",
+    "Mist": "mist",
 }
 
 
@@ -43,6 +45,27 @@ def register_passes(engine, scene, view_layer):
         engine.register_pass(scene, view_layer, "IndexOB", 1, "X", 'VALUE')
     if view_layer.use_pass_material_index:
         engine.register_pass(scene, view_layer, "IndexMA", 1, "X", 'VALUE')
+    if view_layer.use_pass_normal:
+        engine.register_pass(scene, view_layer, "Normal", 3, "XYZ", 'VECTOR')
+    if view_layer.use_pass_mist:
+        engine.register_pass(scene, view_layer, "Mist", 1, "Z", 'VALUE')
+
+
+# World > Mist Pass falloff -> Cycles' exponent.
+_MIST_FALLOFF = {'QUADRATIC': 2.0, 'LINEAR': 1.0, 'INVERSE_QUADRATIC': 0.5}
+
+
+def data_pass_settings(scene, view_layer):
+    """The render settings of the Normal and Mist passes for this view layer (Passes > Data) and
+    the scene's World > Mist Pass (Blender's defaults without a world)."""
+    d = {"normal_pass": bool(view_layer.use_pass_normal),
+         "mist_pass": bool(view_layer.use_pass_mist)}
+    world = scene.world
+    if world is not None:
+        mist = world.mist_settings
+        d.update(mist_start=float(mist.start), mist_depth=float(mist.depth),
+                 mist_falloff=_MIST_FALLOFF.get(mist.falloff, 2.0))
+    return d
 
 
 def layer_buffer(layer, film, combined_rgb):

@@ -118,6 +118,8 @@ class GDPT_PT_passes(Panel):
         col.prop(context.view_layer, "use_pass_z")
         col.prop(context.view_layer, "use_pass_object_index")
         col.prop(context.view_layer, "use_pass_material_index")
+        col.prop(context.view_layer, "use_pass_normal")
+        col.prop(context.view_layer, "use_pass_mist")
 
 
 _classes = (GDPT_PT_sampling, GDPT_PT_light_paths, GDPT_PT_film, GDPT_PT_gradient_domain,
@@ -133,7 +135,8 @@ _EXCLUDE = {
 _EXTRA = {
     "DATA_PT_EEVEE_light", "DATA_PT_spot",
     "EEVEE_MATERIAL_PT_context_material", "EEVEE_MATERIAL_PT_surface",
-    "EEVEE_WORLD_PT_surface", "DATA_PT_camera_dof", "DATA_PT_camera_dof_aperture",
+    "EEVEE_WORLD_PT_surface", "EEVEE_WORLD_PT_mist", "DATA_PT_camera_dof",
+    "DATA_PT_camera_dof_aperture",
 }
 
 _patched = []

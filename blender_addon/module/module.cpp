@@ -39,6 +39,11 @@ RenderSettings settings_from_dict(const py::dict& d) {
   get("shift_threshold", s.shift_roughness_threshold);
   get("samples_per_pass", s.samples_per_pass);
   get("transparent_background", s.transparent_background);
+  get("normal_pass", s.normal_pass);
+  get("mist_pass", s.mist_pass);
+  get("mist_start", s.mist_start);
+  get("mist_depth", s.mist_depth);
+  get("mist_falloff", s.mist_falloff);
   return s;
 }
 

@@ -44,6 +44,10 @@ void FilmPasses::read(const Film& film, int samples) {
   film.object_index(object_index.data());
   material_index.resize(n);
   film.material_index(material_index.data());
+  normal.resize(film.has_normal() ? n * 3 : 0);
+  if (film.has_normal()) film.normal(normal.data());
+  mist.resize(film.has_mist() ? n : 0);
+  if (film.has_mist()) film.mist(mist.data());
   film.primal_rgb(primal.data());
   film.gradient_x_rgb(gradient_x.data());
   film.gradient_y_rgb(gradient_y.data());
@@ -68,6 +72,9 @@ py::dict FilmPasses::to_python() const {
   d["depth"] = to_numpy(std::move(copy.depth), height, width, 1);
   d["object_index"] = to_numpy(std::move(copy.object_index), height, width, 1);
   d["material_index"] = to_numpy(std::move(copy.material_index), height, width, 1);
+  // Only the data passes the render computes (RenderSettings::normal_pass / mist_pass).
+  if (!copy.normal.empty()) d["normal"] = to_numpy(std::move(copy.normal), height, width, 3);
+  if (!copy.mist.empty()) d["mist"] = to_numpy(std::move(copy.mist), height, width, 1);
   return d;
 }
 

@@ -27,6 +27,7 @@ struct FilmPasses {
   int width = 0, height = 0, samples_done = 0;
   std::vector<float> primal, gradient_x, gradient_y, emission, variance, shift_failures, alpha,
       depth, object_index, material_index;
+  std::vector<float> normal, mist;  // empty unless the render computes them
   void read(const Film& film, int samples);
   py::dict to_python() const;  // numpy views owning copies of the vectors
 };

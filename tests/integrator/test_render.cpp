@@ -447,6 +447,75 @@ TEST(Render, DepthPassIsSampleZerosViewAxisDistance) {
   }
 }
 
+// Normal and Mist passes (integrator/data_passes.h, Cycles' definitions), PT and G-PT: a quad
+// 7 below an orthographic camera covering the right half of the view. Normal: the shading normal
+// turned towards the camera, (0, 0, 1), also for the quad seen from its back; 0 for the sky.
+// Mist: 1 - (1 - clamp((7 - start) / depth) ^ falloff), 1 for the sky. Off: the film has none.
+TEST(Render, NormalAndMistPassesAsCycles) {
+  for (const bool back : {false, true}) {
+    Scene scene;
+    Mesh m = quad(1.0f);
+    if (back) m.indices = {0, 2, 1, 0, 3, 2};  // winding reversed: the camera sees the back
+    scene.meshes.push_back(m);
+    scene.materials.push_back(diffuse(Spectrum(0.5f)));
+    scene.instances.push_back(place(0, 0, translation({1, 0, 0})));
+    scene.world.color = Spectrum(0.5f);
+    scene.camera = top_camera(4, 2.0f, 7.0f);
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT})
+      for (const float falloff : {1.0f, 2.0f, 0.5f, 3.0f}) {
+        RenderSettings s = pt(4);
+        s.mode = mode;
+        s.normal_pass = s.mist_pass = true;
+        s.mist_start = 2.0f;
+        s.mist_depth = 10.0f;
+        s.mist_falloff = falloff;
+        RenderSession session(scene, s);
+        std::atomic<bool> cancel{false};
+        session.render(nullptr, cancel);
+        const Film& film = session.film();
+        std::vector<float> normal(3 * film.pixel_count()), mist(film.pixel_count());
+        film.normal(normal.data());
+        film.mist(mist.data());
+        const float expected = 1.0f - (1.0f - std::pow(0.5f, falloff));
+        for (int y = 0; y < 4; ++y)
+          for (int x = 0; x < 4; ++x) {
+            const size_t i = size_t(y) * 4 + size_t(x);
+            const bool hit = x >= 2;  // ortho: the right half exactly
+            EXPECT_EQ(normal[3 * i], 0.0f) << i;
+            EXPECT_EQ(normal[3 * i + 1], 0.0f) << i;
+            EXPECT_FLOAT_EQ(normal[3 * i + 2], hit ? 1.0f : 0.0f) << i << " back " << back;
+            EXPECT_NEAR(mist[i], hit ? expected : 1.0f, 1e-6f) << i << " falloff " << falloff;
+          }
+      }
+  }
+  // A perspective camera measures mist from its position: farther off-axis, more mist.
+  Scene scene;
+  scene.meshes.push_back(quad(10.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  scene.instances.push_back(place(0, 0));
+  scene.camera = top_camera(8, 2.0f, 7.0f);
+  scene.camera.projection = Camera::Projection::Perspective;
+  RenderSettings s = pt(16);
+  s.mist_pass = true;
+  s.mist_start = 0.0f;
+  s.mist_depth = 14.0f;
+  s.mist_falloff = 1.0f;
+  RenderSession session(scene, s);
+  std::atomic<bool> cancel{false};
+  session.render(nullptr, cancel);
+  EXPECT_FALSE(session.film().has_normal());
+  std::vector<float> mist(session.film().pixel_count());
+  session.film().mist(mist.data());
+  const float centre = mist[3 * 8 + 3], corner = mist[0];
+  EXPECT_GT(centre, 0.5f);  // 7 / 14 on the axis, a little more off it
+  EXPECT_LT(centre, 0.52f);
+  EXPECT_GT(corner, centre + 0.01f);
+  // No data passes requested: none stored.
+  RenderSession plain(scene, pt(1));
+  EXPECT_FALSE(plain.film().has_normal());
+  EXPECT_FALSE(plain.film().has_mist());
+}
+
 // --- Light-path semantics ---
 
 TEST(Render, CameraVisibleEmissionGoesToTheEmissionPass) {
