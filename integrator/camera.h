@@ -25,6 +25,7 @@ struct Ray {
   Vec3f direction;  // unit, but for shadow rays to a finite point: the segment, t in [0, 1)
   float t_min = 0.0f;
   float t_max = 1e30f;
+  uint32_t kind = kRayCamera;  // RayKind: which instances it sees (Instance::visibility)
 };
 
 class CameraModel {

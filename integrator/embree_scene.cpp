@@ -98,6 +98,9 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
       world_positions =
           static_cast<const Vec3f*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
     }
+    // Ray visibility: Embree skips the geometry for rays whose mask shares no bit with this.
+    rtcSetGeometryMask(geom, inst.visibility);
+    rtcCommitGeometry(geom);
     const unsigned id = rtcAttachGeometry(top_, geom);
     rtcReleaseGeometry(geom);
     if (id >= instances_.size()) instances_.resize(id + 1);

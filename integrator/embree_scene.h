@@ -75,7 +75,7 @@ inline void to_embree(const Ray& ray, bool active, RTCRay& r) {
   r.tnear = active ? ray.t_min : 1.0f;
   r.tfar = active ? ray.t_max : 0.0f;
   r.time = 0.0f;
-  r.mask = 0xffffffffu;
+  r.mask = ray.kind;
   r.id = 0;
   r.flags = 0;
 }

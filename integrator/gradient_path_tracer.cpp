@@ -239,6 +239,7 @@ struct BaseStep {
   const SurfaceHit* next;
   float u_lobe;
   Vec2f u_dir;
+  uint32_t kind;  // RayKind of the base's segment: the offsets' segments see what it sees
   // Reconnection target x_{d+1} (when found): its base side, and the side the base arrives on.
   shift::ReconnectionBase target;
   bool base_front;
@@ -469,9 +470,10 @@ class GradientPathTracer final : public Integrator {
 
   // The segment from vertex `v` along `dir` up to t_max, leaving the surface on the side of
   // `dir`: an occlusion query only (EmbreeScene::occluded).
-  static Ray shadow_ray(const Vertex& v, const Vec3f& dir, float t_max) {
+  static Ray shadow_ray(const Vertex& v, const Vec3f& dir, float t_max, uint32_t kind) {
     const Vec3f from = v.hit.position;
     Ray shadow;
+    shadow.kind = kind;
     shadow.origin = ray_origin(v, dot(dir, v.ng) > 0.0f);
     shadow.direction = dir;
     shadow.t_min = 0.0f;
@@ -492,9 +494,12 @@ class GradientPathTracer final : public Integrator {
     return shadow;
   }
 
-  bool occluded(const Vertex& v, const Vec3f& dir, float t_max, uint32_t& rays) const {
+  // `kind`: kRayShadow for light samples; a reconnected segment is the kind of the base's
+  // segment it replaces (RayKind, Instance::visibility).
+  bool occluded(const Vertex& v, const Vec3f& dir, float t_max, uint32_t kind,
+                uint32_t& rays) const {
     ++rays;
-    return ctx_.bvh().occluded(shadow_ray(v, dir, t_max));
+    return ctx_.bvh().occluded(shadow_ray(v, dir, t_max, kind));
   }
 
   // Local outgoing direction at `v` for world `dir`; false when the geometric and shading
@@ -727,7 +732,8 @@ class GradientPathTracer final : public Integrator {
             fs = bc.eval_pdf(base.wi, wo, pdf_fs);
             if (!is_black(fs) && !is_black(ls.radiance))
               visible = !occluded(base, ls.direction,
-                                  ls.is_infinite ? kInf : ls.distance * (1.0f - 1e-4f), out.rays);
+                                  ls.is_infinite ? kInf : ls.distance * (1.0f - 1e-4f), kRayShadow,
+                                  out.rays);
           }
           const float pdf_bsdf = (!ls.is_delta && visible) ? pdf_fs : 0.0f;
           if (visible) {
@@ -791,9 +797,9 @@ class GradientPathTracer final : public Integrator {
               fo[k] = o.v.closures->eval_pdf(o.v.wi, wo_o[k], pdf_fo[k]);
               if (!is_black(fo[k]) && !is_black(lo[k].radiance)) {
                 test[k] = true;
-                blocked[k] =
-                    occluded(o.v, lo[k].direction,
-                             lo[k].is_infinite ? kInf : lo[k].distance * (1.0f - 1e-4f), out.rays);
+                blocked[k] = occluded(o.v, lo[k].direction,
+                                      lo[k].is_infinite ? kInf : lo[k].distance * (1.0f - 1e-4f),
+                                      kRayShadow, out.rays);
               }
             }
           }
@@ -872,6 +878,9 @@ class GradientPathTracer final : public Integrator {
       ray.direction = normalize(wo_world);
       ray.t_min = 0.0f;
       ray.t_max = kInf;
+      // Its kind (ray visibility): a straight transparent crossing keeps the previous one.
+      if (!(delta && (bs.lobe & kLobeTransmission) && bs.eta == 1.0f))
+        ray.kind = ray_kind_of_lobe(bs.lobe);
       // The hit goes straight into the next vertex. Its end point only ends the path at the last
       // bounce: no vertex set-up there (the offsets' shifts need its classification alone), and
       // no hit record either when no offset shifts and no triangle emits (as PT).
@@ -910,6 +919,7 @@ class GradientPathTracer final : public Integrator {
         st.next = &next;
         st.u_lobe = u_lobe;
         st.u_dir = u_dir;
+        st.kind = ray.kind;
         st.base_front = false;
         // The reconnection target (a double square root and division) only where shift_segment()
         // may reconnect: x_d and x_{d+1} diffuse.
@@ -969,7 +979,8 @@ class GradientPathTracer final : public Integrator {
               // The light point is a diffuse end vertex: reconnect y_d to it. (A light that only
               // the offset's own direction finds belongs to the reverse reconnection: not here.)
               if (base_lit)
-                reconnect_to_light(o, base, ray.direction, lh, pl_pair, co, d_off, out.rays);
+                reconnect_to_light(o, base, ray.direction, ray.kind, lh, pl_pair, co, d_off,
+                                   out.rays);
             } else if (o.shift == Shift::HalfVector) {
               // The offset's own direction: does its ray cross a light before its surface?
               LightHit lo;
@@ -1136,7 +1147,7 @@ class GradientPathTracer final : public Integrator {
         o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
         o.seg_pdf = pdf;
         // Visibility, a single occlusion query (4-ray packets cost more, see trace()).
-        o.seg_visible = !occluded(y, dir, float(r.distance) * (1.0f - 1e-4f), rays);
+        o.seg_visible = !occluded(y, dir, float(r.distance) * (1.0f - 1e-4f), st.kind, rays);
       } else {
         // Reconnection at infinity: the same direction, J = 1, visibility from y_d.
         Vec3f wo;
@@ -1149,7 +1160,7 @@ class GradientPathTracer final : public Integrator {
         float pdf = 0.0f;
         o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
         o.seg_pdf = pdf;
-        o.seg_visible = !occluded(y, wo_world, kInf, rays);
+        o.seg_visible = !occluded(y, wo_world, kInf, st.kind, rays);
       }
       return;
     }
@@ -1203,6 +1214,7 @@ class GradientPathTracer final : public Integrator {
     o.ray.direction = dir;
     o.ray.t_min = 0.0f;
     o.ray.t_max = kInf;
+    o.ray.kind = st.kind;
     ++rays;
     o.next_found = bvh.intersect(o.ray, o.next_hit);
     // Kill: one path reaches the world and the other does not.
@@ -1234,8 +1246,9 @@ class GradientPathTracer final : public Integrator {
 
   // (a) for a not-connected pair with x_d, y_d diffuse: the offset reconnects to the point the
   // base's ray found on an analytic light.
-  void reconnect_to_light(Offset& o, const Vertex& base, Vec3f base_dir, const LightHit& lh,
-                          float pl_pair, Vec3d& co, PathDensities& d_off, uint32_t& rays) const {
+  void reconnect_to_light(Offset& o, const Vertex& base, Vec3f base_dir, uint32_t kind,
+                          const LightHit& lh, float pl_pair, Vec3d& co, PathDensities& d_off,
+                          uint32_t& rays) const {
     const Vertex& y = o.v;
     if (!std::isfinite(lh.distance)) {
       // A sun disc: reconnection at infinity, the same direction and radiance, J = 1.
@@ -1243,7 +1256,7 @@ class GradientPathTracer final : public Integrator {
       if (!local_dir(y, base_dir, wo)) return;
       float pdf_o = 0.0f;
       const Spectrum fo = y.closures->eval_pdf(y.wi, wo, pdf_o);
-      const bool vis = !occluded(y, base_dir, kInf, rays);
+      const bool vis = !occluded(y, base_dir, kInf, kind, rays);
       co = vis ? mul(mul(o.f, fo), lh.radiance) : Vec3d();
       d_off = shift::offset_densities(o.p, 1.0, pl_pair, vis ? pdf_o : 0.0f);
       return;
@@ -1263,7 +1276,7 @@ class GradientPathTracer final : public Integrator {
                          length_squared(lo.normal - lh.normal) <= kSameNormal2;
     float pdf_o = 0.0f;
     const Spectrum fo = y.closures->eval_pdf(y.wi, wo, pdf_o);
-    const bool vis = reaches && !occluded(y, dir, d * (1.0f - 1e-4f), rays);
+    const bool vis = reaches && !occluded(y, dir, d * (1.0f - 1e-4f), kind, rays);
     co = vis ? mul(mul(o.f, fo), lo.radiance) * r.jacobian : Vec3d();
     // Light sampling from y produces this point only where the light emits towards y (a spot's
     // cone), as the base's pl is counted only for a lit hit.

@@ -270,6 +270,7 @@ class PathTracer final : public Integrator {
               shadow.origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);
               shadow.direction = ls.direction;
               shadow.t_min = 0.0f;
+              shadow.kind = kRayShadow;
               // Stop short of the light's own surface (emissive triangles are geometry too),
               // aiming from the offset origin: the offset shortens the path to a light surface
               // by up to offset / cos, which at grazing angles (a ceiling just above a panel)
@@ -331,6 +332,7 @@ class PathTracer final : public Integrator {
       ray.direction = normalize(wo_world);
       ray.t_min = 0.0f;
       ray.t_max = kInf;
+      if (!crossing) ray.kind = ray_kind_of_lobe(bs.lobe);  // a crossing keeps the kind
     }
     return out;
   }

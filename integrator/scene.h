@@ -29,11 +29,26 @@ struct Mesh {
 };
 
 // A placement of a mesh. Many instances share one Mesh (Embree two-level instancing).
+// Kinds of rays, as Blender's Object > Visibility > Ray Visibility names them (Cycles' path
+// flags), one bit each: a ray hits an instance only when the instance's `visibility` has the bit
+// of the ray's kind (Embree's ray and geometry masks). A ray continuing straight through a
+// Transparent surface keeps its kind; a BSDF-sampled ray is diffuse, glossy or transmission by
+// the lobe it came from (ray_kind_of_lobe).
+enum RayKind : uint32_t {
+  kRayCamera = 1u << 0,
+  kRayDiffuse = 1u << 1,
+  kRayGlossy = 1u << 2,
+  kRayTransmission = 1u << 3,
+  kRayShadow = 1u << 4,
+  kRayAll = 0xffffffffu,
+};
+
 struct Instance {
   uint32_t mesh = 0;
   Transform object_to_world;
   std::vector<int32_t> slot_material;  // slot -> index in Scene::materials (-1 = default)
-  float pass_index = 0.0f;  // Blender's Object > Relations > Pass Index (the IndexOB pass)
+  float pass_index = 0.0f;        // Blender's Object > Relations > Pass Index (the IndexOB pass)
+  uint32_t visibility = kRayAll;  // RayKind bits of the rays that see this instance
 };
 
 // Blender camera. Looks down its local -Z with +Y up, like Blender.

@@ -18,6 +18,13 @@
 
 namespace gdpt {
 
+// The kind of a BSDF-sampled ray (RayKind) from the lobe it was sampled from, as Cycles labels
+// it: transmission, else diffuse, else glossy (delta reflections included).
+inline uint32_t ray_kind_of_lobe(uint32_t lobe) {
+  if (lobe & kLobeTransmission) return kRayTransmission;
+  return (lobe & kLobeDiffuse) ? kRayDiffuse : kRayGlossy;
+}
+
 class SceneContext {
  public:
   // Validates and prepares `scene` (which must outlive the context). Throws std::invalid_argument

@@ -143,6 +143,19 @@ def add_mesh(builder, mesh):
                                   loop_uvs, np.ascontiguousarray(tri_material))
 
 
+# Object > Visibility > Ray Visibility -> the core's RayKind bits (integrator/scene.h).
+_RAY_KINDS = (("visible_camera", 1 << 0), ("visible_diffuse", 1 << 1), ("visible_glossy", 1 << 2),
+              ("visible_transmission", 1 << 3), ("visible_shadow", 1 << 4))
+
+
+def ray_visibility(obj):
+    bits = 0
+    for prop, bit in _RAY_KINDS:
+        if getattr(obj, prop, True):
+            bits |= bit
+    return bits
+
+
 def _matrix12(m):
     a = np.array(m, dtype=np.float32)  # 4x4 rows
     return np.ascontiguousarray(a[:3, :4]).ravel()
@@ -194,4 +207,5 @@ class GeometryExporter:
         if mesh < 0:
             return
         slots = [self.materials.get(slot.material) for slot in obj.material_slots]
-        self.builder.add_instance(mesh, _matrix12(matrix), slots, obj.pass_index)
+        self.builder.add_instance(mesh, _matrix12(matrix), slots, obj.pass_index,
+                                  ray_visibility(obj))

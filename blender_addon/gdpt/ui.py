@@ -122,8 +122,34 @@ class GDPT_PT_passes(Panel):
         col.prop(context.view_layer, "use_pass_mist")
 
 
+class GDPT_PT_ray_visibility(Panel):
+    """Object > Visibility > Ray Visibility: which kinds of rays see the object (as Cycles)."""
+    bl_label = "Ray Visibility"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "object"
+    bl_parent_id = "OBJECT_PT_visibility"
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.object
+        return context.engine in cls.COMPAT_ENGINES and ob is not None and \
+            ob.type in {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META'}
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        ob = context.object
+        col = layout.column(heading="Ray Visibility", align=True)
+        col.prop(ob, "visible_camera", text="Camera", toggle=False)
+        col.prop(ob, "visible_diffuse", text="Diffuse", toggle=False)
+        col.prop(ob, "visible_glossy", text="Glossy", toggle=False)
+        col.prop(ob, "visible_transmission", text="Transmission", toggle=False)
+        col.prop(ob, "visible_shadow", text="Shadow", toggle=False)
+
+
 _classes = (GDPT_PT_sampling, GDPT_PT_light_paths, GDPT_PT_film, GDPT_PT_gradient_domain,
-            GDPT_PT_reconstruction, GDPT_PT_performance, GDPT_PT_passes)
+            GDPT_PT_reconstruction, GDPT_PT_performance, GDPT_PT_passes, GDPT_PT_ray_visibility)
 
 # Blender's engine-agnostic panels carry 'BLENDER_RENDER' in COMPAT_ENGINES (the convention of
 # Blender's own "Custom Render Engine" template); EEVEE's light / material / world panels draw the

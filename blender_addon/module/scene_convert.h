@@ -65,8 +65,10 @@ class SceneBuilder {
                      const FloatArray& normals, bool normals_per_loop, const FloatArray& loop_uvs,
                      const IntArray& poly_material);
   // pass_index: the object's Pass Index (IndexOB pass).
+  // visibility: RayKind bits of the rays that see the instance (Object > Visibility > Ray
+  // Visibility).
   void add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
-                    int pass_index = 0);
+                    int pass_index = 0, uint32_t visibility = kRayAll);
   int add_material(const py::dict& material);
   // rgba: (h, w, 4) or flat, row 0 at the bottom; converted to scene linear from `colorspace`
   // unless it is empty (already scene linear).

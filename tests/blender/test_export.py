@@ -9,7 +9,8 @@
 #    render UV map is not the first;
 #  - n-gons (convex and concave), all flat (no normals), material indices;
 #  - custom split normals;
-#  - an evaluated mesh (Subdivision Surface modifier) from the depsgraph.
+#  - an evaluated mesh (Subdivision Surface modifier) from the depsgraph;
+#  - the object's ray visibility flags as the core's bits, and their panel.
 import os
 import sys
 
@@ -171,6 +172,17 @@ def main():
     evaluated = cube.evaluated_get(depsgraph).data
     check(len(evaluated.polygons) == 24, "the evaluated cube has the modifier's 24 faces")
     compare("evaluated", evaluated)
+
+    # Object > Visibility > Ray Visibility -> RayKind bits (integrator/scene.h), and the panel.
+    from gdpt.export_mesh import ray_visibility
+    obj = bpy.data.objects.new("vis", me)
+    check(ray_visibility(obj) == 31, "all rays see an object by default")
+    obj.visible_camera, obj.visible_shadow = False, False
+    check(ray_visibility(obj) == 2 | 4 | 8, "camera and shadow bits cleared")
+    panel = bpy.types.GDPT_PT_ray_visibility
+    check(panel.bl_parent_id == "OBJECT_PT_visibility" and "GDPT" in panel.COMPAT_ENGINES and
+          "GDPT" in bpy.types.OBJECT_PT_visibility.COMPAT_ENGINES,
+          "the Ray Visibility panel sits under Object > Visibility for Gradient PT")
 
 
 main()

@@ -516,6 +516,50 @@ TEST(Render, NormalAndMistPassesAsCycles) {
   EXPECT_FALSE(plain.film().has_mist());
 }
 
+// Object > Visibility > Ray Visibility (Instance::visibility, RayKind): a 1 x 1 blocker 1 above
+// a floor, under a sun straight down, direct light only (albedo 0.8 / 0.5: radiance 0.8 E / pi on
+// the blocker, 0.5 E / pi on the lit floor). Seen from above through the blocker's square:
+// the blocker (all visible); the floor in its shadow (hidden from the camera); the lit floor
+// (hidden from camera and shadow rays). Outside the square the floor is lit in every case.
+TEST(Render, RayVisibilityHidesInstancesFromRayKinds) {
+  Scene scene;
+  scene.meshes.push_back(quad(50.0f));
+  scene.meshes.push_back(quad(0.5f));
+  scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  scene.materials.push_back(diffuse(Spectrum(0.8f)));
+  scene.instances.push_back(place(0, 0));
+  scene.instances.push_back(place(1, 1, translation({0, 0, 1})));
+  scene.world.color = Spectrum(0.0f);
+  Light sun;
+  sun.type = Light::Type::Sun;
+  sun.power = 3.0f;
+  sun.light_to_world = translation({0, 0, 20});
+  scene.lights.push_back(sun);
+  scene.camera = top_camera(8, 2.0f);  // pixels 2..5 lie inside the blocker's square
+  const float lit_floor = 0.5f * 3.0f / float(kPi), lit_blocker = 0.8f * 3.0f / float(kPi);
+  struct Case {
+    uint32_t visibility;
+    float inside;
+  };
+  const uint32_t secondary = kRayDiffuse | kRayGlossy | kRayTransmission;
+  for (const Case c : {Case{kRayAll, lit_blocker}, Case{kRayAll & ~kRayCamera, 0.0f},
+                       Case{secondary, lit_floor}, Case{kRayCamera | secondary, lit_blocker}})
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      scene.instances[1].visibility = c.visibility;
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      s.max_bounces = 0;
+      const Image img = render(scene, s);
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+          const bool inside = x >= 2 && x < 6 && y >= 2 && y < 6;
+          EXPECT_NEAR(img.at(x, y), inside ? c.inside : lit_floor, 1e-4f)
+              << "visibility " << c.visibility << " pixel " << x << "," << y << " mode "
+              << int(mode);
+        }
+    }
+}
+
 // --- Light-path semantics ---
 
 TEST(Render, CameraVisibleEmissionGoesToTheEmissionPass) {
