@@ -40,9 +40,7 @@ def cornell(scene):
     S.camera((0, -5.5, 2.0), (0, 0, 1.7), lens=30)
     S.light('AREA', (0, 0, 3.95), 150.0, target=(0, 0, 0), size=1.0)
     S.uv_sphere("a", 0.7, (-0.8, 0.2, 0.7), S.diffuse("a", (0.8, 0.8, 0.8)))
-    S.uv_sphere("b", 0.7, (0.8, 0.6, 0.7), S.shader_material(
-        "b", "ShaderNodeBsdfGlossy", Color=(0.9, 0.9, 0.9, 1), Roughness=0.3,
-        distribution='GGX'))
+    S.uv_sphere("b", 0.7, (0.8, 0.6, 0.7), S.glossy("b", 0.3))
 
 
 def textured(scene):

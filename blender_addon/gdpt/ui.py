@@ -13,15 +13,19 @@ def _split(layout):
     return layout
 
 
-class _RenderPanel:
+class _Panel:
+    """A GDPT panel of the Properties editor, shown while GDPT is the render engine."""
     bl_space_type = 'PROPERTIES'
     bl_region_type = 'WINDOW'
-    bl_context = "render"
     COMPAT_ENGINES = {ENGINE}
 
     @classmethod
     def poll(cls, context):
         return context.engine in cls.COMPAT_ENGINES
+
+
+class _RenderPanel(_Panel):
+    bl_context = "render"
 
 
 class GDPT_PT_sampling(_RenderPanel, Panel):
@@ -94,16 +98,9 @@ class GDPT_PT_performance(_RenderPanel, Panel):
         layout.prop(s, "preview_interval")
 
 
-class GDPT_PT_passes(Panel):
+class GDPT_PT_passes(_Panel, Panel):
     bl_label = "Gradient PT Passes"
-    bl_space_type = 'PROPERTIES'
-    bl_region_type = 'WINDOW'
     bl_context = "view_layer"
-    COMPAT_ENGINES = {ENGINE}
-
-    @classmethod
-    def poll(cls, context):
-        return context.engine in cls.COMPAT_ENGINES
 
     def draw(self, context):
         layout = _split(self.layout)
@@ -122,19 +119,16 @@ class GDPT_PT_passes(Panel):
         col.prop(context.view_layer, "use_pass_mist")
 
 
-class GDPT_PT_ray_visibility(Panel):
+class GDPT_PT_ray_visibility(_Panel, Panel):
     """Object > Visibility > Ray Visibility: which kinds of rays see the object (as Cycles)."""
     bl_label = "Ray Visibility"
-    bl_space_type = 'PROPERTIES'
-    bl_region_type = 'WINDOW'
     bl_context = "object"
     bl_parent_id = "OBJECT_PT_visibility"
-    COMPAT_ENGINES = {ENGINE}
 
     @classmethod
     def poll(cls, context):
         ob = context.object
-        return context.engine in cls.COMPAT_ENGINES and ob is not None and \
+        return super().poll(context) and ob is not None and \
             ob.type in {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META'}
 
     def draw(self, context):

@@ -86,6 +86,12 @@ def diffuse(name, color):
     return shader_material(name, "ShaderNodeBsdfDiffuse", Color=(*color, 1.0))
 
 
+def glossy(name, roughness, color=(0.9, 0.9, 0.9)):
+    """A Glossy BSDF with GGX (the distribution GDPT and the Cycles comparisons use)."""
+    return shader_material(name, "ShaderNodeBsdfGlossy", Color=(*color, 1.0), Roughness=roughness,
+                           distribution='GGX')
+
+
 def emission(name, color, strength):
     return shader_material(name, "ShaderNodeEmission", Color=(*color, 1.0), Strength=strength)
 

@@ -48,9 +48,7 @@ def case_diffuse(scene):
 def case_glossy(scene):
     lit_room(scene)
     area_ceiling()
-    m = S.shader_material("gloss", "ShaderNodeBsdfGlossy", Color=(0.9, 0.9, 0.9, 1),
-                          Roughness=0.4, distribution='GGX')
-    S.uv_sphere("ball", 0.9, (0, 0.2, 0.9), m)
+    S.uv_sphere("ball", 0.9, (0, 0.2, 0.9), S.glossy("gloss", 0.4))
     return 4
 
 
@@ -221,9 +219,7 @@ def case_ray_visibility(scene):
     # reflection), one casting no shadow, one hidden from diffuse rays.
     lit_room(scene)
     area_ceiling()
-    m = S.shader_material("gloss", "ShaderNodeBsdfGlossy", Color=(0.9, 0.9, 0.9, 1),
-                          Roughness=0.15, distribution='GGX')
-    S.uv_sphere("mirror", 0.7, (0.0, 0.6, 0.7), m)
+    S.uv_sphere("mirror", 0.7, (0.0, 0.6, 0.7), S.glossy("gloss", 0.15))
     ghost = S.uv_sphere("ghost", 0.5, (-1.1, -0.2, 0.5), S.diffuse("ghost", (0.9, 0.2, 0.2)))
     ghost.visible_camera = False
     unreflected = S.uv_sphere("unreflected", 0.4, (1.1, -0.4, 0.4),

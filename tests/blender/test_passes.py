@@ -36,8 +36,7 @@ def build(scene):
     # The emitter is visible to the camera: it fills the Emission pass.
     S.plane("panel", 1.2, (0, 0, 3.9), (math.pi, 0, 0),
             S.emission("panel", tuple(PANEL_RADIANCE / 5.0), 5.0))
-    gloss = S.shader_material("gloss", "ShaderNodeBsdfGlossy", Color=(0.9, 0.9, 0.9, 1),
-                              Roughness=0.3, distribution='GGX')
+    gloss = S.glossy("gloss", 0.3)
     coll = bpy.data.collections.new("Sphere")
     scene.collection.children.link(coll)
     ball = S.uv_sphere("ball", 0.8, (0.3, 0.2, 0.8), gloss)

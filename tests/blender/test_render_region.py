@@ -34,9 +34,7 @@ def build(scene):
     S.room()
     S.camera((0, -5.5, 2.0), (0, 0, 1.7), lens=30)
     S.light('AREA', (0, 0, 3.95), 150.0, target=(0, 0, 0), size=1.0)
-    S.uv_sphere("ball", 0.7, (0.3, 0.2, 0.7), S.shader_material(
-        "gloss", "ShaderNodeBsdfGlossy", Color=(0.9, 0.9, 0.9, 1), Roughness=0.3,
-        distribution='GGX'))
+    S.uv_sphere("ball", 0.7, (0.3, 0.2, 0.7), S.glossy("gloss", 0.3))
 
 
 def passes(path, names):

@@ -271,6 +271,25 @@ TEST(Render, DiskAreaLightMisMatchesTheAnalyticIrradiance) {
   EXPECT_NEAR(sum / img.primal.size(), expect, 0.01 * expect);
 }
 
+// A floor (albedo 0.5) and a sheet 1 above it, under a sun of irradiance 3 straight down.
+Scene sheet_over_floor(float sheet_half_size, const MaterialDesc& sheet, float sun_angle = 0.0f) {
+  Scene scene;
+  scene.meshes.push_back(quad(50.0f));
+  scene.meshes.push_back(quad(sheet_half_size));
+  scene.materials.push_back(diffuse(Spectrum(0.5f)));
+  scene.materials.push_back(sheet);
+  scene.instances.push_back(place(0, 0));
+  scene.instances.push_back(place(1, 1, translation({0, 0, 1})));
+  scene.world.color = Spectrum(0.0f);
+  Light sun;
+  sun.type = Light::Type::Sun;
+  sun.power = 3.0f;
+  sun.sun_angle = sun_angle;
+  sun.light_to_world = translation({0, 0, 20});
+  scene.lights.push_back(sun);
+  return scene;
+}
+
 // A Transparent BSDF sheet of colour T between a sun and a Lambert floor, viewed from above through
 // the sheet: light crosses it twice, L = albedo E cos / pi * T^2 (Cycles' transparent shadows).
 // Transparent crossings are not bounces: max_bounces = 0 gives the same image, and with a soft
@@ -280,19 +299,7 @@ MaterialDesc transparent(Spectrum color) {
 }
 
 Scene transparent_sheet_scene(float sun_angle) {
-  Scene scene;
-  scene.meshes.push_back(quad(50.0f));
-  scene.materials.push_back(diffuse(Spectrum(0.5f)));
-  scene.materials.push_back(transparent(Spectrum(0.5f, 0.25f, 1.0f)));
-  scene.instances.push_back(place(0, 0));
-  scene.instances.push_back(place(0, 1, translation({0, 0, 1})));
-  scene.world.color = Spectrum(0.0f);
-  Light sun;
-  sun.type = Light::Type::Sun;
-  sun.power = 3.0f;
-  sun.sun_angle = sun_angle;
-  sun.light_to_world = translation({0, 0, 20});
-  scene.lights.push_back(sun);
+  Scene scene = sheet_over_floor(50.0f, transparent(Spectrum(0.5f, 0.25f, 1.0f)), sun_angle);
   scene.camera = top_camera(4, 1.0f, 5.0f);
   return scene;
 }
@@ -522,19 +529,7 @@ TEST(Render, NormalAndMistPassesAsCycles) {
 // the blocker (all visible); the floor in its shadow (hidden from the camera); the lit floor
 // (hidden from camera and shadow rays). Outside the square the floor is lit in every case.
 TEST(Render, RayVisibilityHidesInstancesFromRayKinds) {
-  Scene scene;
-  scene.meshes.push_back(quad(50.0f));
-  scene.meshes.push_back(quad(0.5f));
-  scene.materials.push_back(diffuse(Spectrum(0.5f)));
-  scene.materials.push_back(diffuse(Spectrum(0.8f)));
-  scene.instances.push_back(place(0, 0));
-  scene.instances.push_back(place(1, 1, translation({0, 0, 1})));
-  scene.world.color = Spectrum(0.0f);
-  Light sun;
-  sun.type = Light::Type::Sun;
-  sun.power = 3.0f;
-  sun.light_to_world = translation({0, 0, 20});
-  scene.lights.push_back(sun);
+  Scene scene = sheet_over_floor(0.5f, diffuse(Spectrum(0.8f)));
   scene.camera = top_camera(8, 2.0f);  // pixels 2..5 lie inside the blocker's square
   const float lit_floor = 0.5f * 3.0f / float(kPi), lit_blocker = 0.8f * 3.0f / float(kPi);
   struct Case {
