@@ -629,11 +629,15 @@ class GradientPathTracer final : public Integrator {
     // --- Camera rays (traced by render_tile) ---
     const Ray& cam_ray = *cs.ray;
     const SurfaceHit& hit = *cs.hit;
-    const bool camera_found = cs.found;
+    // A holdout at the camera hit ends the path as an escape to a black world would (Cycles:
+    // nothing added; with a transparent background coverage 0); offsets meeting one are dead.
+    const bool holdouts = ctx_.has_holdout();
+    const bool holdout = cs.found && holdouts && ctx_.is_holdout(*cs.hit);
+    const bool camera_found = cs.found && !holdout;
     // Very direct light, never shifted: lamps visible to the camera, and the world.
     if (has_visible_lamps_) {
       LightHit lh;
-      if (lights.intersect(cam_ray.origin, cam_ray.direction, camera_found ? hit.t : cam_ray.t_max,
+      if (lights.intersect(cam_ray.origin, cam_ray.direction, cs.found ? hit.t : cam_ray.t_max,
                            lh) &&
           lh.camera_visible)
         out.emission += lh.radiance;
@@ -641,7 +645,7 @@ class GradientPathTracer final : public Integrator {
     if (!camera_found) {
       if (settings_.transparent_background)
         out.alpha = 0.0f;
-      else if (has_world_)
+      else if (has_world_ && !holdout)
         out.emission += lights.environment(cam_ray.direction);
       for (Vec3d& g : out.grad) g = Vec3d();
       return;
@@ -661,7 +665,7 @@ class GradientPathTracer final : public Integrator {
       o.p = 1.0;
       o.grad = Vec3d();
       // Base hits a surface, the offset the world: no shift.
-      o.alive = cs.off_found[k];
+      o.alive = cs.off_found[k] && !(holdouts && ctx_.is_holdout(*cs.off_hit[k]));
       if (o.alive) setup_vertex(ctx_, sides_, *cs.off_hit[k], cs.off_ray[k]->direction, o.v);
     }
 

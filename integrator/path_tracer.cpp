@@ -217,6 +217,14 @@ class PathTracer final : public Integrator {
 
       if (!kEmissive && last) break;
 
+      // --- Holdout: the camera path ends here with nothing added; with a transparent
+      // background the coverage is what the transparent surfaces crossed so far took (Cycles) ---
+      if (camera_path && ctx_.has_holdout() && ctx_.is_holdout(hit)) {
+        if (settings_.transparent_background)
+          out.alpha = 1.0f - std::clamp((beta.x + beta.y + beta.z) / 3.0f, 0.0f, 1.0f);
+        break;
+      }
+
       // --- Shading point ---
       const ShadingContext sc{hit.uv, hit.front_facing};
       const Material& material = materials[size_t(hit.material)];

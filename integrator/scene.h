@@ -49,6 +49,9 @@ struct Instance {
   std::vector<int32_t> slot_material;  // slot -> index in Scene::materials (-1 = default)
   float pass_index = 0.0f;        // Blender's Object > Relations > Pass Index (the IndexOB pass)
   uint32_t visibility = kRayAll;  // RayKind bits of the rays that see this instance
+  // Blender's Object > Visibility > Mask > Holdout: where the camera path meets it, the path
+  // ends with nothing added, and with Film > Transparent the pixel's coverage drops (Cycles).
+  bool holdout = false;
 };
 
 // Blender camera. Looks down its local -Z with +Y up, like Blender.

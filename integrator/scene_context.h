@@ -43,6 +43,11 @@ class SceneContext {
                                : 0.0f;
     film.set_first_hit(x, y, camera_.view_depth(hit.position), object, material);
   }
+  // Holdout (Instance::holdout): whether the scene has any, and whether `hit` is on one.
+  bool has_holdout() const { return has_holdout_; }
+  bool is_holdout(const SurfaceHit& hit) const {
+    return hit.instance < scene_.instances.size() && scene_.instances[hit.instance].holdout;
+  }
   const EmbreeScene& bvh() const { return *bvh_; }
   const CameraModel& camera() const { return camera_; }
   const LightSampler& lights() const { return *lights_; }
@@ -61,6 +66,7 @@ class SceneContext {
   std::vector<Material> materials_;
   std::unique_ptr<EmbreeScene> bvh_;
   std::unique_ptr<LightSampler> lights_;
+  bool has_holdout_ = false;
   CameraModel camera_;
   uint32_t features_ = 0, scene_features_ = 0;
   std::vector<std::string> warnings_;

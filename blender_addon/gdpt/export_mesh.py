@@ -170,7 +170,6 @@ class GeometryExporter:
         self.warn = warn
         self.mesh_index = {}  # evaluated data pointer -> scene mesh index (-1: empty)
         self.export_seconds = 0.0
-        self.holdouts_warned = set()  # object names
 
     def _mesh_for(self, obj):
         # Meshes: the evaluated mesh datablock (modifiers applied) is what instances share.
@@ -207,10 +206,6 @@ class GeometryExporter:
         mesh = self._mesh_for(obj)
         if mesh < 0:
             return
-        if obj.is_holdout and obj.name not in self.holdouts_warned:
-            self.holdouts_warned.add(obj.name)
-            self.warn(f"object '{obj.name}': Holdout (Object > Visibility > Mask) is not supported "
-                      f"by Gradient PT; rendered as an ordinary object")
         slots = [self.materials.get(slot.material) for slot in obj.material_slots]
         self.builder.add_instance(mesh, _matrix12(matrix), slots, obj.pass_index,
-                                  ray_visibility(obj))
+                                  ray_visibility(obj), bool(obj.is_holdout))

@@ -92,7 +92,7 @@ PYBIND11_MODULE(_gdpt, m) {
            py::arg("poly_material").noconvert())
       .def("add_instance", &SceneBuilder::add_instance, py::arg("mesh"), py::arg("matrix"),
            py::arg("slot_material"), py::arg("pass_index") = 0,
-           py::arg("visibility") = uint32_t(kRayAll))
+           py::arg("visibility") = uint32_t(kRayAll), py::arg("holdout") = false)
       .def("add_material", &SceneBuilder::add_material)
       .def("add_image", &SceneBuilder::add_image, py::arg("name"), py::arg("width"),
            py::arg("height"), py::arg("rgba").noconvert(), py::arg("colorspace"))

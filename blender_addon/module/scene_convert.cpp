@@ -435,7 +435,7 @@ py::dict SceneBuilder::mesh_arrays(int index) const {
 }
 
 void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
-                                int pass_index, uint32_t visibility) {
+                                int pass_index, uint32_t visibility, bool holdout) {
   if (mesh < 0 || size_t(mesh) >= scene_.meshes.size())
     throw std::invalid_argument("add_instance: mesh index out of range");
   Instance inst;
@@ -443,6 +443,7 @@ void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::li
   inst.object_to_world = to_transform(matrix, "instance");
   inst.pass_index = float(pass_index);
   inst.visibility = visibility;
+  inst.holdout = holdout;
   inst.slot_material.reserve(py::len(slot_material));
   for (const auto& m : slot_material) {
     const int32_t index = m.cast<int32_t>();

@@ -68,7 +68,7 @@ class SceneBuilder {
   // visibility: RayKind bits of the rays that see the instance (Object > Visibility > Ray
   // Visibility).
   void add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
-                    int pass_index = 0, uint32_t visibility = kRayAll);
+                    int pass_index = 0, uint32_t visibility = kRayAll, bool holdout = false);
   int add_material(const py::dict& material);
   // rgba: (h, w, 4) or flat, row 0 at the bottom; converted to scene linear from `colorspace`
   // unless it is empty (already scene linear).

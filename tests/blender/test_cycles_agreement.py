@@ -234,6 +234,16 @@ def case_ray_visibility(scene):
     return 4
 
 
+def case_holdout(scene):
+    # Object > Visibility > Mask > Holdout: the camera sees a black hole where the ball is (its
+    # shadow and its light on the walls stay).
+    lit_room(scene)
+    area_ceiling()
+    ball = S.uv_sphere("ball", 0.8, (0.4, 0.3, 0.8), S.diffuse("ball", (0.8, 0.8, 0.3)))
+    ball.is_holdout = True
+    return 4
+
+
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
 
 # Cases whose noise floor at the default counts lies near the threshold render more samples on
@@ -246,7 +256,7 @@ SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4}
 
 # Cases whose GDPT side is also rendered in PT mode (Combined = Primal + Emission): what the
 # camera sees directly must not depend on the integrator.
-BOTH_MODES = {"area_visible", "area_camera_visible", "ray_visibility"}
+BOTH_MODES = {"area_visible", "area_camera_visible", "ray_visibility", "holdout"}
 
 
 def run_case(name, out_dir, mode=None):

@@ -4,10 +4,13 @@
 #  - the alpha channel agrees with Cycles' (Film > Transparent, same samples, 1-pixel box filter):
 #    mean |difference| < 0.02, the two engines' coverage of the silhouettes;
 #  - G-PT + L1: the same alpha rule, and the reconstructed sky stays black;
-#  - the Gradient Reconstruct compositor node carries the render's alpha.
+#  - the Gradient Reconstruct compositor node carries the render's alpha;
+#  - a Holdout ball (Object > Visibility > Mask): alpha and colour 0 where the camera sees it,
+#    alpha as Cycles' (PT and G-PT + L1).
 import os
 import sys
 
+import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
@@ -77,6 +80,21 @@ def main():
     check(np.array_equal(composite[..., 3], gpt[..., 3]),
           "the compositor node's alpha is the render's")
     scene.use_nodes = False
+
+    # --- Holdout ball: alpha 0 and black where the camera sees it, as Cycles (PT and G-PT) ---
+    bpy.data.objects["ball"].is_holdout = True
+    cyc = rgba(render(scene, "cycles_holdout", True, engine='CYCLES'), "ViewLayer.Combined.")
+    hole = surface & (cyc[..., 3] < 1e-6)  # pixels that saw only the ball
+    check(hole.sum() > 100, f"{hole.sum()} pixels see only the holdout ball")
+    # (G-PT + L1: the reconstruction may leave a trace of colour in the hole, bounded as the sky's.)
+    for mode, recon, bound in (('PT', 'NONE', 0.0), ('GPT', 'L1', 0.05)):
+        img = rgba(render(scene, f"{mode}_holdout", True, mode=mode, reconstruction=recon),
+                   "ViewLayer.Combined.")
+        a_diff = float(np.abs(cyc[..., 3] - img[..., 3]).mean())
+        inside = float(np.abs(img[hole]).max())
+        check(a_diff < 0.02 and float(np.abs(img[hole][:, 3]).max()) == 0.0 and inside <= bound,
+              f"{mode} holdout: alpha agrees with Cycles' (mean |diff| {a_diff:.4f}), RGBA in the "
+              f"hole at most {inside:.4f}")
     print("film transparent: all checks passed")
 
 

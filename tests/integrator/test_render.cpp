@@ -555,6 +555,43 @@ TEST(Render, RayVisibilityHidesInstancesFromRayKinds) {
     }
 }
 
+// Holdout (Instance::holdout): the 1 x 1 sheet of the test above, seen from above, is black,
+// with coverage 0 under Film > Transparent (1 without), and still casts its shadow; the floor
+// around it is lit. G-PT's gradients across the holdout's edge are the primal's steps.
+TEST(Render, HoldoutIsBlackAndUncovered) {
+  Scene scene = sheet_over_floor(0.5f, diffuse(Spectrum(0.8f)));
+  scene.instances[1].holdout = true;
+  scene.camera = top_camera(8, 2.0f);
+  const float lit_floor = 0.5f * 3.0f / float(kPi);
+  for (const bool transparent : {false, true})
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      s.max_bounces = 0;
+      s.transparent_background = transparent;
+      RenderSession session(scene, s);
+      std::atomic<bool> cancel{false};
+      session.render(nullptr, cancel);
+      const Film& film = session.film();
+      std::vector<float> primal(3 * 64), alpha(64), dx(3 * 64);
+      film.primal_rgb(primal.data());
+      film.alpha(alpha.data());
+      film.gradient_x_rgb(dx.data());
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+          const size_t i = size_t(y) * 8 + size_t(x);
+          const bool inside = x >= 2 && x < 6 && y >= 2 && y < 6;
+          EXPECT_NEAR(primal[3 * i], inside ? 0.0f : lit_floor, 1e-4f)
+              << x << "," << y << " mode " << int(mode) << " transparent " << transparent;
+          EXPECT_EQ(alpha[i], inside && transparent ? 0.0f : 1.0f) << x << "," << y;
+          if (x < 7) {  // dx(x) = I(x + 1) - I(x)
+            EXPECT_NEAR(dx[3 * i], primal[3 * (i + 1)] - primal[3 * i], 1e-4f)
+                << x << "," << y << " mode " << int(mode);
+          }
+        }
+    }
+}
+
 // --- Light-path semantics ---
 
 TEST(Render, CameraVisibleEmissionGoesToTheEmissionPass) {
