@@ -8,7 +8,7 @@
 //    mist(d) = clamp((d - start) / depth, 0, 1) ^ falloff, d the distance from the camera
 //    (CameraModel::camera_distance); the film outputs 1 - the mean, so the sky reads 1.
 // The camera path is the camera ray and the straight transparent crossings after it (PT; G-PT
-// records its camera hit only, as for Film > Transparent).
+// records its camera hit only).
 #pragma once
 
 #include <algorithm>

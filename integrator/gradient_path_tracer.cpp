@@ -678,6 +678,10 @@ class GradientPathTracer final : public Integrator {
     Ray ray;  // the base's current segment
 
     Spectrum beta(1.0f);  // f / p of the base, for the primal (PT estimator)
+    // Nothing but straight transparent crossings since the camera (the offsets, which copy
+    // delta events, cross with the base). With Film > Transparent such a path leaves the world
+    // out and the pixel's coverage is what it crossed (Cycles' rule, as PT).
+    bool camera_path = true;
     Vec3d fb(1.0, 1.0, 1.0);
     double pb = 1.0;
 
@@ -883,8 +887,10 @@ class GradientPathTracer final : public Integrator {
       ray.t_min = 0.0f;
       ray.t_max = kInf;
       // Its kind (ray visibility): a straight transparent crossing keeps the previous one.
-      if (!(delta && (bs.lobe & kLobeTransmission) && bs.eta == 1.0f))
-        ray.kind = ray_kind_of_lobe(bs.lobe);
+      const bool crossing = delta && (bs.lobe & kLobeTransmission) && bs.eta == 1.0f;
+      if (!crossing) ray.kind = ray_kind_of_lobe(bs.lobe);
+      camera_path = camera_path && crossing;
+      const bool world_seen = has_world_ && !(camera_path && settings_.transparent_background);
       // The hit goes straight into the next vertex. Its end point only ends the path at the last
       // bounce: no vertex set-up there (the offsets' shifts need its classification alone), and
       // no hit record either when no offset shifts and no triangle emits (as PT).
@@ -1006,7 +1012,9 @@ class GradientPathTracer final : public Integrator {
         Spectrum le(0.0f);
         float pl = 0.0f;
         if (!found) {
-          if (has_world_) {
+          if (camera_path && settings_.transparent_background)
+            out.alpha = 1.0f - std::clamp((beta.x + beta.y + beta.z) / 3.0f, 0.0f, 1.0f);
+          if (world_seen) {
             le = lights.environment(ray.direction);
             if (!delta && !is_black(le)) pl = lights.pdf_environment(ray.direction);
           }
@@ -1029,7 +1037,8 @@ class GradientPathTracer final : public Integrator {
           Vec3d co;
           PathDensities d_off{0.0, 0.0, 0.0};
           const float pl_pair = o.nee_on ? pl : 0.0f;
-          if (o.alive) end_event(o, found, next, le, pl_pair, !delta && o.nee_on, co, d_off);
+          if (o.alive)
+            end_event(o, found, world_seen, next, le, pl_pair, !delta && o.nee_on, co, d_off);
           if (is_zero(cb) && is_zero(co)) continue;
           const double w =
               shift::mis_weight_over_pdf(PathDensities{pb, pl_pair, pdf_b}, d_off, pdf_b);
@@ -1295,8 +1304,10 @@ class GradientPathTracer final : public Integrator {
   // (b)/(c): the offset's contribution and densities for the emission at the end of the segment
   // (world when !found, emissive triangle `next` otherwise). `nee_on`: the pair shifts light
   // sampling here, so the offset's own light density counts.
-  void end_event(const Offset& o, bool found, const SurfaceHit& next, Spectrum le, float pl_pair,
-                 bool nee_on, Vec3d& co, PathDensities& d_off) const {
+  // `world_seen`: the world emits into this segment (not with a transparent background on the
+  // camera path).
+  void end_event(const Offset& o, bool found, bool world_seen, const SurfaceHit& next, Spectrum le,
+                 float pl_pair, bool nee_on, Vec3d& co, PathDensities& d_off) const {
     const LightSampler& lights = ctx_.lights();
     switch (o.shift) {
       case Shift::Follow:
@@ -1327,7 +1338,7 @@ class GradientPathTracer final : public Integrator {
         Spectrum le_o(0.0f);
         float pl_o = 0.0f;
         if (!found) {
-          if (has_world_) le_o = lights.environment(o.ray.direction);
+          if (world_seen) le_o = lights.environment(o.ray.direction);
           if (nee_on && !is_black(le_o)) pl_o = lights.pdf_environment(o.ray.direction);
         } else {
           le_o = triangle_le(o.next_hit, o.v.hit.position);

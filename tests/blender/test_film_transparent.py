@@ -6,7 +6,10 @@
 #  - G-PT + L1: the same alpha rule, and the reconstructed sky stays black;
 #  - the Gradient Reconstruct compositor node carries the render's alpha;
 #  - a Holdout ball (Object > Visibility > Mask): alpha and colour 0 where the camera sees it,
-#    alpha as Cycles' (PT and G-PT + L1).
+#    alpha as Cycles' (PT and G-PT + L1);
+#  - a Transparent sheet before the sky: alpha 1 - mean(sheet colour) there, PT and G-PT, as
+#    Cycles'.
+import math
 import os
 import sys
 
@@ -95,6 +98,22 @@ def main():
         check(a_diff < 0.02 and float(np.abs(img[hole][:, 3]).max()) == 0.0 and inside <= bound,
               f"{mode} holdout: alpha agrees with Cycles' (mean |diff| {a_diff:.4f}), RGBA in the "
               f"hole at most {inside:.4f}")
+
+    # --- A Transparent sheet before the sky: coverage 1 - mean(colour) there, as Cycles' ---
+    bpy.data.objects["ball"].is_holdout = False
+    sheet = S.shader_material("sheet", "ShaderNodeBsdfTransparent", Color=(0.5, 0.25, 1.0, 1))
+    S.plane("sheet", 3.0, (-2.0, -3.0, 2.2), (math.pi / 2, 0, 0), sheet)
+    cyc = rgba(render(scene, "cycles_sheet", True, engine='CYCLES'), "ViewLayer.Combined.")
+    behind = sky & (np.abs(cyc[..., 3] - (1.0 - (0.5 + 0.25 + 1.0) / 3.0)) < 0.02)
+    check(behind.sum() > 50, f"{behind.sum()} pixels see the sky through the sheet only")
+    for mode, recon in (('PT', 'NONE'), ('GPT', 'L1')):
+        img = rgba(render(scene, f"{mode}_sheet", True, mode=mode, reconstruction=recon),
+                   "ViewLayer.Combined.")
+        a_diff = float(np.abs(cyc[..., 3] - img[..., 3]).mean())
+        a_behind = float(np.abs(img[behind][:, 3] - 5.0 / 12.0).max())
+        check(a_diff < 0.02 and a_behind < 1e-5,
+              f"{mode}: alpha through the sheet is 1 - mean(colour) = 5/12 (max error "
+              f"{a_behind:.2g}), all alpha within {a_diff:.4f} of Cycles' on average")
     print("film transparent: all checks passed")
 
 
