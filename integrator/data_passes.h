@@ -7,8 +7,8 @@
 //  - Mist: at every surface of the camera path, (1 - mist(d)) x mean(throughput x coverage),
 //    mist(d) = clamp((d - start) / depth, 0, 1) ^ falloff, d the distance from the camera
 //    (CameraModel::camera_distance); the film outputs 1 - the mean, so the sky reads 1.
-// The camera path is the camera ray and the straight transparent crossings after it (PT; G-PT
-// records its camera hit only).
+// The camera path is the camera ray and the straight transparent crossings after it (PT and
+// G-PT alike).
 #pragma once
 
 #include <algorithm>

@@ -692,6 +692,10 @@ class GradientPathTracer final : public Integrator {
       if (bounce > max_bounces) break;
       const Vertex& base = scratch.verts[cur];
       Vertex& next_base = scratch.verts[cur ^ 1];
+      // Normal / Mist passes at the surfaces the camera path meets after transparent crossings
+      // (the camera hit's are recorded above).
+      if (bounce > 0 && camera_path && data_.active())
+        data_.at_surface(base.hit, *base.closures, beta, out.data);
       if (!base.closures->has_bsdf()) break;
 
       const VertexType base_type = classify(base.roughness);

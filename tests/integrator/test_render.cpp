@@ -521,6 +521,28 @@ TEST(Render, NormalAndMistPassesAsCycles) {
   EXPECT_GT(centre, 0.5f);  // 7 / 14 on the axis, a little more off it
   EXPECT_LT(centre, 0.52f);
   EXPECT_GT(corner, centre + 0.01f);
+  // Through a Transparent sheet of colour 0.7 (coverage 0.3 < 0.5) 1 above the floor, PT and
+  // G-PT: the normal is the floor's; mist (start 2, depth 10, linear) adds the sheet's (1 - 0.4)
+  // x 0.3 and the floor's (1 - 0.5) x 0.7: the pass reads 1 - 0.53.
+  for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+    Scene sheet = sheet_over_floor(50.0f, transparent(Spectrum(0.7f)));
+    sheet.camera = top_camera(4, 2.0f, 7.0f);
+    RenderSettings st = pt(4);
+    st.mode = mode;
+    st.normal_pass = st.mist_pass = true;
+    st.mist_start = 2.0f;
+    st.mist_depth = 10.0f;
+    st.mist_falloff = 1.0f;
+    RenderSession through(sheet, st);
+    through.render(nullptr, cancel);
+    std::vector<float> n(3 * 16), m(16);
+    through.film().normal(n.data());
+    through.film().mist(m.data());
+    for (size_t i = 0; i < 16; ++i) {
+      EXPECT_FLOAT_EQ(n[3 * i + 2], 1.0f) << i << " mode " << int(mode);
+      EXPECT_NEAR(m[i], 0.47f, 1e-5f) << i << " mode " << int(mode);
+    }
+  }
   // No data passes requested: none stored.
   RenderSession plain(scene, pt(1));
   EXPECT_FALSE(plain.film().has_normal());
