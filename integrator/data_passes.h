@@ -43,9 +43,7 @@ class DataPasses {
   // A surface of the camera path, reached with throughput `beta`, its closures evaluated.
   void at_surface(const SurfaceHit& hit, const ClosureSet& closures, Spectrum beta,
                   DataSample& out) const {
-    Spectrum transparency(0.0f);
-    for (int i = 0; i < closures.count(); ++i)
-      if (closures[i].type == ClosureType::Transparent) transparency += closures[i].weight;
+    const Spectrum transparency = closures.transparency();
     const Spectrum coverage(std::clamp(1.0f - transparency.x, 0.0f, 1.0f),
                             std::clamp(1.0f - transparency.y, 0.0f, 1.0f),
                             std::clamp(1.0f - transparency.z, 0.0f, 1.0f));

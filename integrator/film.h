@@ -99,7 +99,7 @@ class Film {
     const size_t i = size_t(y) * width_ + x;
     if (!normal_.empty())
       for (int c = 0; c < 3; ++c) normal_[3 * i + size_t(c)] += normal[c];
-    if (!mist_.empty()) mist_[i] += mist;
+    if (!mist_.empty() && std::isfinite(mist)) mist_[i] += mist;  // as add_path: drop NaN / inf
   }
 
   // --- Bookkeeping (RenderSession) ---

@@ -115,10 +115,7 @@ class PathTracer final : public Integrator {
       if (!ctx_.bvh().intersect(ray, h)) return tr;
       scratch.clear();
       ctx_.materials()[size_t(h.material)].evaluate(ShadingContext{h.uv, h.front_facing}, scratch);
-      Spectrum through(0.0f);
-      for (int i = 0; i < scratch.count(); ++i)
-        if (scratch[i].type == ClosureType::Transparent) through += scratch[i].weight;
-      tr *= through;
+      tr *= scratch.transparency();
       if (is_black(tr)) return tr;
       const Vec3f n =
           dot(ray.direction, h.geometric_normal) > 0.0f ? h.geometric_normal : -h.geometric_normal;

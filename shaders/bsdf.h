@@ -35,6 +35,14 @@ class ClosureSet {
   const Closure& operator[](int i) const { return closures_[i]; }
   Spectrum emission() const { return emission_; }
   bool has_bsdf() const { return count_ > 0; }
+  // Sum of the Transparent closures' weights: what passes straight through the surface (Cycles'
+  // shader transparency; 1 - it is the surface's coverage).
+  Spectrum transparency() const {
+    Spectrum t(0.0f);
+    for (int i = 0; i < count_; ++i)
+      if (closures_[i].type == ClosureType::Transparent) t += closures_[i].weight;
+    return t;
+  }
 
   Spectrum eval(Vec3f wi, Vec3f wo) const {
     return single_lambert() ? lambert::eval(closures_[0], wi, wo) : eval_mixture(wi, wo);
