@@ -102,6 +102,8 @@ struct Image {
   int w = 0, h = 0;
   std::vector<float> primal, emission;
   std::vector<float> alpha, depth, object_index, material_index;  // 1 per pixel
+  std::vector<float> gradient_x;                                  // 3 per pixel
+  std::vector<float> normal, mist;  // 3 / 1 per pixel when the render computes them, else empty
   uint32_t min_samples = 0;
   float at(int x, int y, int c = 0) const { return primal[size_t(y * w + x) * 3 + c]; }
 };
@@ -123,6 +125,16 @@ Image render(const Scene& scene, RenderSettings s, std::string* summary = nullpt
   session.film().depth(img.depth.data());
   session.film().object_index(img.object_index.data());
   session.film().material_index(img.material_index.data());
+  img.gradient_x.resize(session.film().pixel_count() * 3);
+  session.film().gradient_x_rgb(img.gradient_x.data());
+  if (session.film().has_normal()) {
+    img.normal.resize(session.film().pixel_count() * 3);
+    session.film().normal(img.normal.data());
+  }
+  if (session.film().has_mist()) {
+    img.mist.resize(session.film().pixel_count());
+    session.film().mist(img.mist.data());
+  }
   img.min_samples = session.film().min_samples();
   if (summary) *summary = session.features_summary();
   return img;
@@ -480,13 +492,8 @@ TEST(Render, NormalAndMistPassesAsCycles) {
         s.mist_start = 2.0f;
         s.mist_depth = 10.0f;
         s.mist_falloff = falloff;
-        RenderSession session(scene, s);
-        std::atomic<bool> cancel{false};
-        session.render(nullptr, cancel);
-        const Film& film = session.film();
-        std::vector<float> normal(3 * film.pixel_count()), mist(film.pixel_count());
-        film.normal(normal.data());
-        film.mist(mist.data());
+        const Image img = render(scene, s);
+        const std::vector<float>&normal = img.normal, &mist = img.mist;
         const float expected = 1.0f - (1.0f - std::pow(0.5f, falloff));
         for (int y = 0; y < 4; ++y)
           for (int x = 0; x < 4; ++x) {
@@ -511,12 +518,9 @@ TEST(Render, NormalAndMistPassesAsCycles) {
   s.mist_start = 0.0f;
   s.mist_depth = 14.0f;
   s.mist_falloff = 1.0f;
-  RenderSession session(scene, s);
-  std::atomic<bool> cancel{false};
-  session.render(nullptr, cancel);
-  EXPECT_FALSE(session.film().has_normal());
-  std::vector<float> mist(session.film().pixel_count());
-  session.film().mist(mist.data());
+  const Image persp = render(scene, s);
+  EXPECT_TRUE(persp.normal.empty());  // not requested: not stored
+  const std::vector<float>& mist = persp.mist;
   const float centre = mist[3 * 8 + 3], corner = mist[0];
   EXPECT_GT(centre, 0.5f);  // 7 / 14 on the axis, a little more off it
   EXPECT_LT(centre, 0.52f);
@@ -533,11 +537,8 @@ TEST(Render, NormalAndMistPassesAsCycles) {
     st.mist_start = 2.0f;
     st.mist_depth = 10.0f;
     st.mist_falloff = 1.0f;
-    RenderSession through(sheet, st);
-    through.render(nullptr, cancel);
-    std::vector<float> n(3 * 16), m(16);
-    through.film().normal(n.data());
-    through.film().mist(m.data());
+    const Image through = render(sheet, st);
+    const std::vector<float>&n = through.normal, &m = through.mist;
     for (size_t i = 0; i < 16; ++i) {
       EXPECT_FLOAT_EQ(n[3 * i + 2], 1.0f) << i << " mode " << int(mode);
       EXPECT_NEAR(m[i], 0.47f, 1e-5f) << i << " mode " << int(mode);
@@ -595,14 +596,8 @@ TEST(Render, HoldoutIsBlackAndUncovered) {
       s.mode = mode;
       s.max_bounces = 0;
       s.transparent_background = transparent;
-      RenderSession session(scene, s);
-      std::atomic<bool> cancel{false};
-      session.render(nullptr, cancel);
-      const Film& film = session.film();
-      std::vector<float> primal(3 * 64), alpha(64), dx(3 * 64);
-      film.primal_rgb(primal.data());
-      film.alpha(alpha.data());
-      film.gradient_x_rgb(dx.data());
+      const Image img = render(scene, s);
+      const std::vector<float>&primal = img.primal, &alpha = img.alpha, &dx = img.gradient_x;
       for (int y = 0; y < 8; ++y)
         for (int x = 0; x < 8; ++x) {
           const size_t i = size_t(y) * 8 + size_t(x);
