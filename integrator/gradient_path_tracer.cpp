@@ -1,9 +1,10 @@
 // Gradient-domain path tracer: see gradient_path_tracer.h for the estimator and the film layout,
 // shift_mapping.h for the shift mathematics.
 //
-// Parameters (RenderSettings): max_bounces, rr_depth (Russian roulette decided by the base path,
-// its probability multiplied into base and offset densities alike), shift_roughness_threshold
-// (vertex classification), seed, clamp (applied to the primal only, as in PT).
+// Parameters (RenderSettings): max_bounces and the per-kind limits (bounce_limits.h), rr_depth
+// (Russian roulette decided by the base path, its probability multiplied into base and offset
+// densities alike), shift_roughness_threshold (vertex classification), seed, clamp (applied to the
+// primal only, as in PT).
 //
 // Bookkeeping: each path keeps its throughput f (product of BSDF values, not divided by pdfs) and
 // its density p (product of solid-angle densities), both in double; offsets multiply their shift
@@ -11,6 +12,7 @@
 // world) with contribution C = f * segment, and the matching offset contribution C' (Jacobian
 // included), adds w (C' - C) to the gradient half of that offset, w = shift::mis_weight_over_pdf.
 #include "integrator/gradient_path_tracer.h"
+#include "integrator/bounce_limits.h"
 #include "integrator/data_passes.h"
 
 #include <algorithm>
@@ -682,6 +684,7 @@ class GradientPathTracer final : public Integrator {
     // delta events, cross with the base). With Film > Transparent such a path leaves the world
     // out and the pixel's coverage is what it crossed (Cycles' rule, as PT).
     bool camera_path = true;
+    BounceCounts kinds;  // the base's scattering events by kind (per-kind limits)
     Vec3d fb(1.0, 1.0, 1.0);
     double pb = 1.0;
 
@@ -892,13 +895,16 @@ class GradientPathTracer final : public Integrator {
       ray.t_max = kInf;
       // Its kind (ray visibility): a straight transparent crossing keeps the previous one.
       const bool crossing = delta && (bs.lobe & kLobeTransmission) && bs.eta == 1.0f;
-      if (!crossing) ray.kind = ray_kind_of_lobe(bs.lobe);
+      if (!crossing) {
+        ray.kind = ray_kind_of_lobe(bs.lobe);
+        kinds.add(ray.kind);
+      }
       camera_path = camera_path && crossing;
       const bool world_seen = has_world_ && !(camera_path && settings_.transparent_background);
       // The hit goes straight into the next vertex. Its end point only ends the path at the last
       // bounce: no vertex set-up there (the offsets' shifts need its classification alone), and
       // no hit record either when no offset shifts and no triangle emits (as PT).
-      const bool last = bounce == max_bounces;
+      const bool last = bounce == max_bounces || kinds.over(settings_);
       if (!last) u = sampler.vertex_numbers(bounce + 1, has_lights);
       const SurfaceHit& next = next_base.hit;
       const bool found = last && open == 0 && !has_emissive_
@@ -1064,7 +1070,7 @@ class GradientPathTracer final : public Integrator {
           advance(o, last);
         }
       }
-      if (!found) break;
+      if (!found || last) break;  // last: the end point was not set up as a vertex
       cur ^= 1;
     }
 

@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "integrator/bounce_limits.h"
 #include "integrator/data_passes.h"
 #include "integrator/features.h"
 #include "integrator/math/frame.h"
@@ -152,6 +153,7 @@ class PathTracer final : public Integrator {
 
     int bounce = 0;           // Cycles' bounce count: scattering events, transparent ones excluded
     int transparent = 0;      // transparent crossings (Cycles' transparent bounces)
+    BounceCounts kinds;       // scattering events by kind, for the per-kind limits
     bool camera_path = true;  // nothing but transparent crossings since the camera
     bool crossed_since_vertex = false;  // transparent crossings since prev_position
 
@@ -159,7 +161,8 @@ class PathTracer final : public Integrator {
     for (int vertex = 0;; ++vertex) {
       // Past the bounce limits a vertex only ends the path: without emissive triangles its hit
       // needs no record, only the distance (analytic lights in front of it, the world behind).
-      const bool last = bounce > max_bounces || transparent > kMaxTransparentBounces;
+      const bool last =
+          bounce > max_bounces || transparent > kMaxTransparentBounces || kinds.over(settings_);
       // Drawn before the ray is traced, to run alongside it (Sampler::vertex_numbers).
       Sampler::VertexNumbers u;
       if (!last) u = sampler.vertex_numbers(vertex, has_lights);
@@ -337,7 +340,10 @@ class PathTracer final : public Integrator {
       ray.direction = normalize(wo_world);
       ray.t_min = 0.0f;
       ray.t_max = kInf;
-      if (!crossing) ray.kind = ray_kind_of_lobe(bs.lobe);  // a crossing keeps the kind
+      if (!crossing) {  // a crossing keeps the kind and counts for no limit
+        ray.kind = ray_kind_of_lobe(bs.lobe);
+        kinds.add(ray.kind);
+      }
     }
     return out;
   }

@@ -41,8 +41,9 @@ struct RenderSession::Impl {
 RenderSession::RenderSession(Scene scene, RenderSettings settings)
     : impl_(std::make_unique<Impl>()) {
   if (settings.samples < 0) throw std::invalid_argument("render settings: samples must be >= 0");
-  if (settings.max_bounces < 0)
-    throw std::invalid_argument("render settings: max_bounces must be >= 0");
+  if (settings.max_bounces < 0 || settings.max_diffuse_bounces < 0 ||
+      settings.max_glossy_bounces < 0 || settings.max_transmission_bounces < 0)
+    throw std::invalid_argument("render settings: bounce limits must be >= 0");
   if (settings.threads < 0) throw std::invalid_argument("render settings: threads must be >= 0");
   if (settings.samples_per_pass < 1) settings.samples_per_pass = 1;
   Impl& d = *impl_;

@@ -10,6 +10,10 @@ struct RenderSettings {
   int samples = 64;         // samples per pixel
   double time_limit = 0.0;  // seconds, 0 = none
   int max_bounces = 8;      // path segments after the camera ray
+  // Per-kind limits (Cycles' Diffuse / Glossy / Transmission bounces; bounce_limits.h). The core's
+  // defaults leave only max_bounces in force; the add-on passes Blender's settings.
+  int max_diffuse_bounces = 1 << 20, max_glossy_bounces = 1 << 20,
+      max_transmission_bounces = 1 << 20;
   uint32_t seed = 0;
   int threads = 0;                           // 0 = all cores
   float clamp = 0.0f;                        // max sample value, 0 = off

@@ -22,6 +22,16 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
     max_bounces: IntProperty(
         name="Max Bounces", description="Path segments after the camera ray", default=8, min=0,
         max=1024)
+    # Per-kind limits, Cycles' names and defaults.
+    diffuse_bounces: IntProperty(
+        name="Diffuse", description="Maximum number of diffuse reflection bounces, bounded by "
+        "the total maximum", default=4, min=0, max=1024)
+    glossy_bounces: IntProperty(
+        name="Glossy", description="Maximum number of glossy reflection bounces, bounded by the "
+        "total maximum", default=4, min=0, max=1024)
+    transmission_bounces: IntProperty(
+        name="Transmission", description="Maximum number of transmission bounces, bounded by the "
+        "total maximum", default=12, min=0, max=1024)
     mode: EnumProperty(
         name="Integrator",
         items=[('GPT', "Gradient-Domain", "Gradient-domain path tracing: primal, gradients and a "
@@ -89,6 +99,9 @@ def settings_dict(scene):
         "samples": int(s.samples),
         "time_limit": float(s.time_limit),
         "max_bounces": int(s.max_bounces),
+        "max_diffuse_bounces": int(s.diffuse_bounces),
+        "max_glossy_bounces": int(s.glossy_bounces),
+        "max_transmission_bounces": int(s.transmission_bounces),
         "seed": int(s.seed),
         "threads": int(s.threads),
         "clamp": float(s.clamp),

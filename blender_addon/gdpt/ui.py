@@ -48,7 +48,13 @@ class GDPT_PT_light_paths(_RenderPanel, Panel):
 
     def draw(self, context):
         layout = _split(self.layout)
-        layout.prop(context.scene.gdpt, "max_bounces")
+        s = context.scene.gdpt
+        col = layout.column(align=True)
+        col.prop(s, "max_bounces", text="Total")
+        col = layout.column(align=True)
+        col.prop(s, "diffuse_bounces")
+        col.prop(s, "glossy_bounces")
+        col.prop(s, "transmission_bounces")
 
 
 class GDPT_PT_film(_RenderPanel, Panel):

@@ -32,6 +32,9 @@ RenderSettings settings_from_dict(const py::dict& d) {
   get("samples", s.samples);
   get("time_limit", s.time_limit);
   get("max_bounces", s.max_bounces);
+  get("max_diffuse_bounces", s.max_diffuse_bounces);
+  get("max_glossy_bounces", s.max_glossy_bounces);
+  get("max_transmission_bounces", s.max_transmission_bounces);
   get("seed", s.seed);
   get("threads", s.threads);
   get("clamp", s.clamp);

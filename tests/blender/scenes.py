@@ -210,7 +210,7 @@ def setup_gdpt(scene, samples, mode='GPT', reconstruction='L2', bounces=4, seed=
     g.samples = samples
     g.mode = mode
     g.reconstruction = reconstruction
-    g.max_bounces = bounces
+    g.max_bounces = g.diffuse_bounces = g.glossy_bounces = g.transmission_bounces = bounces
     g.seed = seed
     g.time_limit = 0.0
     g.alpha = 0.2

@@ -244,6 +244,18 @@ def case_holdout(scene):
     return 4
 
 
+def case_bounce_limits(scene):
+    # Per-kind limits below the total (Light Paths > Max Bounces), set on both engines in
+    # run_case (KIND_LIMITS): a glass ball and a glossy ball in the diffuse room.
+    lit_room(scene)
+    area_ceiling()
+    S.uv_sphere("glass", 0.6, (-0.7, 0.0, 0.6), S.shader_material(
+        "glass", "ShaderNodeBsdfGlass", Color=(1, 1, 1, 1), Roughness=0.3, IOR=1.5,
+        distribution='GGX'))
+    S.uv_sphere("gloss", 0.6, (0.8, 0.4, 0.6), S.glossy("gloss", 0.2))
+    return 6
+
+
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
 
 # Cases whose noise floor at the default counts lies near the threshold render more samples on
@@ -251,12 +263,19 @@ CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case
 # roulette from vertex 5 and 0.0100 from vertex 3 at 128 / 256 spp, with means within 0.1%.
 # ray_visibility (a GGX 0.15 ball reflecting the lamp: caustics on the floor) measured relMSE 0.011
 # (G-PT) / 0.019 (PT) at the default counts and 0.0047 (PT) at 4x, means within 0.5%: noise.
-SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4}
+# bounce_limits (rough glass and glossy balls): relMSE 0.006 (PT) at 4x, means within 0.3%.
+SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4, "bounce_limits": 4}
+
+
+# Per-kind bounce limits (diffuse, glossy, transmission) set on both engines after the common
+# set-up, which makes them all equal to the total.
+KIND_LIMITS = {"bounce_limits": (1, 2, 3)}
 
 
 # Cases whose GDPT side is also rendered in PT mode (Combined = Primal + Emission): what the
 # camera sees directly must not depend on the integrator.
-BOTH_MODES = {"area_visible", "area_camera_visible", "ray_visibility", "holdout"}
+BOTH_MODES = {"area_visible", "area_camera_visible", "ray_visibility", "holdout",
+              "bounce_limits"}
 
 
 def run_case(name, out_dir, mode=None):
@@ -268,6 +287,10 @@ def run_case(name, out_dir, mode=None):
     gdpt_samples = GDPT_SAMPLES * SAMPLE_SCALE.get(name, 1)
     cycles_samples = CYCLES_SAMPLES * SAMPLE_SCALE.get(name, 1)
     S.setup_gdpt(scene, gdpt_samples, mode=mode, reconstruction=recon, bounces=bounces)
+    limits = KIND_LIMITS.get(name)
+    if limits:
+        g = scene.gdpt
+        g.diffuse_bounces, g.glossy_bounces, g.transmission_bounces = limits
     engine.LAST_RENDER.clear()
     t0 = time.time()
     gdpt_path = S.render(scene, os.path.join(out_dir, f"{name}_gdpt_{mode}.exr"))
@@ -275,6 +298,9 @@ def run_case(name, out_dir, mode=None):
     if engine.LAST_RENDER.get("samples") != gdpt_samples:
         raise RuntimeError(f"{name}: Gradient PT did not render (got {engine.LAST_RENDER})")
     S.setup_cycles(scene, cycles_samples, bounces=bounces)
+    if limits:
+        c = scene.cycles
+        c.diffuse_bounces, c.glossy_bounces, c.transmission_bounces = limits
     t0 = time.time()
     cycles_path = S.render(scene, os.path.join(out_dir, f"{name}_cycles.exr"))
     t_cycles = time.time() - t0

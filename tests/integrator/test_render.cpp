@@ -613,6 +613,47 @@ TEST(Render, HoldoutIsBlackAndUncovered) {
     }
 }
 
+// Per-kind bounce limits (bounce_limits.h, Cycles' Diffuse / Glossy / Transmission bounces):
+// in a scene whose surfaces are all of one kind, a limit of n on that kind ends the paths exactly
+// where a total limit of n does (bit-identical images, PT and G-PT), a limit on another kind
+// changes nothing, and a lower limit darkens the image (fewer bounces of light).
+TEST(Render, PerKindBounceLimitsEndPathsAsTheTotalLimitDoes) {
+  for (const bool glossy_scene : {false, true}) {
+    Scene scene = sheet_over_floor(
+        0.5f, glossy_scene ? glossy(Spectrum(0.9f), 0.4f) : diffuse(Spectrum(0.8f)));
+    scene.materials[0] = glossy_scene ? glossy(Spectrum(0.7f), 0.3f) : diffuse(Spectrum(0.5f));
+    scene.world.color = Spectrum(0.3f);
+    scene.lights.clear();  // the world alone: light between the sheet and the floor bounces
+    scene.camera = top_camera(8, 2.0f);
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      RenderSettings s = pt(8);
+      s.mode = mode;
+      s.rr_depth = 100;  // no roulette: the limits alone end the paths
+      auto mean = [](const Image& img) {
+        double sum = 0.0;
+        for (float v : img.primal) sum += v;
+        return sum / double(img.primal.size());
+      };
+      RenderSettings total = s;
+      total.max_bounces = 1;
+      RenderSettings by_kind = s;
+      (glossy_scene ? by_kind.max_glossy_bounces : by_kind.max_diffuse_bounces) = 1;
+      RenderSettings other = s;
+      (glossy_scene ? other.max_diffuse_bounces : other.max_glossy_bounces) = 0;
+      other.max_transmission_bounces = 0;
+      const Image a = render(scene, total), b = render(scene, by_kind), c = render(scene, other),
+                  full = render(scene, s);
+      EXPECT_EQ(a.primal, b.primal) << "glossy " << glossy_scene << " mode " << int(mode);
+      EXPECT_EQ(c.primal, full.primal) << "glossy " << glossy_scene << " mode " << int(mode);
+      EXPECT_LT(mean(b), 0.995 * mean(full)) << "glossy " << glossy_scene;
+    }
+  }
+  RenderSettings bad = pt(1);
+  bad.max_glossy_bounces = -1;
+  EXPECT_THROW(RenderSession(sheet_over_floor(0.5f, diffuse(Spectrum(0.5f))), bad),
+               std::invalid_argument);
+}
+
 // --- Light-path semantics ---
 
 TEST(Render, CameraVisibleEmissionGoesToTheEmissionPass) {
