@@ -746,7 +746,8 @@ class GradientPathTracer final : public Integrator {
           if (local_dir(base, ls.direction, wo)) {
             fs = bc.eval_pdf(base.wi, wo, pdf_fs);
             if (!is_black(fs) && !is_black(ls.radiance))
-              visible = !occluded(base, ls.direction,
+              visible = !ls.cast_shadow ||  // Light::cast_shadow off: no shadow ray
+                        !occluded(base, ls.direction,
                                   ls.is_infinite ? kInf : ls.distance * (1.0f - 1e-4f), kRayShadow,
                                   out.rays);
           }
@@ -812,7 +813,8 @@ class GradientPathTracer final : public Integrator {
               fo[k] = o.v.closures->eval_pdf(o.v.wi, wo_o[k], pdf_fo[k]);
               if (!is_black(fo[k]) && !is_black(lo[k].radiance)) {
                 test[k] = true;
-                blocked[k] = occluded(o.v, lo[k].direction,
+                blocked[k] = ls.cast_shadow &&  // the same lamp as the base's sample
+                             occluded(o.v, lo[k].direction,
                                       lo[k].is_infinite ? kInf : lo[k].distance * (1.0f - 1e-4f),
                                       kRayShadow, out.rays);
               }

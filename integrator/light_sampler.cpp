@@ -104,6 +104,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
       case Light::Type::Spot: {
         lights::PointLight s = lights::PointLight::from_light(l);
         s.camera_visible = l.camera_visible;
+        s.cast_shadow = l.cast_shadow;
         const float p = s.power();
         if (!(p > 0.0f) || !std::isfinite(p)) break;
         I.entries.push_back({Kind::Point, uint32_t(points_.size())});
@@ -114,6 +115,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
       case Light::Type::Area: {
         lights::AreaLight a = lights::AreaLight::from_light(l);
         a.camera_visible = l.camera_visible;
+        a.cast_shadow = l.cast_shadow;
         const float p = a.power();
         if (!(p > 0.0f) || !std::isfinite(p)) break;
         I.entries.push_back({Kind::Area, uint32_t(areas_.size())});
@@ -124,6 +126,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
       case Light::Type::Sun: {
         lights::SunLight s = lights::SunLight::from_light(l);
         s.camera_visible = l.camera_visible;
+        s.cast_shadow = l.cast_shadow;
         const float p = s.power(radius);
         if (!(p > 0.0f) || !std::isfinite(p)) break;
         I.entries.push_back({Kind::Sun, uint32_t(I.suns.size())});
@@ -250,7 +253,8 @@ bool LightSampler::has_environment() const {
 LightSample LightSampler::sample_only_area(Vec3f ref, Vec2f u) const {
   // Its pmf is 1 and its radiance finite (a non-finite one has non-finite power: not stored).
   LightSample s;
-  if (!areas_[0].sample(ref, u, s)) s = LightSample{};
+  if (!areas_[0].sample(ref, u, s)) return LightSample{};
+  s.cast_shadow = areas_[0].cast_shadow;
   return s;
 }
 
@@ -267,12 +271,15 @@ LightSample LightSampler::sample_any(Vec3f ref, float u_select, Vec2f u) const {
   switch (e.kind) {
     case Kind::Point:
       ok = points_[e.index].sample(ref, u, s);
+      s.cast_shadow = points_[e.index].cast_shadow;
       break;
     case Kind::Area:
       ok = areas_[e.index].sample(ref, u, s);
+      s.cast_shadow = areas_[e.index].cast_shadow;
       break;
     case Kind::Sun:
       ok = I.suns[e.index].sample(ref, u, s);
+      s.cast_shadow = I.suns[e.index].cast_shadow;
       break;
     case Kind::Triangle: {
       const lights::TriangleLight& t = I.triangles[e.index];

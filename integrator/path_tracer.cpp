@@ -290,7 +290,8 @@ class PathTracer final : public Integrator {
                 shadow.direction = ls.position - shadow.origin;
                 shadow.t_max = 1.0f - 1e-4f;
               }
-              const Spectrum tr = transmittance(shadow, scratch, out.rays);
+              const Spectrum tr =
+                  ls.cast_shadow ? transmittance(shadow, scratch, out.rays) : Spectrum(1.0f);
               if (!is_black(tr)) {
                 const float w = ls.is_delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
                 out.primal += beta * f * tr * ls.radiance * (w / ls.pdf);

@@ -97,6 +97,9 @@ struct Light {
   float size_x = 1.0f, size_y = 1.0f;  // area light extent, metres (before object scale)
   // Blender's Object.visible_camera: camera rays see the lamp itself (default False in 3.4).
   bool camera_visible = false;
+  // Cycles' Light > Cast Shadow (light.cycles.cast_shadow): off, light samples of this lamp skip
+  // the shadow ray (nothing occludes it); rays that hit it by BSDF sampling are still blocked.
+  bool cast_shadow = true;
 };
 
 struct World {

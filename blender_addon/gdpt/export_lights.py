@@ -22,6 +22,8 @@ def light_dict(obj, matrix, warn):
         "power": float(light.energy),
         # Object > Visibility > Camera: Cycles shows the lamp itself to camera rays only then.
         "camera_visible": bool(obj.visible_camera),
+        # Cycles' Light > Cast Shadow (its add-on's property group; absent without Cycles).
+        "cast_shadow": bool(getattr(getattr(light, "cycles", None), "cast_shadow", True)),
     }
     if light.type in {'POINT', 'SPOT'}:
         d["radius"] = float(light.shadow_soft_size)

@@ -148,8 +148,24 @@ class GDPT_PT_ray_visibility(_Panel, Panel):
         col.prop(ob, "visible_shadow", text="Shadow", toggle=False)
 
 
+class GDPT_PT_light_shadow(_Panel, Panel):
+    """Light Properties: Cycles' Cast Shadow (its property; shown when Cycles is loaded)."""
+    bl_label = "Shadow"
+    bl_context = "data"
+
+    @classmethod
+    def poll(cls, context):
+        light = context.light
+        return super().poll(context) and light is not None and hasattr(light, "cycles")
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        layout.prop(context.light.cycles, "cast_shadow")
+
+
 _classes = (GDPT_PT_sampling, GDPT_PT_light_paths, GDPT_PT_film, GDPT_PT_gradient_domain,
-            GDPT_PT_reconstruction, GDPT_PT_performance, GDPT_PT_passes, GDPT_PT_ray_visibility)
+            GDPT_PT_reconstruction, GDPT_PT_performance, GDPT_PT_passes, GDPT_PT_ray_visibility,
+            GDPT_PT_light_shadow)
 
 # Blender's engine-agnostic panels carry 'BLENDER_RENDER' in COMPAT_ENGINES (the convention of
 # Blender's own "Custom Render Engine" template); EEVEE's light / material / world panels draw the

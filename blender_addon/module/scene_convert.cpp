@@ -559,6 +559,7 @@ void SceneBuilder::add_light(const py::dict& d) {
   get(d, "size_x", light.size_x);
   get(d, "size_y", light.size_y);
   get(d, "camera_visible", light.camera_visible);
+  get(d, "cast_shadow", light.cast_shadow);
   scene_.lights.push_back(light);
 }
 

@@ -17,6 +17,7 @@ struct LightSample {
   bool is_delta = false;     // cannot be hit by BSDF sampling (no MIS)
   bool is_infinite = false;  // sun or world
   bool valid = false;
+  bool cast_shadow = true;  // false: unoccluded, no shadow ray (Light::cast_shadow)
   // Area lights only (0 for the others): selection pmf / area, the density per unit area of
   // uniform area sampling. G-PT weighs its techniques with the area-sampling density
   // area_pdf d^2 / cos of a light point, the same function from every reference point.

@@ -35,6 +35,7 @@ struct PointLight {
   float smooth = 0.0f;          // (1 - cos_half_angle) * blend
   float select_pmf = 0.0f;      // filled by LightSampler
   bool camera_visible = false;  // filled by LightSampler
+  bool cast_shadow = true;      // filled by LightSampler
 
   static PointLight from_light(const Light& l) {
     PointLight s;

@@ -32,6 +32,7 @@ struct SunLight {
   Spectrum strength;               // c P, W/m^2
   float select_pmf = 0.0f;         // filled by LightSampler
   bool camera_visible = false;     // filled by LightSampler
+  bool cast_shadow = true;         // filled by LightSampler
 
   static SunLight from_light(const Light& l) {
     SunLight s;

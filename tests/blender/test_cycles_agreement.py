@@ -256,6 +256,16 @@ def case_bounce_limits(scene):
     return 6
 
 
+def case_no_shadow(scene):
+    # Cycles' Light > Cast Shadow off: the ceiling lamp's light samples are never occluded (the
+    # ball casts no shadow from it); its BSDF-sampled hits are still blocked.
+    lit_room(scene)
+    lamp = area_ceiling()
+    lamp.data.cycles.cast_shadow = False
+    S.uv_sphere("ball", 0.8, (0.4, 0.3, 0.8), S.diffuse("ball", (0.8, 0.8, 0.3)))
+    return 4
+
+
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
 
 # Cases whose noise floor at the default counts lies near the threshold render more samples on
@@ -275,7 +285,7 @@ KIND_LIMITS = {"bounce_limits": (1, 2, 3)}
 # Cases whose GDPT side is also rendered in PT mode (Combined = Primal + Emission): what the
 # camera sees directly must not depend on the integrator.
 BOTH_MODES = {"area_visible", "area_camera_visible", "ray_visibility", "holdout",
-              "bounce_limits"}
+              "bounce_limits", "no_shadow"}
 
 
 def run_case(name, out_dir, mode=None):

@@ -183,6 +183,14 @@ def main():
     check(panel.bl_parent_id == "OBJECT_PT_visibility" and "GDPT" in panel.COMPAT_ENGINES and
           "GDPT" in bpy.types.OBJECT_PT_visibility.COMPAT_ENGINES,
           "the Ray Visibility panel sits under Object > Visibility for Gradient PT")
+    lamp = bpy.data.lights.new("lamp", 'POINT')
+    from gdpt.export_lights import light_dict
+    check(light_dict(bpy.data.objects.new("lamp", lamp), obj.matrix_world, print)["cast_shadow"],
+          "lamps cast shadows by default")
+    lamp.cycles.cast_shadow = False
+    check(not light_dict(bpy.data.objects.new("lamp2", lamp), obj.matrix_world, print)[
+        "cast_shadow"], "Cycles' Cast Shadow off is exported")
+    check("GDPT" in bpy.types.GDPT_PT_light_shadow.COMPAT_ENGINES, "the Shadow light panel")
 
 
 main()

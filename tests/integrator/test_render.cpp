@@ -582,6 +582,30 @@ TEST(Render, RayVisibilityHidesInstancesFromRayKinds) {
     }
 }
 
+// Light::cast_shadow off (Cycles' Cast Shadow): the sun's light samples skip the shadow ray, so
+// the floor under the sheet (hidden from the camera, direct light only) is lit as the floor
+// around it; on, it is in shadow. PT and G-PT.
+TEST(Render, LampWithoutCastShadowIsUnoccluded) {
+  Scene scene = sheet_over_floor(0.5f, diffuse(Spectrum(0.8f)));
+  scene.instances[1].visibility = kRayAll & ~kRayCamera;
+  scene.camera = top_camera(8, 2.0f);
+  const float lit_floor = 0.5f * 3.0f / float(kPi);
+  for (const bool cast : {true, false})
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      scene.lights[0].cast_shadow = cast;
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      s.max_bounces = 0;
+      const Image img = render(scene, s);
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+          const bool inside = x >= 2 && x < 6 && y >= 2 && y < 6;
+          EXPECT_NEAR(img.at(x, y), inside && cast ? 0.0f : lit_floor, 1e-4f)
+              << x << "," << y << " cast " << cast << " mode " << int(mode);
+        }
+    }
+}
+
 // Holdout (Instance::holdout): the 1 x 1 sheet of the test above, seen from above, is black,
 // with coverage 0 under Film > Transparent (1 without), and still casts its shadow; the floor
 // around it is lit. G-PT's gradients across the holdout's edge are the primal's steps.
