@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -550,6 +551,22 @@ TEST(Render, NormalAndMistPassesAsCycles) {
   EXPECT_FALSE(plain.film().has_mist());
 }
 
+// Renders a sheet_over_floor scene under an 8 x 8 top view with direct light only and checks
+// its primal: `inside` on the sheet's square (pixels 2..5), `outside` around it.
+void expect_square(const Scene& scene, RenderSettings::Mode mode, float inside, float outside,
+                   const std::string& what) {
+  RenderSettings s = pt(4);
+  s.mode = mode;
+  s.max_bounces = 0;
+  const Image img = render(scene, s);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const bool in = x >= 2 && x < 6 && y >= 2 && y < 6;
+      EXPECT_NEAR(img.at(x, y), in ? inside : outside, 1e-4f)
+          << what << ", pixel " << x << "," << y << ", mode " << int(mode);
+    }
+}
+
 // Object > Visibility > Ray Visibility (Instance::visibility, RayKind): a 1 x 1 blocker 1 above
 // a floor, under a sun straight down, direct light only (albedo 0.8 / 0.5: radiance 0.8 E / pi on
 // the blocker, 0.5 E / pi on the lit floor). Seen from above through the blocker's square:
@@ -568,17 +585,7 @@ TEST(Render, RayVisibilityHidesInstancesFromRayKinds) {
                        Case{secondary, lit_floor}, Case{kRayCamera | secondary, lit_blocker}})
     for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
       scene.instances[1].visibility = c.visibility;
-      RenderSettings s = pt(4);
-      s.mode = mode;
-      s.max_bounces = 0;
-      const Image img = render(scene, s);
-      for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x) {
-          const bool inside = x >= 2 && x < 6 && y >= 2 && y < 6;
-          EXPECT_NEAR(img.at(x, y), inside ? c.inside : lit_floor, 1e-4f)
-              << "visibility " << c.visibility << " pixel " << x << "," << y << " mode "
-              << int(mode);
-        }
+      expect_square(scene, mode, c.inside, lit_floor, "visibility " + std::to_string(c.visibility));
     }
 }
 
@@ -593,16 +600,8 @@ TEST(Render, LampWithoutCastShadowIsUnoccluded) {
   for (const bool cast : {true, false})
     for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
       scene.lights[0].cast_shadow = cast;
-      RenderSettings s = pt(4);
-      s.mode = mode;
-      s.max_bounces = 0;
-      const Image img = render(scene, s);
-      for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x) {
-          const bool inside = x >= 2 && x < 6 && y >= 2 && y < 6;
-          EXPECT_NEAR(img.at(x, y), inside && cast ? 0.0f : lit_floor, 1e-4f)
-              << x << "," << y << " cast " << cast << " mode " << int(mode);
-        }
+      expect_square(scene, mode, cast ? 0.0f : lit_floor, lit_floor,
+                    std::string("cast shadow ") + (cast ? "on" : "off"));
     }
 }
 
