@@ -216,6 +216,7 @@ struct Offset {
   // HalfVector: the offset's own next vertex.
   Ray ray;
   bool next_found = false;
+  bool holdout_end = false;  // next_found is false because the segment met a holdout
   SurfaceHit next_hit;
   bool killed = false;  // the continuing path is not invertible / mismatched
 };
@@ -241,7 +242,8 @@ struct BaseStep {
   const SurfaceHit* next;
   float u_lobe;
   Vec2f u_dir;
-  uint32_t kind;  // RayKind of the base's segment: the offsets' segments see what it sees
+  uint32_t kind;      // RayKind of the base's segment: the offsets' segments see what it sees
+  bool holdout_ends;  // a holdout at the segment's end ends the path (the camera path's)
   // Reconnection target x_{d+1} (when found): its base side, and the side the base arrives on.
   shift::ReconnectionBase target;
   bool base_front;
@@ -909,11 +911,16 @@ class GradientPathTracer final : public Integrator {
       const bool last = bounce == max_bounces || kinds.over(settings_);
       if (!last) u = sampler.vertex_numbers(bounce + 1, has_lights);
       const SurfaceHit& next = next_base.hit;
-      const bool found = last && open == 0 && !has_emissive_
-                             ? bvh.intersect_distance(ray, next_base.hit.t)
-                             : bvh.intersect(ray, next_base.hit);
+      // A holdout met by the camera path (only transparent crossings so far) ends it as an escape
+      // into a black world would (Cycles); the offsets' segments likewise (shift_segment).
+      const bool holdout_ends = holdouts && camera_path;
+      bool found = last && open == 0 && !has_emissive_ && !holdout_ends
+                       ? bvh.intersect_distance(ray, next_base.hit.t)
+                       : bvh.intersect(ray, next_base.hit);
       ++out.rays;
+      const bool base_holdout = found && holdout_ends && ctx_.is_holdout(next);
       const float t_hit = found ? next.t : kInf;
+      found = found && !base_holdout;
       LightHit lh;
       const bool light_hit = lights.intersect(ray.origin, ray.direction, t_hit, lh);
       VertexType next_type = VertexType::Diffuse;
@@ -942,6 +949,7 @@ class GradientPathTracer final : public Integrator {
         st.u_lobe = u_lobe;
         st.u_dir = u_dir;
         st.kind = ray.kind;
+        st.holdout_ends = holdout_ends;
         st.base_front = false;
         // The reconnection target (a double square root and division) only where shift_segment()
         // may reconnect: x_d and x_{d+1} diffuse.
@@ -1006,7 +1014,7 @@ class GradientPathTracer final : public Integrator {
             } else if (o.shift == Shift::HalfVector) {
               // The offset's own direction: does its ray cross a light before its surface?
               LightHit lo;
-              const float t_o = o.next_found ? o.next_hit.t : kInf;
+              const float t_o = o.next_found || o.holdout_end ? o.next_hit.t : kInf;
               if (lights.intersect(o.ray.origin, o.ray.direction, t_o, lo))
                 co = mul(mul(o.f, o.seg_value), lo.radiance) * o.seg_jacobian;
               d_off = shift::offset_densities(o.p, o.seg_jacobian, 0.0, o.seg_pdf);
@@ -1026,7 +1034,7 @@ class GradientPathTracer final : public Integrator {
         if (!found) {
           if (camera_path && settings_.transparent_background)
             out.alpha = 1.0f - std::clamp((beta.x + beta.y + beta.z) / 3.0f, 0.0f, 1.0f);
-          if (world_seen) {
+          if (world_seen && !base_holdout) {
             le = lights.environment(ray.direction);
             if (!delta && !is_black(le)) pl = lights.pdf_environment(ray.direction);
           }
@@ -1113,7 +1121,7 @@ class GradientPathTracer final : public Integrator {
     o.seg_jacobian = 1.0;
     o.seg_visible = true;
     o.killed = false;
-    o.next_found = false;
+    o.next_found = o.holdout_end = false;
     switch (o.link) {
       case Link::Connected:
         o.shift = Shift::Follow;
@@ -1242,7 +1250,9 @@ class GradientPathTracer final : public Integrator {
     o.ray.kind = st.kind;
     ++rays;
     o.next_found = bvh.intersect(o.ray, o.next_hit);
-    // Kill: one path reaches the world and the other does not.
+    o.holdout_end = o.next_found && st.holdout_ends && ctx_.is_holdout(o.next_hit);
+    if (o.holdout_end) o.next_found = false;  // as an escape into a black world
+    // Kill: one path reaches the world (or a holdout) and the other does not.
     if (o.next_found != found) {
       o.killed = true;
       return;
@@ -1350,7 +1360,7 @@ class GradientPathTracer final : public Integrator {
         Spectrum le_o(0.0f);
         float pl_o = 0.0f;
         if (!found) {
-          if (world_seen) le_o = lights.environment(o.ray.direction);
+          if (world_seen && !o.holdout_end) le_o = lights.environment(o.ray.direction);
           if (nee_on && !is_black(le_o)) pl_o = lights.pdf_environment(o.ray.direction);
         } else {
           le_o = triangle_le(o.next_hit, o.v.hit.position);

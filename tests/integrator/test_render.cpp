@@ -634,6 +634,39 @@ TEST(Render, HoldoutIsBlackAndUncovered) {
           }
         }
     }
+  // Seen through a Transparent sheet (colour 0.5, over everything at height 2): the holdout is
+  // still black, its coverage under Film > Transparent the sheet's 0.5; around it the emitting
+  // floor (radiance 1) shows at 0.5. (Emission, not a lamp: G-PT's shadow rays do not pass
+  // Transparent surfaces, see Known limitations.) Combined = primal + emission (PT files the
+  // floor seen through the sheet as camera-visible emission, G-PT as primal); each mode's
+  // gradients follow its primal.
+  scene.lights.clear();
+  scene.materials[0] = emission(Spectrum(1.0f), 1.0f);
+  scene.materials[1] = diffuse(Spectrum(0.0f));
+  scene.meshes.push_back(quad(50.0f));
+  scene.materials.push_back(transparent(Spectrum(0.5f)));
+  scene.instances.push_back(place(2, 2, translation({0, 0, 2})));
+  for (const bool transparent_bg : {false, true})
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      s.max_bounces = 1;
+      s.transparent_background = transparent_bg;
+      const Image img = render(scene, s);
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+          const size_t i = size_t(y) * 8 + size_t(x);
+          const bool inside = x >= 2 && x < 6 && y >= 2 && y < 6;
+          EXPECT_NEAR(img.primal[3 * i] + img.emission[3 * i], inside ? 0.0f : 0.5f, 1e-5f)
+              << x << "," << y << " mode " << int(mode) << " behind the sheet";
+          EXPECT_NEAR(img.alpha[i], inside && transparent_bg ? 0.5f : 1.0f, 1e-6f)
+              << x << "," << y << " mode " << int(mode) << " behind the sheet";
+          if (x < 7) {
+            EXPECT_NEAR(img.gradient_x[3 * i], img.primal[3 * (i + 1)] - img.primal[3 * i], 1e-4f)
+                << x << "," << y << " mode " << int(mode) << " behind the sheet";
+          }
+        }
+    }
 }
 
 // Per-kind bounce limits (bounce_limits.h, Cycles' Diffuse / Glossy / Transmission bounces):
