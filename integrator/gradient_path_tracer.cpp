@@ -316,6 +316,7 @@ struct PathScratch {
   // (eight doubles each) ran on every bounce. Each is read only after trace() has set it.
   BaseStep step;
   shift::ReconnectionBase light_base;
+  ClosureSet shadow_closures;  // surfaces a transparent shadow ray crosses
 };
 
 class GradientPathTracer final : public Integrator {
@@ -328,7 +329,8 @@ class GradientPathTracer final : public Integrator {
         has_dof_(ctx.camera().has_dof()),
         has_emissive_((ctx.features() & kSceneEmissiveTriangles) != 0),
         sides_(material_sides(ctx)),
-        data_(settings, ctx.camera()) {}
+        data_(settings, ctx.camera()),
+        transparent_shadows_((ctx.features() & kFeatureTransparent) != 0) {}
 
   bool estimates_gradients() const override { return true; }
 
@@ -504,6 +506,24 @@ class GradientPathTracer final : public Integrator {
                 uint32_t& rays) const {
     ++rays;
     return ctx_.bvh().occluded(shadow_ray(v, dir, t_max, kind));
+  }
+
+  // Whether a light sample of lamp `ls` (its cast_shadow and is_delta) taken from `v` towards
+  // `dir`, `distance` away (infinite lamps: any distance), is unblocked. Delta lamps see through
+  // Transparent surfaces as in PT (Cycles' transparent shadows: `le` is multiplied by the
+  // transmittance), because no BSDF sample can reach them; the light of other lamps through such
+  // surfaces arrives by BSDF sampling (a crossing is a delta event of the path), so their shadow
+  // rays stay opaque and nothing is counted twice.
+  bool lamp_visible(const Vertex& v, const LightSample& ls, const Vec3f& dir, float distance,
+                    bool infinite, ClosureSet& scratch, Spectrum& le, uint32_t& rays) const {
+    if (!ls.cast_shadow) return true;  // Light::cast_shadow off: no shadow ray
+    const float t_max = infinite ? kInf : distance * (1.0f - 1e-4f);
+    if (ls.is_delta && transparent_shadows_) {
+      const Spectrum tr = ctx_.transmittance(shadow_ray(v, dir, t_max, kRayShadow), scratch, rays);
+      le *= tr;
+      return !is_black(tr);
+    }
+    return !occluded(v, dir, t_max, kRayShadow, rays);
   }
 
   // Local outgoing direction at `v` for world `dir`; false when the geometric and shading
@@ -745,20 +765,19 @@ class GradientPathTracer final : public Integrator {
           Spectrum fs(0.0f);
           float pdf_fs = 0.0f;
           bool visible = false;
+          Spectrum le = ls.radiance;  // arriving: times the transmittance of delta lamps' rays
           if (local_dir(base, ls.direction, wo)) {
             fs = bc.eval_pdf(base.wi, wo, pdf_fs);
             if (!is_black(fs) && !is_black(ls.radiance))
-              visible = !ls.cast_shadow ||  // Light::cast_shadow off: no shadow ray
-                        !occluded(base, ls.direction,
-                                  ls.is_infinite ? kInf : ls.distance * (1.0f - 1e-4f), kRayShadow,
-                                  out.rays);
+              visible = lamp_visible(base, ls, ls.direction, ls.distance, ls.is_infinite,
+                                     scratch.shadow_closures, le, out.rays);
           }
           const float pdf_bsdf = (!ls.is_delta && visible) ? pdf_fs : 0.0f;
           if (visible) {
             const float w = ls.is_delta ? 1.0f : power_heuristic(ls.pdf, pdf_bsdf);
-            out.primal += beta * fs * ls.radiance * (w / ls.pdf);
+            out.primal += beta * fs * le * (w / ls.pdf);
           }
-          const Vec3d cb = visible ? mul(mul(fb, fs), ls.radiance) : Vec3d();
+          const Vec3d cb = visible ? mul(mul(fb, fs), le) : Vec3d();
           // The pair weights see the light technique through mis_light_pdf().
           const float pl_mis = ls.is_infinite ? ls.pdf
                                               : mis_light_pdf(ls.area_pdf, ls.pdf, ls.distance,
@@ -768,8 +787,7 @@ class GradientPathTracer final : public Integrator {
 
           // --- Merged offsets (connected or dead) ---
           if (visible)
-            add_merged(off, fb, pb,
-                       connected_event(mul(Vec3d(fs), ls.radiance), tech_l, pl_mis, pdf_bsdf));
+            add_merged(off, fb, pb, connected_event(mul(Vec3d(fs), le), tech_l, pl_mis, pdf_bsdf));
 
           // --- Open offsets ---
           // First pass: the offsets' light samples and the shadow rays of the not-connected
@@ -815,10 +833,10 @@ class GradientPathTracer final : public Integrator {
               fo[k] = o.v.closures->eval_pdf(o.v.wi, wo_o[k], pdf_fo[k]);
               if (!is_black(fo[k]) && !is_black(lo[k].radiance)) {
                 test[k] = true;
-                blocked[k] = ls.cast_shadow &&  // the same lamp as the base's sample
-                             occluded(o.v, lo[k].direction,
-                                      lo[k].is_infinite ? kInf : lo[k].distance * (1.0f - 1e-4f),
-                                      kRayShadow, out.rays);
+                // The same lamp as the base's sample (its cast_shadow and is_delta).
+                blocked[k] =
+                    !lamp_visible(o.v, ls, lo[k].direction, lo[k].distance, lo[k].is_infinite,
+                                  scratch.shadow_closures, lo[k].radiance, out.rays);
               }
             }
           }
@@ -846,7 +864,7 @@ class GradientPathTracer final : public Integrator {
                   }
                   if (ls.is_delta) pdf_o = 0.0f;
                 }
-                co = mul(mul(o.f, f_r), ls.radiance);
+                co = mul(mul(o.f, f_r), le);
                 d_off = shift::offset_densities(o.p, 1.0, pl_mis, pdf_o);
                 break;
               }
@@ -1417,6 +1435,7 @@ class GradientPathTracer final : public Integrator {
   bool has_emissive_ = false;
   std::vector<MaterialSide> sides_;
   DataPasses data_;
+  bool transparent_shadows_ = false;  // some material has a Transparent closure
 };
 
 }  // namespace

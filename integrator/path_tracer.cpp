@@ -21,8 +21,6 @@ namespace {
 
 constexpr uint32_t kSpecialised =
     kSceneDoF | kSceneWorld | kSceneAnalyticLights | kSceneEmissiveTriangles | kFeatureTransparent;
-// Cycles' default transparent_max_bounces.
-constexpr int kMaxTransparentBounces = 8;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // Shading normal ns (unit) tilted towards wi until dot(ns, wi) >= kMinCos; ng if that degenerates.
@@ -104,27 +102,14 @@ class PathTracer final : public Integrator {
   }
 
  private:
-  // Fraction of light passing along the shadow ray: 0 if an opaque surface blocks it, else the
-  // product of the Transparent closure weights of the surfaces crossed (Cycles' transparent
-  // shadows), at most kMaxTransparentBounces of them. Opaque-only scenes use one occlusion query.
-  Spectrum transmittance(Ray ray, ClosureSet& scratch, uint32_t& rays) const {
-    ++rays;
-    if (!kTransparentShadows) return ctx_.bvh().occluded(ray) ? Spectrum(0.0f) : Spectrum(1.0f);
-    Spectrum tr(1.0f);
-    SurfaceHit h;
-    for (int crossing = 0; crossing <= kMaxTransparentBounces; ++crossing) {
-      if (!ctx_.bvh().intersect(ray, h)) return tr;
-      scratch.clear();
-      ctx_.materials()[size_t(h.material)].evaluate(ShadingContext{h.uv, h.front_facing}, scratch);
-      tr *= scratch.transparency();
-      if (is_black(tr)) return tr;
-      const Vec3f n =
-          dot(ray.direction, h.geometric_normal) > 0.0f ? h.geometric_normal : -h.geometric_normal;
-      ray.origin = offset_ray_origin(h.position, n);
-      ray.t_max -= h.t;
+  // Fraction of light passing along the shadow ray (SceneContext::transmittance); opaque-only
+  // scenes use one occlusion query.
+  Spectrum transmittance(const Ray& ray, ClosureSet& scratch, uint32_t& rays) const {
+    if (!kTransparentShadows) {
       ++rays;
+      return ctx_.bvh().occluded(ray) ? Spectrum(0.0f) : Spectrum(1.0f);
     }
-    return Spectrum(0.0f);
+    return ctx_.transmittance(ray, scratch, rays);
   }
 
   // The camera ray of pixel (px, py) of the frame.

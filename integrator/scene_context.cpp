@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "integrator/features.h"
+#include "shaders/shading_context.h"
 
 namespace gdpt {
 
@@ -111,5 +112,24 @@ SceneContext::SceneContext(const Scene& scene, const RenderSettings& settings) :
 }
 
 SceneContext::~SceneContext() = default;
+
+Spectrum SceneContext::transmittance(Ray ray, ClosureSet& scratch, uint32_t& rays) const {
+  ++rays;
+  Spectrum tr(1.0f);
+  SurfaceHit h;
+  for (int crossing = 0; crossing <= kMaxTransparentBounces; ++crossing) {
+    if (!bvh_->intersect(ray, h)) return tr;
+    scratch.clear();
+    materials_[size_t(h.material)].evaluate(ShadingContext{h.uv, h.front_facing}, scratch);
+    tr *= scratch.transparency();
+    if (is_black(tr)) return tr;
+    const Vec3f n =
+        dot(ray.direction, h.geometric_normal) > 0.0f ? h.geometric_normal : -h.geometric_normal;
+    ray.origin = offset_ray_origin(h.position, n);
+    ray.t_max -= h.t;
+    ++rays;
+  }
+  return Spectrum(0.0f);
+}
 
 }  // namespace gdpt

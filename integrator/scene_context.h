@@ -18,6 +18,9 @@
 
 namespace gdpt {
 
+// Cycles' default transparent_max_bounces: transparent crossings a path or shadow ray may make.
+constexpr int kMaxTransparentBounces = 8;
+
 // The kind of a BSDF-sampled ray (RayKind) from the lobe it was sampled from, as Cycles labels
 // it: transmission, else diffuse, else glossy (delta reflections included).
 inline uint32_t ray_kind_of_lobe(uint32_t lobe) {
@@ -43,6 +46,11 @@ class SceneContext {
                                : 0.0f;
     film.set_first_hit(x, y, camera_.view_depth(hit.position), object, material);
   }
+  // Fraction of light passing along the shadow ray `ray`: 0 if an opaque surface blocks it, else
+  // the product of the Transparent closure weights of the surfaces crossed (Cycles' transparent
+  // shadows), at most kMaxTransparentBounces of them. `scratch` holds their closures; `rays`
+  // counts the queries.
+  Spectrum transmittance(Ray ray, ClosureSet& scratch, uint32_t& rays) const;
   // Holdout (Instance::holdout): whether the scene has any, and whether `hit` is on one.
   bool has_holdout() const { return has_holdout_; }
   bool is_holdout(const SurfaceHit& hit) const {

@@ -266,6 +266,16 @@ def case_no_shadow(scene):
     return 4
 
 
+def case_transparent_shadow(scene):
+    # A Transparent BSDF sheet between a point lamp (radius 0: a delta lamp) and the floor:
+    # transparent shadows, which G-PT's light samples of delta lamps take too.
+    lit_room(scene)
+    S.light('POINT', (0.5, -0.5, 3.0), 300.0, shadow_soft_size=0.0)
+    sheet = S.shader_material("sheet", "ShaderNodeBsdfTransparent", Color=(0.5, 0.7, 0.9, 1))
+    S.plane("sheet", 1.6, (0.3, 0.0, 1.6), material=sheet)
+    return 3
+
+
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
 
 # Cases whose noise floor at the default counts lies near the threshold render more samples on
@@ -285,7 +295,7 @@ KIND_LIMITS = {"bounce_limits": (1, 2, 3)}
 # Cases whose GDPT side is also rendered in PT mode (Combined = Primal + Emission): what the
 # camera sees directly must not depend on the integrator.
 BOTH_MODES = {"area_visible", "area_camera_visible", "ray_visibility", "holdout",
-              "bounce_limits", "no_shadow"}
+              "bounce_limits", "no_shadow", "transparent_shadow"}
 
 
 def run_case(name, out_dir, mode=None):
