@@ -618,61 +618,44 @@ TEST(Render, HoldoutIsBlackAndUncovered) {
   Scene scene = sheet_over_floor(0.5f, diffuse(Spectrum(0.8f)));
   scene.instances[1].holdout = true;
   scene.camera = top_camera(8, 2.0f);
-  const float lit_floor = 0.5f * 3.0f / float(kPi);
-  for (const bool transparent : {false, true})
-    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
-      RenderSettings s = pt(4);
-      s.mode = mode;
-      s.max_bounces = 0;
-      s.transparent_background = transparent;
-      const Image img = render(scene, s);
-      const std::vector<float>&primal = img.primal, &alpha = img.alpha, &dx = img.gradient_x;
-      for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x) {
-          const size_t i = size_t(y) * 8 + size_t(x);
-          const bool inside = x >= 2 && x < 6 && y >= 2 && y < 6;
-          EXPECT_NEAR(primal[3 * i], inside ? 0.0f : lit_floor, 1e-4f)
-              << x << "," << y << " mode " << int(mode) << " transparent " << transparent;
-          EXPECT_EQ(alpha[i], inside && transparent ? 0.0f : 1.0f) << x << "," << y;
-          if (x < 7) {  // dx(x) = I(x + 1) - I(x)
-            EXPECT_NEAR(dx[3 * i], primal[3 * (i + 1)] - primal[3 * i], 1e-4f)
-                << x << "," << y << " mode " << int(mode);
+  // Combined (primal + emission) `outside` the square and 0 inside, alpha `covered` inside under
+  // Film > Transparent (else 1), G-PT's x gradients the steps of its primal; PT and G-PT.
+  auto check = [&](int max_bounces, float outside, float covered, const char* what) {
+    for (const bool transparent : {false, true})
+      for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+        RenderSettings s = pt(4);
+        s.mode = mode;
+        s.max_bounces = max_bounces;
+        s.transparent_background = transparent;
+        const Image img = render(scene, s);
+        for (int y = 0; y < 8; ++y)
+          for (int x = 0; x < 8; ++x) {
+            const size_t i = size_t(y) * 8 + size_t(x);
+            const bool inside = x >= 2 && x < 6 && y >= 2 && y < 6;
+            EXPECT_NEAR(img.primal[3 * i] + img.emission[3 * i], inside ? 0.0f : outside, 1e-4f)
+                << what << " " << x << "," << y << " mode " << int(mode) << " transparent "
+                << transparent;
+            EXPECT_NEAR(img.alpha[i], inside && transparent ? covered : 1.0f, 1e-6f)
+                << what << " " << x << "," << y;
+            if (x < 7) {  // dx(x) = I(x + 1) - I(x)
+              EXPECT_NEAR(img.gradient_x[3 * i], img.primal[3 * (i + 1)] - img.primal[3 * i], 1e-4f)
+                  << what << " " << x << "," << y << " mode " << int(mode);
+            }
           }
-        }
-    }
+      }
+  };
+  check(0, 0.5f * 3.0f / float(kPi), 0.0f, "direct");
   // Seen through a Transparent sheet (colour 0.5, over everything at height 2): the holdout is
-  // still black, its coverage under Film > Transparent the sheet's 0.5; around it the emitting
-  // floor (radiance 1) shows at 0.5 (emission: exact, no light sampling involved). Combined =
-  // primal + emission (PT files the
-  // floor seen through the sheet as camera-visible emission, G-PT as primal); each mode's
-  // gradients follow its primal.
+  // still black, its coverage the sheet's 0.5; around it the emitting floor (radiance 1) shows
+  // at 0.5 (PT files it as camera-visible emission, G-PT as primal; max_bounces 1: G-PT counts
+  // the crossing as a bounce).
   scene.lights.clear();
   scene.materials[0] = emission(Spectrum(1.0f), 1.0f);
   scene.materials[1] = diffuse(Spectrum(0.0f));
   scene.meshes.push_back(quad(50.0f));
   scene.materials.push_back(transparent(Spectrum(0.5f)));
   scene.instances.push_back(place(2, 2, translation({0, 0, 2})));
-  for (const bool transparent_bg : {false, true})
-    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
-      RenderSettings s = pt(4);
-      s.mode = mode;
-      s.max_bounces = 1;
-      s.transparent_background = transparent_bg;
-      const Image img = render(scene, s);
-      for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x) {
-          const size_t i = size_t(y) * 8 + size_t(x);
-          const bool inside = x >= 2 && x < 6 && y >= 2 && y < 6;
-          EXPECT_NEAR(img.primal[3 * i] + img.emission[3 * i], inside ? 0.0f : 0.5f, 1e-5f)
-              << x << "," << y << " mode " << int(mode) << " behind the sheet";
-          EXPECT_NEAR(img.alpha[i], inside && transparent_bg ? 0.5f : 1.0f, 1e-6f)
-              << x << "," << y << " mode " << int(mode) << " behind the sheet";
-          if (x < 7) {
-            EXPECT_NEAR(img.gradient_x[3 * i], img.primal[3 * (i + 1)] - img.primal[3 * i], 1e-4f)
-                << x << "," << y << " mode " << int(mode) << " behind the sheet";
-          }
-        }
-    }
+  check(1, 0.5f, 0.5f, "behind the sheet");
 }
 
 // Per-kind bounce limits (bounce_limits.h, Cycles' Diffuse / Glossy / Transmission bounces):
