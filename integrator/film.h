@@ -3,6 +3,7 @@
 // differences in those rows: dx(x, y) ~ I(x+1, y) - I(x, y), dy(x, y) ~ I(x, y+1) - I(x, y).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -10,6 +11,12 @@
 #include "integrator/math/vec.h"
 
 namespace gdpt {
+
+// A sample's alpha when its camera path ends uncovered (in a transparent background, or on a
+// holdout) with `throughput` left after the transparent surfaces it crossed: what they took.
+inline float uncovered_alpha(Spectrum throughput) {
+  return 1.0f - std::clamp((throughput.x + throughput.y + throughput.z) / 3.0f, 0.0f, 1.0f);
+}
 
 class Film {
  public:

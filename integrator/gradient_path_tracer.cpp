@@ -916,7 +916,7 @@ class GradientPathTracer final : public Integrator {
       ray.t_min = 0.0f;
       ray.t_max = kInf;
       // Its kind (ray visibility): a straight transparent crossing keeps the previous one.
-      const bool crossing = delta && (bs.lobe & kLobeTransmission) && bs.eta == 1.0f;
+      const bool crossing = bs.is_straight_crossing();
       if (!crossing) {
         ray.kind = ray_kind_of_lobe(bs.lobe);
         kinds.add(ray.kind);
@@ -1050,8 +1050,7 @@ class GradientPathTracer final : public Integrator {
         Spectrum le(0.0f);
         float pl = 0.0f;
         if (!found) {
-          if (camera_path && settings_.transparent_background)
-            out.alpha = 1.0f - std::clamp((beta.x + beta.y + beta.z) / 3.0f, 0.0f, 1.0f);
+          if (camera_path && settings_.transparent_background) out.alpha = uncovered_alpha(beta);
           if (world_seen && !base_holdout) {
             le = lights.environment(ray.direction);
             if (!delta && !is_black(le)) pl = lights.pdf_environment(ray.direction);

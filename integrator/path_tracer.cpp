@@ -184,8 +184,7 @@ class PathTracer final : public Integrator {
       // --- Escape: the world (with a transparent background, a camera path that gets here
       // leaves it out and reports the transparency it crossed: Cycles' alpha) ---
       if (!found) {
-        if (camera_path && settings_.transparent_background)
-          out.alpha = 1.0f - std::clamp((beta.x + beta.y + beta.z) / 3.0f, 0.0f, 1.0f);
+        if (camera_path && settings_.transparent_background) out.alpha = uncovered_alpha(beta);
         if constexpr (kWorld) {
           const Spectrum le = lights.environment(ray.direction);
           if (camera_path) {
@@ -205,8 +204,7 @@ class PathTracer final : public Integrator {
       // --- Holdout: the camera path ends here with nothing added; with a transparent
       // background the coverage is what the transparent surfaces crossed so far took (Cycles) ---
       if (camera_path && ctx_.has_holdout() && ctx_.is_holdout(hit)) {
-        if (settings_.transparent_background)
-          out.alpha = 1.0f - std::clamp((beta.x + beta.y + beta.z) / 3.0f, 0.0f, 1.0f);
+        if (settings_.transparent_background) out.alpha = uncovered_alpha(beta);
         break;
       }
 
@@ -300,7 +298,7 @@ class PathTracer final : public Integrator {
       // status and keeps the MIS state of the last real scattering vertex: shadow rays see
       // through transparent surfaces too (transmittance()), so the NEE density from that vertex
       // is still the competing technique.
-      const bool crossing = bs.is_delta() && (bs.lobe & kLobeTransmission) != 0 && bs.eta == 1.0f;
+      const bool crossing = bs.is_straight_crossing();
       if (crossing) {
         ++transparent;
         crossed_since_vertex = true;

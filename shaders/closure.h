@@ -68,6 +68,11 @@ struct BsdfSample {
   uint8_t lobe = 0;        // LobeFlags of the sampled lobe
   bool valid = false;
   bool is_delta() const { return (lobe & kLobeDelta) != 0; }
+  // Straight through without refraction (a Transparent closure): Cycles' transparent bounce,
+  // which is not a scattering event of the path.
+  bool is_straight_crossing() const {
+    return is_delta() && (lobe & kLobeTransmission) != 0 && eta == 1.0f;
+  }
   Spectrum weight() const { return pdf > 0.0f ? value / pdf : Spectrum(0.0f); }
 };
 
