@@ -120,6 +120,16 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
       d.corner_uvs = mesh.corner_uvs.data();
       d.corner_uv_tris = uint32_t(std::min(mesh.corner_uvs.size() / 3, tris));
     }
+    if (!mesh.corner_tangents.empty()) {
+      if (mesh.corner_tangent_signs.size() != mesh.corner_tangents.size())
+        throw std::invalid_argument("mesh " + std::to_string(inst.mesh) + ": " +
+                                    std::to_string(mesh.corner_tangents.size()) +
+                                    " corner tangents but " +
+                                    std::to_string(mesh.corner_tangent_signs.size()) + " signs");
+      d.corner_tangents = mesh.corner_tangents.data();
+      d.corner_tangent_signs = mesh.corner_tangent_signs.data();
+      d.corner_tangent_tris = uint32_t(std::min(mesh.corner_tangents.size() / 3, tris));
+    }
     // Slot -> material with the default applied (-1 and out-of-range indices).
     auto resolve = [&](int32_t mat) {
       return (mat >= 0 && mat < default_material_) ? mat : default_material_;
@@ -287,6 +297,38 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
                        ? d.slot_materials[size_t(slot)]
                        : default_material_;
   }
+  if (primitive < d.corner_tangent_tris) [[unlikely]]
+    map_normal(d, primitive, u, v, hit);
+}
+
+// Cycles builds the normal-mapped normal in object space, x t + y s (n x t) + z n, and moves it
+// to world space as a normal. Here the same combination is formed in world space around the
+// (unit) shading normal: the tangent moves as a direction, keeping its object-space length (the
+// interpolated MikkTSpace tangent is ~unit there, as the normal), and a mirroring transform
+// flips n x t. Equal to Cycles' up to normalisation for rotations, mirrors and uniform scales.
+void EmbreeScene::map_normal(const InstanceData& d, uint32_t primitive, float u, float v,
+                             SurfaceHit& hit) const {
+  if (size_t(hit.material) >= materials_.size()) return;
+  const Material& material = materials_[size_t(hit.material)];
+  if (!material.has_normal_map()) return;
+  const float w = 1.0f - u - v;
+  const Vec3f* T = d.corner_tangents + size_t(primitive) * 3;
+  const float* S = d.corner_tangent_signs + size_t(primitive) * 3;
+  const Vec3f t_object = T[0] * w + T[1] * u + T[2] * v;
+  const float sign = S[0] * w + S[1] * u + S[2] * v;
+  Vec3f t;
+  for (int r = 0; r < 3; ++r)
+    t[r] = d.to_world_cols[0][r] * t_object.x + d.to_world_cols[1][r] * t_object.y +
+           d.to_world_cols[2][r] * t_object.z;
+  const float tl = length(t);
+  if (!(tl > 0.0f) || !std::isfinite(tl)) return;  // no tangent here (no UVs): unchanged
+  t = t * (length(t_object) / tl);
+  const Vec3f n = hit.shading_normal;
+  const Vec3f b = cross(n, t) * (sign * d.winding);
+  const Vec3f c = material.normal_map_direction(hit.uv);
+  const Vec3f mapped = t * c.x + b * c.y + n * c.z;
+  const float l2 = length_squared(mapped);
+  if (l2 > 0.0f && std::isfinite(l2)) hit.shading_normal = mapped / std::sqrt(l2);
 }
 
 }  // namespace gdpt

@@ -12,12 +12,14 @@
 #include <emmintrin.h>
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "integrator/camera.h"
 #include "integrator/math/transform.h"
 #include "integrator/math/vec.h"
 #include "integrator/scene.h"
+#include "shaders/material.h"
 
 namespace gdpt {
 
@@ -127,6 +129,10 @@ class EmbreeScene {
   void intersect_stream(const Ray* rays, const bool* valid, int n, bool* found,
                         SurfaceHit* hits) const;
 
+  // The scene's materials (indexed as SurfaceHit::material), for Normal Map nodes: hits on
+  // meshes with tangents whose material has one get the mapped shading normal. Unset: none.
+  void set_materials(std::span<const Material> materials) { materials_ = materials; }
+
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
   size_t instanced_triangle_count() const { return instanced_triangles_; }
   // Fills the rest of a hit from (top-level geometry id, primitive, barycentrics).
@@ -172,6 +178,9 @@ class EmbreeScene {
     const Vec3f* vertex_normals = nullptr;
     const Vec2f* corner_uvs = nullptr;  // for primitives < corner_uv_tris; else uv = 0
     uint32_t corner_uv_tris = 0;
+    const Vec3f* corner_tangents = nullptr;  // Normal Map nodes, primitives < corner_tangent_tris
+    const float* corner_tangent_signs = nullptr;
+    uint32_t corner_tangent_tris = 0;
     // Material: `uniform_material` when every triangle resolves to one (the common case), else
     // slot_materials[material_slot[primitive]] (slot 0 past material_slot_count, default
     // material for slots outside the table).
@@ -188,6 +197,11 @@ class EmbreeScene {
   RTCScene top_ = nullptr;
   std::vector<RTCScene> mesh_scenes_;
   std::vector<InstanceData> instances_;  // indexed by top-level Embree geometry id
+  // Replaces hit.shading_normal by the material's normal map, if it has one (out of line: rare).
+  [[gnu::noinline]] void map_normal(const InstanceData& d, uint32_t primitive, float u, float v,
+                                    SurfaceHit& hit) const;
+
+  std::span<const Material> materials_;
   int32_t default_material_ = -1;
   size_t triangles_ = 0, instanced_triangles_ = 0;
 };

@@ -16,10 +16,14 @@ namespace gdpt {
 // Triangle mesh in object space. Attributes are per triangle corner (Blender loop triangles),
 // except vertex_normals.
 struct Mesh {
-  std::vector<Vec3f> positions;        // vertices
-  std::vector<uint32_t> indices;       // 3 per triangle, into positions
-  std::vector<Vec3f> corner_normals;   // 3 per triangle (split normals); empty = flat shading
-  std::vector<Vec2f> corner_uvs;       // 3 per triangle; empty = no UVs (uv = 0)
+  std::vector<Vec3f> positions;       // vertices
+  std::vector<uint32_t> indices;      // 3 per triangle, into positions
+  std::vector<Vec3f> corner_normals;  // 3 per triangle (split normals); empty = flat shading
+  std::vector<Vec2f> corner_uvs;      // 3 per triangle; empty = no UVs (uv = 0)
+  // 3 per triangle, for Normal Map nodes (NormalMapDesc): the UV map's tangents (Blender's
+  // MikkTSpace, object space) and bitangent signs; empty = none (normal maps do nothing).
+  std::vector<Vec3f> corner_tangents;
+  std::vector<float> corner_tangent_signs;
   std::vector<int32_t> material_slot;  // per triangle; empty = slot 0
   // Per-vertex shading normals, used when corner_normals is empty: what a smooth mesh without
   // split normals has, in a sixth of the memory (a 1M-triangle smooth mesh: 6 MB instead of the

@@ -67,6 +67,7 @@ SceneContext::SceneContext(const Scene& scene, const RenderSettings& settings) :
   materials_.emplace_back();  // Blender's default grey diffuse
 
   bvh_ = std::make_unique<EmbreeScene>(scene, default_material());
+  bvh_->set_materials(materials_);
   for (const Instance& inst : scene.instances) has_holdout_ = has_holdout_ || inst.holdout;
   lights_ = std::make_unique<LightSampler>(scene, materials_, textures_);
   camera_ = CameraModel(scene.camera);

@@ -229,6 +229,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
   }
   nodes_ = desc.nodes;
   root_ = desc.root;
+  normal_map_ = desc.normal_map;
   const std::string where = "material '" + desc.name + "': ";
   auto check_node = [&](int32_t i) {
     if (i < 0 || size_t(i) >= nodes_.size())
@@ -326,6 +327,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
     }
   };
   visit(visit, root_, 0);
+  if (normal_map_.enabled) note(normal_map_.color);
 
   // --- Mean of every texture the tree uses, for average_emission().
   std::vector<Rgba> means(textures.size());
@@ -363,6 +365,13 @@ void Material::evaluate(const ShadingContext& ctx, ClosureSet& out) const {
 Spectrum Material::emission(const ShadingContext& ctx) const {
   if (!(features_ & kFeatureEmission)) return Spectrum(0.0f);
   return walk(nodes_, root_, PointInputs{textures_, ctx.uv, ctx.front_facing}, nullptr);
+}
+
+Vec3f Material::normal_map_direction(Vec2f uv) const {
+  const Spectrum c = PointInputs{textures_, uv, true}.color(normal_map_.color);
+  const float s = normal_map_.strength;
+  return {2.0f * (c.x - 0.5f) * s, 2.0f * (c.y - 0.5f) * s,
+          1.0f + (2.0f * (c.z - 0.5f) - 1.0f) * std::clamp(s, 0.0f, 1.0f)};
 }
 
 }  // namespace gdpt

@@ -41,6 +41,10 @@ class Material {
   // Emission averaged over textures (for sampling emissive triangles by power).
   Spectrum average_emission() const { return average_emission_; }
   uint32_t features() const { return features_; }
+  // Normal Map node (NormalMapDesc): the tangent-space direction at `uv`, strength applied, not
+  // normalised (x tangent, y bitangent, z normal).
+  bool has_normal_map() const { return normal_map_.enabled; }
+  Vec3f normal_map_direction(Vec2f uv) const;
 
  private:
   void cache_if_constant();
@@ -53,6 +57,7 @@ class Material {
   int32_t root_ = -1;
   std::span<const Texture> textures_;
   uint32_t features_ = 0;
+  NormalMapDesc normal_map_;
   Spectrum average_emission_{0.0f, 0.0f, 0.0f};
 };
 

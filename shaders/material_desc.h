@@ -66,11 +66,22 @@ struct ShaderNode {
   FloatInput emission_strength{1.0f};
 };
 
+// Blender's Normal Map node in tangent space, feeding the material's BSDF Normal inputs: the
+// colour c, read as the tangent-space direction 2 (c - 0.5) (x along the UV map's tangent, y along
+// the bitangent, z along the interpolated normal), replaces the shading normal. Strength s scales
+// x and y by s and moves z from 1 to its value by clamp(s, 0, 1), as Cycles (svm_node_normal_map).
+struct NormalMapDesc {
+  bool enabled = false;
+  ColorInput color{Spectrum(0.5f, 0.5f, 1.0f)};  // non-colour data: used as stored
+  float strength = 1.0f;
+};
+
 struct MaterialDesc {
   std::string name;
   std::vector<ShaderNode> nodes;
-  int32_t root = -1;        // -1: Blender's default grey diffuse (0.8)
-  float pass_index = 0.0f;  // Blender's Material > Settings > Pass Index (the IndexMA pass)
+  int32_t root = -1;         // -1: Blender's default grey diffuse (0.8)
+  NormalMapDesc normal_map;  // needs the meshes' corner tangents (Mesh::corner_tangents)
+  float pass_index = 0.0f;   // Blender's Material > Settings > Pass Index (the IndexMA pass)
 };
 
 // Image pixels in scene-linear RGBA float (the loader converts from the file's colour space via

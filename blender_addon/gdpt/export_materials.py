@@ -31,6 +31,7 @@ class _Translator:
         self.warn_sink = warn
         self.warned = set()
         self.nodes = []
+        self.normal_map = None  # (Normal Map node, its dict) of the BSDFs' Normal inputs
 
     # --- reporting ---------------------------------------------------------------------------
 
@@ -102,7 +103,8 @@ class _Translator:
         for name in ("Sheen", "Clearcoat"):
             if i[name].is_linked or i[name].default_value > 0.0:
                 self.warn(n, f"{name.lower()} of")
-        for name in ("Normal", "Clearcoat Normal", "Tangent"):
+        self.normal(i["Normal"])
+        for name in ("Clearcoat Normal", "Tangent"):
             if i[name].is_linked:
                 self.warn(self._source(i[name]).node if self._source(i[name]) else n,
                           "normal / tangent input node")
@@ -121,12 +123,14 @@ class _Translator:
         })
 
     def _bsdf_diffuse(self, n):
+        self.normal(n.inputs["Normal"])
         return self._add({"kind": "DIFFUSE", "color": self.color(n.inputs["Color"]),
                           "roughness": self.value(n.inputs["Roughness"])})
 
     def _bsdf_glossy(self, n):
         if n.distribution not in _GGX_LIKE:
             self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
+        self.normal(n.inputs["Normal"])
         roughness = self.value(n.inputs["Roughness"])
         if n.distribution == 'SHARP':
             roughness = {"value": 0.0}
@@ -136,6 +140,7 @@ class _Translator:
     def _bsdf_glass(self, n):
         if n.distribution not in _GGX_LIKE:
             self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
+        self.normal(n.inputs["Normal"])
         roughness = self.value(n.inputs["Roughness"])
         if n.distribution == 'SHARP':
             roughness = {"value": 0.0}
@@ -161,6 +166,30 @@ class _Translator:
         return self._add({"kind": "ADD", "a": a, "b": b})
 
     # --- inputs ------------------------------------------------------------------------------
+
+    def normal(self, socket):
+        """A BSDF's Normal input: a tangent-space Normal Map node becomes the material's normal
+        map (one per material: the first found; another one is reported and ignored)."""
+        out = self._source(socket)
+        if out is None:
+            return
+        node = out.node
+        if node.type != 'NORMAL_MAP':
+            self.warn(node, "normal / tangent input node")
+            return
+        if node.space != 'TANGENT':
+            self.warn(node, f"{node.space.lower()}-space normal map")
+            return
+        if self.normal_map is not None:
+            if self.normal_map[0] != node:
+                self.warn(node, "second normal map (the first one is used) in")
+            return
+        if node.uv_map:
+            self.warn(node, "UV map other than the active render UV map in")
+        if node.inputs["Strength"].is_linked:
+            self.warn(node, "linked Strength (its default value is used) of")
+        self.normal_map = (node, {"color": self.color(node.inputs["Color"]),
+                                  "strength": float(node.inputs["Strength"].default_value)})
 
     def color(self, socket):
         d = {"value": self._default_rgb(socket)}
@@ -301,7 +330,10 @@ def _translate_surface(material, images, warn):
     if root < 0:
         # Nothing connected: Cycles renders such a surface black. A black diffuse does the same.
         root = t._add({"kind": "DIFFUSE", "color": {"value": (0.0, 0.0, 0.0)}})
-    return {"name": material.name, "nodes": t.nodes, "root": root}
+    d = {"name": material.name, "nodes": t.nodes, "root": root}
+    if t.normal_map is not None:
+        d["normal_map"] = t.normal_map[1]
+    return d
 
 
 class MaterialCache:
@@ -310,6 +342,7 @@ class MaterialCache:
         self.images = images
         self.warn = warn
         self.index = {}
+        self.normal_mapped = set()  # scene material indices with a normal map
 
     def get(self, material):
         """Scene material index for a Blender material, -1 for an empty slot."""
@@ -319,5 +352,10 @@ class MaterialCache:
         if key not in self.index:
             desc = translate_material(material, self.images, self.warn)
             self.index[key] = self.builder.add_material(desc)
+            if "normal_map" in desc:
+                self.normal_mapped.add(self.index[key])
         return self.index[key]
+
+    def has_normal_map(self, index):
+        return index in self.normal_mapped
 

@@ -117,13 +117,44 @@ def _poly_material(mesh):
     return poly_material
 
 
-def add_mesh(builder, mesh):
+def _loop_tangents(mesh, warn):
+    """Blender's MikkTSpace tangents of the active render UV map and the bitangent signs, 4
+    floats per loop (what Cycles' Normal Map node uses), or None when Blender cannot compute them
+    (no UV map, or faces with more than 4 corners)."""
+    layer = next((l for l in mesh.uv_layers if l.active_render), None)
+    if layer is None and len(mesh.uv_layers):
+        layer = mesh.uv_layers[0]
+    if layer is None:
+        warn(f"mesh '{mesh.name}' has a normal-mapped material but no UV map: the normal map is "
+             "ignored there")
+        return None
+    try:
+        mesh.calc_tangents(uvmap=layer.name)
+    except RuntimeError as e:
+        reason = str(e).strip()
+        warn(f"mesh '{mesh.name}': no tangents for its normal map ({reason}); the normal map "
+             "is ignored there")
+        return None
+    loops = len(mesh.loops)
+    tangents = _empty(loops * 3, np.float32)
+    mesh.loops.foreach_get("tangent", tangents)
+    signs = _empty(loops, np.float32)
+    mesh.loops.foreach_get("bitangent_sign", signs)
+    out = np.empty((loops, 4), dtype=np.float32)
+    out[:, :3] = tangents.reshape(loops, 3)
+    out[:, 3] = signs
+    return out.ravel()
+
+
+def add_mesh(builder, mesh, tangents=False, warn=print):
     """Adds `mesh` to the scene; returns its index, or -1 when it has no faces. Only Blender's
     own arrays (vertices, loops, polygons) are read here; the module builds the triangles and
-    gathers the corner attributes in C++."""
+    gathers the corner attributes in C++. `tangents`: also the UV map's tangents (for materials
+    with a Normal Map node)."""
     poly_count = len(mesh.polygons)
     if poly_count == 0:
         return -1
+    loop_tangents = _loop_tangents(mesh, warn) if tangents else None
     positions = _empty(len(mesh.vertices) * 3, np.float32)
     mesh.vertices.foreach_get("co", positions)
     loop_total = _int_field(mesh.polygons, 1, "loop_total")  # MPoly.totloop
@@ -133,14 +164,14 @@ def add_mesh(builder, mesh):
     if loop_total.min() >= 3 and loop_total.max() <= 4:
         loop_start = _int_field(mesh.polygons, 0, "loop_start")  # MPoly.loopstart
         return builder.add_mesh_polys(positions, loop_vertex, loop_start, loop_total, normals,
-                                      per_loop, loop_uvs, poly_material)
+                                      per_loop, loop_uvs, poly_material, loop_tangents)
     # N-gons: Blender's ear clipping, through its loop triangles (slower reads).
     corner_loops, tri_poly = _corner_loops_slow(mesh)
     if len(corner_loops) == 0:
         return -1
     tri_material = poly_material[tri_poly] if len(poly_material) else poly_material
     return builder.add_mesh_loops(positions, loop_vertex, corner_loops, normals, per_loop,
-                                  loop_uvs, np.ascontiguousarray(tri_material))
+                                  loop_uvs, np.ascontiguousarray(tri_material), loop_tangents)
 
 
 # Object > Visibility > Ray Visibility -> the core's RayKind bits (integrator/scene.h).
@@ -171,30 +202,31 @@ class GeometryExporter:
         self.mesh_index = {}  # evaluated data pointer -> scene mesh index (-1: empty)
         self.export_seconds = 0.0
 
-    def _mesh_for(self, obj):
+    def _mesh_for(self, obj, tangents):
         # Meshes: the evaluated mesh datablock (modifiers applied) is what instances share.
         # Other types: to_mesh() depends on the object's own modifiers, so key by the original
-        # object (instances of it in collections or particles still share one mesh).
+        # object (instances of it in collections or particles still share one mesh). Tangents are
+        # read only for objects whose materials have a normal map (part of the key).
         if obj.type == 'MESH':
-            key = obj.data.as_pointer()
+            key = (obj.data.as_pointer(), tangents)
         else:
-            key = ("object", obj.original.as_pointer())
+            key = ("object", obj.original.as_pointer(), tangents)
         if key in self.mesh_index:
             return self.mesh_index[key]
         if obj.type == 'MESH':
             mesh = obj.data
-            index = self._add_mesh(mesh)
+            index = self._add_mesh(mesh, tangents)
         else:
             mesh = obj.to_mesh()
             try:
-                index = self._add_mesh(mesh) if mesh is not None else -1
+                index = self._add_mesh(mesh, tangents) if mesh is not None else -1
             finally:
                 obj.to_mesh_clear()
         self.mesh_index[key] = index
         return index
 
-    def _add_mesh(self, mesh):
-        return add_mesh(self.builder, mesh)
+    def _add_mesh(self, mesh, tangents):
+        return add_mesh(self.builder, mesh, tangents, self.warn)
 
     def visit(self, inst, obj, matrix):
         """Adds one instance of geometry object `obj` placed by `matrix` (already copied)."""
@@ -203,9 +235,10 @@ class GeometryExporter:
         if obj.type == 'CURVES':
             self.warn(f"hair curves of '{obj.name}' are not supported by Gradient PT (skipped)")
             return
-        mesh = self._mesh_for(obj)
+        slots = [self.materials.get(slot.material) for slot in obj.material_slots]
+        tangents = any(self.materials.has_normal_map(index) for index in slots)
+        mesh = self._mesh_for(obj, tangents)
         if mesh < 0:
             return
-        slots = [self.materials.get(slot.material) for slot in obj.material_slots]
         self.builder.add_instance(mesh, _matrix12(matrix), slots, obj.pass_index,
                                   ray_visibility(obj), bool(obj.is_holdout))

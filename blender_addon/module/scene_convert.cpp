@@ -215,12 +215,14 @@ struct CornerSource {
   size_t loop_count = 0;
   const float* normals = nullptr;  // per loop or per vertex, or null
   bool normals_per_loop = false;
-  const float* loop_uvs = nullptr;  // per loop, or null
+  const float* loop_uvs = nullptr;       // per loop, or null
+  const float* loop_tangents = nullptr;  // 4 per loop (tangent, bitangent sign), or null
 };
 
 CornerSource corner_source(const FloatArray& positions, const IntArray& loop_vertex,
                            const FloatArray& normals, bool normals_per_loop,
-                           const FloatArray& loop_uvs) {
+                           const FloatArray& loop_uvs,
+                           const std::optional<FloatArray>& loop_tangents) {
   if (positions.size() % 3 != 0) throw std::invalid_argument("positions: size not a multiple of 3");
   CornerSource s;
   s.positions = positions.data();
@@ -237,6 +239,8 @@ CornerSource corner_source(const FloatArray& positions, const IntArray& loop_ver
     s.normals_per_loop = normals_per_loop;
   }
   if (loop_uvs.size() > 0) s.loop_uvs = checked_data(loop_uvs, s.loop_count * 2, "loop_uvs");
+  if (loop_tangents && loop_tangents->size() > 0)
+    s.loop_tangents = checked_data(*loop_tangents, s.loop_count * 4, "loop_tangents");
   return s;
 }
 
@@ -281,6 +285,18 @@ Mesh gather_mesh(const CornerSource& src, size_t triangles, bool with_material,
         },
         [](int32_t) {});
   }
+  if (src.loop_tangents) {
+    const float* t = src.loop_tangents;
+    reserve_fresh(mesh.corner_tangents, corner_count);
+    reserve_fresh(mesh.corner_tangent_signs, corner_count);
+    corners(
+        [&](int32_t loop) {
+          const size_t i = 4 * size_t(loop);
+          mesh.corner_tangents.emplace_back(t[i], t[i + 1], t[i + 2]);
+          mesh.corner_tangent_signs.push_back(t[i + 3]);
+        },
+        [](int32_t) {});
+  }
   if (with_material)
     corners([](int32_t) {}, [&](int32_t slot) { mesh.material_slot.push_back(slot); });
   return mesh;
@@ -298,7 +314,8 @@ bool any_nonzero(const IntArray& a) {
 int SceneBuilder::add_mesh_loops(const FloatArray& positions, const IntArray& loop_vertex,
                                  const IntArray& corner_loops, const FloatArray& normals,
                                  bool normals_per_loop, const FloatArray& loop_uvs,
-                                 const IntArray& material_slot) {
+                                 const IntArray& material_slot,
+                                 const std::optional<FloatArray>& loop_tangents) {
   if (corner_loops.size() % 3 != 0)
     throw std::invalid_argument("corner_loops: size not a multiple of 3");
   if (material_slot.size() > 0 && material_slot.size() * 3 != corner_loops.size())
@@ -307,7 +324,7 @@ int SceneBuilder::add_mesh_loops(const FloatArray& positions, const IntArray& lo
   {
     py::gil_scoped_release no_gil;
     const CornerSource src =
-        corner_source(positions, loop_vertex, normals, normals_per_loop, loop_uvs);
+        corner_source(positions, loop_vertex, normals, normals_per_loop, loop_uvs, loop_tangents);
     const int32_t* corners = corner_loops.data();
     const size_t triangles = size_t(corner_loops.size()) / 3;
     for (size_t i = 0; i < triangles * 3; ++i)
@@ -331,7 +348,8 @@ int SceneBuilder::add_mesh_loops(const FloatArray& positions, const IntArray& lo
 int SceneBuilder::add_mesh_polys(const FloatArray& positions, const IntArray& loop_vertex,
                                  const IntArray& loop_start, const IntArray& loop_total,
                                  const FloatArray& normals, bool normals_per_loop,
-                                 const FloatArray& loop_uvs, const IntArray& poly_material) {
+                                 const FloatArray& loop_uvs, const IntArray& poly_material,
+                                 const std::optional<FloatArray>& loop_tangents) {
   const size_t poly_count = size_t(loop_start.size());
   if (size_t(loop_total.size()) != poly_count)
     throw std::invalid_argument("loop_start / loop_total differ in size");
@@ -341,7 +359,7 @@ int SceneBuilder::add_mesh_polys(const FloatArray& positions, const IntArray& lo
   {
     py::gil_scoped_release no_gil;
     const CornerSource src =
-        corner_source(positions, loop_vertex, normals, normals_per_loop, loop_uvs);
+        corner_source(positions, loop_vertex, normals, normals_per_loop, loop_uvs, loop_tangents);
     const int32_t* start = loop_start.data();
     const int32_t* total = loop_total.data();
     size_t triangles = 0;
@@ -431,6 +449,9 @@ py::dict SceneBuilder::mesh_arrays(int index) const {
   d["corner_normals"] = copy(m.corner_normals, {m.corner_normals.empty() ? 0 : t, 3, 3}, 0.0f);
   d["corner_uvs"] = copy(m.corner_uvs, {m.corner_uvs.empty() ? 0 : t, 3, 2}, 0.0f);
   d["material_slot"] = copy(m.material_slot, {py::ssize_t(m.material_slot.size())}, int32_t(0));
+  d["corner_tangents"] = copy(m.corner_tangents, {m.corner_tangents.empty() ? 0 : t, 3, 3}, 0.0f);
+  d["corner_tangent_signs"] =
+      copy(m.corner_tangent_signs, {m.corner_tangent_signs.empty() ? 0 : t, 3}, 0.0f);
   return d;
 }
 
@@ -489,6 +510,13 @@ int SceneBuilder::add_material(const py::dict& material) {
       desc.nodes.push_back(node);
     }
   }
+  // Normal Map node (tangent space): {"color": colour input, "strength": float}.
+  if (material.contains("normal_map")) {
+    const auto d = material["normal_map"].cast<py::dict>();
+    desc.normal_map.enabled = true;
+    read_color(d, "color", desc.normal_map.color);
+    get(d, "strength", desc.normal_map.strength);
+  }
   // Child and image indices are checked here so a bad export fails with a message, not a crash.
   const auto n = int32_t(desc.nodes.size());
   if (desc.root < -1 || desc.root >= n) throw std::invalid_argument("material root out of range");
@@ -504,6 +532,8 @@ int SceneBuilder::add_material(const py::dict& material) {
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
     }
   }
+  if (desc.normal_map.color.texture.image >= int32_t(scene_.images.size()))
+    throw std::invalid_argument("material '" + desc.name + "': image index out of range");
   scene_.materials.push_back(std::move(desc));
   return int(scene_.materials.size()) - 1;
 }

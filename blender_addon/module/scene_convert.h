@@ -53,17 +53,19 @@ class SceneBuilder {
   // loops, much faster than numpy fancy indexing): corner_loops (3 per triangle) index
   // loop_vertex; normals are per vertex (normals_per_loop false: kept per vertex, as
   // Mesh::vertex_normals) or per loop (gathered per corner), or empty; loop_uvs (2 per loop) may
-  // be empty.
+  // be empty; loop_tangents (4 per loop: Blender's loop tangent and bitangent sign, for Normal
+  // Map nodes) may be None or empty.
   int add_mesh_loops(const FloatArray& positions, const IntArray& loop_vertex,
                      const IntArray& corner_loops, const FloatArray& normals, bool normals_per_loop,
-                     const FloatArray& loop_uvs, const IntArray& material_slot);
+                     const FloatArray& loop_uvs, const IntArray& material_slot,
+                     const std::optional<FloatArray>& loop_tangents);
   // Triangle/quad meshes straight from Blender's polygon arrays: triangulated here with Blender's
   // loop-triangle rule (quads split 0-2, or 1-3 when the 0-2 split folds the quad), so the
   // add-on never touches per-triangle data in Python. poly_material: one per polygon.
   int add_mesh_polys(const FloatArray& positions, const IntArray& loop_vertex,
                      const IntArray& loop_start, const IntArray& loop_total,
                      const FloatArray& normals, bool normals_per_loop, const FloatArray& loop_uvs,
-                     const IntArray& poly_material);
+                     const IntArray& poly_material, const std::optional<FloatArray>& loop_tangents);
   // pass_index: the object's Pass Index (IndexOB pass).
   // visibility: RayKind bits of the rays that see the instance (Object > Visibility > Ray
   // Visibility).

@@ -5,6 +5,7 @@ import os
 import sys
 
 import bpy
+import numpy as np
 from mathutils import Vector
 
 sys.path.insert(0, os.path.dirname(__file__))
@@ -103,6 +104,36 @@ def image_material(name, image):
     tex.image = image
     nt.links.new(tex.outputs["Color"], bsdf.inputs["Color"])
     nt.links.new(bsdf.outputs[0], out.inputs["Surface"])
+    return m
+
+
+def normal_map_image(name, size=64, waves=3, tilt=0.6):
+    """Non-colour float image of a wavy tangent-space normal field: x varies along u, y along v."""
+    img = bpy.data.images.new(name, size, size, alpha=True, float_buffer=True)
+    img.colorspace_settings.name = 'Non-Color'
+    c = (np.arange(size) + 0.5) / size
+    n = np.zeros((size, size, 3), np.float32)
+    n[..., 0] = tilt * np.sin(2 * np.pi * waves * c)[None, :]
+    n[..., 1] = tilt * np.cos(2 * np.pi * waves * c)[:, None]
+    n[..., 2] = 1.0
+    n /= np.linalg.norm(n, axis=2, keepdims=True)
+    rgba = np.ones((size, size, 4), np.float32)
+    rgba[..., :3] = 0.5 + 0.5 * n
+    img.pixels.foreach_set(rgba.ravel())
+    img.pack()
+    return img
+
+
+def normal_mapped(name, node_type, image, strength, **inputs):
+    m = shader_material(name, node_type, **inputs)
+    nt = m.node_tree
+    bsdf = next(n for n in nt.nodes if n.bl_idname == node_type)
+    nm = nt.nodes.new("ShaderNodeNormalMap")
+    nm.inputs["Strength"].default_value = strength
+    tex = nt.nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    nt.links.new(tex.outputs["Color"], nm.inputs["Color"])
+    nt.links.new(nm.outputs["Normal"], bsdf.inputs["Normal"])
     return m
 
 

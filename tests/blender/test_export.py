@@ -70,11 +70,11 @@ def reference(mesh):
     return ref
 
 
-def compare(name, mesh):
+def compare(name, mesh, tangents=False):
     import gdpt.export_mesh as export_mesh
     from gdpt import _gdpt
     builder = _gdpt.SceneBuilder()
-    index = export_mesh.add_mesh(builder, mesh)
+    index = export_mesh.add_mesh(builder, mesh, tangents)
     got = builder.mesh_arrays(index)
     print(f"{name}: normals per " + ("corner" if got["corner_normals"].size else "vertex" if
                                      got["vertex_normals"].size else "- (flat)"))
@@ -106,6 +106,18 @@ def compare(name, mesh):
               f"{name}: corner UVs from the active render UV map")
     slots = got["material_slot"] if got["material_slot"].size else np.zeros(len(ref["indices"]))
     check(np.array_equal(slots, ref["material_slot"]), f"{name}: material slot per triangle")
+    if tangents:  # for Normal Map nodes: Blender's MikkTSpace tangents of the render UV map
+        layer = next(u for u in mesh.uv_layers if u.active_render)
+        mesh.calc_tangents(uvmap=layer.name)
+        corners = np.array([list(t.loops) for t in mesh.loop_triangles], dtype=np.int64)
+        t_ref = np.array([l.tangent[:] for l in mesh.loops], dtype=np.float32)[corners]
+        s_ref = np.array([l.bitangent_sign for l in mesh.loops], dtype=np.float32)[corners]
+        check(np.array_equal(got["corner_tangents"][same], t_ref[same]) and
+              np.array_equal(got["corner_tangent_signs"][same], s_ref[same]) and
+              np.abs(s_ref).min() == 1.0,
+              f"{name}: corner tangents and bitangent signs are Blender's loop tangents")
+    else:
+        check(got["corner_tangents"].size == 0, f"{name}: no tangents unless asked for")
     return ref
 
 
@@ -122,6 +134,7 @@ def main():
     faces = [(0, 1, 2, 3), (1, 4, 5, 2), (6, 7, 8, 9), (10, 11, 12)]
     me = make_mesh("mixed", verts, faces, smooth=lambda i: i % 2 == 0, materials=(red, green))
     ref = compare("mixed", me)
+    compare("mixed", me, tangents=True)
     arrow = ref["indices"][4:6]  # faces 0 and 1 give two triangles each
     check(sorted(map(tuple, arrow.tolist())) == [(6, 7, 9), (7, 8, 9)],
           "the arrowhead quad is split along its 1-3 diagonal")
@@ -142,6 +155,7 @@ def main():
     me = make_mesh("smooth", verts, faces, smooth=lambda i: True, uv_layers=("A", "B"),
                    render_uv=1)
     compare("smooth", me)
+    compare("smooth", me, tangents=True)
 
     # N-gons: a convex hexagon, a concave (L-shaped) hexagon, a pentagon, plus a quad; flat.
     verts = [(0, 0, 0), (2, 0, 0), (3, 1, 0), (2, 2, 0), (0, 2, 0), (-1, 1, 0),

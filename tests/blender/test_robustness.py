@@ -59,6 +59,42 @@ def test_unsupported_node(out):
     check(right[..., 2].mean() > right[..., 0].mean(), "pass-through kept the RGB colour")
 
 
+def test_normal_map_limits(out):
+    """Normal maps Gradient PT cannot apply are reported, and the render still finishes: a
+    normal-mapped mesh without a UV map, one with a 5-sided face (Blender computes no tangents
+    for it), an object-space Normal Map node and a Bump node."""
+    import gdpt.engine as engine
+    scene = S.clear()
+    basic_scene(scene)
+    img = S.normal_map_image("bumps")
+    tangent = S.normal_mapped("nm", "ShaderNodeBsdfDiffuse", img, 1.0)
+    S.mesh_object("no_uvs", [(-2, -1, 0.01), (-1, -1, 0.01), (-1, 0, 0.01), (-2, 0, 0.01)],
+                  [(0, 1, 2, 3)], tangent, uvs=False)
+    S.mesh_object("pentagon", [(1, -1, 0.01), (2, -1, 0.01), (2.3, -0.5, 0.01), (2, 0, 0.01),
+                               (1, 0, 0.01)], [(0, 1, 2, 3, 4)], tangent)
+    obj_space = S.normal_mapped("object_space", "ShaderNodeBsdfDiffuse", img, 1.0)
+    next(n for n in obj_space.node_tree.nodes if n.type == 'NORMAL_MAP').space = 'OBJECT'
+    m, nt, outn = S._material("bumped")
+    bump = nt.nodes.new("ShaderNodeBump")
+    bump.name = "My Bump"
+    bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    nt.links.new(bump.outputs["Normal"], bsdf.inputs["Normal"])
+    nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
+    S.uv_sphere("ball", 0.5, (-0.8, 0.3, 0.5), obj_space)
+    S.uv_sphere("ball2", 0.5, (0.8, 0.3, 0.5), m)
+    S.setup_gdpt(scene, 8)
+    path = S.render(scene, os.path.join(out, "normal_map_limits.exr"))
+    info = engine.LAST_RENDER
+    check(info.get("status") == "finished", f"render finished ({info.get('status')})")
+    warnings = info.get("warnings", [])
+    print("\n".join(warnings))
+    for needle, what in (("'no_uvs'", "the mesh without UVs"), ("'pentagon'", "the 5-sided face"),
+                         ("object-space normal map", "the object-space map"),
+                         ("My Bump", "the Bump node")):
+        check(sum(needle in w for w in warnings) == 1, f"one warning names {what}")
+    check(S.read_rgb(path).mean() > 0.01, "the image was written")
+
+
 def test_no_camera(out):
     import gdpt.engine as engine
     scene = S.clear()
@@ -177,6 +213,7 @@ def main():
     out = S.args()["out"]
     os.makedirs(out, exist_ok=True)
     test_unsupported_node(out)
+    test_normal_map_limits(out)
     test_no_camera(out)
     test_time_limit(out)
     test_geometry_types(out)
