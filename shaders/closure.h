@@ -24,6 +24,7 @@ enum class ClosureType : uint8_t {
   Lambert,            // color / pi
   OrenNayar,          // Cycles' Oren-Nayar with sigma = roughness
   PrincipledDiffuse,  // Disney/Burley diffuse as in Cycles' Principled v1
+  PrincipledSheen,    // Cycles' Principled v1 sheen (grazing retro-reflection)
   GGXReflection,  // GGX with Fresnel mode below (Glossy: none; Principled specular: Schlick mix)
   GGXDielectric,  // GGX glass: reflection + refraction by dielectric Fresnel; alpha 0 = smooth
   Transparent,    // straight through, delta

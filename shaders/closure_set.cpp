@@ -12,6 +12,7 @@
 #include "shaders/bsdf_lambert.h"
 #include "shaders/bsdf_oren_nayar.h"
 #include "shaders/bsdf_principled_diffuse.h"
+#include "shaders/bsdf_principled_sheen.h"
 #include "shaders/bsdf_transparent.h"
 
 namespace gdpt {
@@ -27,6 +28,8 @@ namespace {
       return oren_nayar::call;           \
     case ClosureType::PrincipledDiffuse: \
       return principled_diffuse::call;   \
+    case ClosureType::PrincipledSheen:   \
+      return principled_sheen::call;     \
     case ClosureType::GGXReflection:     \
       return ggx_reflection::call;       \
     case ClosureType::GGXDielectric:     \
@@ -65,7 +68,7 @@ bool lobe_is_delta(const Closure& c) {
 
 bool lobe_is_diffuse(const Closure& c) {
   return c.type == ClosureType::Lambert || c.type == ClosureType::OrenNayar ||
-         c.type == ClosureType::PrincipledDiffuse;
+         c.type == ClosureType::PrincipledDiffuse || c.type == ClosureType::PrincipledSheen;
 }
 
 // Unnormalised selection weights; returns their sum.

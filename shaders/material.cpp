@@ -134,6 +134,8 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       p.roughness = in.scalar(n.roughness);
       p.ior = in.scalar(n.ior);
       p.transmission = in.scalar(n.transmission);
+      p.sheen = in.scalar(n.sheen);
+      p.sheen_tint = in.scalar(n.sheen_tint);
       p.alpha = in.scalar(n.alpha);
       p.emission = in.color(n.emission) * in.scalar(n.emission_strength);
       p.front_facing = in.front_facing;
@@ -305,6 +307,8 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         note(n.specular);
         note(n.specular_tint);
         note(n.transmission);
+        note(n.sheen);
+        note(n.sheen_tint);
         note(n.alpha);
         note(n.emission);
         note(n.emission_strength);

@@ -61,6 +61,8 @@ struct ShaderNode {
   FloatInput specular{0.5f};
   FloatInput specular_tint{0.0f};
   FloatInput transmission{0.0f};
+  FloatInput sheen{0.0f};
+  FloatInput sheen_tint{0.5f};
   FloatInput alpha{1.0f};
   ColorInput emission{Spectrum(0.0f)};
   FloatInput emission_strength{1.0f};

@@ -49,6 +49,18 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
     out.add(d);
   }
 
+  // --- Sheen, with the diffuse (Cycles tints it by the base colour's hue at scene-linear Rec.709
+  // luminance, unlike the specular tint below).
+  const float sheen = p.sheen;
+  if (diffuse_weight > kWeightCutoff && sheen > kWeightCutoff) {
+    const float lum = 0.2126729f * base.x + 0.7151522f * base.y + 0.0721750f * base.z;
+    const Spectrum hue = lum > 0.0f ? base / lum : Spectrum(1.0f);
+    Closure s;
+    s.type = ClosureType::PrincipledSheen;
+    s.weight = (Spectrum(1.0f - p.sheen_tint) + hue * p.sheen_tint) * (w * sheen * diffuse_weight);
+    out.add(s);
+  }
+
   // --- Specular reflection.
   if (specular_weight > kWeightCutoff && (specular > kWeightCutoff || metallic > kWeightCutoff)) {
     Closure s;

@@ -9,9 +9,11 @@
 //   transmission GGXDielectric, weight transmission' = transmission (1 - metallic); the reflected
 //                part blends mix(1, base, specular_tint) towards white, the refracted part is
 //                tinted by base
+//   sheen        PrincipledSheen, weight sheen mix(1, base / lum(base), sheen_tint)
+//                (1 - metallic)(1 - transmission), lum the scene-linear Rec.709 luminance
 //   emission     emission * emission_strength
 //   alpha        everything above times alpha, plus Transparent (white) times 1 - alpha
-// Subsurface, sheen, clearcoat, anisotropy and the multiscatter GGX variant are not modelled.
+// Subsurface, clearcoat, anisotropy and the multiscatter GGX variant are not modelled.
 // All weights are multiplied by `mix_weight` (the Mix/Add tree weight).
 #pragma once
 
@@ -27,6 +29,8 @@ struct PrincipledParams {
   float roughness = 0.5f;
   float ior = 1.45f;
   float transmission = 0.0f;
+  float sheen = 0.0f;
+  float sheen_tint = 0.5f;
   float alpha = 1.0f;
   Spectrum emission{0.0f};   // colour * strength
   bool front_facing = true;  // false: the transmission closure gets 1 / ior (leaving the object)

@@ -100,9 +100,8 @@ class _Translator:
             self.warn(n, f"distribution {n.distribution} of")
         if i["Subsurface"].is_linked or i["Subsurface"].default_value > 0.0:
             self.warn(n, "subsurface scattering of")
-        for name in ("Sheen", "Clearcoat"):
-            if i[name].is_linked or i[name].default_value > 0.0:
-                self.warn(n, f"{name.lower()} of")
+        if i["Clearcoat"].is_linked or i["Clearcoat"].default_value > 0.0:
+            self.warn(n, "clearcoat of")
         self.normal(i["Normal"])
         for name in ("Clearcoat Normal", "Tangent"):
             if i[name].is_linked:
@@ -117,6 +116,8 @@ class _Translator:
             "roughness": self.value(i["Roughness"]),
             "ior": self.value(i["IOR"]),
             "transmission": self.value(i["Transmission"]),
+            "sheen": self.value(i["Sheen"]),
+            "sheen_tint": self.value(i["Sheen Tint"]),
             "emission": self.color(i["Emission"]),
             "emission_strength": self.value(i["Emission Strength"]),
             "alpha": self.value(i["Alpha"]),

@@ -504,6 +504,8 @@ int SceneBuilder::add_material(const py::dict& material) {
       read_float(d, "specular", node.specular);
       read_float(d, "specular_tint", node.specular_tint);
       read_float(d, "transmission", node.transmission);
+      read_float(d, "sheen", node.sheen);
+      read_float(d, "sheen_tint", node.sheen_tint);
       read_float(d, "alpha", node.alpha);
       read_color(d, "emission", node.emission);
       read_float(d, "emission_strength", node.emission_strength);
@@ -526,8 +528,9 @@ int SceneBuilder::add_material(const py::dict& material) {
     for (const TextureLookup* t :
          {&node.color.texture, &node.roughness.texture, &node.ior.texture, &node.strength.texture,
           &node.fac.texture, &node.metallic.texture, &node.specular.texture,
-          &node.specular_tint.texture, &node.transmission.texture, &node.alpha.texture,
-          &node.emission.texture, &node.emission_strength.texture}) {
+          &node.specular_tint.texture, &node.transmission.texture, &node.sheen.texture,
+          &node.sheen_tint.texture, &node.alpha.texture, &node.emission.texture,
+          &node.emission_strength.texture}) {
       if (t->image >= int32_t(scene_.images.size()))
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
     }

@@ -81,6 +81,19 @@ def case_principled_dielectric(scene):
     return 4
 
 
+def case_principled_sheen(scene):
+    # Sheen is a grazing-angle layer: a dark floor seen at a low angle against a low sun shows
+    # it everywhere (the sun sits behind the floor as seen from the camera).
+    m = S.shader_material("sheen", "ShaderNodeBsdfPrincipled", **{
+        "Base Color": (0.02, 0.03, 0.05, 1.0), "Roughness": 0.5, "Specular": 0.0,
+        "Sheen": 1.0, "Sheen Tint": 0.3, "distribution": 'GGX'})
+    S.plane("floor", 40.0, (0, 0, 0), material=m)
+    S.uv_sphere("ball", 0.6, (0, 2.0, 0.6), m)
+    S.camera((0, -5.0, 0.8), (0, 3.0, 0.0), lens=35)
+    S.light('SUN', (0, 20.0, 7.0), 3.0, target=(0, 0, 0))
+    return 4
+
+
 def case_point(scene):
     lit_room(scene)
     S.light('POINT', (0.5, -0.5, 3.0), 300.0, shadow_soft_size=0.2)

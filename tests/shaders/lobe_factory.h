@@ -29,6 +29,12 @@ inline Closure principled_diffuse(float roughness, Spectrum c = Spectrum(1.0f)) 
   k.alpha = roughness;
   return k;
 }
+inline Closure principled_sheen(Spectrum c = Spectrum(1.0f)) {
+  Closure k;
+  k.type = ClosureType::PrincipledSheen;
+  k.weight = c;
+  return k;
+}
 inline Closure ggx(float alpha, Spectrum c = Spectrum(1.0f)) {
   Closure k;
   k.type = ClosureType::GGXReflection;

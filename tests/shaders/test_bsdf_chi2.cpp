@@ -23,6 +23,7 @@ std::vector<Case> lobe_cases() {
   cases.push_back({"OrenNayar05", set_of({oren_nayar(0.5f)})});
   cases.push_back({"OrenNayar1", set_of({oren_nayar(1.0f)})});
   cases.push_back({"PrincipledDiffuse05", set_of({principled_diffuse(0.5f)})});
+  cases.push_back({"PrincipledSheen", set_of({principled_sheen()})});
   for (float a : {0.05f, 0.2f, 0.5f, 1.0f}) {
     const std::string s = std::to_string(int(a * 100 + 0.5f));
     cases.push_back({"GGX" + s, set_of({ggx(a)})});
@@ -41,6 +42,8 @@ std::vector<Case> lobe_cases() {
   // Mixtures: diffuse + glossy (Principled-like), and a set with a delta lobe.
   cases.push_back({"MixDiffuseGlossy", set_of({principled_diffuse(0.3f, Spectrum(0.6f, 0.3f, 0.2f)),
                                                ggx_principled(0.04f, 1.5f, Spectrum(0.04f))})});
+  cases.push_back({"MixDiffuseSheen", set_of({principled_diffuse(0.5f, Spectrum(0.05f)),
+                                              principled_sheen(Spectrum(0.8f, 0.7f, 0.6f))})});
   cases.push_back({"MixLambertGlassTransparent",
                    set_of({lambert(Spectrum(0.3f)), glass(0.3f, 1.33f, Spectrum(0.7f)),
                            transparent(Spectrum(0.2f))})});

@@ -82,7 +82,11 @@ TEST(BsdfEnergy, GgxWhiteFurnaceLossIsSmallForSmoothAndLargerForRough) {
 }
 
 TEST(BsdfReciprocity, ReflectionLobesAreSymmetric) {
-  const Closure lobes[] = {lambert(), oren_nayar(0.6f), principled_diffuse(0.8f), ggx(0.3f),
+  const Closure lobes[] = {lambert(),
+                           oren_nayar(0.6f),
+                           principled_diffuse(0.8f),
+                           principled_sheen(),
+                           ggx(0.3f),
                            ggx_principled(0.15f, 1.6f, Spectrum(0.7f, 0.4f, 0.2f))};
   Pcg32 rng(3);
   for (const Closure& c : lobes) {
@@ -206,6 +210,14 @@ TEST(DiffuseModels, ClosedFormValues) {
     EXPECT_NEAR(s.eval(n, wo).x, expected, 1e-6);
     EXPECT_NEAR(set_of({principled_diffuse(0.0f)}).eval(n, n).x, 1.0 / M_PI, 1e-6);
   }
+  // Principled sheen (Cycles' form, no 1/pi): F(dot(wo, h)) cos_o; wi = normal and wo at 60
+  // degrees give a 30-degree half angle; wi = wo gives F(1) = 0.
+  {
+    const ClosureSet s = set_of({principled_sheen(Spectrum(0.5f))});
+    EXPECT_NEAR(s.eval(n, wo).x, 0.5 * std::pow(1.0 - std::cos(M_PI / 6), 5) * 0.5, 1e-7);
+    EXPECT_EQ(s.eval(wo, wo).x, 0.0f);
+    EXPECT_EQ(s.eval(n, Vec3f(wo.x, wo.y, -wo.z)).x, 0.0f);  // no transmission
+  }
   // Oren-Nayar (Cycles' form), sigma = 1.
   {
     const ClosureSet s = set_of({oren_nayar(1.0f)});
@@ -287,7 +299,7 @@ TEST(ClosureSet, SampleReportsLobeFlagsEtaAndRoughness) {
 // Degenerate inputs: zero roughness, exactly grazing wi (z = 0), wo = -wi, wo = wi, poles.
 TEST(BsdfRobustness, NoNaNOrInfInDegenerateConfigurations) {
   std::vector<Closure> lobes = {lambert(), oren_nayar(1.0f), principled_diffuse(1.0f),
-                                transparent()};
+                                principled_sheen(), transparent()};
   for (float a : {0.0f, 1e-6f, 1e-4f, 3.2e-4f, 1e-3f, 1.0f}) {
     lobes.push_back(ggx(a));
     lobes.push_back(ggx_principled(a, 1.5f, Spectrum(0.5f)));

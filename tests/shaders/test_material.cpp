@@ -180,6 +180,32 @@ TEST(Material, PrincipledWeightsFollowCycles) {
                                    kFeatureTransparent | kFeatureDelta));
 }
 
+// Sheen: weight sheen * mix(1, base / lum(base), tint) * (1 - metallic)(1 - transmission), lum
+// the Rec.709 luminance; none without diffuse (metallic 1) or at sheen 0.
+TEST(Material, PrincipledSheenFollowsCycles) {
+  auto sheen_of = [](float sheen, float metallic) {
+    MaterialDesc d;
+    ShaderNode n = node(ShaderNodeKind::Principled, Spectrum(0.5f, 0.4f, 0.3f));
+    n.metallic = FloatInput(metallic);
+    n.transmission = FloatInput(0.5f);
+    n.sheen = FloatInput(sheen);
+    n.sheen_tint = FloatInput(0.25f);
+    d.nodes.push_back(n);
+    d.root = 0;
+    const ClosureSet s = eval(Material(d, {}));
+    for (int i = 0; i < s.count(); ++i)
+      if (s[i].type == ClosureType::PrincipledSheen) return std::optional<Closure>(s[i]);
+    return std::optional<Closure>();
+  };
+  const std::optional<Closure> c = sheen_of(0.8f, 0.2f);
+  ASSERT_TRUE(c.has_value());
+  const float lum = 0.2126729f * 0.5f + 0.7151522f * 0.4f + 0.0721750f * 0.3f;
+  const Spectrum tint = Spectrum(0.75f) + Spectrum(0.5f, 0.4f, 0.3f) / lum * 0.25f;
+  expect_spectrum(c->weight, tint * (0.8f * 0.8f * 0.5f), 1e-6f);
+  EXPECT_FALSE(sheen_of(0.0f, 0.2f).has_value());
+  EXPECT_FALSE(sheen_of(0.8f, 1.0f).has_value());
+}
+
 TEST(Material, GlassNodes) {
   MaterialDesc d;
   ShaderNode g = node(ShaderNodeKind::Glass, Spectrum(0.9f));
