@@ -41,9 +41,93 @@ float channel(const Rgba& c, FloatInput::Channel which) {
   return luminance(c.rgb);
 }
 
+// Cycles' svm_mix for the supported blend types (t already clamped when the node asks).
+Spectrum mix_blend(MixBlend blend, float t, Spectrum a, Spectrum b) {
+  switch (blend) {
+    case MixBlend::Mix:
+      return lerp(a, b, t);
+    case MixBlend::Add:
+      return a + b * t;
+    case MixBlend::Multiply:
+      return a * (Spectrum(1.0f - t) + b * t);
+    case MixBlend::Subtract:
+      return a - b * t;
+    case MixBlend::Screen:
+      return Spectrum(1.0f) -
+             (Spectrum(1.0f - t) + (Spectrum(1.0f) - b) * t) * (Spectrum(1.0f) - a);
+    case MixBlend::Divide: {
+      Spectrum r = a;
+      for (int k = 0; k < 3; ++k)
+        if (b[k] != 0.0f) r[k] = (1.0f - t) * a[k] + t * a[k] / b[k];
+      return r;
+    }
+    case MixBlend::Difference:
+      return lerp(a, Spectrum(std::fabs(a.x - b.x), std::fabs(a.y - b.y), std::fabs(a.z - b.z)), t);
+    case MixBlend::Darken:
+      return lerp(a, Spectrum(std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)), t);
+    case MixBlend::Lighten:
+      return lerp(a, Spectrum(std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)), t);
+  }
+  return a;
+}
+
+// Cycles' svm_math for the supported operations (safe division and power: 0 where undefined).
+float math_op(MathOp op, float a, float b) {
+  switch (op) {
+    case MathOp::Add:
+      return a + b;
+    case MathOp::Subtract:
+      return a - b;
+    case MathOp::Multiply:
+      return a * b;
+    case MathOp::Divide:
+      return b != 0.0f ? a / b : 0.0f;
+    case MathOp::Power:
+      if (a < 0.0f && b != std::floor(b)) return 0.0f;
+      return std::pow(a, b);
+    case MathOp::Minimum:
+      return std::min(a, b);
+    case MathOp::Maximum:
+      return std::max(a, b);
+  }
+  return 0.0f;
+}
+
+// One input node's result from its operands, read through `in` (PointInputs or AverageInputs,
+// which come back here for nested nodes; the tree is acyclic and shallow, checked at load).
+template <class Inputs>
+Spectrum input_node_result(const InputNode& n, const Inputs& in) {
+  Spectrum r;
+  switch (n.kind) {
+    case InputNodeKind::Mix: {
+      float t = in.scalar(n.fac);
+      if (n.clamp_factor) t = saturate(t);
+      r = mix_blend(n.blend, t, in.color(n.a), in.color(n.b));
+      break;
+    }
+    case InputNodeKind::Math:
+      r = Spectrum(math_op(n.math, in.scalar(n.value_a), in.scalar(n.value_b)));
+      break;
+    case InputNodeKind::Invert: {
+      const Spectrum a = in.color(n.a);
+      r = lerp(a, Spectrum(1.0f) - a, in.scalar(n.fac));
+      break;
+    }
+  }
+  return n.clamp_result ? saturate(r) : r;
+}
+
+// A float socket fed by a node: Math results directly, colours by their luminance.
+template <class Inputs>
+float input_node_scalar(const InputNode& n, const Inputs& in) {
+  const Spectrum r = input_node_result(n, in);
+  return n.kind == InputNodeKind::Math ? r.x : luminance(r);
+}
+
 // Inputs at a hit point: texture lookups at the mapped UV.
 struct PointInputs {
   std::span<const Texture> textures;
+  std::span<const InputNode> nodes;
   Vec2f uv;
   bool front_facing;
 
@@ -52,33 +136,35 @@ struct PointInputs {
     return textures[size_t(t.image)].lookup(Vec2f(p.x, p.y), t.interpolation, t.extension);
   }
   Spectrum color(const ColorInput& in) const {
+    if (in.node >= 0) return input_node_result(nodes[size_t(in.node)], *this);
     return in.texture.image < 0 ? in.value : fetch(in.texture).rgb;
   }
   float scalar(const FloatInput& in) const {
+    if (in.node >= 0) return input_node_scalar(nodes[size_t(in.node)], *this);
     if (in.texture.image < 0) return in.value;
     const Rgba c = fetch(in.texture);
     return channel(c, in.channel);
   }
 };
 
-// Inputs averaged over the whole texture (for light power estimates).
+// Inputs averaged over the whole texture (for light power estimates; through input nodes this is
+// the node of the means, an estimate).
 struct AverageInputs {
   const std::vector<Rgba>* means;
+  std::span<const InputNode> nodes;
   bool front_facing = true;
 
   Spectrum color(const ColorInput& in) const {
+    if (in.node >= 0) return input_node_result(nodes[size_t(in.node)], *this);
     return in.texture.image < 0 ? in.value : (*means)[size_t(in.texture.image)].rgb;
   }
   float scalar(const FloatInput& in) const {
+    if (in.node >= 0) return input_node_scalar(nodes[size_t(in.node)], *this);
     if (in.texture.image < 0) return in.value;
     const Rgba& c = (*means)[size_t(in.texture.image)];
     return channel(c, in.channel);
   }
 };
-
-float clamp01(float x) {
-  return std::clamp(x, 0.0f, 1.0f);
-}
 
 // Adds the lobes of one BSDF node (weight w) to `out`.
 template <class Inputs>
@@ -86,7 +172,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
   Closure c;
   switch (n.kind) {
     case ShaderNodeKind::Diffuse: {
-      const float r = clamp01(in.scalar(n.roughness));
+      const float r = saturate(in.scalar(n.roughness));
       c.type = r > 0.0f ? ClosureType::OrenNayar : ClosureType::Lambert;
       c.alpha = r;
       c.weight = in.color(n.color) * w;
@@ -94,7 +180,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       return;
     }
     case ShaderNodeKind::Glossy: {
-      const float r = clamp01(in.scalar(n.roughness));
+      const float r = saturate(in.scalar(n.roughness));
       c.type = ClosureType::GGXReflection;
       c.fresnel = FresnelMode::None;
       c.alpha = r * r;
@@ -103,7 +189,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       return;
     }
     case ShaderNodeKind::Glass: {
-      const float r = clamp01(in.scalar(n.roughness));
+      const float r = saturate(in.scalar(n.roughness));
       const float ior = std::max(in.scalar(n.ior), 1e-5f);
       c.weight = in.color(n.color) * w;
       if (std::fabs(ior - 1.0f) < 1e-4f) {
@@ -153,7 +239,7 @@ Spectrum node_emission(const ShaderNode& n, float w, const Inputs& in) {
   if (n.kind == ShaderNodeKind::Emission) return in.color(n.color) * (in.scalar(n.strength) * w);
   if (n.kind == ShaderNodeKind::Principled)
     return in.color(n.emission) *
-           (in.scalar(n.emission_strength) * clamp01(in.scalar(n.alpha)) * w);
+           (in.scalar(n.emission_strength) * saturate(in.scalar(n.alpha)) * w);
   return Spectrum(0.0f);
 }
 
@@ -171,7 +257,7 @@ Spectrum walk(const std::vector<ShaderNode>& nodes, int32_t root, const Inputs& 
     const ShaderNode& n = nodes[size_t(e.node)];
     switch (n.kind) {
       case ShaderNodeKind::Mix: {
-        const float fac = clamp01(in.scalar(n.fac));
+        const float fac = saturate(in.scalar(n.fac));
         // Second child pushed first so the first child's lobes come first.
         stack[top++] = {n.b, e.weight * fac};
         stack[top++] = {n.a, e.weight * (1.0f - fac)};
@@ -206,7 +292,7 @@ bool has_texture(const FloatInput& f) {
 // Could a roughness input give a delta lobe (alpha = r^2 below kDeltaAlpha)?
 bool may_be_delta(const FloatInput& roughness) {
   if (has_texture(roughness)) return true;
-  const float r = clamp01(roughness.value);
+  const float r = saturate(roughness.value);
   return is_delta_alpha(r * r);
 }
 
@@ -230,6 +316,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
     return;
   }
   nodes_ = desc.nodes;
+  inputs_ = desc.inputs;
   root_ = desc.root;
   normal_map_ = desc.normal_map;
   const std::string where = "material '" + desc.name + "': ";
@@ -249,13 +336,28 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
   // --- Validate the reachable tree (indices, depth, cycles) and collect features. Recursion is
   // fine here: this runs once at scene load, the per-hit walk uses the explicit stack.
   std::vector<bool> uses_image(textures.size(), false);
-  auto note = [&](const auto& input) {
+  // An input: its texture, or its input node's operands (depth-limited: no cycles).
+  auto note_input = [&](auto&& self, const auto& input, int depth) -> void {
+    if (input.node >= 0) {
+      if (size_t(input.node) >= inputs_.size())
+        throw std::invalid_argument(where + "input node index " + std::to_string(input.node) +
+                                    " out of range (" + std::to_string(inputs_.size()) +
+                                    " input nodes)");
+      if (depth > kMaxTreeDepth)
+        throw std::invalid_argument(where + "input nodes nested deeper than " +
+                                    std::to_string(kMaxTreeDepth) + " (or cyclic)");
+      const InputNode& n = inputs_[size_t(input.node)];
+      for (const FloatInput* f : {&n.fac, &n.value_a, &n.value_b}) self(self, *f, depth + 1);
+      for (const ColorInput* c : {&n.a, &n.b}) self(self, *c, depth + 1);
+      return;
+    }
     check_lookup(input.texture);
     if (has_texture(input)) {
       features_ |= kFeatureTextures;
       uses_image[size_t(input.texture.image)] = true;
     }
   };
+  auto note = [&](const auto& input) { note_input(note_input, input, 0); };
   auto visit = [&](auto&& self, int32_t i, int depth) -> void {
     check_node(i);
     if (depth > kMaxTreeDepth)
@@ -340,7 +442,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
     means[i] = textures[i].mean();
   }
   if (features_ & kFeatureEmission)
-    average_emission_ = walk(nodes_, root_, AverageInputs{&means, true}, nullptr);
+    average_emission_ = walk(nodes_, root_, AverageInputs{&means, inputs_, true}, nullptr);
   cache_if_constant();
 }
 
@@ -351,7 +453,7 @@ void Material::cache_if_constant() {
     ClosureSet& set = constant_closures_[side];
     set.clear();
     set.add_emission(
-        walk(nodes_, root_, PointInputs{textures_, Vec2f(0.0f, 0.0f), side == 1}, &set));
+        walk(nodes_, root_, PointInputs{textures_, inputs_, Vec2f(0.0f, 0.0f), side == 1}, &set));
   }
   constant_ = true;
 }
@@ -362,17 +464,18 @@ void Material::evaluate(const ShadingContext& ctx, ClosureSet& out) const {
     return;
   }
   out.clear();
-  const Spectrum e = walk(nodes_, root_, PointInputs{textures_, ctx.uv, ctx.front_facing}, &out);
+  const Spectrum e =
+      walk(nodes_, root_, PointInputs{textures_, inputs_, ctx.uv, ctx.front_facing}, &out);
   out.add_emission(e);
 }
 
 Spectrum Material::emission(const ShadingContext& ctx) const {
   if (!(features_ & kFeatureEmission)) return Spectrum(0.0f);
-  return walk(nodes_, root_, PointInputs{textures_, ctx.uv, ctx.front_facing}, nullptr);
+  return walk(nodes_, root_, PointInputs{textures_, inputs_, ctx.uv, ctx.front_facing}, nullptr);
 }
 
 Vec3f Material::normal_map_direction(Vec2f uv) const {
-  const Spectrum c = PointInputs{textures_, uv, true}.color(normal_map_.color);
+  const Spectrum c = PointInputs{textures_, inputs_, uv, true}.color(normal_map_.color);
   const float s = normal_map_.strength;
   return {2.0f * (c.x - 0.5f) * s, 2.0f * (c.y - 0.5f) * s,
           1.0f + (2.0f * (c.z - 0.5f) - 1.0f) * std::clamp(s, 0.0f, 1.0f)};

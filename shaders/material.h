@@ -54,6 +54,7 @@ class Material {
   bool constant_ = false;
   ClosureSet constant_closures_[2];
   std::vector<ShaderNode> nodes_;
+  std::vector<InputNode> inputs_;  // colour / math nodes of the inputs (MaterialDesc::inputs)
   int32_t root_ = -1;
   std::span<const Texture> textures_;
   uint32_t features_ = 0;

@@ -1,6 +1,7 @@
 // Plain-data description of a material, translated from a Blender node tree by the add-on
 // (or built directly by tests). A material is a small expression tree of shader nodes; inputs are
-// constants or image-texture lookups. shaders/ compiles it into closures at each hit point.
+// constants, image-texture lookups, or small expression trees of colour / math nodes over them
+// (InputNode). shaders/ compiles it into closures at each hit point.
 #pragma once
 
 #include <cstdint>
@@ -25,6 +26,7 @@ struct ColorInput {
   explicit ColorInput(Spectrum v) : value(v) {}
   Spectrum value{0.8f, 0.8f, 0.8f};
   TextureLookup texture;  // when texture.image >= 0, the texture's RGB replaces value
+  int32_t node = -1;      // when >= 0: MaterialDesc::inputs[node]'s result replaces both
 };
 
 struct FloatInput {
@@ -33,6 +35,40 @@ struct FloatInput {
   float value = 0.0f;
   TextureLookup texture;  // when texture.image >= 0: the texture's channel below replaces value
   enum class Channel : uint8_t { Luminance, Red, Alpha } channel = Channel::Luminance;
+  // When >= 0: MaterialDesc::inputs[node]'s result replaces value and texture (a colour result is
+  // read as its luminance, as Blender converts a colour socket to a float one).
+  int32_t node = -1;
+};
+
+// Colour and math nodes between textures / constants and shader inputs, with Cycles' semantics
+// (kernel/svm/mix.h, math_util.h, invert.h). Results are colours (a Math result is grey).
+enum class InputNodeKind : uint8_t {
+  Mix,     // Blender's Mix (colour) / MixRGB: blend of a and b by fac, `blend` below
+  Math,    // Blender's Math on value_a, value_b: `math` below
+  Invert,  // mix(a, 1 - a, fac)
+};
+enum class MixBlend : uint8_t {
+  Mix,
+  Add,
+  Multiply,
+  Subtract,
+  Screen,
+  Divide,
+  Difference,
+  Darken,
+  Lighten,
+};
+enum class MathOp : uint8_t { Add, Subtract, Multiply, Divide, Power, Minimum, Maximum };
+
+struct InputNode {
+  InputNodeKind kind = InputNodeKind::Mix;
+  MixBlend blend = MixBlend::Mix;
+  MathOp math = MathOp::Add;
+  bool clamp_factor = true;     // Mix: fac clamped to [0, 1] first
+  bool clamp_result = false;    // result clamped to [0, 1] per channel
+  FloatInput fac{0.5f};         // Mix, Invert
+  ColorInput a, b;              // Mix (a, b), Invert (a)
+  FloatInput value_a, value_b;  // Math
 };
 
 enum class ShaderNodeKind : uint8_t {
@@ -81,9 +117,10 @@ struct NormalMapDesc {
 struct MaterialDesc {
   std::string name;
   std::vector<ShaderNode> nodes;
-  int32_t root = -1;         // -1: Blender's default grey diffuse (0.8)
-  NormalMapDesc normal_map;  // needs the meshes' corner tangents (Mesh::corner_tangents)
-  float pass_index = 0.0f;   // Blender's Material > Settings > Pass Index (the IndexMA pass)
+  int32_t root = -1;              // -1: Blender's default grey diffuse (0.8)
+  NormalMapDesc normal_map;       // needs the meshes' corner tangents (Mesh::corner_tangents)
+  std::vector<InputNode> inputs;  // referenced by ColorInput::node / FloatInput::node
+  float pass_index = 0.0f;        // Blender's Material > Settings > Pass Index (the IndexMA pass)
 };
 
 // Image pixels in scene-linear RGBA float (the loader converts from the file's colour space via

@@ -9,12 +9,6 @@ namespace {
 // Cycles drops closures lighter than this (CLOSURE_WEIGHT_CUTOFF).
 constexpr float kWeightCutoff = 1e-5f;
 
-float saturate(float x) {
-  return std::clamp(x, 0.0f, 1.0f);
-}
-Spectrum saturate(Spectrum c) {
-  return {saturate(c.x), saturate(c.y), saturate(c.z)};
-}
 }  // namespace
 
 void add_principled_closures(const PrincipledParams& p, float mix_weight, ClosureSet& out) {

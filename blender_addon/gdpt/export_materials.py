@@ -18,6 +18,11 @@ _SHADERS = {
     'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER',
 }
 _GGX_LIKE = {'GGX', 'SHARP'}
+# Colour / math nodes between inputs and shaders, and their modes the core models.
+_INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT'}
+_BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
+           'LIGHTEN'}
+_MATH_OPS = {'ADD', 'SUBTRACT', 'MULTIPLY', 'DIVIDE', 'POWER', 'MINIMUM', 'MAXIMUM'}
 
 
 def _matrix12(m):
@@ -32,6 +37,8 @@ class _Translator:
         self.warned = set()
         self.nodes = []
         self.normal_map = None  # (Normal Map node, its dict) of the BSDFs' Normal inputs
+        self.inputs = []  # colour / math input nodes (MaterialDesc::inputs)
+        self.input_index = {}  # node name -> index in self.inputs
 
     # --- reporting ---------------------------------------------------------------------------
 
@@ -205,8 +212,11 @@ class _Translator:
             d["value"] = (v, v, v)
         elif node.type == 'TEX_IMAGE':
             self._texture(node, d)
+        elif node.type in _INPUT_NODES and self._input_node(node) is not None:
+            d["node"] = self._input_node(node)
         else:
-            self.warn(node, "input node")
+            if node.type not in _INPUT_NODES:  # those warned about their mode
+                self.warn(node, "input node")
             passthrough = self._passthrough_input(node, out)
             if passthrough is not None and passthrough.type in {'RGBA', 'VALUE', 'VECTOR'}:
                 return self.color(passthrough)
@@ -227,12 +237,49 @@ class _Translator:
         elif node.type == 'TEX_IMAGE':
             self._texture(node, d)
             d["channel"] = 'ALPHA' if out.name == "Alpha" else 'LUMINANCE'
+        elif node.type in _INPUT_NODES and self._input_node(node) is not None:
+            d["node"] = self._input_node(node)
         else:
-            self.warn(node, "input node")
+            if node.type not in _INPUT_NODES:  # those warned about their mode
+                self.warn(node, "input node")
             passthrough = self._passthrough_input(node, out)
             if passthrough is not None and passthrough.type in {'RGBA', 'VALUE'}:
                 return self.value(passthrough)
         return d
+
+    def _input_node(self, node):
+        """Index of a Mix / MixRGB / Math / Invert node in self.inputs (translated once), or
+        None (with a warning) for a mode Gradient PT does not model."""
+        if node.name in self.input_index:
+            return self.input_index[node.name]
+        d = None
+        if node.type == 'MIX_RGB' and node.blend_type in _BLENDS:
+            d = {"kind": "MIX", "blend": node.blend_type, "clamp_result": bool(node.use_clamp),
+                 "fac": self.value(node.inputs["Fac"]), "a": self.color(node.inputs["Color1"]),
+                 "b": self.color(node.inputs["Color2"])}
+        elif node.type == 'MIX' and (node.data_type == 'RGBA' and node.blend_type in _BLENDS or
+                                     node.data_type == 'FLOAT'):
+            # Blender 3.4's Mix node: inputs 0 Factor (float), 2 / 3 A / B (float), 6 / 7 A / B
+            # (colour). A float mix is a plain interpolation, linear in the operands, so it is
+            # done on colours and read as luminance by the float socket downstream.
+            rgba = node.data_type == 'RGBA'
+            a, b = (node.inputs[6], node.inputs[7]) if rgba else (node.inputs[2], node.inputs[3])
+            d = {"kind": "MIX", "blend": node.blend_type if rgba else 'MIX',
+                 "clamp_factor": bool(node.clamp_factor), "clamp_result": bool(node.clamp_result),
+                 "fac": self.value(node.inputs[0]), "a": self.color(a), "b": self.color(b)}
+        elif node.type == 'MATH' and node.operation in _MATH_OPS:
+            d = {"kind": "MATH", "op": node.operation, "clamp_result": bool(node.use_clamp),
+                 "value_a": self.value(node.inputs[0]), "value_b": self.value(node.inputs[1])}
+        elif node.type == 'INVERT':
+            d = {"kind": "INVERT", "fac": self.value(node.inputs["Fac"]),
+                 "a": self.color(node.inputs["Color"])}
+        if d is None:
+            mode = getattr(node, "blend_type", None) or getattr(node, "operation", None)
+            self.warn(node, f"mode {mode} of the input node")
+            return None
+        self.inputs.append(d)
+        self.input_index[node.name] = len(self.inputs) - 1
+        return self.input_index[node.name]
 
     @staticmethod
     def _default_rgb(socket):
@@ -331,7 +378,7 @@ def _translate_surface(material, images, warn):
     if root < 0:
         # Nothing connected: Cycles renders such a surface black. A black diffuse does the same.
         root = t._add({"kind": "DIFFUSE", "color": {"value": (0.0, 0.0, 0.0)}})
-    d = {"name": material.name, "nodes": t.nodes, "root": root}
+    d = {"name": material.name, "nodes": t.nodes, "root": root, "inputs": t.inputs}
     if t.normal_map is not None:
         d["normal_map"] = t.normal_map[1]
     return d

@@ -78,6 +78,7 @@ void read_color(const py::dict& node, const char* key, ColorInput& out) {
   const auto d = node[key].cast<py::dict>();
   get_vec3(d, "value", out.value);
   read_lookup(d, out.texture);
+  get(d, "node", out.node);
 }
 
 void read_float(const py::dict& node, const char* key, FloatInput& out) {
@@ -85,6 +86,7 @@ void read_float(const py::dict& node, const char* key, FloatInput& out) {
   const auto d = node[key].cast<py::dict>();
   get(d, "value", out.value);
   read_lookup(d, out.texture);
+  get(d, "node", out.node);
   const std::string channel = get_str(d, "channel", "LUMINANCE");
   if (channel == "LUMINANCE")
     out.channel = FloatInput::Channel::Luminance;
@@ -94,6 +96,53 @@ void read_float(const py::dict& node, const char* key, FloatInput& out) {
     out.channel = FloatInput::Channel::Alpha;
   else
     bad_enum("float channel", channel);
+}
+
+// {"kind": "MIX" | "MATH" | "INVERT", "blend": Blender's blend_type, "op": Blender's Math
+// operation, "clamp_factor", "clamp_result", "fac", "a", "b" (colour inputs), "value_a",
+// "value_b" (float inputs)}.
+InputNode read_input_node(const py::dict& d) {
+  InputNode n;
+  const std::string kind = get_str(d, "kind", "MIX");
+  if (kind == "MIX")
+    n.kind = InputNodeKind::Mix;
+  else if (kind == "MATH")
+    n.kind = InputNodeKind::Math;
+  else if (kind == "INVERT")
+    n.kind = InputNodeKind::Invert;
+  else
+    bad_enum("input node kind", kind);
+  const std::string blend = get_str(d, "blend", "MIX");
+  static const std::pair<const char*, MixBlend> kBlends[] = {{"MIX", MixBlend::Mix},
+                                                             {"ADD", MixBlend::Add},
+                                                             {"MULTIPLY", MixBlend::Multiply},
+                                                             {"SUBTRACT", MixBlend::Subtract},
+                                                             {"SCREEN", MixBlend::Screen},
+                                                             {"DIVIDE", MixBlend::Divide},
+                                                             {"DIFFERENCE", MixBlend::Difference},
+                                                             {"DARKEN", MixBlend::Darken},
+                                                             {"LIGHTEN", MixBlend::Lighten}};
+  bool found = false;
+  for (const auto& [name, value] : kBlends)
+    if (blend == name) n.blend = value, found = true;
+  if (!found) bad_enum("mix blend", blend);
+  const std::string op = get_str(d, "op", "ADD");
+  static const std::pair<const char*, MathOp> kOps[] = {
+      {"ADD", MathOp::Add},        {"SUBTRACT", MathOp::Subtract}, {"MULTIPLY", MathOp::Multiply},
+      {"DIVIDE", MathOp::Divide},  {"POWER", MathOp::Power},       {"MINIMUM", MathOp::Minimum},
+      {"MAXIMUM", MathOp::Maximum}};
+  found = false;
+  for (const auto& [name, value] : kOps)
+    if (op == name) n.math = value, found = true;
+  if (!found) bad_enum("math operation", op);
+  get(d, "clamp_factor", n.clamp_factor);
+  get(d, "clamp_result", n.clamp_result);
+  read_float(d, "fac", n.fac);
+  read_color(d, "a", n.a);
+  read_color(d, "b", n.b);
+  read_float(d, "value_a", n.value_a);
+  read_float(d, "value_b", n.value_b);
+  return n;
 }
 
 ShaderNodeKind to_kind(const std::string& kind) {
@@ -512,6 +561,9 @@ int SceneBuilder::add_material(const py::dict& material) {
       desc.nodes.push_back(node);
     }
   }
+  if (material.contains("inputs"))
+    for (const auto& item : material["inputs"].cast<py::list>())
+      desc.inputs.push_back(read_input_node(item.cast<py::dict>()));
   // Normal Map node (tangent space): {"color": colour input, "strength": float}.
   if (material.contains("normal_map")) {
     const auto d = material["normal_map"].cast<py::dict>();
@@ -537,6 +589,11 @@ int SceneBuilder::add_material(const py::dict& material) {
   }
   if (desc.normal_map.color.texture.image >= int32_t(scene_.images.size()))
     throw std::invalid_argument("material '" + desc.name + "': image index out of range");
+  for (const InputNode& node : desc.inputs)
+    for (const TextureLookup* t : {&node.fac.texture, &node.a.texture, &node.b.texture,
+                                   &node.value_a.texture, &node.value_b.texture})
+      if (t->image >= int32_t(scene_.images.size()))
+        throw std::invalid_argument("material '" + desc.name + "': image index out of range");
   scene_.materials.push_back(std::move(desc));
   return int(scene_.materials.size()) - 1;
 }

@@ -108,6 +108,13 @@ constexpr bool is_finite(Vec3f v) {
 constexpr Vec3f lerp(Vec3f a, Vec3f b, float t) {
   return a * (1.0f - t) + b * t;
 }
+// Clamped to [0, 1] (per component): Cycles' saturatef / saturate.
+constexpr float saturate(float x) {
+  return x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x);
+}
+constexpr Vec3f saturate(Vec3f v) {
+  return {saturate(v.x), saturate(v.y), saturate(v.z)};
+}
 
 // Colour: linear RGB in the scene-linear space of the Blender file (Rec.709 primaries by default).
 using Spectrum = Vec3f;

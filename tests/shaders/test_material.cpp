@@ -260,6 +260,113 @@ TEST(Material, AverageEmissionUsesTextureMeans) {
   expect_spectrum(s.emission(), Spectrum(0, 0, 4));
 }
 
+// Colour / math input nodes with Cycles' formulas (svm_mix, svm_math, invert), on constants
+// and on a texture, nested, read by colour and float sockets.
+TEST(Material, InputNodesFollowCycles) {
+  const Spectrum a(0.2f, 0.5f, 0.8f), b(0.6f, 0.4f, 0.0f);
+  auto diffuse_colour = [](const MaterialDesc& d, Vec2f uv = {0.25f, 0.25f},
+                           std::span<const Texture> textures = {}) {
+    const Material m(d, textures);
+    const ClosureSet s = eval(m, uv);
+    return s.count() ? s[0].weight : Spectrum(-1.0f);
+  };
+  auto mix = [&](MixBlend blend, float fac) {
+    MaterialDesc d;
+    d.nodes.push_back(node(ShaderNodeKind::Diffuse));
+    d.nodes[0].color.node = 0;
+    d.root = 0;
+    InputNode n;
+    n.kind = InputNodeKind::Mix;
+    n.blend = blend;
+    n.fac = FloatInput(fac);
+    n.a = ColorInput(a);
+    n.b = ColorInput(b);
+    d.inputs.push_back(n);
+    return diffuse_colour(d);
+  };
+  const float t = 0.25f;
+  expect_spectrum(mix(MixBlend::Mix, t), a * 0.75f + b * 0.25f);
+  expect_spectrum(mix(MixBlend::Add, t), a + b * t);
+  expect_spectrum(mix(MixBlend::Multiply, t), a * (Spectrum(0.75f) + b * t));
+  expect_spectrum(mix(MixBlend::Subtract, t), a - b * t);
+  expect_spectrum(
+      mix(MixBlend::Screen, t),
+      Spectrum(1.0f) - (Spectrum(0.75f) + (Spectrum(1.0f) - b) * t) * (Spectrum(1.0f) - a));
+  // Divide: a channel divided by 0 keeps a.
+  expect_spectrum(mix(MixBlend::Divide, t),
+                  Spectrum(0.75f * 0.2f + t * 0.2f / 0.6f, 0.75f * 0.5f + t * 0.5f / 0.4f, 0.8f));
+  expect_spectrum(mix(MixBlend::Difference, t), a * 0.75f + Spectrum(0.4f, 0.1f, 0.8f) * t);
+  expect_spectrum(mix(MixBlend::Darken, t), a * 0.75f + Spectrum(0.2f, 0.4f, 0.0f) * t);
+  expect_spectrum(mix(MixBlend::Lighten, t), a * 0.75f + Spectrum(0.6f, 0.5f, 0.8f) * t);
+  expect_spectrum(mix(MixBlend::Mix, 1.7f), b);  // factor clamped by default
+
+  // Roughness from Math(op, x, y), clamped to [0, 1] only when asked; colour from Invert.
+  auto math = [&](MathOp op, float x, float y, bool clamp) {
+    MaterialDesc d;
+    d.nodes.push_back(node(ShaderNodeKind::Diffuse));
+    d.nodes[0].roughness.node = 0;
+    d.root = 0;
+    InputNode n;
+    n.kind = InputNodeKind::Math;
+    n.math = op;
+    n.clamp_result = clamp;
+    n.value_a = FloatInput(x);
+    n.value_b = FloatInput(y);
+    d.inputs.push_back(n);
+    // Diffuse roughness r > 0 gives Oren-Nayar with sigma r (clamped to [0, 1] by the node).
+    const ClosureSet s = eval(Material(d, {}));
+    return s[0].alpha;
+  };
+  EXPECT_FLOAT_EQ(math(MathOp::Add, 0.2f, 0.3f, false), 0.5f);
+  EXPECT_FLOAT_EQ(math(MathOp::Subtract, 0.9f, 0.3f, false), 0.6f);
+  EXPECT_FLOAT_EQ(math(MathOp::Multiply, 0.5f, 0.6f, false), 0.3f);
+  EXPECT_FLOAT_EQ(math(MathOp::Divide, 0.3f, 0.6f, false), 0.5f);
+  EXPECT_FLOAT_EQ(math(MathOp::Divide, 0.3f, 0.0f, false), 0.0f);  // safe division
+  EXPECT_FLOAT_EQ(math(MathOp::Power, 0.25f, 0.5f, false), 0.5f);
+  EXPECT_FLOAT_EQ(math(MathOp::Minimum, 0.25f, 0.5f, false), 0.25f);
+  EXPECT_FLOAT_EQ(math(MathOp::Maximum, 0.25f, 0.5f, false), 0.5f);
+  EXPECT_FLOAT_EQ(math(MathOp::Subtract, 0.2f, 0.5f, true), 0.0f);
+
+  // Nested, on a texture: colour = Multiply(texture, Invert(0.3 grey, fac from Math 0.5 * 2)).
+  ImageDesc img;
+  img.width = img.height = 1;
+  img.rgba = {0.4f, 0.6f, 0.8f, 1.0f};
+  const std::vector<Texture> textures{Texture(img)};
+  MaterialDesc d;
+  d.nodes.push_back(node(ShaderNodeKind::Diffuse));
+  d.nodes[0].color.node = 0;
+  d.root = 0;
+  InputNode mul;
+  mul.kind = InputNodeKind::Mix;
+  mul.blend = MixBlend::Multiply;
+  mul.fac = FloatInput(1.0f);
+  mul.a.texture.image = 0;
+  mul.b.node = 1;
+  InputNode inv;
+  inv.kind = InputNodeKind::Invert;
+  inv.a = ColorInput(Spectrum(0.3f));
+  inv.fac.node = 2;
+  InputNode half;
+  half.kind = InputNodeKind::Math;
+  half.math = MathOp::Multiply;
+  half.value_a = FloatInput(0.5f);
+  half.value_b = FloatInput(2.0f);
+  d.inputs = {mul, inv, half};
+  const Material m(d, textures);
+  EXPECT_TRUE(m.features() & kFeatureTextures);
+  expect_spectrum(diffuse_colour(d, {0.5f, 0.5f}, textures), Spectrum(0.4f, 0.6f, 0.8f) * 0.7f);
+  // A float socket reads a colour result as its luminance.
+  d.nodes[0].color = ColorInput(Spectrum(1.0f));
+  d.nodes[0].roughness.node = 0;
+  const ClosureSet s = eval(Material(d, textures), {0.5f, 0.5f});
+  EXPECT_NEAR(s[0].alpha, luminance(Spectrum(0.4f, 0.6f, 0.8f) * 0.7f), 1e-6f);
+  // Malformed: an index out of range, a cycle.
+  d.inputs[1].fac.node = 7;
+  EXPECT_THROW(Material(d, textures), std::invalid_argument);
+  d.inputs[1].fac.node = 1;
+  EXPECT_THROW(Material(d, textures), std::invalid_argument);
+}
+
 TEST(Material, MalformedTreesThrow) {
   MaterialDesc d;
   d.name = "broken";
