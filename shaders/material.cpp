@@ -113,6 +113,19 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       r = lerp(a, Spectrum(1.0f) - a, in.scalar(n.fac));
       break;
     }
+    case InputNodeKind::Ramp: {
+      // Cycles' rgb_ramp_lookup without extrapolation.
+      const int size = int(n.ramp.size() / 4);
+      const float f = saturate(in.scalar(n.fac)) * float(size - 1);
+      const int i = std::clamp(int(f), 0, size - 1);
+      const float t = f - float(i);
+      const float* e = &n.ramp[4 * size_t(i)];
+      float v[4] = {e[0], e[1], e[2], e[3]};
+      if (n.ramp_interpolate && t > 0.0f)
+        for (int k = 0; k < 4; ++k) v[k] = (1.0f - t) * v[k] + t * e[4 + k];
+      r = n.ramp_alpha ? Spectrum(v[3]) : Spectrum(v[0], v[1], v[2]);
+      break;
+    }
   }
   return n.clamp_result ? saturate(r) : r;
 }
@@ -121,7 +134,9 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
 template <class Inputs>
 float input_node_scalar(const InputNode& n, const Inputs& in) {
   const Spectrum r = input_node_result(n, in);
-  return n.kind == InputNodeKind::Math ? r.x : luminance(r);
+  const bool grey =
+      n.kind == InputNodeKind::Math || (n.kind == InputNodeKind::Ramp && n.ramp_alpha);
+  return grey ? r.x : luminance(r);
 }
 
 // Inputs at a hit point: texture lookups at the mapped UV.
@@ -347,6 +362,10 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         throw std::invalid_argument(where + "input nodes nested deeper than " +
                                     std::to_string(kMaxTreeDepth) + " (or cyclic)");
       const InputNode& n = inputs_[size_t(input.node)];
+      if (n.kind == InputNodeKind::Ramp && (n.ramp.size() < 8 || n.ramp.size() % 4 != 0))
+        throw std::invalid_argument(where + "colour ramp table of " +
+                                    std::to_string(n.ramp.size()) +
+                                    " floats (expected 4 per entry, at least 2 entries)");
       for (const FloatInput* f : {&n.fac, &n.value_a, &n.value_b}) self(self, *f, depth + 1);
       for (const ColorInput* c : {&n.a, &n.b}) self(self, *c, depth + 1);
       return;

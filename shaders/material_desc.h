@@ -46,6 +46,7 @@ enum class InputNodeKind : uint8_t {
   Mix,     // Blender's Mix (colour) / MixRGB: blend of a and b by fac, `blend` below
   Math,    // Blender's Math on value_a, value_b: `math` below
   Invert,  // mix(a, 1 - a, fac)
+  Ramp,    // Blender's Color Ramp read at fac: `ramp` table, Cycles' lookup (rgb_ramp_lookup)
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -69,6 +70,12 @@ struct InputNode {
   FloatInput fac{0.5f};         // Mix, Invert
   ColorInput a, b;              // Mix (a, b), Invert (a)
   FloatInput value_a, value_b;  // Math
+  // Ramp: RGBA at fac = i / (n - 1), i < n (Blender's ColorRamp.evaluate, as Cycles bakes it),
+  // interpolated linearly between entries unless the ramp is Constant; the result is the colour,
+  // or the alpha as grey for the node's Alpha output.
+  std::vector<float> ramp;  // 4 n floats
+  bool ramp_interpolate = true;
+  bool ramp_alpha = false;
 };
 
 enum class ShaderNodeKind : uint8_t {

@@ -19,7 +19,8 @@ _SHADERS = {
 }
 _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
-_INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT'}
+_INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB'}
+_RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
 _MATH_OPS = {'ADD', 'SUBTRACT', 'MULTIPLY', 'DIVIDE', 'POWER', 'MINIMUM', 'MAXIMUM'}
@@ -212,8 +213,8 @@ class _Translator:
             d["value"] = (v, v, v)
         elif node.type == 'TEX_IMAGE':
             self._texture(node, d)
-        elif node.type in _INPUT_NODES and self._input_node(node) is not None:
-            d["node"] = self._input_node(node)
+        elif node.type in _INPUT_NODES and self._input_node(node, out) is not None:
+            d["node"] = self._input_node(node, out)
         else:
             if node.type not in _INPUT_NODES:  # those warned about their mode
                 self.warn(node, "input node")
@@ -237,8 +238,8 @@ class _Translator:
         elif node.type == 'TEX_IMAGE':
             self._texture(node, d)
             d["channel"] = 'ALPHA' if out.name == "Alpha" else 'LUMINANCE'
-        elif node.type in _INPUT_NODES and self._input_node(node) is not None:
-            d["node"] = self._input_node(node)
+        elif node.type in _INPUT_NODES and self._input_node(node, out) is not None:
+            d["node"] = self._input_node(node, out)
         else:
             if node.type not in _INPUT_NODES:  # those warned about their mode
                 self.warn(node, "input node")
@@ -247,11 +248,13 @@ class _Translator:
                 return self.value(passthrough)
         return d
 
-    def _input_node(self, node):
-        """Index of a Mix / MixRGB / Math / Invert node in self.inputs (translated once), or
-        None (with a warning) for a mode Gradient PT does not model."""
-        if node.name in self.input_index:
-            return self.input_index[node.name]
+    def _input_node(self, node, out):
+        """Index of a Mix / MixRGB / Math / Invert / Color Ramp node's output `out` in
+        self.inputs (translated once), or None (with a warning) for a mode Gradient PT does not
+        model."""
+        key = (node.name, out.name if node.type == 'VALTORGB' else "")
+        if key in self.input_index:
+            return self.input_index[key]
         d = None
         if node.type == 'MIX_RGB' and node.blend_type in _BLENDS:
             d = {"kind": "MIX", "blend": node.blend_type, "clamp_result": bool(node.use_clamp),
@@ -273,13 +276,22 @@ class _Translator:
         elif node.type == 'INVERT':
             d = {"kind": "INVERT", "fac": self.value(node.inputs["Fac"]),
                  "a": self.color(node.inputs["Color"])}
+        elif node.type == 'VALTORGB':
+            # The table Cycles bakes from the ramp: RAMP_TABLE_SIZE entries of evaluate().
+            ramp = node.color_ramp
+            table = []
+            for i in range(_RAMP_TABLE_SIZE):
+                table.extend(ramp.evaluate(i / (_RAMP_TABLE_SIZE - 1)))
+            d = {"kind": "RAMP", "fac": self.value(node.inputs["Fac"]), "ramp": table,
+                 "ramp_interpolate": ramp.interpolation != 'CONSTANT',
+                 "ramp_alpha": out.name == "Alpha"}
         if d is None:
             mode = getattr(node, "blend_type", None) or getattr(node, "operation", None)
-            self.warn(node, f"mode {mode} of the input node")
+            self.warn(node, f"mode {mode} of the input node" if mode else "input node")
             return None
         self.inputs.append(d)
-        self.input_index[node.name] = len(self.inputs) - 1
-        return self.input_index[node.name]
+        self.input_index[key] = len(self.inputs) - 1
+        return self.input_index[key]
 
     @staticmethod
     def _default_rgb(socket):

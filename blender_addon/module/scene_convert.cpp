@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include <pybind11/stl.h>  // lists to std::vector (colour ramp tables)
+
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
@@ -110,6 +112,8 @@ InputNode read_input_node(const py::dict& d) {
     n.kind = InputNodeKind::Math;
   else if (kind == "INVERT")
     n.kind = InputNodeKind::Invert;
+  else if (kind == "RAMP")
+    n.kind = InputNodeKind::Ramp;
   else
     bad_enum("input node kind", kind);
   const std::string blend = get_str(d, "blend", "MIX");
@@ -142,6 +146,9 @@ InputNode read_input_node(const py::dict& d) {
   read_color(d, "b", n.b);
   read_float(d, "value_a", n.value_a);
   read_float(d, "value_b", n.value_b);
+  if (d.contains("ramp")) n.ramp = d["ramp"].cast<std::vector<float>>();
+  get(d, "ramp_interpolate", n.ramp_interpolate);
+  get(d, "ramp_alpha", n.ramp_alpha);
   return n;
 }
 

@@ -360,6 +360,32 @@ TEST(Material, InputNodesFollowCycles) {
   d.nodes[0].roughness.node = 0;
   const ClosureSet s = eval(Material(d, textures), {0.5f, 0.5f});
   EXPECT_NEAR(s[0].alpha, luminance(Spectrum(0.4f, 0.6f, 0.8f) * 0.7f), 1e-6f);
+  // Color ramp: three entries (0, 0.5, 1); linear between them, or the lower one (Constant);
+  // fac clamped; the Alpha output as a float.
+  {
+    MaterialDesc r;
+    r.nodes.push_back(node(ShaderNodeKind::Diffuse));
+    r.nodes[0].color.node = 0;
+    r.nodes[0].roughness.node = 1;
+    r.root = 0;
+    InputNode ramp;
+    ramp.kind = InputNodeKind::Ramp;
+    ramp.ramp = {1, 0, 0, 0.2f, 0, 1, 0, 0.4f, 0, 0, 1, 0.6f};
+    ramp.fac = FloatInput(0.75f);
+    InputNode alpha = ramp;
+    alpha.ramp_alpha = true;
+    r.inputs = {ramp, alpha};
+    ClosureSet s = eval(Material(r, {}));
+    expect_spectrum(s[0].weight, Spectrum(0.0f, 0.5f, 0.5f));
+    EXPECT_FLOAT_EQ(s[0].alpha, 0.5f);  // Oren-Nayar sigma = the ramp's alpha at 0.75
+    r.inputs[0].ramp_interpolate = false;
+    r.inputs[1].fac = FloatInput(7.0f);  // clamped to 1: the last entry
+    s = eval(Material(r, {}));
+    expect_spectrum(s[0].weight, Spectrum(0.0f, 1.0f, 0.0f));
+    EXPECT_FLOAT_EQ(s[0].alpha, 0.6f);
+    r.inputs[0].ramp.resize(6);  // not whole entries
+    EXPECT_THROW(Material(r, {}), std::invalid_argument);
+  }
   // Malformed: an index out of range, a cycle.
   d.inputs[1].fac.node = 7;
   EXPECT_THROW(Material(d, textures), std::invalid_argument);
