@@ -126,6 +126,30 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       r = n.ramp_alpha ? Spectrum(v[3]) : Spectrum(v[0], v[1], v[2]);
       break;
     }
+    case InputNodeKind::Separate:
+      r = Spectrum(in.color(n.a)[std::min<int>(n.channel, 2)]);
+      break;
+    case InputNodeKind::Combine:
+      r = Spectrum(in.scalar(n.value_a), in.scalar(n.value_b), in.scalar(n.value_c));
+      break;
+    case InputNodeKind::Gamma: {
+      const float g = in.scalar(n.value_a);
+      r = in.color(n.a);
+      if (g == 0.0f) {
+        r = Spectrum(1.0f);
+      } else {
+        for (int k = 0; k < 3; ++k)
+          if (r[k] > 0.0f) r[k] = std::pow(r[k], g);
+      }
+      break;
+    }
+    case InputNodeKind::BrightContrast: {
+      const float contrast = in.scalar(n.value_b);
+      const float a = 1.0f + contrast, b = in.scalar(n.value_a) - contrast * 0.5f;
+      r = in.color(n.a);
+      for (int k = 0; k < 3; ++k) r[k] = std::max(a * r[k] + b, 0.0f);
+      break;
+    }
   }
   return n.clamp_result ? saturate(r) : r;
 }
@@ -134,8 +158,8 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
 template <class Inputs>
 float input_node_scalar(const InputNode& n, const Inputs& in) {
   const Spectrum r = input_node_result(n, in);
-  const bool grey =
-      n.kind == InputNodeKind::Math || (n.kind == InputNodeKind::Ramp && n.ramp_alpha);
+  const bool grey = n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
+                    (n.kind == InputNodeKind::Ramp && n.ramp_alpha);
   return grey ? r.x : luminance(r);
 }
 
@@ -366,7 +390,8 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         throw std::invalid_argument(where + "colour ramp table of " +
                                     std::to_string(n.ramp.size()) +
                                     " floats (expected 4 per entry, at least 2 entries)");
-      for (const FloatInput* f : {&n.fac, &n.value_a, &n.value_b}) self(self, *f, depth + 1);
+      for (const FloatInput* f : {&n.fac, &n.value_a, &n.value_b, &n.value_c})
+        self(self, *f, depth + 1);
       for (const ColorInput* c : {&n.a, &n.b}) self(self, *c, depth + 1);
       return;
     }

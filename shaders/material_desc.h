@@ -43,10 +43,14 @@ struct FloatInput {
 // Colour and math nodes between textures / constants and shader inputs, with Cycles' semantics
 // (kernel/svm/mix.h, math_util.h, invert.h). Results are colours (a Math result is grey).
 enum class InputNodeKind : uint8_t {
-  Mix,     // Blender's Mix (colour) / MixRGB: blend of a and b by fac, `blend` below
-  Math,    // Blender's Math on value_a, value_b: `math` below
-  Invert,  // mix(a, 1 - a, fac)
-  Ramp,    // Blender's Color Ramp read at fac: `ramp` table, Cycles' lookup (rgb_ramp_lookup)
+  Mix,       // Blender's Mix (colour) / MixRGB: blend of a and b by fac, `blend` below
+  Math,      // Blender's Math on value_a, value_b: `math` below
+  Invert,    // mix(a, 1 - a, fac)
+  Ramp,      // Blender's Color Ramp read at fac: `ramp` table, Cycles' lookup (rgb_ramp_lookup)
+  Separate,  // one channel (`channel`) of a, as grey (Separate RGB / Separate Color in RGB)
+  Combine,   // (value_a, value_b, value_c) (Combine RGB / Combine Color in RGB)
+  Gamma,     // a^value_a per positive channel; 1 for gamma 0 (svm_math_gamma_color)
+  BrightContrast,  // max((1 + c) a + b - c / 2, 0), b = value_a, c = value_b
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -69,7 +73,9 @@ struct InputNode {
   bool clamp_result = false;    // result clamped to [0, 1] per channel
   FloatInput fac{0.5f};         // Mix, Invert
   ColorInput a, b;              // Mix (a, b), Invert (a)
-  FloatInput value_a, value_b;  // Math
+  FloatInput value_a, value_b;  // Math, Gamma (a), Bright / Contrast (a, b), Combine (a, b)
+  FloatInput value_c;           // Combine
+  uint8_t channel = 0;          // Separate: 0 red, 1 green, 2 blue
   // Ramp: RGBA at fac = i / (n - 1), i < n (Blender's ColorRamp.evaluate, as Cycles bakes it),
   // interpolated linearly between entries unless the ramp is Constant; the result is the colour,
   // or the alpha as grey for the node's Alpha output.

@@ -19,7 +19,8 @@ _SHADERS = {
 }
 _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
-_INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB'}
+_INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
+                'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -225,7 +226,12 @@ class _Translator:
         return d
 
     def value(self, socket):
-        d = {"value": float(socket.default_value)}
+        # A colour socket (an unsupported node's pass-through input) reads as its luminance.
+        v = socket.default_value
+        if hasattr(v, "__len__"):
+            r, g, b = tuple(v)[:3]
+            v = 0.2126 * r + 0.7152 * g + 0.0722 * b
+        d = {"value": float(v)}
         out = self._source(socket)
         if out is None:
             return d
@@ -252,7 +258,8 @@ class _Translator:
         """Index of a Mix / MixRGB / Math / Invert / Color Ramp node's output `out` in
         self.inputs (translated once), or None (with a warning) for a mode Gradient PT does not
         model."""
-        key = (node.name, out.name if node.type == 'VALTORGB' else "")
+        per_output = node.type in {'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR'}
+        key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
         d = None
@@ -285,8 +292,22 @@ class _Translator:
             d = {"kind": "RAMP", "fac": self.value(node.inputs["Fac"]), "ramp": table,
                  "ramp_interpolate": ramp.interpolation != 'CONSTANT',
                  "ramp_alpha": out.name == "Alpha"}
+        elif node.type == 'SEPRGB' or (node.type == 'SEPARATE_COLOR' and node.mode == 'RGB'):
+            channel = [o.name for o in node.outputs].index(out.name)
+            d = {"kind": "SEPARATE", "a": self.color(node.inputs[0]), "channel": channel}
+        elif node.type == 'COMBRGB' or (node.type == 'COMBINE_COLOR' and node.mode == 'RGB'):
+            d = {"kind": "COMBINE", "value_a": self.value(node.inputs[0]),
+                 "value_b": self.value(node.inputs[1]), "value_c": self.value(node.inputs[2])}
+        elif node.type == 'GAMMA':
+            d = {"kind": "GAMMA", "a": self.color(node.inputs["Color"]),
+                 "value_a": self.value(node.inputs["Gamma"])}
+        elif node.type == 'BRIGHTCONTRAST':
+            d = {"kind": "BRIGHT_CONTRAST", "a": self.color(node.inputs["Color"]),
+                 "value_a": self.value(node.inputs["Bright"]),
+                 "value_b": self.value(node.inputs["Contrast"])}
         if d is None:
-            mode = getattr(node, "blend_type", None) or getattr(node, "operation", None)
+            mode = (getattr(node, "blend_type", None) or getattr(node, "operation", None) or
+                    getattr(node, "mode", None))
             self.warn(node, f"mode {mode} of the input node" if mode else "input node")
             return None
         self.inputs.append(d)

@@ -114,6 +114,14 @@ InputNode read_input_node(const py::dict& d) {
     n.kind = InputNodeKind::Invert;
   else if (kind == "RAMP")
     n.kind = InputNodeKind::Ramp;
+  else if (kind == "SEPARATE")
+    n.kind = InputNodeKind::Separate;
+  else if (kind == "COMBINE")
+    n.kind = InputNodeKind::Combine;
+  else if (kind == "GAMMA")
+    n.kind = InputNodeKind::Gamma;
+  else if (kind == "BRIGHT_CONTRAST")
+    n.kind = InputNodeKind::BrightContrast;
   else
     bad_enum("input node kind", kind);
   const std::string blend = get_str(d, "blend", "MIX");
@@ -146,6 +154,11 @@ InputNode read_input_node(const py::dict& d) {
   read_color(d, "b", n.b);
   read_float(d, "value_a", n.value_a);
   read_float(d, "value_b", n.value_b);
+  read_float(d, "value_c", n.value_c);
+  int channel = 0;
+  get(d, "channel", channel);
+  if (channel < 0 || channel > 2) throw std::invalid_argument("separate: channel out of range");
+  n.channel = uint8_t(channel);
   if (d.contains("ramp")) n.ramp = d["ramp"].cast<std::vector<float>>();
   get(d, "ramp_interpolate", n.ramp_interpolate);
   get(d, "ramp_alpha", n.ramp_alpha);
@@ -597,8 +610,9 @@ int SceneBuilder::add_material(const py::dict& material) {
   if (desc.normal_map.color.texture.image >= int32_t(scene_.images.size()))
     throw std::invalid_argument("material '" + desc.name + "': image index out of range");
   for (const InputNode& node : desc.inputs)
-    for (const TextureLookup* t : {&node.fac.texture, &node.a.texture, &node.b.texture,
-                                   &node.value_a.texture, &node.value_b.texture})
+    for (const TextureLookup* t :
+         {&node.fac.texture, &node.a.texture, &node.b.texture, &node.value_a.texture,
+          &node.value_b.texture, &node.value_c.texture})
       if (t->image >= int32_t(scene_.images.size()))
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
   scene_.materials.push_back(std::move(desc));

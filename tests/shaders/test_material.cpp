@@ -386,6 +386,40 @@ TEST(Material, InputNodesFollowCycles) {
     r.inputs[0].ramp.resize(6);  // not whole entries
     EXPECT_THROW(Material(r, {}), std::invalid_argument);
   }
+  // Separate / Combine (RGB), Gamma, Bright / Contrast on constants.
+  {
+    auto colour_of = [](InputNode n, InputNode inner = InputNode()) {
+      MaterialDesc r;
+      r.nodes.push_back(node(ShaderNodeKind::Diffuse));
+      r.nodes[0].color.node = 0;
+      r.root = 0;
+      r.inputs = {n, inner};
+      return eval(Material(r, {}))[0].weight;
+    };
+    InputNode sep;
+    sep.kind = InputNodeKind::Separate;
+    sep.a = ColorInput(Spectrum(0.4f, 0.6f, 0.8f));
+    sep.channel = 1;
+    InputNode comb;
+    comb.kind = InputNodeKind::Combine;
+    comb.value_a = FloatInput(0.1f);
+    comb.value_b.node = 1;  // the green channel above, read as a float
+    comb.value_c = FloatInput(0.3f);
+    expect_spectrum(colour_of(comb, sep), Spectrum(0.1f, 0.6f, 0.3f));
+    InputNode gamma;
+    gamma.kind = InputNodeKind::Gamma;
+    gamma.a = ColorInput(Spectrum(0.25f, -0.5f, 0.0f));
+    gamma.value_a = FloatInput(2.0f);
+    expect_spectrum(colour_of(gamma), Spectrum(0.0625f, -0.5f, 0.0f));  // only positive channels
+    gamma.value_a = FloatInput(0.0f);
+    expect_spectrum(colour_of(gamma), Spectrum(1.0f));
+    InputNode bc;
+    bc.kind = InputNodeKind::BrightContrast;
+    bc.a = ColorInput(Spectrum(0.5f, 0.1f, 0.9f));
+    bc.value_a = FloatInput(0.1f);  // bright
+    bc.value_b = FloatInput(0.4f);  // contrast: 1.4 c + 0.1 - 0.2, at least 0
+    expect_spectrum(colour_of(bc), Spectrum(0.6f, 0.04f, 1.16f), 1e-6f);
+  }
   // Malformed: an index out of range, a cycle.
   d.inputs[1].fac.node = 7;
   EXPECT_THROW(Material(d, textures), std::invalid_argument);
