@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include "shaders/texture.h"  // srgb_to_linear
+
 namespace gdpt {
 
 namespace {
@@ -30,22 +32,32 @@ Vec3f EnvironmentMap::uv_to_direction(Vec2f uv) {
   return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), std::cos(theta)};
 }
 
-Spectrum EnvironmentMap::texel(int x, int y) const {
+Spectrum EnvironmentMap::stored_texel(int x, int y) const {
   const int w = image_->width, h = image_->height;
   const size_t i = (size_t(std::clamp(y, 0, h - 1)) * size_t(w) + size_t(wrap(x, w))) * 4;
   const float* p = image_->rgba.data() + i;
   return {p[0], p[1], p[2]};
 }
 
+Spectrum EnvironmentMap::decoded(Spectrum stored) const {
+  if (!image_->srgb_encoded) return stored;
+  return {srgb_to_linear(stored.x), srgb_to_linear(stored.y), srgb_to_linear(stored.z)};
+}
+
+Spectrum EnvironmentMap::texel(int x, int y) const {
+  return decoded(stored_texel(x, y));
+}
+
 Spectrum EnvironmentMap::lookup(Vec2f uv) const {
-  // Pixel centres at (i + 0.5) / width.
+  // Pixel centres at (i + 0.5) / width. 8-bit sRGB images are interpolated encoded, then
+  // decoded (as Texture::lookup, and Cycles).
   const float x = uv.x * float(image_->width) - 0.5f;
   const float y = uv.y * float(image_->height) - 0.5f;
   const float fx = std::floor(x), fy = std::floor(y);
   const float tx = x - fx, ty = y - fy;
   const int ix = int(fx), iy = int(fy);
-  return lerp(lerp(texel(ix, iy), texel(ix + 1, iy), tx),
-              lerp(texel(ix, iy + 1), texel(ix + 1, iy + 1), tx), ty);
+  return decoded(lerp(lerp(stored_texel(ix, iy), stored_texel(ix + 1, iy), tx),
+                      lerp(stored_texel(ix, iy + 1), stored_texel(ix + 1, iy + 1), tx), ty));
 }
 
 EnvironmentMap::EnvironmentMap(const ImageDesc& image, const Transform& rotation, float strength)

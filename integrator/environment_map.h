@@ -39,7 +39,9 @@ class EnvironmentMap {
   static Vec3f uv_to_direction(Vec2f uv);
 
  private:
-  Spectrum texel(int x, int y) const;  // x wraps, y clamps
+  Spectrum stored_texel(int x, int y) const;  // as stored (x wraps, y clamps)
+  Spectrum decoded(Spectrum stored) const;    // linear (sRGB-encoded images decoded)
+  Spectrum texel(int x, int y) const;         // decoded
   Spectrum lookup(Vec2f uv) const;
 
   const ImageDesc* image_;

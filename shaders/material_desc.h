@@ -142,6 +142,10 @@ struct ImageDesc {
   std::string name;
   int width = 0, height = 0;
   std::vector<float> rgba;  // width * height * 4, row 0 at the bottom (Blender's convention)
+  // RGB holds sRGB-encoded values (an 8-bit sRGB image): lookups interpolate them encoded and
+  // decode the result with the sRGB curve, as Cycles does for such images (it keeps them as
+  // bytes and linearises after interpolation). Alpha is linear either way.
+  bool srgb_encoded = false;
 };
 
 }  // namespace gdpt

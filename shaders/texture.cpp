@@ -24,10 +24,14 @@ Texture::Texture(const ImageDesc& image) : width_(image.width), height_(image.he
                                 std::to_string(height_) + " needs " + std::to_string(expected) +
                                 " floats, has " + std::to_string(image.rgba.size()));
   if (!encode(image.rgba)) rgba_ = image.rgba;
+  srgb_ = image.srgb_encoded;
   double sum[4] = {0, 0, 0, 0};
   const size_t count = size_t(width_) * size_t(height_);
   for (size_t p = 0; p < count; ++p)
-    for (int ch = 0; ch < 4; ++ch) sum[ch] += image.rgba[p * 4 + size_t(ch)];
+    for (int ch = 0; ch < 4; ++ch) {
+      const float v = image.rgba[p * 4 + size_t(ch)];
+      sum[ch] += srgb_ && ch < 3 ? srgb_to_linear(v) : v;
+    }
   const double inv = count > 0 ? 1.0 / double(count) : 0.0;
   mean_ = {Spectrum(float(sum[0] * inv), float(sum[1] * inv), float(sum[2] * inv)),
            float(sum[3] * inv)};
@@ -95,8 +99,34 @@ inline int wrap_index(int i, int n, TextureLookup::Extension ext) {
 
 }  // namespace
 
+float srgb_to_linear(float encoded) {
+  constexpr int kSegments = 4096;
+  struct Table {
+    float v[kSegments + 1];
+    Table() {
+      for (int i = 0; i <= kSegments; ++i) {
+        const double c = double(i) / kSegments;
+        v[i] = float(c < 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+      }
+    }
+  };
+  static const Table table;
+  const float x = std::clamp(encoded, 0.0f, 1.0f) * float(kSegments);
+  const int i = std::min(int(x), kSegments - 1);
+  const float t = x - float(i);
+  return table.v[i] + (table.v[i + 1] - table.v[i]) * t;
+}
+
 Rgba Texture::lookup(Vec2f uv, TextureLookup::Interpolation interpolation,
                      TextureLookup::Extension extension) const {
+  Rgba c = lookup_stored(uv, interpolation, extension);
+  if (srgb_)
+    c.rgb = Spectrum(srgb_to_linear(c.rgb.x), srgb_to_linear(c.rgb.y), srgb_to_linear(c.rgb.z));
+  return c;
+}
+
+Rgba Texture::lookup_stored(Vec2f uv, TextureLookup::Interpolation interpolation,
+                            TextureLookup::Extension extension) const {
   if (width_ == 0 || height_ == 0) return {Spectrum(1.0f, 0.0f, 1.0f), 1.0f};
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return {Spectrum(0.0f), 0.0f};
 

@@ -629,7 +629,11 @@ int SceneBuilder::add_image(const std::string& name, int width, int height, cons
   const size_t count = size_t(width) * size_t(height) * 4;
   const float* p = checked_data(rgba, count, "image pixels");
   image.rgba.assign(p, p + count);
-  if (!colorspace.empty()) convert_to_scene_linear(image, colorspace);
+  // 8-bit sRGB images stay encoded and are decoded after interpolation, as Cycles does.
+  if (colorspace == "sRGB")
+    image.srgb_encoded = true;
+  else if (!colorspace.empty())
+    convert_to_scene_linear(image, colorspace);
   scene_.images.push_back(std::move(image));
   return int(scene_.images.size()) - 1;
 }

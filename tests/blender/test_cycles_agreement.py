@@ -458,9 +458,9 @@ CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case
 # bounce_limits (rough glass and glossy balls): relMSE 0.006 (PT) at 4x, means within 0.3%.
 # normal_map: relMSE 0.0076 (G-PT) / 0.0094 (PT) at the default counts, 0.0020 / 0.0025 at 4x
 # (noise; 2.8 with the normal maps ignored).
-# input_nodes: relMSE 0.0011 at 2x (0.068 with only the colour ramps ignored, 0.19 with all nodes).
-# channel_nodes: relMSE 0.0018, mean 1.013 (1.012 at 4x: Cycles interpolates 8-bit sRGB texels
-# before linearising them, which the gamma 2.2 amplifies); 0.52 with the nodes ignored.
+# input_nodes: relMSE 0.0008 at 2x (0.068 with only the colour ramps ignored, 0.19 with all nodes).
+# channel_nodes: relMSE 0.0009, mean 1.0008 (0.52 with the nodes ignored; 0.0018 / 1.013 when
+# 8-bit sRGB textures were linearised before interpolation, unlike Cycles).
 SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map": 4,
                 "input_nodes": 2}
 

@@ -126,5 +126,41 @@ TEST(Texture, EightBitImagesAreCodedAndLookUpTheSameValues) {
   EXPECT_NEAR(coded.mean().a, plain.mean().a, 1e-7f);
 }
 
+// The exact sRGB curve (IEC 61966-2-1), in double.
+double srgb_exact(double c) {
+  return c < 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+TEST(Texture, SrgbCurveTableMatchesTheExactCurve) {
+  double worst = 0.0;
+  for (int i = 0; i <= 100000; ++i) {
+    const double c = i / 100000.0;
+    worst = std::max(worst, std::fabs(double(srgb_to_linear(float(c))) - srgb_exact(c)));
+  }
+  EXPECT_LT(worst, 2e-7);
+}
+
+// 8-bit sRGB images (ImageDesc::srgb_encoded) interpolate the encoded values and decode the
+// result, as Cycles does: between two pixels the value is decode(mean of codes), not the mean
+// of the decoded values. Pixel centres, Closest and the mean decode per pixel; alpha is linear.
+TEST(Texture, SrgbEncodedImagesInterpolateBeforeDecoding) {
+  ImageDesc img;
+  img.name = "srgb";
+  img.width = 2;
+  img.height = 1;
+  const float a = 51.0f / 255.0f, b = 204.0f / 255.0f;  // 8-bit codes 51 and 204
+  img.rgba = {a, a, a, 0.2f, b, b, b, 0.6f};
+  img.srgb_encoded = true;
+  const Texture t(img);
+  EXPECT_TRUE(t.coded());
+  const float da = float(srgb_exact(a)), db = float(srgb_exact(b));
+  expect_rgba(t.lookup({0.25f, 0.5f}, I::Linear, E::Extend), Spectrum(da), 0.2f);
+  expect_rgba(t.lookup({0.75f, 0.5f}, I::Closest, E::Extend), Spectrum(db), 0.6f);
+  const float mid = float(srgb_exact(0.5 * (double(a) + double(b))));
+  expect_rgba(t.lookup({0.5f, 0.5f}, I::Linear, E::Extend), Spectrum(mid), 0.4f);
+  EXPECT_GT(std::fabs(mid - 0.5f * (da + db)), 0.05f);  // the order matters here
+  expect_rgba(t.mean(), Spectrum(0.5f * (da + db)), 0.4f);
+}
+
 }  // namespace
 }  // namespace gdpt
