@@ -93,6 +93,42 @@ float math_op(MathOp op, float a, float b) {
   return 0.0f;
 }
 
+// Cycles' rgb_to_hsv / hsv_to_rgb (util/color.h).
+Vec3f rgb_to_hsv(Spectrum rgb) {
+  const float cmax = std::max(rgb.x, std::max(rgb.y, rgb.z));
+  const float cmin = std::min(rgb.x, std::min(rgb.y, rgb.z));
+  const float cdelta = cmax - cmin;
+  const float s = cmax != 0.0f ? cdelta / cmax : 0.0f;
+  float h = 0.0f;
+  if (s != 0.0f) {
+    const Spectrum c = (Spectrum(cmax) - rgb) / cdelta;
+    if (rgb.x == cmax)
+      h = c.z - c.y;
+    else if (rgb.y == cmax)
+      h = 2.0f + c.x - c.z;
+    else
+      h = 4.0f + c.y - c.x;
+    h /= 6.0f;
+    if (h < 0.0f) h += 1.0f;
+  }
+  return {h, s, cmax};
+}
+Spectrum hsv_to_rgb(Vec3f hsv) {
+  float h = hsv.x;
+  const float s = hsv.y, v = hsv.z;
+  if (s == 0.0f) return Spectrum(v);
+  if (h == 1.0f) h = 0.0f;
+  h *= 6.0f;
+  const float i = std::floor(h), f = h - i;
+  const float p = v * (1.0f - s), q = v * (1.0f - s * f), t = v * (1.0f - s * (1.0f - f));
+  if (i == 0.0f) return {v, t, p};
+  if (i == 1.0f) return {q, v, p};
+  if (i == 2.0f) return {p, v, t};
+  if (i == 3.0f) return {p, q, v};
+  if (i == 4.0f) return {t, p, v};
+  return {v, p, q};
+}
+
 // One input node's result from its operands, read through `in` (PointInputs or AverageInputs,
 // which come back here for nested nodes; the tree is acyclic and shallow, checked at load).
 template <class Inputs>
@@ -143,6 +179,36 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       }
       break;
     }
+    case InputNodeKind::HueSaturation: {
+      const Spectrum in_color = in.color(n.a);
+      Vec3f hsv = rgb_to_hsv(in_color);
+      hsv.x = std::fmod(hsv.x + in.scalar(n.value_a) + 0.5f, 1.0f);
+      hsv.y = saturate(hsv.y * in.scalar(n.value_b));
+      hsv.z *= in.scalar(n.value_c);
+      const float fac = in.scalar(n.fac);
+      const Spectrum c = hsv_to_rgb(hsv);
+      r = c * fac + in_color * (1.0f - fac);
+      r = max(r, Spectrum(0.0f));  // over-saturation can go negative
+      break;
+    }
+    case InputNodeKind::MapRange: {
+      // Blender's Map Range (Linear, float): bounds in ramp[0..3] (from min / max, to min / max).
+      const float* b = n.ramp.data();
+      const float v = in.scalar(n.value_a);
+      const float span = b[1] - b[0];
+      float m = span != 0.0f ? b[2] + (v - b[0]) / span * (b[3] - b[2]) : 0.0f;
+      if (n.clamp_result) m = b[3] > b[2] ? std::clamp(m, b[2], b[3]) : std::clamp(m, b[3], b[2]);
+      return Spectrum(m);  // the clamp is the node's own (to the target range)
+    }
+    case InputNodeKind::Clamp: {
+      const float v = in.scalar(n.value_a), lo = in.scalar(n.value_b), hi = in.scalar(n.value_c);
+      r = Spectrum(lo > hi && n.clamp_range ? std::min(std::max(v, hi), lo)
+                                            : std::min(std::max(v, lo), hi));
+      break;
+    }
+    case InputNodeKind::ToBw:
+      r = Spectrum(luminance(in.color(n.a)));
+      break;
     case InputNodeKind::BrightContrast: {
       const float contrast = in.scalar(n.value_b);
       const float a = 1.0f + contrast, b = in.scalar(n.value_a) - contrast * 0.5f;
@@ -159,6 +225,8 @@ template <class Inputs>
 float input_node_scalar(const InputNode& n, const Inputs& in) {
   const Spectrum r = input_node_result(n, in);
   const bool grey = n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
+                    n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
+                    n.kind == InputNodeKind::ToBw ||
                     (n.kind == InputNodeKind::Ramp && n.ramp_alpha);
   return grey ? r.x : luminance(r);
 }
@@ -386,6 +454,9 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         throw std::invalid_argument(where + "input nodes nested deeper than " +
                                     std::to_string(kMaxTreeDepth) + " (or cyclic)");
       const InputNode& n = inputs_[size_t(input.node)];
+      if (n.kind == InputNodeKind::MapRange && n.ramp.size() != 4)
+        throw std::invalid_argument(where + "map range needs 4 bounds, has " +
+                                    std::to_string(n.ramp.size()));
       if (n.kind == InputNodeKind::Ramp && (n.ramp.size() < 8 || n.ramp.size() % 4 != 0))
         throw std::invalid_argument(where + "colour ramp table of " +
                                     std::to_string(n.ramp.size()) +

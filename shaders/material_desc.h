@@ -51,6 +51,11 @@ enum class InputNodeKind : uint8_t {
   Combine,   // (value_a, value_b, value_c) (Combine RGB / Combine Color in RGB)
   Gamma,     // a^value_a per positive channel; 1 for gamma 0 (svm_math_gamma_color)
   BrightContrast,  // max((1 + c) a + b - c / 2, 0), b = value_a, c = value_b
+  HueSaturation,   // Hue/Saturation/Value of a: hue value_a, saturation value_b, value value_c,
+                   // blended by fac (svm_node_hsv)
+  MapRange,        // linear Map Range of value_a from [ramp 0, 1] to [ramp 2, 3], clamp_result
+  Clamp,           // value_a clamped to [value_b, value_c] (Min Max; swapped bounds: Range)
+  ToBw,            // luminance of a, as grey (RGB to BW)
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -82,6 +87,7 @@ struct InputNode {
   std::vector<float> ramp;  // 4 n floats
   bool ramp_interpolate = true;
   bool ramp_alpha = false;
+  bool clamp_range = false;  // Clamp: Range type (swapped bounds clamp to [max, min])
 };
 
 enum class ShaderNodeKind : uint8_t {

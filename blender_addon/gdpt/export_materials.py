@@ -20,7 +20,8 @@ _SHADERS = {
 _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
-                'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST'}
+                'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
+                'CLAMP', 'RGBTOBW'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -301,13 +302,34 @@ class _Translator:
         elif node.type == 'GAMMA':
             d = {"kind": "GAMMA", "a": self.color(node.inputs["Color"]),
                  "value_a": self.value(node.inputs["Gamma"])}
+        elif node.type == 'HUE_SAT':
+            d = {"kind": "HUE_SAT", "a": self.color(node.inputs["Color"]),
+                 "fac": self.value(node.inputs["Fac"]), "value_a": self.value(node.inputs["Hue"]),
+                 "value_b": self.value(node.inputs["Saturation"]),
+                 "value_c": self.value(node.inputs["Value"])}
+        elif node.type == 'MAP_RANGE' and node.data_type == 'FLOAT' and \
+                node.interpolation_type == 'LINEAR':
+            bounds = [node.inputs[k] for k in ("From Min", "From Max", "To Min", "To Max")]
+            for socket in bounds:
+                if socket.is_linked:
+                    self.warn(node, f"linked {socket.name} (its default value is used) of")
+            d = {"kind": "MAP_RANGE", "value_a": self.value(node.inputs["Value"]),
+                 "ramp": [float(s.default_value) for s in bounds],
+                 "clamp_result": bool(node.clamp)}
+        elif node.type == 'CLAMP':
+            d = {"kind": "CLAMP", "value_a": self.value(node.inputs["Value"]),
+                 "value_b": self.value(node.inputs["Min"]),
+                 "value_c": self.value(node.inputs["Max"]),
+                 "clamp_range": node.clamp_type == 'RANGE'}
+        elif node.type == 'RGBTOBW':
+            d = {"kind": "RGB_TO_BW", "a": self.color(node.inputs["Color"])}
         elif node.type == 'BRIGHTCONTRAST':
             d = {"kind": "BRIGHT_CONTRAST", "a": self.color(node.inputs["Color"]),
                  "value_a": self.value(node.inputs["Bright"]),
                  "value_b": self.value(node.inputs["Contrast"])}
         if d is None:
             mode = (getattr(node, "blend_type", None) or getattr(node, "operation", None) or
-                    getattr(node, "mode", None))
+                    getattr(node, "mode", None) or getattr(node, "interpolation_type", None))
             self.warn(node, f"mode {mode} of the input node" if mode else "input node")
             return None
         self.inputs.append(d)

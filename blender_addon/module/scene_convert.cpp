@@ -122,6 +122,14 @@ InputNode read_input_node(const py::dict& d) {
     n.kind = InputNodeKind::Gamma;
   else if (kind == "BRIGHT_CONTRAST")
     n.kind = InputNodeKind::BrightContrast;
+  else if (kind == "HUE_SAT")
+    n.kind = InputNodeKind::HueSaturation;
+  else if (kind == "MAP_RANGE")
+    n.kind = InputNodeKind::MapRange;
+  else if (kind == "CLAMP")
+    n.kind = InputNodeKind::Clamp;
+  else if (kind == "RGB_TO_BW")
+    n.kind = InputNodeKind::ToBw;
   else
     bad_enum("input node kind", kind);
   const std::string blend = get_str(d, "blend", "MIX");
@@ -162,6 +170,7 @@ InputNode read_input_node(const py::dict& d) {
   if (d.contains("ramp")) n.ramp = d["ramp"].cast<std::vector<float>>();
   get(d, "ramp_interpolate", n.ramp_interpolate);
   get(d, "ramp_alpha", n.ramp_alpha);
+  get(d, "clamp_range", n.clamp_range);
   return n;
 }
 

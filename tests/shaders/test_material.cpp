@@ -419,6 +419,62 @@ TEST(Material, InputNodesFollowCycles) {
     bc.value_a = FloatInput(0.1f);  // bright
     bc.value_b = FloatInput(0.4f);  // contrast: 1.4 c + 0.1 - 0.2, at least 0
     expect_spectrum(colour_of(bc), Spectrum(0.6f, 0.04f, 1.16f), 1e-6f);
+    // Hue/Saturation/Value: hue 0.5 is no shift, +1/3 turns red into green; saturation 0
+    // leaves the value as grey; value scales; fac blends with the input.
+    InputNode hsv;
+    hsv.kind = InputNodeKind::HueSaturation;
+    hsv.a = ColorInput(Spectrum(0.8f, 0.2f, 0.2f));
+    hsv.fac = FloatInput(1.0f);
+    hsv.value_a = FloatInput(0.5f);
+    hsv.value_b = FloatInput(1.0f);
+    hsv.value_c = FloatInput(1.0f);
+    expect_spectrum(colour_of(hsv), Spectrum(0.8f, 0.2f, 0.2f), 1e-6f);
+    hsv.value_a = FloatInput(0.5f + 1.0f / 3.0f);
+    expect_spectrum(colour_of(hsv), Spectrum(0.2f, 0.8f, 0.2f), 1e-5f);
+    hsv.value_a = FloatInput(0.5f);
+    hsv.value_b = FloatInput(0.0f);
+    hsv.value_c = FloatInput(0.5f);
+    expect_spectrum(colour_of(hsv), Spectrum(0.4f), 1e-6f);
+    hsv.fac = FloatInput(0.5f);
+    expect_spectrum(colour_of(hsv), Spectrum(0.6f, 0.3f, 0.3f), 1e-6f);
+    // RGB to BW: the luminance as grey.
+    InputNode bw;
+    bw.kind = InputNodeKind::ToBw;
+    bw.a = ColorInput(Spectrum(0.4f, 0.6f, 0.8f));
+    expect_spectrum(colour_of(bw), Spectrum(luminance(Spectrum(0.4f, 0.6f, 0.8f))));
+    // Map Range (linear): 0.25 from [0, 0.5] to [1, 3] is 2; 0.75 gives 4, or 3 clamped; an
+    // empty source range gives 0.
+    InputNode mr;
+    mr.kind = InputNodeKind::MapRange;
+    mr.ramp = {0.0f, 0.5f, 1.0f, 3.0f};
+    mr.value_a = FloatInput(0.25f);
+    expect_spectrum(colour_of(mr), Spectrum(2.0f));
+    mr.value_a = FloatInput(0.75f);
+    expect_spectrum(colour_of(mr), Spectrum(4.0f));
+    mr.clamp_result = true;
+    expect_spectrum(colour_of(mr), Spectrum(3.0f));
+    mr.ramp = {0.5f, 0.5f, 1.0f, 3.0f};
+    expect_spectrum(colour_of(mr), Spectrum(1.0f));  // 0, then the node's clamp to [1, 3]
+    mr.clamp_result = false;
+    {
+      MaterialDesc r;  // colour 0: the black diffuse lobe is dropped
+      r.nodes.push_back(node(ShaderNodeKind::Diffuse));
+      r.nodes[0].color.node = 0;
+      r.root = 0;
+      r.inputs = {mr};
+      EXPECT_EQ(eval(Material(r, {})).count(), 0);
+    }
+    // Clamp: Min Max, and Range with swapped bounds.
+    InputNode cl;
+    cl.kind = InputNodeKind::Clamp;
+    cl.value_a = FloatInput(0.9f);
+    cl.value_b = FloatInput(0.2f);
+    cl.value_c = FloatInput(0.5f);
+    expect_spectrum(colour_of(cl), Spectrum(0.5f));
+    cl.value_b = FloatInput(0.7f);                   // min > max
+    expect_spectrum(colour_of(cl), Spectrum(0.5f));  // Min Max: max wins
+    cl.clamp_range = true;
+    expect_spectrum(colour_of(cl), Spectrum(0.7f));  // Range: clamped to [0.5, 0.7]
   }
   // Malformed: an index out of range, a cycle.
   d.inputs[1].fac.node = 7;
