@@ -193,13 +193,10 @@ def case_image_texture(scene):
     return 3
 
 
-def case_input_nodes(scene):
-    # Colour / math nodes between textures and shaders: the back wall's colour is a linear color
-    # ramp of a grid image multiplied by orange (legacy MixRGB, fac 0.7); the floor's Principled base colour is the new
-    # Mix node (screen) of the image's inverse and blue, its roughness Math(multiply, image
-    # luminance, 0.8) clamped by a Math(add) with clamp on, its specular the Alpha output of a
-    # Constant color ramp of the image; the ball's Glossy roughness is a float Mix of 0.1 and
-    # 0.6 by the image, its colour an Ease color ramp of the image.
+def grid_room(scene):
+    """The lit room and two helpers for the input-node cases: material(name, bsdf node type,
+    **inputs) -> (material, node tree, BSDF node, Image Texture node of a colour-grid image),
+    and assign(object name, material)."""
     lit_room(scene)
     area_ceiling(size=2.0, energy=200.0)
     img = bpy.data.images.new("grid", 64, 64)
@@ -212,6 +209,23 @@ def case_input_nodes(scene):
         tex.image = img
         return m, nt, next(n for n in nt.nodes if n.bl_idname == bsdf_type), tex
 
+    def assign(obj_name, m):
+        obj = bpy.data.objects[obj_name]
+        obj.data.materials.clear()
+        obj.data.materials.append(m)
+
+    return material, assign
+
+
+def case_input_nodes(scene):
+    # Colour / math nodes between textures and shaders: the back wall's colour is a linear color
+    # ramp of a grid image multiplied by orange (legacy MixRGB, fac 0.7); the floor's Principled base colour is the new
+    # Mix node (screen) of the image's inverse and blue, its roughness Math(multiply, image
+    # luminance, 0.8) clamped by a Math(add) with clamp on, its specular the Alpha output of a
+    # Constant color ramp of the image; the ball's Glossy roughness is a float Mix of 0.1 and
+    # 0.6 by the image, its colour an Ease color ramp of the image.
+    material, assign = grid_room(scene)
+
     m, nt, bsdf, tex = material("wall", "ShaderNodeBsdfDiffuse")
     mul = nt.nodes.new("ShaderNodeMixRGB")
     mul.blend_type = 'MULTIPLY'
@@ -223,9 +237,7 @@ def case_input_nodes(scene):
     nt.links.new(tex.outputs["Color"], wall_ramp.inputs["Fac"])
     nt.links.new(wall_ramp.outputs["Color"], mul.inputs["Color1"])
     nt.links.new(mul.outputs["Color"], bsdf.inputs["Color"])
-    back = bpy.data.objects["back"]
-    back.data.materials.clear()
-    back.data.materials.append(m)
+    assign("back", m)
 
     m, nt, bsdf, tex = material("floor", "ShaderNodeBsdfPrincipled", distribution='GGX')
     inv = nt.nodes.new("ShaderNodeInvert")
@@ -254,9 +266,7 @@ def case_input_nodes(scene):
     steps.color_ramp.elements[1].color = (1, 1, 1, 0.9)
     nt.links.new(tex.outputs["Color"], steps.inputs["Fac"])
     nt.links.new(steps.outputs["Alpha"], bsdf.inputs["Specular"])
-    floor = bpy.data.objects["floor"]
-    floor.data.materials.clear()
-    floor.data.materials.append(m)
+    assign("floor", m)
 
     m, nt, bsdf, tex = material("ball", "ShaderNodeBsdfGlossy", distribution='GGX')
     fmix = nt.nodes.new("ShaderNodeMix")
@@ -282,22 +292,7 @@ def case_channel_nodes(scene):
     # Gamma 2.2 of it; the floor's colour is Combine Color (the image's blue, 0.4, its red from
     # the legacy Separate RGB); the ball's Principled roughness is the image's green (Separate
     # Color) and its base colour a Combine RGB.
-    lit_room(scene)
-    area_ceiling(size=2.0, energy=200.0)
-    img = bpy.data.images.new("grid", 64, 64)
-    img.generated_type = 'COLOR_GRID'
-
-    def material(name, bsdf_type, **inputs):
-        m = S.shader_material(name, bsdf_type, **inputs)
-        nt = m.node_tree
-        tex = nt.nodes.new("ShaderNodeTexImage")
-        tex.image = img
-        return m, nt, next(n for n in nt.nodes if n.bl_idname == bsdf_type), tex
-
-    def assign(obj_name, m):
-        obj = bpy.data.objects[obj_name]
-        obj.data.materials.clear()
-        obj.data.materials.append(m)
+    material, assign = grid_room(scene)
 
     m, nt, bsdf, tex = material("wall", "ShaderNodeBsdfDiffuse")
     gamma = nt.nodes.new("ShaderNodeGamma")
@@ -339,22 +334,7 @@ def case_adjust_nodes(scene):
     # Adjustment nodes over an image: the back wall's colour is Hue/Saturation/Value of it; the
     # floor's Principled roughness is Map Range (clamped) of its RGB to BW; the ball's Glossy
     # roughness is a Clamp (Range, swapped bounds) of the same.
-    lit_room(scene)
-    area_ceiling(size=2.0, energy=200.0)
-    img = bpy.data.images.new("grid", 64, 64)
-    img.generated_type = 'COLOR_GRID'
-
-    def material(name, bsdf_type, **inputs):
-        m = S.shader_material(name, bsdf_type, **inputs)
-        nt = m.node_tree
-        tex = nt.nodes.new("ShaderNodeTexImage")
-        tex.image = img
-        return m, nt, next(n for n in nt.nodes if n.bl_idname == bsdf_type), tex
-
-    def assign(obj_name, m):
-        obj = bpy.data.objects[obj_name]
-        obj.data.materials.clear()
-        obj.data.materials.append(m)
+    material, assign = grid_room(scene)
 
     m, nt, bsdf, tex = material("wall", "ShaderNodeBsdfDiffuse")
     hsv = nt.nodes.new("ShaderNodeHueSaturation")

@@ -24,8 +24,19 @@ def basic_scene(scene):
     S.light('AREA', (0, 0, 3.95), 150.0, target=(0, 0, 0), size=1.0)
 
 
-def test_unsupported_node(out):
+def render_finished(scene, path):
+    """Renders 8 spp with Gradient PT, checks that the render finished; (image path, warnings)."""
     import gdpt.engine as engine
+    S.setup_gdpt(scene, 8)
+    path = S.render(scene, path)
+    info = engine.LAST_RENDER
+    check(info.get("status") == "finished", f"render finished ({info.get('status')})")
+    warnings = info.get("warnings", [])
+    print("\n".join(warnings))
+    return path, warnings
+
+
+def test_unsupported_node(out):
     scene = S.clear()
     basic_scene(scene)
     # Toon BSDF: unsupported shader, no shader pass-through -> magenta stand-in.
@@ -48,12 +59,7 @@ def test_unsupported_node(out):
     nt.links.new(rgb.outputs[0], curves.inputs["Color"])
     nt.links.new(curves.outputs[0], bsdf.inputs["Roughness"])
     S.uv_sphere("ball2", 0.6, (0.8, 0.3, 0.6), m)
-    S.setup_gdpt(scene, 8)
-    path = S.render(scene, os.path.join(out, "unsupported.exr"))
-    info = engine.LAST_RENDER
-    check(info.get("status") == "finished", f"render finished ({info.get('status')})")
-    warnings = info.get("warnings", [])
-    print("\n".join(warnings))
+    path, warnings = render_finished(scene, os.path.join(out, "unsupported.exr"))
     toon_w = [w for w in warnings if "Toon BSDF" in w and "'toon'" in w]
     bc_w = [w for w in warnings if "My RGB Curves" in w]
     check(len(toon_w) == 1, "one warning names the Toon BSDF node of material 'toon'")
@@ -69,7 +75,6 @@ def test_normal_map_limits(out):
     """Normal maps Gradient PT cannot apply are reported, and the render still finishes: a
     normal-mapped mesh without a UV map, one with a 5-sided face (Blender computes no tangents
     for it), an object-space Normal Map node and a Bump node."""
-    import gdpt.engine as engine
     scene = S.clear()
     basic_scene(scene)
     img = S.normal_map_image("bumps")
@@ -88,12 +93,7 @@ def test_normal_map_limits(out):
     nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
     S.uv_sphere("ball", 0.5, (-0.8, 0.3, 0.5), obj_space)
     S.uv_sphere("ball2", 0.5, (0.8, 0.3, 0.5), m)
-    S.setup_gdpt(scene, 8)
-    path = S.render(scene, os.path.join(out, "normal_map_limits.exr"))
-    info = engine.LAST_RENDER
-    check(info.get("status") == "finished", f"render finished ({info.get('status')})")
-    warnings = info.get("warnings", [])
-    print("\n".join(warnings))
+    path, warnings = render_finished(scene, os.path.join(out, "normal_map_limits.exr"))
     for needle, what in (("'no_uvs'", "the mesh without UVs"), ("'pentagon'", "the 5-sided face"),
                          ("object-space normal map", "the object-space map"),
                          ("My Bump", "the Bump node")):

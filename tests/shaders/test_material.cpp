@@ -260,6 +260,16 @@ TEST(Material, AverageEmissionUsesTextureMeans) {
   expect_spectrum(s.emission(), Spectrum(0, 0, 4));
 }
 
+// A diffuse material whose colour (or roughness) is input node 0 of `inputs`.
+MaterialDesc diffuse_reading(std::vector<InputNode> inputs, bool roughness = false) {
+  MaterialDesc d;
+  d.nodes.push_back(node(ShaderNodeKind::Diffuse));
+  (roughness ? d.nodes[0].roughness.node : d.nodes[0].color.node) = 0;
+  d.root = 0;
+  d.inputs = std::move(inputs);
+  return d;
+}
+
 // Colour / math input nodes with Cycles' formulas (svm_mix, svm_math, invert), on constants
 // and on a texture, nested, read by colour and float sockets.
 TEST(Material, InputNodesFollowCycles) {
@@ -271,18 +281,13 @@ TEST(Material, InputNodesFollowCycles) {
     return s.count() ? s[0].weight : Spectrum(-1.0f);
   };
   auto mix = [&](MixBlend blend, float fac) {
-    MaterialDesc d;
-    d.nodes.push_back(node(ShaderNodeKind::Diffuse));
-    d.nodes[0].color.node = 0;
-    d.root = 0;
     InputNode n;
     n.kind = InputNodeKind::Mix;
     n.blend = blend;
     n.fac = FloatInput(fac);
     n.a = ColorInput(a);
     n.b = ColorInput(b);
-    d.inputs.push_back(n);
-    return diffuse_colour(d);
+    return diffuse_colour(diffuse_reading({n}));
   };
   const float t = 0.25f;
   expect_spectrum(mix(MixBlend::Mix, t), a * 0.75f + b * 0.25f);
@@ -302,19 +307,14 @@ TEST(Material, InputNodesFollowCycles) {
 
   // Roughness from Math(op, x, y), clamped to [0, 1] only when asked; colour from Invert.
   auto math = [&](MathOp op, float x, float y, bool clamp) {
-    MaterialDesc d;
-    d.nodes.push_back(node(ShaderNodeKind::Diffuse));
-    d.nodes[0].roughness.node = 0;
-    d.root = 0;
     InputNode n;
     n.kind = InputNodeKind::Math;
     n.math = op;
     n.clamp_result = clamp;
     n.value_a = FloatInput(x);
     n.value_b = FloatInput(y);
-    d.inputs.push_back(n);
     // Diffuse roughness r > 0 gives Oren-Nayar with sigma r (clamped to [0, 1] by the node).
-    const ClosureSet s = eval(Material(d, {}));
+    const ClosureSet s = eval(Material(diffuse_reading({n}, true), {}));
     return s[0].alpha;
   };
   EXPECT_FLOAT_EQ(math(MathOp::Add, 0.2f, 0.3f, false), 0.5f);
@@ -332,10 +332,6 @@ TEST(Material, InputNodesFollowCycles) {
   img.width = img.height = 1;
   img.rgba = {0.4f, 0.6f, 0.8f, 1.0f};
   const std::vector<Texture> textures{Texture(img)};
-  MaterialDesc d;
-  d.nodes.push_back(node(ShaderNodeKind::Diffuse));
-  d.nodes[0].color.node = 0;
-  d.root = 0;
   InputNode mul;
   mul.kind = InputNodeKind::Mix;
   mul.blend = MixBlend::Multiply;
@@ -351,7 +347,7 @@ TEST(Material, InputNodesFollowCycles) {
   half.math = MathOp::Multiply;
   half.value_a = FloatInput(0.5f);
   half.value_b = FloatInput(2.0f);
-  d.inputs = {mul, inv, half};
+  MaterialDesc d = diffuse_reading({mul, inv, half});
   const Material m(d, textures);
   EXPECT_TRUE(m.features() & kFeatureTextures);
   expect_spectrum(diffuse_colour(d, {0.5f, 0.5f}, textures), Spectrum(0.4f, 0.6f, 0.8f) * 0.7f);
@@ -363,18 +359,14 @@ TEST(Material, InputNodesFollowCycles) {
   // Color ramp: three entries (0, 0.5, 1); linear between them, or the lower one (Constant);
   // fac clamped; the Alpha output as a float.
   {
-    MaterialDesc r;
-    r.nodes.push_back(node(ShaderNodeKind::Diffuse));
-    r.nodes[0].color.node = 0;
-    r.nodes[0].roughness.node = 1;
-    r.root = 0;
     InputNode ramp;
     ramp.kind = InputNodeKind::Ramp;
     ramp.ramp = {1, 0, 0, 0.2f, 0, 1, 0, 0.4f, 0, 0, 1, 0.6f};
     ramp.fac = FloatInput(0.75f);
     InputNode alpha = ramp;
     alpha.ramp_alpha = true;
-    r.inputs = {ramp, alpha};
+    MaterialDesc r = diffuse_reading({ramp, alpha});
+    r.nodes[0].roughness.node = 1;
     ClosureSet s = eval(Material(r, {}));
     expect_spectrum(s[0].weight, Spectrum(0.0f, 0.5f, 0.5f));
     EXPECT_FLOAT_EQ(s[0].alpha, 0.5f);  // Oren-Nayar sigma = the ramp's alpha at 0.75
@@ -389,12 +381,7 @@ TEST(Material, InputNodesFollowCycles) {
   // Separate / Combine (RGB), Gamma, Bright / Contrast on constants.
   {
     auto colour_of = [](InputNode n, InputNode inner = InputNode()) {
-      MaterialDesc r;
-      r.nodes.push_back(node(ShaderNodeKind::Diffuse));
-      r.nodes[0].color.node = 0;
-      r.root = 0;
-      r.inputs = {n, inner};
-      return eval(Material(r, {}))[0].weight;
+      return eval(Material(diffuse_reading({n, inner}), {}))[0].weight;
     };
     InputNode sep;
     sep.kind = InputNodeKind::Separate;
@@ -456,14 +443,8 @@ TEST(Material, InputNodesFollowCycles) {
     mr.ramp = {0.5f, 0.5f, 1.0f, 3.0f};
     expect_spectrum(colour_of(mr), Spectrum(1.0f));  // 0, then the node's clamp to [1, 3]
     mr.clamp_result = false;
-    {
-      MaterialDesc r;  // colour 0: the black diffuse lobe is dropped
-      r.nodes.push_back(node(ShaderNodeKind::Diffuse));
-      r.nodes[0].color.node = 0;
-      r.root = 0;
-      r.inputs = {mr};
-      EXPECT_EQ(eval(Material(r, {})).count(), 0);
-    }
+    // Colour 0: the black diffuse lobe is dropped.
+    EXPECT_EQ(eval(Material(diffuse_reading({mr}), {})).count(), 0);
     // Clamp: Min Max, and Range with swapped bounds.
     InputNode cl;
     cl.kind = InputNodeKind::Clamp;
