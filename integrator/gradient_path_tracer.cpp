@@ -707,6 +707,9 @@ class GradientPathTracer final : public Integrator {
     // out and the pixel's coverage is what it crossed (Cycles' rule, as PT).
     bool camera_path = true;
     BounceCounts kinds;  // the base's scattering events by kind (per-kind limits)
+    // Cycles' bounce counts, as PT's: scattering events (`bounce` below numbers every vertex,
+    // straight transparent crossings included, for the sampler's dimensions) and crossings.
+    int scatterings = 0, crossings = 0;
     Vec3d fb(1.0, 1.0, 1.0);
     double pb = 1.0;
 
@@ -714,7 +717,7 @@ class GradientPathTracer final : public Integrator {
     // alongside it (Sampler::vertex_numbers).
     Sampler::VertexNumbers u = sampler.vertex_numbers(0, has_lights);
     for (int bounce = 0;; ++bounce) {
-      if (bounce > max_bounces) break;
+      if (scatterings > max_bounces) break;
       const Vertex& base = scratch.verts[cur];
       Vertex& next_base = scratch.verts[cur ^ 1];
       // Normal / Mist passes at the surfaces the camera path meets after transparent crossings
@@ -899,8 +902,11 @@ class GradientPathTracer final : public Integrator {
       const VertexType xd_type = delta ? VertexType::Specular : base_type;
 
       beta *= bs.value / bs.pdf;
+      // A straight transparent crossing is no bounce (Cycles' transparent bounce): it counts for
+      // no limit and no roulette, and keeps the ray's kind.
+      const bool crossing = bs.is_straight_crossing();
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
-      if (bounce >= settings_.rr_depth) {
+      if (!crossing && scatterings >= settings_.rr_depth) {
         const float q = roulette_continuation(beta);
         if (q < 1.0f) {
           if (!(sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kRoulette)) < q)) break;
@@ -915,9 +921,10 @@ class GradientPathTracer final : public Integrator {
       ray.direction = normalize(wo_world);
       ray.t_min = 0.0f;
       ray.t_max = kInf;
-      // Its kind (ray visibility): a straight transparent crossing keeps the previous one.
-      const bool crossing = bs.is_straight_crossing();
-      if (!crossing) {
+      if (crossing) {
+        ++crossings;
+      } else {
+        ++scatterings;
         ray.kind = ray_kind_of_lobe(bs.lobe);
         kinds.add(ray.kind);
       }
@@ -926,7 +933,8 @@ class GradientPathTracer final : public Integrator {
       // The hit goes straight into the next vertex. Its end point only ends the path at the last
       // bounce: no vertex set-up there (the offsets' shifts need its classification alone), and
       // no hit record either when no offset shifts and no triangle emits (as PT).
-      const bool last = bounce == max_bounces || kinds.over(settings_);
+      const bool last =
+          scatterings > max_bounces || crossings > kMaxTransparentBounces || kinds.over(settings_);
       if (!last) u = sampler.vertex_numbers(bounce + 1, has_lights);
       const SurfaceHit& next = next_base.hit;
       // A holdout met by the camera path (only transparent crossings so far) ends it as an escape
