@@ -120,6 +120,10 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
       d.corner_uvs = mesh.corner_uvs.data();
       d.corner_uv_tris = uint32_t(std::min(mesh.corner_uvs.size() / 3, tris));
     }
+    if (!mesh.corner_colors.empty()) {
+      d.corner_colors = mesh.corner_colors.data();
+      d.corner_color_tris = uint32_t(std::min(mesh.corner_colors.size() / 3, tris));
+    }
     if (!mesh.corner_tangents.empty()) {
       if (mesh.corner_tangent_signs.size() != mesh.corner_tangents.size())
         throw std::invalid_argument("mesh " + std::to_string(inst.mesh) + ": " +
@@ -162,6 +166,18 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
   const RTCError err = rtcGetDeviceError(device_);
   if (err != RTC_ERROR_NONE)
     throw std::runtime_error("Embree: scene build failed with error " + std::to_string(int(err)));
+}
+
+void EmbreeScene::set_materials(std::span<const Material> materials) {
+  materials_ = materials;
+  auto reads = [&](int32_t m) {
+    return m >= 0 && size_t(m) < materials.size() && materials[size_t(m)].reads_color_attribute();
+  };
+  for (InstanceData& d : instances_) {
+    d.writes_color =
+        d.corner_colors != nullptr || reads(d.uniform_material) || reads(default_material_);
+    for (int32_t m : d.slot_materials) d.writes_color = d.writes_color || reads(m);
+  }
 }
 
 EmbreeScene::~EmbreeScene() {
@@ -288,6 +304,14 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
     uv = interpolate(load2(T[0]), load2(T[1]), load2(T[2]), W, U, V);
   }
   _mm_storel_pi(reinterpret_cast<__m64*>(&hit.uv.x), uv);
+  if (d.writes_color) [[unlikely]] {
+    __m128 color = _mm_setzero_ps();
+    if (primitive < d.corner_color_tris) {
+      const Vec3f* C = d.corner_colors + size_t(primitive) * 3;
+      color = interpolate(load3(C[0]), load3(C[1]), load3(C[2]), W, U, V);
+    }
+    store3(hit.color, color);
+  }
 
   if (d.uniform_material >= 0) {
     hit.material = d.uniform_material;

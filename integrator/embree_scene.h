@@ -29,6 +29,8 @@ struct SurfaceHit {
   Vec3f geometric_normal;  // unit, world, as the triangle winding gives it (not flipped)
   Vec3f shading_normal;    // unit, world, interpolated corner normal (= geometric if flat)
   Vec2f uv;
+  Vec3f color;  // colour attribute (Mesh::corner_colors), 0 when the mesh has none; only set
+                // on instances that have one or whose materials read one
   uint32_t instance = 0, primitive = 0;  // index in Scene::instances, triangle in its mesh
   int32_t material = -1;     // index into SceneContext::materials() (always valid after hit())
   bool front_facing = true;  // the ray came from the side geometric_normal points to
@@ -131,7 +133,9 @@ class EmbreeScene {
 
   // The scene's materials (indexed as SurfaceHit::material), for Normal Map nodes: hits on
   // meshes with tangents whose material has one get the mapped shading normal. Unset: none.
-  void set_materials(std::span<const Material> materials) { materials_ = materials; }
+  // Also decides which instances' hits carry a colour attribute: those whose mesh has one or
+  // whose materials read one (black then); other hits skip it.
+  void set_materials(std::span<const Material> materials);
 
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
   size_t instanced_triangle_count() const { return instanced_triangles_; }
@@ -178,6 +182,9 @@ class EmbreeScene {
     const Vec3f* vertex_normals = nullptr;
     const Vec2f* corner_uvs = nullptr;  // for primitives < corner_uv_tris; else uv = 0
     uint32_t corner_uv_tris = 0;
+    const Vec3f* corner_colors = nullptr;  // Color Attribute nodes, primitives < corner_color_tris
+    uint32_t corner_color_tris = 0;
+    bool writes_color = false;               // hits fill SurfaceHit::color (set_materials)
     const Vec3f* corner_tangents = nullptr;  // Normal Map nodes, primitives < corner_tangent_tris
     const float* corner_tangent_signs = nullptr;
     uint32_t corner_tangent_tris = 0;

@@ -178,6 +178,11 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
         t.uv1 = mesh.corner_uvs[size_t(tri) * 3 + 1];
         t.uv2 = mesh.corner_uvs[size_t(tri) * 3 + 2];
       }
+      if (!mesh.corner_colors.empty()) {
+        t.color0 = mesh.corner_colors[size_t(tri) * 3 + 0];
+        t.color1 = mesh.corner_colors[size_t(tri) * 3 + 1];
+        t.color2 = mesh.corner_colors[size_t(tri) * 3 + 2];
+      }
       t.material = uint32_t(mat);
       t.finish();
       const float p = t.power(materials[size_t(mat)].average_emission());

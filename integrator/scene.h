@@ -24,6 +24,9 @@ struct Mesh {
   // MikkTSpace, object space) and bitangent signs; empty = none (normal maps do nothing).
   std::vector<Vec3f> corner_tangents;
   std::vector<float> corner_tangent_signs;
+  // 3 per triangle, for Color Attribute nodes: the attribute's linear RGB; empty = none (the
+  // node reads black, as in Cycles).
+  std::vector<Vec3f> corner_colors;
   std::vector<int32_t> material_slot;  // per triangle; empty = slot 0
   // Per-vertex shading normals, used when corner_normals is empty: what a smooth mesh without
   // split normals has, in a sixth of the memory (a 1M-triangle smooth mesh: 6 MB instead of the

@@ -209,6 +209,9 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
     case InputNodeKind::ToBw:
       r = Spectrum(luminance(in.color(n.a)));
       break;
+    case InputNodeKind::Attribute:
+      r = in.attribute_color();
+      break;
     case InputNodeKind::BrightContrast: {
       const float contrast = in.scalar(n.value_b);
       const float a = 1.0f + contrast, b = in.scalar(n.value_a) - contrast * 0.5f;
@@ -237,6 +240,9 @@ struct PointInputs {
   std::span<const InputNode> nodes;
   Vec2f uv;
   bool front_facing;
+  const Vec3f* attribute = nullptr;  // ShadingContext::color
+
+  Spectrum attribute_color() const { return attribute ? *attribute : Spectrum(0.0f); }
 
   Rgba fetch(const TextureLookup& t) const {
     const Vec3f p = t.uv_mapping.point(Vec3f(uv.x, uv.y, 0.0f));
@@ -260,6 +266,9 @@ struct AverageInputs {
   const std::vector<Rgba>* means;
   std::span<const InputNode> nodes;
   bool front_facing = true;
+
+  // Unknown without the mesh: white, an upper bound for power estimates (emitter selection).
+  Spectrum attribute_color() const { return Spectrum(1.0f); }
 
   Spectrum color(const ColorInput& in) const {
     if (in.node >= 0) return input_node_result(nodes[size_t(in.node)], *this);
@@ -454,6 +463,11 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         throw std::invalid_argument(where + "input nodes nested deeper than " +
                                     std::to_string(kMaxTreeDepth) + " (or cyclic)");
       const InputNode& n = inputs_[size_t(input.node)];
+      // Values that vary over the surface: no per-side constant closures (cache_if_constant).
+      if (n.kind == InputNodeKind::Attribute) {
+        features_ |= kFeatureTextures;
+        reads_color_attribute_ = true;
+      }
       if (n.kind == InputNodeKind::MapRange && n.ramp.size() != 4)
         throw std::invalid_argument(where + "map range needs 4 bounds, has " +
                                     std::to_string(n.ramp.size()));
@@ -579,14 +593,15 @@ void Material::evaluate(const ShadingContext& ctx, ClosureSet& out) const {
     return;
   }
   out.clear();
-  const Spectrum e =
-      walk(nodes_, root_, PointInputs{textures_, inputs_, ctx.uv, ctx.front_facing}, &out);
+  const Spectrum e = walk(
+      nodes_, root_, PointInputs{textures_, inputs_, ctx.uv, ctx.front_facing, ctx.color}, &out);
   out.add_emission(e);
 }
 
 Spectrum Material::emission(const ShadingContext& ctx) const {
   if (!(features_ & kFeatureEmission)) return Spectrum(0.0f);
-  return walk(nodes_, root_, PointInputs{textures_, inputs_, ctx.uv, ctx.front_facing}, nullptr);
+  return walk(nodes_, root_, PointInputs{textures_, inputs_, ctx.uv, ctx.front_facing, ctx.color},
+              nullptr);
 }
 
 Vec3f Material::normal_map_direction(Vec2f uv) const {

@@ -14,7 +14,7 @@ namespace gdpt {
 
 // What a material uses; the integrator ORs these over the scene to pick a specialised kernel.
 enum MaterialFeature : uint32_t {
-  kFeatureTextures = 1u << 0,
+  kFeatureTextures = 1u << 0,  // inputs vary over the surface (image textures, colour attributes)
   kFeatureTransmission = 1u << 1,  // glass / principled transmission (refraction)
   kFeatureGlossy = 1u << 2,        // GGX lobes
   kFeatureDelta = 1u << 3,         // smooth glass / transparent
@@ -44,6 +44,8 @@ class Material {
   // Normal Map node (NormalMapDesc): the tangent-space direction at `uv`, strength applied, not
   // normalised (x tangent, y bitangent, z normal).
   bool has_normal_map() const { return normal_map_.enabled; }
+  // Some input reads the mesh's colour attribute (ShadingContext::color).
+  bool reads_color_attribute() const { return reads_color_attribute_; }
   Vec3f normal_map_direction(Vec2f uv) const;
 
  private:
@@ -59,6 +61,7 @@ class Material {
   std::span<const Texture> textures_;
   uint32_t features_ = 0;
   NormalMapDesc normal_map_;
+  bool reads_color_attribute_ = false;
   Spectrum average_emission_{0.0f, 0.0f, 0.0f};
 };
 

@@ -56,6 +56,7 @@ enum class InputNodeKind : uint8_t {
   MapRange,        // linear Map Range of value_a from [ramp 0, 1] to [ramp 2, 3], clamp_result
   Clamp,           // value_a clamped to [value_b, value_c] (Min Max; swapped bounds: Range)
   ToBw,            // luminance of a, as grey (RGB to BW)
+  Attribute,       // the mesh's colour attribute (Color Attribute node; ShadingContext::color)
 };
 enum class MixBlend : uint8_t {
   Mix,

@@ -8,6 +8,9 @@ namespace gdpt {
 struct ShadingContext {
   Vec2f uv;                  // mesh UV (0 when the mesh has none)
   bool front_facing = true;  // the ray hit the side the geometric normal points to
+  // The mesh's colour attribute (Mesh::corner_colors) when the hit has one, else null (black).
+  // A pointer: most materials never read it, and the context is built at every vertex.
+  const Vec3f* color = nullptr;
 };
 
 }  // namespace gdpt

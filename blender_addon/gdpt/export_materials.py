@@ -21,7 +21,7 @@ _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
-                'CLAMP', 'RGBTOBW'}
+                'CLAMP', 'RGBTOBW', 'VERTEX_COLOR'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -41,6 +41,7 @@ class _Translator:
         self.nodes = []
         self.normal_map = None  # (Normal Map node, its dict) of the BSDFs' Normal inputs
         self.inputs = []  # colour / math input nodes (MaterialDesc::inputs)
+        self.color_attribute = None  # name read by Color Attribute nodes ("": the render one)
         self.input_index = {}  # node name -> index in self.inputs
 
     # --- reporting ---------------------------------------------------------------------------
@@ -321,6 +322,12 @@ class _Translator:
                  "value_b": self.value(node.inputs["Min"]),
                  "value_c": self.value(node.inputs["Max"]),
                  "clamp_range": node.clamp_type == 'RANGE'}
+        elif node.type == 'VERTEX_COLOR' and out.name == "Color":
+            if self.color_attribute is not None and self.color_attribute != node.layer_name:
+                self.warn(node, "second colour attribute (the first one is used) in")
+            if self.color_attribute is None:
+                self.color_attribute = node.layer_name
+            d = {"kind": "ATTRIBUTE"}
         elif node.type == 'RGBTOBW':
             d = {"kind": "RGB_TO_BW", "a": self.color(node.inputs["Color"])}
         elif node.type == 'BRIGHTCONTRAST':
@@ -436,6 +443,8 @@ def _translate_surface(material, images, warn):
     d = {"name": material.name, "nodes": t.nodes, "root": root, "inputs": t.inputs}
     if t.normal_map is not None:
         d["normal_map"] = t.normal_map[1]
+    if t.color_attribute is not None:
+        d["color_attribute"] = t.color_attribute
     return d
 
 
@@ -446,6 +455,7 @@ class MaterialCache:
         self.warn = warn
         self.index = {}
         self.normal_mapped = set()  # scene material indices with a normal map
+        self.color_attributes = {}  # scene material index -> colour attribute name it reads
 
     def get(self, material):
         """Scene material index for a Blender material, -1 for an empty slot."""
@@ -457,8 +467,15 @@ class MaterialCache:
             self.index[key] = self.builder.add_material(desc)
             if "normal_map" in desc:
                 self.normal_mapped.add(self.index[key])
+            if "color_attribute" in desc:
+                self.color_attributes[self.index[key]] = desc["color_attribute"]
         return self.index[key]
 
     def has_normal_map(self, index):
         return index in self.normal_mapped
+
+    def color_attribute(self, index):
+        """Name of the colour attribute material `index` reads ("" for the render one), or
+        None."""
+        return self.color_attributes.get(index)
 

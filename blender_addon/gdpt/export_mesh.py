@@ -146,15 +146,38 @@ def _loop_tangents(mesh, warn):
     return out.ravel()
 
 
-def add_mesh(builder, mesh, tangents=False, warn=print):
+def _loop_colors(mesh, name, warn):
+    """The colour attribute `name` ("" for the render colour attribute) as linear RGB per loop,
+    what Cycles' Color Attribute node reads; None (with a warning) when the mesh has none."""
+    attrs = mesh.color_attributes
+    attr = None
+    if name:
+        attr = attrs.get(name)
+    elif 0 <= attrs.render_color_index < len(attrs):
+        attr = attrs[attrs.render_color_index]
+    if attr is None or attr.domain not in {'POINT', 'CORNER'}:
+        warn(f"mesh '{mesh.name}' has no colour attribute '{name or '(render)'}': the Color "
+             "Attribute node reads black there, as in Cycles")
+        return None
+    rgba = _empty(len(attr.data) * 4, np.float32)
+    attr.data.foreach_get("color", rgba)
+    rgb = rgba.reshape(-1, 4)[:, :3]
+    if attr.domain == 'POINT':
+        rgb = rgb[_int_field(mesh.loops, 0, "vertex_index")]
+    return np.ascontiguousarray(rgb, dtype=np.float32).ravel()
+
+
+def add_mesh(builder, mesh, tangents=False, warn=print, color_attribute=None):
     """Adds `mesh` to the scene; returns its index, or -1 when it has no faces. Only Blender's
     own arrays (vertices, loops, polygons) are read here; the module builds the triangles and
     gathers the corner attributes in C++. `tangents`: also the UV map's tangents (for materials
-    with a Normal Map node)."""
+    with a Normal Map node); `color_attribute`: also that colour attribute ("" for the render
+    one; None: none), for Color Attribute nodes."""
     poly_count = len(mesh.polygons)
     if poly_count == 0:
         return -1
     loop_tangents = _loop_tangents(mesh, warn) if tangents else None
+    loop_colors = None if color_attribute is None else _loop_colors(mesh, color_attribute, warn)
     positions = _empty(len(mesh.vertices) * 3, np.float32)
     mesh.vertices.foreach_get("co", positions)
     loop_total = _int_field(mesh.polygons, 1, "loop_total")  # MPoly.totloop
@@ -164,14 +187,16 @@ def add_mesh(builder, mesh, tangents=False, warn=print):
     if loop_total.min() >= 3 and loop_total.max() <= 4:
         loop_start = _int_field(mesh.polygons, 0, "loop_start")  # MPoly.loopstart
         return builder.add_mesh_polys(positions, loop_vertex, loop_start, loop_total, normals,
-                                      per_loop, loop_uvs, poly_material, loop_tangents)
+                                      per_loop, loop_uvs, poly_material, loop_tangents,
+                                      loop_colors)
     # N-gons: Blender's ear clipping, through its loop triangles (slower reads).
     corner_loops, tri_poly = _corner_loops_slow(mesh)
     if len(corner_loops) == 0:
         return -1
     tri_material = poly_material[tri_poly] if len(poly_material) else poly_material
     return builder.add_mesh_loops(positions, loop_vertex, corner_loops, normals, per_loop,
-                                  loop_uvs, np.ascontiguousarray(tri_material), loop_tangents)
+                                  loop_uvs, np.ascontiguousarray(tri_material), loop_tangents,
+                                  loop_colors)
 
 
 # Object > Visibility > Ray Visibility -> the core's RayKind bits (integrator/scene.h).
@@ -202,31 +227,31 @@ class GeometryExporter:
         self.mesh_index = {}  # evaluated data pointer -> scene mesh index (-1: empty)
         self.export_seconds = 0.0
 
-    def _mesh_for(self, obj, tangents):
+    def _mesh_for(self, obj, tangents, colors):
         # Meshes: the evaluated mesh datablock (modifiers applied) is what instances share.
         # Other types: to_mesh() depends on the object's own modifiers, so key by the original
-        # object (instances of it in collections or particles still share one mesh). Tangents are
-        # read only for objects whose materials have a normal map (part of the key).
+        # object (instances of it in collections or particles still share one mesh). Tangents and
+        # colours are read only for objects whose materials use them (part of the key).
         if obj.type == 'MESH':
-            key = (obj.data.as_pointer(), tangents)
+            key = (obj.data.as_pointer(), tangents, colors)
         else:
-            key = ("object", obj.original.as_pointer(), tangents)
+            key = ("object", obj.original.as_pointer(), tangents, colors)
         if key in self.mesh_index:
             return self.mesh_index[key]
         if obj.type == 'MESH':
             mesh = obj.data
-            index = self._add_mesh(mesh, tangents)
+            index = self._add_mesh(mesh, tangents, colors)
         else:
             mesh = obj.to_mesh()
             try:
-                index = self._add_mesh(mesh, tangents) if mesh is not None else -1
+                index = self._add_mesh(mesh, tangents, colors) if mesh is not None else -1
             finally:
                 obj.to_mesh_clear()
         self.mesh_index[key] = index
         return index
 
-    def _add_mesh(self, mesh, tangents):
-        return add_mesh(self.builder, mesh, tangents, self.warn)
+    def _add_mesh(self, mesh, tangents, colors):
+        return add_mesh(self.builder, mesh, tangents, self.warn, colors)
 
     def visit(self, inst, obj, matrix):
         """Adds one instance of geometry object `obj` placed by `matrix` (already copied)."""
@@ -237,7 +262,9 @@ class GeometryExporter:
             return
         slots = [self.materials.get(slot.material) for slot in obj.material_slots]
         tangents = any(self.materials.has_normal_map(index) for index in slots)
-        mesh = self._mesh_for(obj, tangents)
+        colors = next((self.materials.color_attribute(index) for index in slots
+                       if self.materials.color_attribute(index) is not None), None)
+        mesh = self._mesh_for(obj, tangents, colors)
         if mesh < 0:
             return
         self.builder.add_instance(mesh, _matrix12(matrix), slots, obj.pass_index,

@@ -88,12 +88,14 @@ PYBIND11_MODULE(_gdpt, m) {
            py::arg("loop_vertex").noconvert(), py::arg("corner_loops").noconvert(),
            py::arg("normals").noconvert(), py::arg("normals_per_loop"),
            py::arg("loop_uvs").noconvert(), py::arg("material_slot").noconvert(),
-           py::arg("loop_tangents").noconvert() = py::none())
+           py::arg("loop_tangents").noconvert() = py::none(),
+           py::arg("loop_colors").noconvert() = py::none())
       .def("add_mesh_polys", &SceneBuilder::add_mesh_polys, py::arg("positions").noconvert(),
            py::arg("loop_vertex").noconvert(), py::arg("loop_start").noconvert(),
            py::arg("loop_total").noconvert(), py::arg("normals").noconvert(),
            py::arg("normals_per_loop"), py::arg("loop_uvs").noconvert(),
-           py::arg("poly_material").noconvert(), py::arg("loop_tangents").noconvert() = py::none())
+           py::arg("poly_material").noconvert(), py::arg("loop_tangents").noconvert() = py::none(),
+           py::arg("loop_colors").noconvert() = py::none())
       .def("add_instance", &SceneBuilder::add_instance, py::arg("mesh"), py::arg("matrix"),
            py::arg("slot_material"), py::arg("pass_index") = 0,
            py::arg("visibility") = uint32_t(kRayAll), py::arg("holdout") = false)

@@ -130,6 +130,8 @@ InputNode read_input_node(const py::dict& d) {
     n.kind = InputNodeKind::Clamp;
   else if (kind == "RGB_TO_BW")
     n.kind = InputNodeKind::ToBw;
+  else if (kind == "ATTRIBUTE")
+    n.kind = InputNodeKind::Attribute;
   else
     bad_enum("input node kind", kind);
   const std::string blend = get_str(d, "blend", "MIX");
@@ -295,12 +297,14 @@ struct CornerSource {
   bool normals_per_loop = false;
   const float* loop_uvs = nullptr;       // per loop, or null
   const float* loop_tangents = nullptr;  // 4 per loop (tangent, bitangent sign), or null
+  const float* loop_colors = nullptr;    // 3 per loop (colour attribute, linear RGB), or null
 };
 
 CornerSource corner_source(const FloatArray& positions, const IntArray& loop_vertex,
                            const FloatArray& normals, bool normals_per_loop,
                            const FloatArray& loop_uvs,
-                           const std::optional<FloatArray>& loop_tangents) {
+                           const std::optional<FloatArray>& loop_tangents,
+                           const std::optional<FloatArray>& loop_colors) {
   if (positions.size() % 3 != 0) throw std::invalid_argument("positions: size not a multiple of 3");
   CornerSource s;
   s.positions = positions.data();
@@ -319,6 +323,8 @@ CornerSource corner_source(const FloatArray& positions, const IntArray& loop_ver
   if (loop_uvs.size() > 0) s.loop_uvs = checked_data(loop_uvs, s.loop_count * 2, "loop_uvs");
   if (loop_tangents && loop_tangents->size() > 0)
     s.loop_tangents = checked_data(*loop_tangents, s.loop_count * 4, "loop_tangents");
+  if (loop_colors && loop_colors->size() > 0)
+    s.loop_colors = checked_data(*loop_colors, s.loop_count * 3, "loop_colors");
   return s;
 }
 
@@ -375,6 +381,16 @@ Mesh gather_mesh(const CornerSource& src, size_t triangles, bool with_material,
         },
         [](int32_t) {});
   }
+  if (src.loop_colors) {
+    const float* c = src.loop_colors;
+    reserve_fresh(mesh.corner_colors, corner_count);
+    corners(
+        [&](int32_t loop) {
+          const size_t i = 3 * size_t(loop);
+          mesh.corner_colors.emplace_back(c[i], c[i + 1], c[i + 2]);
+        },
+        [](int32_t) {});
+  }
   if (with_material)
     corners([](int32_t) {}, [&](int32_t slot) { mesh.material_slot.push_back(slot); });
   return mesh;
@@ -393,7 +409,8 @@ int SceneBuilder::add_mesh_loops(const FloatArray& positions, const IntArray& lo
                                  const IntArray& corner_loops, const FloatArray& normals,
                                  bool normals_per_loop, const FloatArray& loop_uvs,
                                  const IntArray& material_slot,
-                                 const std::optional<FloatArray>& loop_tangents) {
+                                 const std::optional<FloatArray>& loop_tangents,
+                                 const std::optional<FloatArray>& loop_colors) {
   if (corner_loops.size() % 3 != 0)
     throw std::invalid_argument("corner_loops: size not a multiple of 3");
   if (material_slot.size() > 0 && material_slot.size() * 3 != corner_loops.size())
@@ -401,8 +418,8 @@ int SceneBuilder::add_mesh_loops(const FloatArray& positions, const IntArray& lo
   Mesh mesh;
   {
     py::gil_scoped_release no_gil;
-    const CornerSource src =
-        corner_source(positions, loop_vertex, normals, normals_per_loop, loop_uvs, loop_tangents);
+    const CornerSource src = corner_source(positions, loop_vertex, normals, normals_per_loop,
+                                           loop_uvs, loop_tangents, loop_colors);
     const int32_t* corners = corner_loops.data();
     const size_t triangles = size_t(corner_loops.size()) / 3;
     for (size_t i = 0; i < triangles * 3; ++i)
@@ -427,7 +444,8 @@ int SceneBuilder::add_mesh_polys(const FloatArray& positions, const IntArray& lo
                                  const IntArray& loop_start, const IntArray& loop_total,
                                  const FloatArray& normals, bool normals_per_loop,
                                  const FloatArray& loop_uvs, const IntArray& poly_material,
-                                 const std::optional<FloatArray>& loop_tangents) {
+                                 const std::optional<FloatArray>& loop_tangents,
+                                 const std::optional<FloatArray>& loop_colors) {
   const size_t poly_count = size_t(loop_start.size());
   if (size_t(loop_total.size()) != poly_count)
     throw std::invalid_argument("loop_start / loop_total differ in size");
@@ -436,8 +454,8 @@ int SceneBuilder::add_mesh_polys(const FloatArray& positions, const IntArray& lo
   Mesh mesh;
   {
     py::gil_scoped_release no_gil;
-    const CornerSource src =
-        corner_source(positions, loop_vertex, normals, normals_per_loop, loop_uvs, loop_tangents);
+    const CornerSource src = corner_source(positions, loop_vertex, normals, normals_per_loop,
+                                           loop_uvs, loop_tangents, loop_colors);
     const int32_t* start = loop_start.data();
     const int32_t* total = loop_total.data();
     size_t triangles = 0;
@@ -530,6 +548,7 @@ py::dict SceneBuilder::mesh_arrays(int index) const {
   d["corner_tangents"] = copy(m.corner_tangents, {m.corner_tangents.empty() ? 0 : t, 3, 3}, 0.0f);
   d["corner_tangent_signs"] =
       copy(m.corner_tangent_signs, {m.corner_tangent_signs.empty() ? 0 : t, 3}, 0.0f);
+  d["corner_colors"] = copy(m.corner_colors, {m.corner_colors.empty() ? 0 : t, 3, 3}, 0.0f);
   return d;
 }
 

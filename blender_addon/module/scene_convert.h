@@ -54,18 +54,21 @@ class SceneBuilder {
   // loop_vertex; normals are per vertex (normals_per_loop false: kept per vertex, as
   // Mesh::vertex_normals) or per loop (gathered per corner), or empty; loop_uvs (2 per loop) may
   // be empty; loop_tangents (4 per loop: Blender's loop tangent and bitangent sign, for Normal
-  // Map nodes) may be None or empty.
+  // Map nodes) and loop_colors (3 per loop: a colour attribute, for Color Attribute nodes) may
+  // be None or empty.
   int add_mesh_loops(const FloatArray& positions, const IntArray& loop_vertex,
                      const IntArray& corner_loops, const FloatArray& normals, bool normals_per_loop,
                      const FloatArray& loop_uvs, const IntArray& material_slot,
-                     const std::optional<FloatArray>& loop_tangents);
+                     const std::optional<FloatArray>& loop_tangents,
+                     const std::optional<FloatArray>& loop_colors);
   // Triangle/quad meshes straight from Blender's polygon arrays: triangulated here with Blender's
   // loop-triangle rule (quads split 0-2, or 1-3 when the 0-2 split folds the quad), so the
   // add-on never touches per-triangle data in Python. poly_material: one per polygon.
   int add_mesh_polys(const FloatArray& positions, const IntArray& loop_vertex,
                      const IntArray& loop_start, const IntArray& loop_total,
                      const FloatArray& normals, bool normals_per_loop, const FloatArray& loop_uvs,
-                     const IntArray& poly_material, const std::optional<FloatArray>& loop_tangents);
+                     const IntArray& poly_material, const std::optional<FloatArray>& loop_tangents,
+                     const std::optional<FloatArray>& loop_colors);
   // pass_index: the object's Pass Index (IndexOB pass).
   // visibility: RayKind bits of the rays that see the instance (Object > Visibility > Ray
   // Visibility).

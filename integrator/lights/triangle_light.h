@@ -23,7 +23,8 @@ struct TriangleLight {
   Vec3f normal;      // geometric normal (unit), winding order
   float area = 0.0f;
   Vec2f uv0, uv1, uv2;
-  uint32_t material = 0;  // index into the materials span
+  Vec3f color0{0.0f}, color1{0.0f}, color2{0.0f};  // colour attribute at the corners
+  uint32_t material = 0;                           // index into the materials span
   float select_pmf = 0.0f;
   float max_edge2 = 0.0f;  // squared longest edge
 
@@ -96,6 +97,8 @@ struct TriangleLight {
     }
     ShadingContext ctx;
     ctx.uv = uv_at(b.x, b.y);
+    const Vec3f color = color0 * (1.0f - b.x - b.y) + color1 * b.x + color2 * b.y;
+    ctx.color = &color;
     ctx.front_facing = dot(dir, normal) < 0.0f;  // the receiver is on the normal's side
     s.radiance = m.emission(ctx);
     s.position = p;

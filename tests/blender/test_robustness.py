@@ -72,9 +72,10 @@ def test_unsupported_node(out):
 
 
 def test_normal_map_limits(out):
-    """Normal maps Gradient PT cannot apply are reported, and the render still finishes: a
-    normal-mapped mesh without a UV map, one with a 5-sided face (Blender computes no tangents
-    for it), an object-space Normal Map node and a Bump node."""
+    """Normal maps and attributes Gradient PT cannot apply are reported, and the render still
+    finishes: a normal-mapped mesh without a UV map, one with a 5-sided face (Blender computes no
+    tangents for it), an object-space Normal Map node, a Bump node, a Color Attribute node
+    naming an attribute the mesh lacks."""
     scene = S.clear()
     basic_scene(scene)
     img = S.normal_map_image("bumps")
@@ -93,10 +94,19 @@ def test_normal_map_limits(out):
     nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
     S.uv_sphere("ball", 0.5, (-0.8, 0.3, 0.5), obj_space)
     S.uv_sphere("ball2", 0.5, (0.8, 0.3, 0.5), m)
+    # A Color Attribute node on a mesh without that attribute: reported, read as black.
+    painted, nt, outn = S._material("painted")
+    attr = nt.nodes.new("ShaderNodeVertexColor")
+    attr.layer_name = "Missing"
+    bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    nt.links.new(attr.outputs["Color"], bsdf.inputs["Color"])
+    nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
+    S.uv_sphere("unpainted", 0.4, (0, 1.0, 0.4), painted)
     path, warnings = render_finished(scene, os.path.join(out, "normal_map_limits.exr"))
     for needle, what in (("'no_uvs'", "the mesh without UVs"), ("'pentagon'", "the 5-sided face"),
                          ("object-space normal map", "the object-space map"),
-                         ("My Bump", "the Bump node")):
+                         ("My Bump", "the Bump node"),
+                         ("no colour attribute 'Missing'", "the missing colour attribute")):
         check(sum(needle in w for w in warnings) == 1, f"one warning names {what}")
     check(S.read_rgb(path).mean() > 0.01, "the image was written")
 

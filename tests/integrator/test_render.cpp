@@ -253,6 +253,46 @@ TEST(Render, NormalMapTiltsTheShadingNormalAsCycles) {
     }
 }
 
+// A Color Attribute node: the albedo is the mesh's interpolated corner colour (a plane whose
+// corners are all one colour, under a sun straight above: L = colour E / pi per channel), PT and
+// G-PT; a mesh without colours reads black, as in Cycles.
+TEST(Render, ColorAttributeIsTheInterpolatedCornerColour) {
+  const Spectrum c(0.2f, 0.5f, 0.8f);
+  for (const bool with_colors : {true, false})
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      Scene scene;
+      Mesh plane = quad(50.0f);
+      if (with_colors) plane.corner_colors.assign(6, c);
+      scene.meshes.push_back(plane);
+      MaterialDesc m = diffuse(Spectrum(0.9f));
+      InputNode attribute;
+      attribute.kind = InputNodeKind::Attribute;
+      m.inputs.push_back(attribute);
+      m.nodes[0].color.node = 0;
+      scene.materials.push_back(m);
+      scene.instances.push_back(place(0, 0));
+      scene.world.color = Spectrum(0.0f);
+      Light sun;
+      sun.type = Light::Type::Sun;
+      sun.power = 3.0f;
+      sun.light_to_world = translation({0, 0, 20});
+      scene.lights.push_back(sun);
+      scene.camera = top_camera(8, 2.0f);
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      s.max_bounces = 0;
+      const Image img = render(scene, s);
+      for (int ch = 0; ch < 3; ++ch) {
+        double sum = 0.0;
+        for (size_t i = size_t(ch); i < img.primal.size(); i += 3) sum += img.primal[i];
+        const double expect = with_colors ? c[ch] * 3.0 / kPi : 0.0;
+        EXPECT_NEAR(sum / (img.primal.size() / 3), expect, 1e-3 * (1.0 + expect))
+            << "channel " << ch << " colours " << with_colors << " G-PT "
+            << (mode == RenderSettings::Mode::GPT);
+      }
+    }
+}
+
 TEST(Render, SoftSunOnLambertPlane) {
   sun_test(0.6f, 0.02f);  // a 1.1-degree disc: cos varies by < 1e-4 over it
 }
