@@ -21,7 +21,7 @@ _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
-                'CLAMP', 'RGBTOBW', 'VERTEX_COLOR'}
+                'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -322,11 +322,14 @@ class _Translator:
                  "value_b": self.value(node.inputs["Min"]),
                  "value_c": self.value(node.inputs["Max"]),
                  "clamp_range": node.clamp_type == 'RANGE'}
-        elif node.type == 'VERTEX_COLOR' and out.name == "Color":
-            if self.color_attribute is not None and self.color_attribute != node.layer_name:
+        elif out.name == "Color" and (node.type == 'VERTEX_COLOR' or (
+                node.type == 'ATTRIBUTE' and node.attribute_type == 'GEOMETRY')):
+            # Color Attribute node, or the Attribute node naming a colour attribute.
+            name = node.layer_name if node.type == 'VERTEX_COLOR' else node.attribute_name
+            if self.color_attribute is not None and self.color_attribute != name:
                 self.warn(node, "second colour attribute (the first one is used) in")
             if self.color_attribute is None:
-                self.color_attribute = node.layer_name
+                self.color_attribute = name
             d = {"kind": "ATTRIBUTE"}
         elif node.type == 'RGBTOBW':
             d = {"kind": "RGB_TO_BW", "a": self.color(node.inputs["Color"])}
