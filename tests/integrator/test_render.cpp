@@ -170,12 +170,14 @@ TEST(Render, WhiteFurnace) {
   EXPECT_NEAR(sum / (img.w * img.h), 1.0, 0.01);
 }
 
-// Plane of albedo 0.5 under a sun of irradiance E at angle theta: L = albedo E cos(theta) / pi.
-void sun_test(float theta, float sun_angle) {
+// `plane` (placed by `placement`) with `material` under a sun of irradiance 3 tilted by `theta`
+// about x, seen from straight above by an 8x8 orthographic camera, on a black world.
+Scene sunlit_plane(Mesh plane, MaterialDesc material, float theta, Transform placement = {},
+                   float sun_angle = 0.0f) {
   Scene scene;
-  scene.meshes.push_back(quad(50.0f));
-  scene.materials.push_back(diffuse(Spectrum(0.5f)));
-  scene.instances.push_back(place(0, 0));
+  scene.meshes.push_back(std::move(plane));
+  scene.materials.push_back(std::move(material));
+  scene.instances.push_back(place(0, 0, placement));
   scene.world.color = Spectrum(0.0f);
   Light sun;
   sun.type = Light::Type::Sun;
@@ -184,6 +186,12 @@ void sun_test(float theta, float sun_angle) {
   sun.light_to_world = rotation_x(theta, {0, 0, 20});
   scene.lights.push_back(sun);
   scene.camera = top_camera(8, 2.0f);
+  return scene;
+}
+
+// Plane of albedo 0.5 under a sun of irradiance E at angle theta: L = albedo E cos(theta) / pi.
+void sun_test(float theta, float sun_angle) {
+  const Scene scene = sunlit_plane(quad(50.0f), diffuse(Spectrum(0.5f)), theta, {}, sun_angle);
   const Image img = render(scene, pt(16));
   const double expect = 0.5 * 3.0 * std::cos(theta) / kPi;
   double sum = 0.0;
@@ -217,29 +225,19 @@ TEST(Render, NormalMapTiltsTheShadingNormalAsCycles) {
   };
   for (const Case& c : cases)
     for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
-      Scene scene;
       Mesh plane = quad(50.0f);
       plane.corner_tangents.assign(6, Vec3f(1, 0, 0));
       plane.corner_tangent_signs.assign(6, 1.0f);
-      scene.meshes.push_back(plane);
       MaterialDesc m = diffuse(Spectrum(0.5f));
       m.normal_map.enabled = true;
       m.normal_map.color =
           ColorInput(Spectrum(0.5f + 0.5f * float(sx), 0.5f, 0.5f + 0.5f * float(cz)));
       m.normal_map.strength = c.strength;
-      scene.materials.push_back(m);
       Transform rot;
       rot.m[0][0] = rot.m[1][1] = std::cos(c.rotate_z);
       rot.m[0][1] = -std::sin(c.rotate_z);
       rot.m[1][0] = std::sin(c.rotate_z);
-      scene.instances.push_back(place(0, 0, rot));
-      scene.world.color = Spectrum(0.0f);
-      Light sun;
-      sun.type = Light::Type::Sun;
-      sun.power = 3.0f;
-      sun.light_to_world = rotation_x(c.sun_theta, {0, 0, 20});
-      scene.lights.push_back(sun);
-      scene.camera = top_camera(8, 2.0f);
+      const Scene scene = sunlit_plane(plane, m, c.sun_theta, rot);
       RenderSettings s = pt(16);
       s.mode = mode;
       s.max_bounces = 0;
@@ -260,24 +258,14 @@ TEST(Render, ColorAttributeIsTheInterpolatedCornerColour) {
   const Spectrum c(0.2f, 0.5f, 0.8f);
   for (const bool with_colors : {true, false})
     for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
-      Scene scene;
       Mesh plane = quad(50.0f);
       if (with_colors) plane.corner_colors.assign(6, c);
-      scene.meshes.push_back(plane);
       MaterialDesc m = diffuse(Spectrum(0.9f));
       InputNode attribute;
       attribute.kind = InputNodeKind::Attribute;
       m.inputs.push_back(attribute);
       m.nodes[0].color.node = 0;
-      scene.materials.push_back(m);
-      scene.instances.push_back(place(0, 0));
-      scene.world.color = Spectrum(0.0f);
-      Light sun;
-      sun.type = Light::Type::Sun;
-      sun.power = 3.0f;
-      sun.light_to_world = translation({0, 0, 20});
-      scene.lights.push_back(sun);
-      scene.camera = top_camera(8, 2.0f);
+      const Scene scene = sunlit_plane(plane, m, 0.0f);
       RenderSettings s = pt(4);
       s.mode = mode;
       s.max_bounces = 0;
