@@ -173,10 +173,18 @@ void EmbreeScene::set_materials(std::span<const Material> materials) {
   auto reads = [&](int32_t m) {
     return m >= 0 && size_t(m) < materials.size() && materials[size_t(m)].reads_color_attribute();
   };
+  auto perturbs = [&](int32_t m) {
+    return m >= 0 && size_t(m) < materials.size() &&
+           (materials[size_t(m)].has_normal_map() || materials[size_t(m)].has_bump());
+  };
   for (InstanceData& d : instances_) {
     d.writes_color =
         d.corner_colors != nullptr || reads(d.uniform_material) || reads(default_material_);
-    for (int32_t m : d.slot_materials) d.writes_color = d.writes_color || reads(m);
+    d.perturbs_normal = perturbs(d.uniform_material) || perturbs(default_material_);
+    for (int32_t m : d.slot_materials) {
+      d.writes_color = d.writes_color || reads(m);
+      d.perturbs_normal = d.perturbs_normal || perturbs(m);
+    }
   }
 }
 
@@ -321,7 +329,7 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
                        ? d.slot_materials[size_t(slot)]
                        : default_material_;
   }
-  if (primitive < d.corner_tangent_tris) [[unlikely]]
+  if (d.perturbs_normal) [[unlikely]]
     map_normal(d, primitive, u, v, hit);
 }
 
@@ -334,7 +342,8 @@ void EmbreeScene::map_normal(const InstanceData& d, uint32_t primitive, float u,
                              SurfaceHit& hit) const {
   if (size_t(hit.material) >= materials_.size()) return;
   const Material& material = materials_[size_t(hit.material)];
-  if (!material.has_normal_map()) return;
+  if (material.has_bump()) return bump_normal(d, primitive, hit, material);
+  if (!material.has_normal_map() || primitive >= d.corner_tangent_tris) return;
   const float w = 1.0f - u - v;
   const Vec3f* T = d.corner_tangents + size_t(primitive) * 3;
   const float* S = d.corner_tangent_signs + size_t(primitive) * 3;
@@ -353,6 +362,55 @@ void EmbreeScene::map_normal(const InstanceData& d, uint32_t primitive, float u,
   const Vec3f mapped = t * c.x + b * c.y + n * c.z;
   const float l2 = length_squared(mapped);
   if (l2 > 0.0f && std::isfinite(l2)) hit.shading_normal = mapped / std::sqrt(l2);
+}
+
+// Cycles' bump (svm_node_set_bump) tilts N against the surface gradient of the height, which it
+// takes from heights at the ray differentials' offsets: to first order N' = normalize(N -
+// distance grad h). Here grad h comes from forward differences of the height in UV, mapped to
+// the surface through the triangle's UV parameterisation (grad u, grad v in its plane). Cycles
+// works with the normal facing the ray: on back faces the tilt flips with it.
+void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
+                              const Material& material) const {
+  if (primitive >= d.corner_uv_tris) return;  // no UVs: no gradient
+  const uint32_t* idx = d.indices + size_t(primitive) * 3;
+  Vec3f p[3];
+  for (int k = 0; k < 3; ++k) {
+    const Vec3f q = d.positions[idx[k]];
+    if (d.world_space) {
+      p[k] = q;
+    } else {
+      for (int r = 0; r < 3; ++r)
+        p[k][r] =
+            d.to_world_cols[0][r] * q.x + d.to_world_cols[1][r] * q.y + d.to_world_cols[2][r] * q.z;
+    }
+  }
+  const Vec2f* T = d.corner_uvs + size_t(primitive) * 3;
+  const Vec3f e1 = p[1] - p[0], e2 = p[2] - p[0];
+  const float du1 = T[1].x - T[0].x, dv1 = T[1].y - T[0].y;
+  const float du2 = T[2].x - T[0].x, dv2 = T[2].y - T[0].y;
+  const float det = du1 * dv2 - du2 * dv1;
+  if (!(std::fabs(det) > 0.0f)) return;
+  // dP/du, dP/dv, then the gradients of u and v in the triangle's plane.
+  const Vec3f dpdu = (e1 * dv2 - e2 * dv1) / det, dpdv = (e2 * du1 - e1 * du2) / det;
+  const Vec3f ng = cross(e1, e2);
+  const float jac = dot(ng, cross(dpdu, dpdv));
+  if (!(std::fabs(jac) > 0.0f) || !std::isfinite(jac)) return;
+  const Vec3f grad_u = cross(dpdv, ng) / jac, grad_v = cross(ng, dpdu) / jac;
+  constexpr float kStep = 1.0f / 1024.0f;  // in UV: about a quarter texel of a 256 image
+  float h[3];
+  material.bump_heights(hit.uv, d.writes_color ? &hit.color : nullptr, kStep, h);
+  const Vec3f grad = (grad_u * (h[1] - h[0]) + grad_v * (h[2] - h[0])) / kStep;
+  const BumpDesc& b = material.bump();
+  float distance = b.invert ? -b.distance : b.distance;
+  if (!hit.front_facing) distance = -distance;
+  const Vec3f n = hit.shading_normal;
+  const Vec3f bumped = n - grad * distance;
+  const float l2 = length_squared(bumped);
+  if (!(l2 > 0.0f) || !std::isfinite(l2)) return;
+  const float strength = std::max(b.strength, 0.0f);
+  const Vec3f mixed = bumped / std::sqrt(l2) * strength + n * (1.0f - strength);
+  const float m2 = length_squared(mixed);
+  if (m2 > 0.0f && std::isfinite(m2)) hit.shading_normal = mixed / std::sqrt(m2);
 }
 
 }  // namespace gdpt

@@ -184,7 +184,8 @@ class EmbreeScene {
     uint32_t corner_uv_tris = 0;
     const Vec3f* corner_colors = nullptr;  // Color Attribute nodes, primitives < corner_color_tris
     uint32_t corner_color_tris = 0;
-    bool writes_color = false;               // hits fill SurfaceHit::color (set_materials)
+    bool writes_color = false;     // hits fill SurfaceHit::color (set_materials)
+    bool perturbs_normal = false;  // some material has a normal map or a bump (set_materials)
     const Vec3f* corner_tangents = nullptr;  // Normal Map nodes, primitives < corner_tangent_tris
     const float* corner_tangent_signs = nullptr;
     uint32_t corner_tangent_tris = 0;
@@ -204,9 +205,12 @@ class EmbreeScene {
   RTCScene top_ = nullptr;
   std::vector<RTCScene> mesh_scenes_;
   std::vector<InstanceData> instances_;  // indexed by top-level Embree geometry id
-  // Replaces hit.shading_normal by the material's normal map, if it has one (out of line: rare).
+  // Replaces hit.shading_normal by the material's normal map or bump, if it has one (out of
+  // line: rare).
   [[gnu::noinline]] void map_normal(const InstanceData& d, uint32_t primitive, float u, float v,
                                     SurfaceHit& hit) const;
+  void bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
+                   const Material& material) const;
 
   std::span<const Material> materials_;
   int32_t default_material_ = -1;

@@ -435,6 +435,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
   inputs_ = desc.inputs;
   root_ = desc.root;
   normal_map_ = desc.normal_map;
+  bump_ = desc.bump;
   const std::string where = "material '" + desc.name + "': ";
   auto check_node = [&](int32_t i) {
     if (i < 0 || size_t(i) >= nodes_.size())
@@ -563,6 +564,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
   };
   visit(visit, root_, 0);
   if (normal_map_.enabled) note(normal_map_.color);
+  if (bump_.enabled) note(bump_.height);
 
   // --- Mean of every texture the tree uses, for average_emission().
   std::vector<Rgba> means(textures.size());
@@ -609,6 +611,15 @@ Vec3f Material::normal_map_direction(Vec2f uv) const {
   const float s = normal_map_.strength;
   return {2.0f * (c.x - 0.5f) * s, 2.0f * (c.y - 0.5f) * s,
           1.0f + (2.0f * (c.z - 0.5f) - 1.0f) * std::clamp(s, 0.0f, 1.0f)};
+}
+
+void Material::bump_heights(Vec2f uv, const Vec3f* color, float du, float h[3]) const {
+  for (int i = 0; i < 3; ++i) {
+    const Vec2f at(uv.x + (i == 1 ? du : 0.0f), uv.y + (i == 2 ? du : 0.0f));
+    PointInputs in{textures_, inputs_, at, true};
+    in.attribute = color;
+    h[i] = in.scalar(bump_.height);
+  }
 }
 
 }  // namespace gdpt

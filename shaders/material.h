@@ -44,6 +44,11 @@ class Material {
   // Normal Map node (NormalMapDesc): the tangent-space direction at `uv`, strength applied, not
   // normalised (x tangent, y bitangent, z normal).
   bool has_normal_map() const { return normal_map_.enabled; }
+  // Bump node (BumpDesc): heights at uv and one step `du` along u and along v (forward
+  // differences).
+  bool has_bump() const { return bump_.enabled; }
+  const BumpDesc& bump() const { return bump_; }
+  void bump_heights(Vec2f uv, const Vec3f* color, float du, float h[3]) const;
   // Some input reads the mesh's colour attribute (ShadingContext::color).
   bool reads_color_attribute() const { return reads_color_attribute_; }
   Vec3f normal_map_direction(Vec2f uv) const;
@@ -61,6 +66,7 @@ class Material {
   std::span<const Texture> textures_;
   uint32_t features_ = 0;
   NormalMapDesc normal_map_;
+  BumpDesc bump_;
   bool reads_color_attribute_ = false;
   Spectrum average_emission_{0.0f, 0.0f, 0.0f};
 };

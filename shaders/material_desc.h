@@ -134,11 +134,24 @@ struct NormalMapDesc {
   float strength = 1.0f;
 };
 
+// Blender's Bump node on the material's BSDF Normal inputs: the shading normal tilts against the
+// surface gradient of `height`, N' = normalize(N - distance grad h) (Cycles' svm_node_set_bump to
+// first order in its ray differentials; the gradient here is a forward difference in UV), then
+// mixed with N by strength. Invert negates the distance.
+struct BumpDesc {
+  bool enabled = false;
+  FloatInput height{0.0f};
+  float strength = 1.0f;
+  float distance = 1.0f;
+  bool invert = false;
+};
+
 struct MaterialDesc {
   std::string name;
   std::vector<ShaderNode> nodes;
   int32_t root = -1;              // -1: Blender's default grey diffuse (0.8)
   NormalMapDesc normal_map;       // needs the meshes' corner tangents (Mesh::corner_tangents)
+  BumpDesc bump;                  // needs UVs; not together with normal_map
   std::vector<InputNode> inputs;  // referenced by ColorInput::node / FloatInput::node
   float pass_index = 0.0f;        // Blender's Material > Settings > Pass Index (the IndexMA pass)
 };

@@ -40,6 +40,7 @@ class _Translator:
         self.warned = set()
         self.nodes = []
         self.normal_map = None  # (Normal Map node, its dict) of the BSDFs' Normal inputs
+        self.bump = None  # (Bump node, its dict), likewise
         self.inputs = []  # colour / math input nodes (MaterialDesc::inputs)
         self.color_attribute = None  # name read by Color Attribute nodes ("": the render one)
         self.input_index = {}  # node name -> index in self.inputs
@@ -186,15 +187,18 @@ class _Translator:
         if out is None:
             return
         node = out.node
+        if node.type == 'BUMP':
+            self._bump(node)
+            return
         if node.type != 'NORMAL_MAP':
             self.warn(node, "normal / tangent input node")
             return
         if node.space != 'TANGENT':
             self.warn(node, f"{node.space.lower()}-space normal map")
             return
-        if self.normal_map is not None:
-            if self.normal_map[0] != node:
-                self.warn(node, "second normal map (the first one is used) in")
+        if self.normal_map is not None or self.bump is not None:
+            if self.normal_map is None or self.normal_map[0] != node:
+                self.warn(node, "second normal perturbation (the first one is used) in")
             return
         if node.uv_map:
             self.warn(node, "UV map other than the active render UV map in")
@@ -202,6 +206,23 @@ class _Translator:
             self.warn(node, "linked Strength (its default value is used) of")
         self.normal_map = (node, {"color": self.color(node.inputs["Color"]),
                                   "strength": float(node.inputs["Strength"].default_value)})
+
+    def _bump(self, node):
+        """A Bump node on a BSDF's Normal input: the material's bump (one per material, not
+        with a normal map; its own Normal input is not followed)."""
+        if self.normal_map is not None or self.bump is not None:
+            if self.bump is None or self.bump[0] != node:
+                self.warn(node, "second normal perturbation (the first one is used) in")
+            return
+        for name in ("Strength", "Distance"):
+            if node.inputs[name].is_linked:
+                self.warn(node, f"linked {name} (its default value is used) of")
+        if node.inputs["Normal"].is_linked:
+            self.warn(node, "linked Normal (not followed) of")
+        self.bump = (node, {"height": self.value(node.inputs["Height"]),
+                            "strength": float(node.inputs["Strength"].default_value),
+                            "distance": float(node.inputs["Distance"].default_value),
+                            "invert": bool(node.invert)})
 
     def color(self, socket):
         d = {"value": self._default_rgb(socket)}
@@ -446,6 +467,8 @@ def _translate_surface(material, images, warn):
     d = {"name": material.name, "nodes": t.nodes, "root": root, "inputs": t.inputs}
     if t.normal_map is not None:
         d["normal_map"] = t.normal_map[1]
+    if t.bump is not None:
+        d["bump"] = t.bump[1]
     if t.color_attribute is not None:
         d["color_attribute"] = t.color_attribute
     return d

@@ -612,6 +612,15 @@ int SceneBuilder::add_material(const py::dict& material) {
   if (material.contains("inputs"))
     for (const auto& item : material["inputs"].cast<py::list>())
       desc.inputs.push_back(read_input_node(item.cast<py::dict>()));
+  // Bump node: {"height": float input, "strength", "distance": float, "invert": bool}.
+  if (material.contains("bump")) {
+    const auto d = material["bump"].cast<py::dict>();
+    desc.bump.enabled = true;
+    read_float(d, "height", desc.bump.height);
+    get(d, "strength", desc.bump.strength);
+    get(d, "distance", desc.bump.distance);
+    get(d, "invert", desc.bump.invert);
+  }
   // Normal Map node (tangent space): {"color": colour input, "strength": float}.
   if (material.contains("normal_map")) {
     const auto d = material["normal_map"].cast<py::dict>();
@@ -635,7 +644,8 @@ int SceneBuilder::add_material(const py::dict& material) {
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
     }
   }
-  if (desc.normal_map.color.texture.image >= int32_t(scene_.images.size()))
+  if (desc.normal_map.color.texture.image >= int32_t(scene_.images.size()) ||
+      desc.bump.height.texture.image >= int32_t(scene_.images.size()))
     throw std::invalid_argument("material '" + desc.name + "': image index out of range");
   for (const InputNode& node : desc.inputs)
     for (const TextureLookup* t :

@@ -74,8 +74,8 @@ def test_unsupported_node(out):
 def test_normal_map_limits(out):
     """Normal maps and attributes Gradient PT cannot apply are reported, and the render still
     finishes: a normal-mapped mesh without a UV map, one with a 5-sided face (Blender computes no
-    tangents for it), an object-space Normal Map node, a Bump node, a Color Attribute node
-    naming an attribute the mesh lacks."""
+    tangents for it), an object-space Normal Map node, a Geometry node's Normal, a Color
+    Attribute node naming an attribute the mesh lacks."""
     scene = S.clear()
     basic_scene(scene)
     img = S.normal_map_image("bumps")
@@ -86,11 +86,11 @@ def test_normal_map_limits(out):
                                (1, 0, 0.01)], [(0, 1, 2, 3, 4)], tangent)
     obj_space = S.normal_mapped("object_space", "ShaderNodeBsdfDiffuse", img, 1.0)
     next(n for n in obj_space.node_tree.nodes if n.type == 'NORMAL_MAP').space = 'OBJECT'
-    m, nt, outn = S._material("bumped")
-    bump = nt.nodes.new("ShaderNodeBump")
-    bump.name = "My Bump"
+    m, nt, outn = S._material("geometry_normal")
+    geometry = nt.nodes.new("ShaderNodeNewGeometry")
+    geometry.name = "My Geometry"
     bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
-    nt.links.new(bump.outputs["Normal"], bsdf.inputs["Normal"])
+    nt.links.new(geometry.outputs["Normal"], bsdf.inputs["Normal"])
     nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
     S.uv_sphere("ball", 0.5, (-0.8, 0.3, 0.5), obj_space)
     S.uv_sphere("ball2", 0.5, (0.8, 0.3, 0.5), m)
@@ -105,7 +105,7 @@ def test_normal_map_limits(out):
     path, warnings = render_finished(scene, os.path.join(out, "normal_map_limits.exr"))
     for needle, what in (("'no_uvs'", "the mesh without UVs"), ("'pentagon'", "the 5-sided face"),
                          ("object-space normal map", "the object-space map"),
-                         ("My Bump", "the Bump node"),
+                         ("My Geometry", "the Geometry node's normal"),
                          ("no colour attribute 'Missing'", "the missing colour attribute")):
         check(sum(needle in w for w in warnings) == 1, f"one warning names {what}")
     check(S.read_rgb(path).mean() > 0.01, "the image was written")

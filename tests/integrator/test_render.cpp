@@ -281,6 +281,54 @@ TEST(Render, ColorAttributeIsTheInterpolatedCornerColour) {
     }
 }
 
+// A Bump node whose height rises linearly along u (a 2x1 texture 0 -> 1, bilinear: slope 2 per
+// unit of u between the pixel centres) on a 100 m plane mapped to [0, 1]^2: grad h = 0.02 / m
+// along x, so with distance 10 the normal tilts to normalize(0, 0, 1) - (0.2, 0, 0)) and the sun
+// straight above lights it with cos = 1 / sqrt(1.04); strength 0.5 mixes it half-way back
+// towards the normal; invert tilts the other way (same cosine). PT and G-PT.
+TEST(Render, BumpTiltsTheNormalAgainstTheHeightGradient) {
+  ImageDesc ramp;
+  ramp.name = "ramp";
+  ramp.width = 2;
+  ramp.height = 1;
+  ramp.rgba = {0, 0, 0, 1, 1, 1, 1, 1};
+  const double tilted = 1.0 / std::sqrt(1.04);
+  // Strength 0.5: normalize(0.5 n' + 0.5 n), n' = (-0.2, 0, 1) / sqrt(1.04).
+  const double hx = 0.5 * -0.2 / std::sqrt(1.04), hz = 0.5 / std::sqrt(1.04) + 0.5;
+  const double half = hz / std::sqrt(hx * hx + hz * hz);
+  struct Case {
+    float strength;
+    bool invert;
+    double cosine;
+  };
+  for (const Case& c :
+       {Case{1.0f, false, tilted}, Case{0.5f, false, half}, Case{1.0f, true, tilted}})
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      Mesh plane = quad(50.0f);
+      plane.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
+      MaterialDesc m = diffuse(Spectrum(0.5f));
+      m.bump.enabled = true;
+      m.bump.height.texture.image = 0;
+      m.bump.height.texture.extension = TextureLookup::Extension::Extend;
+      m.bump.height.channel = FloatInput::Channel::Red;
+      m.bump.distance = 10.0f;
+      m.bump.strength = c.strength;
+      m.bump.invert = c.invert;
+      Scene scene = sunlit_plane(plane, m, 0.0f);
+      scene.images.push_back(ramp);
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      s.max_bounces = 0;
+      const Image img = render(scene, s);
+      double sum = 0.0;
+      for (float v : img.primal) sum += v;
+      const double expect = 0.5 * 3.0 * c.cosine / kPi;
+      EXPECT_NEAR(sum / img.primal.size(), expect, 1e-3 * expect)
+          << "strength " << c.strength << " invert " << c.invert << " G-PT "
+          << (mode == RenderSettings::Mode::GPT);
+    }
+}
+
 TEST(Render, SoftSunOnLambertPlane) {
   sun_test(0.6f, 0.02f);  // a 1.1-degree disc: cos varies by < 1e-4 over it
 }
