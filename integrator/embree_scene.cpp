@@ -330,16 +330,36 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
                        : default_material_;
   }
   if (d.perturbs_normal) [[unlikely]]
-    map_normal(d, primitive, u, v, hit);
+    perturb_normal(d, primitive, u, v, hit);
 }
+
+namespace {
+
+// The linear part of a transform (its columns, InstanceData::to_world_cols) applied to v (a
+// direction, or a position whose translation cancels in differences).
+Vec3f world_direction(const float (*cols)[4], Vec3f v) {
+  Vec3f w;
+  for (int r = 0; r < 3; ++r) w[r] = cols[0][r] * v.x + cols[1][r] * v.y + cols[2][r] * v.z;
+  return w;
+}
+
+// out = v / |v| when that is finite and non-zero (else out keeps its value); whether it was set.
+bool set_unit(Vec3f v, Vec3f& out) {
+  const float l2 = length_squared(v);
+  if (!(l2 > 0.0f) || !std::isfinite(l2)) return false;
+  out = v / std::sqrt(l2);
+  return true;
+}
+
+}  // namespace
 
 // Cycles builds the normal-mapped normal in object space, x t + y s (n x t) + z n, and moves it
 // to world space as a normal. Here the same combination is formed in world space around the
 // (unit) shading normal: the tangent moves as a direction, keeping its object-space length (the
 // interpolated MikkTSpace tangent is ~unit there, as the normal), and a mirroring transform
 // flips n x t. Equal to Cycles' up to normalisation for rotations, mirrors and uniform scales.
-void EmbreeScene::map_normal(const InstanceData& d, uint32_t primitive, float u, float v,
-                             SurfaceHit& hit) const {
+void EmbreeScene::perturb_normal(const InstanceData& d, uint32_t primitive, float u, float v,
+                                 SurfaceHit& hit) const {
   if (size_t(hit.material) >= materials_.size()) return;
   const Material& material = materials_[size_t(hit.material)];
   if (material.has_bump()) return bump_normal(d, primitive, hit, material);
@@ -349,19 +369,14 @@ void EmbreeScene::map_normal(const InstanceData& d, uint32_t primitive, float u,
   const float* S = d.corner_tangent_signs + size_t(primitive) * 3;
   const Vec3f t_object = T[0] * w + T[1] * u + T[2] * v;
   const float sign = S[0] * w + S[1] * u + S[2] * v;
-  Vec3f t;
-  for (int r = 0; r < 3; ++r)
-    t[r] = d.to_world_cols[0][r] * t_object.x + d.to_world_cols[1][r] * t_object.y +
-           d.to_world_cols[2][r] * t_object.z;
+  Vec3f t = world_direction(d.to_world_cols, t_object);
   const float tl = length(t);
   if (!(tl > 0.0f) || !std::isfinite(tl)) return;  // no tangent here (no UVs): unchanged
   t = t * (length(t_object) / tl);
   const Vec3f n = hit.shading_normal;
   const Vec3f b = cross(n, t) * (sign * d.winding);
   const Vec3f c = material.normal_map_direction(hit.uv);
-  const Vec3f mapped = t * c.x + b * c.y + n * c.z;
-  const float l2 = length_squared(mapped);
-  if (l2 > 0.0f && std::isfinite(l2)) hit.shading_normal = mapped / std::sqrt(l2);
+  set_unit(t * c.x + b * c.y + n * c.z, hit.shading_normal);
 }
 
 // Cycles' bump (svm_node_set_bump) tilts N against the surface gradient of the height, which it
@@ -376,13 +391,8 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
   Vec3f p[3];
   for (int k = 0; k < 3; ++k) {
     const Vec3f q = d.positions[idx[k]];
-    if (d.world_space) {
-      p[k] = q;
-    } else {
-      for (int r = 0; r < 3; ++r)
-        p[k][r] =
-            d.to_world_cols[0][r] * q.x + d.to_world_cols[1][r] * q.y + d.to_world_cols[2][r] * q.z;
-    }
+    p[k] = d.world_space ? q
+                         : world_direction(d.to_world_cols, q);  // differences only: no translation
   }
   const Vec2f* T = d.corner_uvs + size_t(primitive) * 3;
   const Vec3f e1 = p[1] - p[0], e2 = p[2] - p[0];
@@ -404,13 +414,10 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
   float distance = b.invert ? -b.distance : b.distance;
   if (!hit.front_facing) distance = -distance;
   const Vec3f n = hit.shading_normal;
-  const Vec3f bumped = n - grad * distance;
-  const float l2 = length_squared(bumped);
-  if (!(l2 > 0.0f) || !std::isfinite(l2)) return;
+  Vec3f bumped;
+  if (!set_unit(n - grad * distance, bumped)) return;
   const float strength = std::max(b.strength, 0.0f);
-  const Vec3f mixed = bumped / std::sqrt(l2) * strength + n * (1.0f - strength);
-  const float m2 = length_squared(mixed);
-  if (m2 > 0.0f && std::isfinite(m2)) hit.shading_normal = mixed / std::sqrt(m2);
+  set_unit(bumped * strength + n * (1.0f - strength), hit.shading_normal);
 }
 
 }  // namespace gdpt

@@ -131,10 +131,10 @@ class EmbreeScene {
   void intersect_stream(const Ray* rays, const bool* valid, int n, bool* found,
                         SurfaceHit* hits) const;
 
-  // The scene's materials (indexed as SurfaceHit::material), for Normal Map nodes: hits on
-  // meshes with tangents whose material has one get the mapped shading normal. Unset: none.
-  // Also decides which instances' hits carry a colour attribute: those whose mesh has one or
-  // whose materials read one (black then); other hits skip it.
+  // The scene's materials (indexed as SurfaceHit::material), for Normal Map and Bump nodes and
+  // colour attributes. Decides per instance whether its hits perturb the shading normal (some
+  // material has a normal map or bump) and carry a colour attribute (the mesh has one, or some
+  // material reads one: black then); other hits skip both. Unset: neither.
   void set_materials(std::span<const Material> materials);
 
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
@@ -207,8 +207,8 @@ class EmbreeScene {
   std::vector<InstanceData> instances_;  // indexed by top-level Embree geometry id
   // Replaces hit.shading_normal by the material's normal map or bump, if it has one (out of
   // line: rare).
-  [[gnu::noinline]] void map_normal(const InstanceData& d, uint32_t primitive, float u, float v,
-                                    SurfaceHit& hit) const;
+  [[gnu::noinline]] void perturb_normal(const InstanceData& d, uint32_t primitive, float u, float v,
+                                        SurfaceHit& hit) const;
   void bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
                    const Material& material) const;
 

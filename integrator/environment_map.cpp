@@ -41,7 +41,7 @@ Spectrum EnvironmentMap::stored_texel(int x, int y) const {
 
 Spectrum EnvironmentMap::decoded(Spectrum stored) const {
   if (!image_->srgb_encoded) return stored;
-  return {srgb_to_linear(stored.x), srgb_to_linear(stored.y), srgb_to_linear(stored.z)};
+  return srgb_to_linear(stored);
 }
 
 Spectrum EnvironmentMap::texel(int x, int y) const {

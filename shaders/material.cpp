@@ -192,8 +192,8 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       break;
     }
     case InputNodeKind::MapRange: {
-      // Blender's Map Range (Linear, float): bounds in ramp[0..3] (from min / max, to min / max).
-      const float* b = n.ramp.data();
+      // Blender's Map Range (Linear, float).
+      const std::array<float, 4>& b = n.bounds;
       const float v = in.scalar(n.value_a);
       const float span = b[1] - b[0];
       float m = span != 0.0f ? b[2] + (v - b[0]) / span * (b[3] - b[2]) : 0.0f;
@@ -469,9 +469,6 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         features_ |= kFeatureTextures;
         reads_color_attribute_ = true;
       }
-      if (n.kind == InputNodeKind::MapRange && n.ramp.size() != 4)
-        throw std::invalid_argument(where + "map range needs 4 bounds, has " +
-                                    std::to_string(n.ramp.size()));
       if (n.kind == InputNodeKind::Ramp && (n.ramp.size() < 8 || n.ramp.size() % 4 != 0))
         throw std::invalid_argument(where + "colour ramp table of " +
                                     std::to_string(n.ramp.size()) +

@@ -4,6 +4,7 @@
 // (InputNode). shaders/ compiles it into closures at each hit point.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -53,7 +54,7 @@ enum class InputNodeKind : uint8_t {
   BrightContrast,  // max((1 + c) a + b - c / 2, 0), b = value_a, c = value_b
   HueSaturation,   // Hue/Saturation/Value of a: hue value_a, saturation value_b, value value_c,
                    // blended by fac (svm_node_hsv)
-  MapRange,        // linear Map Range of value_a from [ramp 0, 1] to [ramp 2, 3], clamp_result
+  MapRange,        // linear Map Range of value_a from [bounds 0, 1] to [bounds 2, 3], clamp_result
   Clamp,           // value_a clamped to [value_b, value_c] (Min Max; swapped bounds: Range)
   ToBw,            // luminance of a, as grey (RGB to BW)
   Attribute,       // the mesh's colour attribute (Color Attribute node; ShadingContext::color)
@@ -86,6 +87,8 @@ struct InputNode {
   // interpolated linearly between entries unless the ramp is Constant; the result is the colour,
   // or the alpha as grey for the node's Alpha output.
   std::vector<float> ramp;  // 4 n floats
+  // MapRange: from min, from max, to min, to max (constants; Blender's default range).
+  std::array<float, 4> bounds{0.0f, 1.0f, 0.0f, 1.0f};
   bool ramp_interpolate = true;
   bool ramp_alpha = false;
   bool clamp_range = false;  // Clamp: Range type (swapped bounds clamp to [max, min])

@@ -120,8 +120,7 @@ float srgb_to_linear(float encoded) {
 Rgba Texture::lookup(Vec2f uv, TextureLookup::Interpolation interpolation,
                      TextureLookup::Extension extension) const {
   Rgba c = lookup_stored(uv, interpolation, extension);
-  if (srgb_)
-    c.rgb = Spectrum(srgb_to_linear(c.rgb.x), srgb_to_linear(c.rgb.y), srgb_to_linear(c.rgb.z));
+  if (srgb_) c.rgb = srgb_to_linear(c.rgb);
   return c;
 }
 

@@ -23,6 +23,9 @@ struct Rgba {
 // The sRGB curve (encoded [0, 1] -> linear), from a 4096-segment table with linear
 // interpolation: within 1e-7 of the exact curve, without a pow per channel and lookup.
 float srgb_to_linear(float encoded);
+inline Spectrum srgb_to_linear(Spectrum encoded) {
+  return {srgb_to_linear(encoded.x), srgb_to_linear(encoded.y), srgb_to_linear(encoded.z)};
+}
 
 class Texture {
  public:

@@ -336,7 +336,7 @@ class _Translator:
                 if socket.is_linked:
                     self.warn(node, f"linked {socket.name} (its default value is used) of")
             d = {"kind": "MAP_RANGE", "value_a": self.value(node.inputs["Value"]),
-                 "ramp": [float(s.default_value) for s in bounds],
+                 "bounds": [float(s.default_value) for s in bounds],
                  "clamp_result": bool(node.clamp)}
         elif node.type == 'CLAMP':
             d = {"kind": "CLAMP", "value_a": self.value(node.inputs["Value"]),

@@ -170,6 +170,11 @@ InputNode read_input_node(const py::dict& d) {
   if (channel < 0 || channel > 2) throw std::invalid_argument("separate: channel out of range");
   n.channel = uint8_t(channel);
   if (d.contains("ramp")) n.ramp = d["ramp"].cast<std::vector<float>>();
+  if (d.contains("bounds")) {
+    const auto bounds = d["bounds"].cast<std::vector<float>>();
+    if (bounds.size() != 4) throw std::invalid_argument("map range: expected 4 bounds");
+    std::copy(bounds.begin(), bounds.end(), n.bounds.begin());
+  }
   get(d, "ramp_interpolate", n.ramp_interpolate);
   get(d, "ramp_alpha", n.ramp_alpha);
   get(d, "clamp_range", n.clamp_range);

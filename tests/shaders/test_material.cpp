@@ -433,14 +433,14 @@ TEST(Material, InputNodesFollowCycles) {
     // empty source range gives 0.
     InputNode mr;
     mr.kind = InputNodeKind::MapRange;
-    mr.ramp = {0.0f, 0.5f, 1.0f, 3.0f};
+    mr.bounds = {0.0f, 0.5f, 1.0f, 3.0f};
     mr.value_a = FloatInput(0.25f);
     expect_spectrum(colour_of(mr), Spectrum(2.0f));
     mr.value_a = FloatInput(0.75f);
     expect_spectrum(colour_of(mr), Spectrum(4.0f));
     mr.clamp_result = true;
     expect_spectrum(colour_of(mr), Spectrum(3.0f));
-    mr.ramp = {0.5f, 0.5f, 1.0f, 3.0f};
+    mr.bounds = {0.5f, 0.5f, 1.0f, 3.0f};
     expect_spectrum(colour_of(mr), Spectrum(1.0f));  // 0, then the node's clamp to [1, 3]
     mr.clamp_result = false;
     // Colour 0: the black diffuse lobe is dropped.
