@@ -15,7 +15,7 @@ namespace gdpt {
 namespace {}  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
-    : default_material_(default_material) {
+    : scene_(&scene), default_material_(default_material) {
   // $GDPT_EMBREE_CONFIG is passed to Embree as its device configuration (e.g. "isa=avx2",
   // "verbose=2"), for benchmarking Embree's kernels on a given machine.
   device_ = rtcNewDevice(std::getenv("GDPT_EMBREE_CONFIG"));
@@ -109,6 +109,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     d.world_space = world_positions != nullptr;
     d.winding = det < 0.0f ? -1.0f : 1.0f;
     d.positions = world_positions ? world_positions : mesh.positions.data();
+    d.object_positions = mesh.positions.data();
     d.indices = mesh.indices.data();
     const size_t tris = mesh.triangle_count();
     if (!mesh.corner_normals.empty()) {
@@ -177,14 +178,44 @@ void EmbreeScene::set_materials(std::span<const Material> materials) {
     return m >= 0 && size_t(m) < materials.size() &&
            (materials[size_t(m)].has_normal_map() || materials[size_t(m)].has_bump());
   };
+  auto reads_coords = [&](int32_t m) {
+    return m >= 0 && size_t(m) < materials.size() && materials[size_t(m)].reads_coordinates();
+  };
   for (InstanceData& d : instances_) {
     d.writes_color =
         d.corner_colors != nullptr || reads(d.uniform_material) || reads(default_material_);
     d.perturbs_normal = perturbs(d.uniform_material) || perturbs(default_material_);
+    d.writes_coords = reads_coords(d.uniform_material) || reads_coords(default_material_);
     for (int32_t m : d.slot_materials) {
       d.writes_color = d.writes_color || reads(m);
       d.perturbs_normal = d.perturbs_normal || perturbs(m);
+      d.writes_coords = d.writes_coords || reads_coords(m);
     }
+    if (d.writes_coords) set_generated_mapping(d, scene_->meshes[scene_->instances[d.index].mesh]);
+  }
+}
+
+// Generated = (p - location) / (2 size) + 0.5 (Cycles' mesh_texture_space); Blender's auto
+// texture space is the bounding box, with flat axes of size 1.
+void EmbreeScene::set_generated_mapping(InstanceData& d, const Mesh& mesh) {
+  Vec3f location = mesh.texspace_location, size = mesh.texspace_size;
+  if (size == Vec3f(0.0f)) {
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    Vec3f lo(kInf), hi(-kInf);
+    for (const Vec3f& p : mesh.positions) {
+      lo = min(lo, p);
+      hi = max(hi, p);
+    }
+    if (mesh.positions.empty()) lo = Vec3f(-1.0f), hi = Vec3f(1.0f);
+    location = (lo + hi) * 0.5f;
+    size = (hi - lo) * 0.5f;
+    for (int k = 0; k < 3; ++k)
+      if (size[k] == 0.0f) size[k] = 1.0f;
+  }
+  for (int k = 0; k < 3; ++k) {
+    const float scale = size[k] != 0.0f ? 0.5f / size[k] : 0.0f;
+    d.generated_scale[k] = scale;
+    d.generated_offset[k] = 0.5f - location[k] * scale;
   }
 }
 
@@ -320,6 +351,14 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
     }
     store3(hit.color, color);
   }
+  if (d.writes_coords) [[unlikely]] {
+    const Vec3f* P = d.object_positions;
+    const __m128 object =
+        interpolate(load3(P[idx[0]]), load3(P[idx[1]]), load3(P[idx[2]]), W, U, V);
+    store3(hit.coords.object, object);
+    store3(hit.coords.generated, _mm_add_ps(_mm_mul_ps(object, _mm_load_ps(d.generated_scale)),
+                                            _mm_load_ps(d.generated_offset)));
+  }
 
   if (d.uniform_material >= 0) {
     hit.material = d.uniform_material;
@@ -375,41 +414,73 @@ void EmbreeScene::perturb_normal(const InstanceData& d, uint32_t primitive, floa
   t = t * (length(t_object) / tl);
   const Vec3f n = hit.shading_normal;
   const Vec3f b = cross(n, t) * (sign * d.winding);
-  const Vec3f c = material.normal_map_direction(hit.uv);
+  const Vec3f c = material.normal_map_direction(shading_context(d, hit));
   set_unit(t * c.x + b * c.y + n * c.z, hit.shading_normal);
 }
 
 // Cycles' bump (svm_node_set_bump) tilts N against the surface gradient of the height, which it
 // takes from heights at the ray differentials' offsets: to first order N' = normalize(N -
-// distance grad h). Here grad h comes from forward differences of the height in UV, mapped to
-// the surface through the triangle's UV parameterisation (grad u, grad v in its plane). Cycles
-// works with the normal facing the ray: on back faces the tilt flips with it.
+// distance grad h). Here grad h comes from forward differences of the height along two
+// directions a0, a1 of the triangle's plane, through their dual basis (g_i . a_j = delta_ij):
+// along dP/du and dP/dv with a step in UV when the mesh has UVs, else along the triangle's edges
+// with a step in barycentrics. Every coordinate moves with the step (UV, and object-space
+// coordinates along the object-space image of the direction), so image and procedural heights
+// both differentiate. Cycles works with the normal facing the ray: on back faces the tilt flips
+// with it.
 void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
                               const Material& material) const {
-  if (primitive >= d.corner_uv_tris) return;  // no UVs: no gradient
   const uint32_t* idx = d.indices + size_t(primitive) * 3;
+  const Vec3f* P = d.object_positions;
   Vec3f p[3];
   for (int k = 0; k < 3; ++k) {
     const Vec3f q = d.positions[idx[k]];
     p[k] = d.world_space ? q
                          : world_direction(d.to_world_cols, q);  // differences only: no translation
   }
-  const Vec2f* T = d.corner_uvs + size_t(primitive) * 3;
   const Vec3f e1 = p[1] - p[0], e2 = p[2] - p[0];
-  const float du1 = T[1].x - T[0].x, dv1 = T[1].y - T[0].y;
-  const float du2 = T[2].x - T[0].x, dv2 = T[2].y - T[0].y;
-  const float det = du1 * dv2 - du2 * dv1;
-  if (!(std::fabs(det) > 0.0f)) return;
-  // dP/du, dP/dv, then the gradients of u and v in the triangle's plane.
-  const Vec3f dpdu = (e1 * dv2 - e2 * dv1) / det, dpdv = (e2 * du1 - e1 * du2) / det;
+  const Vec3f o1 = P[idx[1]] - P[idx[0]], o2 = P[idx[2]] - P[idx[0]];
+  // Directions in world (a) and object (o) space and their UV steps, per unit step.
+  Vec3f a[2] = {e1, e2}, o[2] = {o1, o2};
+  Vec2f duv[2] = {Vec2f(0.0f, 0.0f), Vec2f(0.0f, 0.0f)};
+  if (primitive < d.corner_uv_tris) {
+    const Vec2f* T = d.corner_uvs + size_t(primitive) * 3;
+    const float du1 = T[1].x - T[0].x, dv1 = T[1].y - T[0].y;
+    const float du2 = T[2].x - T[0].x, dv2 = T[2].y - T[0].y;
+    const float det = du1 * dv2 - du2 * dv1;
+    if (std::fabs(det) > 0.0f) {  // dP/du, dP/dv
+      a[0] = (e1 * dv2 - e2 * dv1) / det;
+      a[1] = (e2 * du1 - e1 * du2) / det;
+      o[0] = (o1 * dv2 - o2 * dv1) / det;
+      o[1] = (o2 * du1 - o1 * du2) / det;
+      duv[0] = Vec2f(1.0f, 0.0f);
+      duv[1] = Vec2f(0.0f, 1.0f);
+    } else {
+      duv[0] = T[1] - T[0];
+      duv[1] = T[2] - T[0];
+    }
+  }
   const Vec3f ng = cross(e1, e2);
-  const float jac = dot(ng, cross(dpdu, dpdv));
+  const float jac = dot(ng, cross(a[0], a[1]));
   if (!(std::fabs(jac) > 0.0f) || !std::isfinite(jac)) return;
-  const Vec3f grad_u = cross(dpdv, ng) / jac, grad_v = cross(ng, dpdu) / jac;
-  constexpr float kStep = 1.0f / 1024.0f;  // in UV: about a quarter texel of a 256 image
+  const Vec3f g0 = cross(a[1], ng) / jac, g1 = cross(ng, a[0]) / jac;
+  // In UV: about a quarter texel of a 256 image; in barycentrics: a 1024th of the triangle.
+  constexpr float kStep = 1.0f / 1024.0f;
   float h[3];
-  material.bump_heights(hit.uv, d.writes_color ? &hit.color : nullptr, kStep, h);
-  const Vec3f grad = (grad_u * (h[1] - h[0]) + grad_v * (h[2] - h[0])) / kStep;
+  ShadingContext at = shading_context(d, hit);
+  h[0] = material.bump_height(at);
+  const TexCoords base = hit.coords;
+  for (int k = 0; k < 2; ++k) {
+    at.uv = hit.uv + duv[k] * kStep;
+    TexCoords shifted = base;
+    if (d.writes_coords) {
+      shifted.object = base.object + o[k] * kStep;
+      for (int c = 0; c < 3; ++c)
+        shifted.generated[c] = base.generated[c] + o[k][c] * kStep * d.generated_scale[c];
+    }
+    at.coords = d.writes_coords ? &shifted : nullptr;
+    h[k + 1] = material.bump_height(at);
+  }
+  const Vec3f grad = (g0 * (h[1] - h[0]) + g1 * (h[2] - h[0])) / kStep;
   const BumpDesc& b = material.bump();
   float distance = b.invert ? -b.distance : b.distance;
   if (!hit.front_facing) distance = -distance;

@@ -20,6 +20,7 @@
 #include "integrator/math/vec.h"
 #include "integrator/scene.h"
 #include "shaders/material.h"
+#include "shaders/shading_context.h"
 
 namespace gdpt {
 
@@ -29,12 +30,18 @@ struct SurfaceHit {
   Vec3f geometric_normal;  // unit, world, as the triangle winding gives it (not flipped)
   Vec3f shading_normal;    // unit, world, interpolated corner normal (= geometric if flat)
   Vec2f uv;
-  Vec3f color;  // colour attribute (Mesh::corner_colors), 0 when the mesh has none; only set
-                // on instances that have one or whose materials read one
+  Vec3f color;       // colour attribute (Mesh::corner_colors), 0 when the mesh has none; only set
+                     // on instances that have one or whose materials read one
+  TexCoords coords;  // object-space coordinates; only set on instances whose materials read them
   uint32_t instance = 0, primitive = 0;  // index in Scene::instances, triangle in its mesh
   int32_t material = -1;     // index into SceneContext::materials() (always valid after hit())
   bool front_facing = true;  // the ray came from the side geometric_normal points to
 };
+
+// What a material sees of a hit.
+inline ShadingContext shading_context_of(const SurfaceHit& hit) {
+  return {hit.uv, hit.front_facing, &hit.color, &hit.coords};
+}
 
 // Moves p off the surface along n (the side the new ray leaves to) by an amount proportional to
 // the floating-point spacing at p, in the spirit of Wächter & Binder (Ray Tracing Gems, ch. 6):
@@ -186,6 +193,11 @@ class EmbreeScene {
     uint32_t corner_color_tris = 0;
     bool writes_color = false;     // hits fill SurfaceHit::color (set_materials)
     bool perturbs_normal = false;  // some material has a normal map or a bump (set_materials)
+    bool writes_coords = false;    // some material reads Generated / Object (set_materials)
+    const Vec3f* object_positions = nullptr;  // the Mesh's own (object-space) positions
+    // Generated coordinates = object position * generated_scale + generated_offset (lanes).
+    alignas(16) float generated_scale[4] = {};
+    alignas(16) float generated_offset[4] = {};
     const Vec3f* corner_tangents = nullptr;  // Normal Map nodes, primitives < corner_tangent_tris
     const float* corner_tangent_signs = nullptr;
     uint32_t corner_tangent_tris = 0;
@@ -211,6 +223,13 @@ class EmbreeScene {
                                         SurfaceHit& hit) const;
   void bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
                    const Material& material) const;
+  // The shading context of a completed hit (its colour and coordinates where it has them).
+  static ShadingContext shading_context(const InstanceData& d, const SurfaceHit& hit) {
+    return {hit.uv, true, d.writes_color ? &hit.color : nullptr,
+            d.writes_coords ? &hit.coords : nullptr};
+  }
+  static void set_generated_mapping(InstanceData& d, const Mesh& mesh);
+  const Scene* scene_ = nullptr;
 
   std::span<const Material> materials_;
   int32_t default_material_ = -1;

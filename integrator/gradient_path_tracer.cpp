@@ -161,8 +161,7 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
     v.lambert = side.lambert;
   } else {
     v.own.clear();
-    ctx.materials()[size_t(hit.material)].evaluate(
-        ShadingContext{hit.uv, hit.front_facing, &hit.color}, v.own);
+    ctx.materials()[size_t(hit.material)].evaluate(shading_context_of(hit), v.own);
     v.closures = &v.own;
     v.roughness = vertex_roughness(v.own);
     v.lambert = single_lambert(v.own);
@@ -187,8 +186,8 @@ void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
 Spectrum triangle_emission(const SceneContext& ctx, const SurfaceHit& hit, Vec3f from) {
   const Material& m = ctx.materials()[size_t(hit.material)];
   if (!m.is_emissive()) return Spectrum(0.0f);
-  const ShadingContext sc{hit.uv, dot(from - hit.position, hit.geometric_normal) > 0.0f,
-                          &hit.color};
+  ShadingContext sc = shading_context_of(hit);
+  sc.front_facing = dot(from - hit.position, hit.geometric_normal) > 0.0f;
   return m.emission(sc);
 }
 
@@ -1302,8 +1301,7 @@ class GradientPathTracer final : public Integrator {
     const MaterialSide& side = sides_[2 * size_t(h.material) + (h.front_facing ? 1 : 0)];
     if (side.set) return side.roughness;
     ClosureSet cs;
-    ctx_.materials()[size_t(h.material)].evaluate(ShadingContext{h.uv, h.front_facing, &h.color},
-                                                  cs);
+    ctx_.materials()[size_t(h.material)].evaluate(shading_context_of(h), cs);
     return vertex_roughness(cs);
   }
 

@@ -209,7 +209,7 @@ class PathTracer final : public Integrator {
       }
 
       // --- Shading point ---
-      const ShadingContext sc{hit.uv, hit.front_facing, &hit.color};
+      const ShadingContext sc = shading_context_of(hit);
       const Material& material = materials[size_t(hit.material)];
       if constexpr (kEmissive) {
         if (material.is_emissive()) {

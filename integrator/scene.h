@@ -32,6 +32,10 @@ struct Mesh {
   // split normals has, in a sixth of the memory (a 1M-triangle smooth mesh: 6 MB instead of the
   // 36 MB of corner normals). Both empty = flat shading.
   std::vector<Vec3f> vertex_normals;
+  // Texture space (Blender's Mesh.texspace_location / texspace_size): Generated coordinates are
+  // (p - location) / (2 size) + 0.5 per axis. A zero size means the bounding box (Blender's auto
+  // texture space), with flat axes of size 1 as Blender sets them.
+  Vec3f texspace_location{0.0f}, texspace_size{0.0f};
   size_t triangle_count() const { return indices.size() / 3; }
 };
 

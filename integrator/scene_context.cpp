@@ -121,8 +121,7 @@ Spectrum SceneContext::transmittance(Ray ray, ClosureSet& scratch, uint32_t& ray
   for (int crossing = 0; crossing <= kMaxTransparentBounces; ++crossing) {
     if (!bvh_->intersect(ray, h)) return tr;
     scratch.clear();
-    materials_[size_t(h.material)].evaluate(ShadingContext{h.uv, h.front_facing, &h.color},
-                                            scratch);
+    materials_[size_t(h.material)].evaluate(shading_context_of(h), scratch);
     tr *= scratch.transparency();
     if (is_black(tr)) return tr;
     const Vec3f n =

@@ -15,6 +15,7 @@
 
 #include "shaders/microfacet.h"
 #include "shaders/principled.h"
+#include "shaders/procedural_texture.h"
 
 namespace gdpt {
 
@@ -212,6 +213,27 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
     case InputNodeKind::Attribute:
       r = in.attribute_color();
       break;
+    case InputNodeKind::Checker: {
+      const Vec3f p = in.vector(n.vector) * in.scalar(n.value_a);
+      r = Inputs::kAverage ? (in.color(n.a) + in.color(n.b)) * 0.5f
+                           : (checker_texture(p) == 1.0f ? in.color(n.a) : in.color(n.b));
+      if (n.fac_output) r = Spectrum(Inputs::kAverage ? 0.5f : checker_texture(p));
+      break;
+    }
+    case InputNodeKind::Coordinates:
+      r = in.vector(n.vector);
+      break;
+    case InputNodeKind::Noise: {
+      if (Inputs::kAverage) {
+        r = Spectrum(0.5f);
+        break;
+      }
+      const Vec3f p = in.vector(n.vector) * in.scalar(n.value_a);
+      const NoiseTextureResult t = noise_texture(p, in.scalar(n.value_b), in.scalar(n.value_c),
+                                                 in.scalar(n.fac), !n.fac_output);
+      r = n.fac_output ? Spectrum(t.fac) : t.color;
+      break;
+    }
     case InputNodeKind::BrightContrast: {
       const float contrast = in.scalar(n.value_b);
       const float a = 1.0f + contrast, b = in.scalar(n.value_a) - contrast * 0.5f;
@@ -227,25 +249,36 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
 template <class Inputs>
 float input_node_scalar(const InputNode& n, const Inputs& in) {
   const Spectrum r = input_node_result(n, in);
-  const bool grey = n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
-                    n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
-                    n.kind == InputNodeKind::ToBw ||
-                    (n.kind == InputNodeKind::Ramp && n.ramp_alpha);
+  const bool grey =
+      n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
+      n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
+      n.kind == InputNodeKind::ToBw || (n.kind == InputNodeKind::Ramp && n.ramp_alpha) ||
+      ((n.kind == InputNodeKind::Checker || n.kind == InputNodeKind::Noise) && n.fac_output);
   return grey ? r.x : luminance(r);
 }
 
-// Inputs at a hit point: texture lookups at the mapped UV.
+// Inputs at a hit point: texture lookups at their mapped coordinates.
 struct PointInputs {
+  static constexpr bool kAverage = false;
   std::span<const Texture> textures;
   std::span<const InputNode> nodes;
-  Vec2f uv;
-  bool front_facing;
-  const Vec3f* attribute = nullptr;  // ShadingContext::color
+  ShadingContext at;
+  bool front_facing() const { return at.front_facing; }
 
-  Spectrum attribute_color() const { return attribute ? *attribute : Spectrum(0.0f); }
+  Spectrum attribute_color() const { return at.color ? *at.color : Spectrum(0.0f); }
 
+  // A texture's coordinates: the source (zero without object-space coordinates), then its
+  // mapping.
+  Vec3f vector(const TextureVector& v) const {
+    Vec3f p(at.uv.x, at.uv.y, 0.0f);
+    if (v.source != TexCoordSource::UV)
+      p = !at.coords                              ? Vec3f(0.0f)
+          : v.source == TexCoordSource::Generated ? at.coords->generated
+                                                  : at.coords->object;
+    return v.mapping.point(p);
+  }
   Rgba fetch(const TextureLookup& t) const {
-    const Vec3f p = t.uv_mapping.point(Vec3f(uv.x, uv.y, 0.0f));
+    const Vec3f p = vector(t.vector);
     return textures[size_t(t.image)].lookup(Vec2f(p.x, p.y), t.interpolation, t.extension);
   }
   Spectrum color(const ColorInput& in) const {
@@ -263,9 +296,12 @@ struct PointInputs {
 // Inputs averaged over the whole texture (for light power estimates; through input nodes this is
 // the node of the means, an estimate).
 struct AverageInputs {
+  static constexpr bool kAverage = true;
   const std::vector<Rgba>* means;
   std::span<const InputNode> nodes;
-  bool front_facing = true;
+  bool front_facing() const { return true; }
+  // Procedural textures average to their mid value (Vec3f(0.5) through input_node_result).
+  Vec3f vector(const TextureVector&) const { return Vec3f(0.5f); }
 
   // Unknown without the mesh: white, an upper bound for power estimates (emitter selection).
   Spectrum attribute_color() const { return Spectrum(1.0f); }
@@ -317,7 +353,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
         c.alpha = r * r;
         // The integrators orient the frame towards the incoming ray (as Cycles flips N for back
         // faces), so the closure's IOR is that of the far side: 1 / ior when leaving the object.
-        c.ior = in.front_facing ? ior : 1.0f / ior;
+        c.ior = in.front_facing() ? ior : 1.0f / ior;
       }
       out.add(c);
       return;
@@ -340,7 +376,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       p.sheen_tint = in.scalar(n.sheen_tint);
       p.alpha = in.scalar(n.alpha);
       p.emission = in.color(n.emission) * in.scalar(n.emission_strength);
-      p.front_facing = in.front_facing;
+      p.front_facing = in.front_facing();
       add_principled_closures(p, w, out);
       return;
     }
@@ -398,16 +434,18 @@ Spectrum walk(const std::vector<ShaderNode>& nodes, int32_t root, const Inputs& 
   return emission;
 }
 
-bool has_texture(const ColorInput& c) {
-  return c.texture.image >= 0;
+// The input is not its constant value: an image lookup or an input node (whose result the
+// constant does not bound: an emission colour from a Color Ramp has a black default).
+bool varies(const ColorInput& c) {
+  return c.texture.image >= 0 || c.node >= 0;
 }
-bool has_texture(const FloatInput& f) {
-  return f.texture.image >= 0;
+bool varies(const FloatInput& f) {
+  return f.texture.image >= 0 || f.node >= 0;
 }
 
 // Could a roughness input give a delta lobe (alpha = r^2 below kDeltaAlpha)?
 bool may_be_delta(const FloatInput& roughness) {
-  if (has_texture(roughness)) return true;
+  if (varies(roughness)) return true;
   const float r = saturate(roughness.value);
   return is_delta_alpha(r * r);
 }
@@ -469,6 +507,11 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         features_ |= kFeatureTextures;
         reads_color_attribute_ = true;
       }
+      if (n.kind == InputNodeKind::Checker || n.kind == InputNodeKind::Noise ||
+          n.kind == InputNodeKind::Coordinates) {
+        features_ |= kFeatureTextures;
+        reads_coordinates_ |= n.vector.source != TexCoordSource::UV;
+      }
       if (n.kind == InputNodeKind::Ramp && (n.ramp.size() < 8 || n.ramp.size() % 4 != 0))
         throw std::invalid_argument(where + "colour ramp table of " +
                                     std::to_string(n.ramp.size()) +
@@ -479,9 +522,10 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       return;
     }
     check_lookup(input.texture);
-    if (has_texture(input)) {
+    if (input.texture.image >= 0) {
       features_ |= kFeatureTextures;
       uses_image[size_t(input.texture.image)] = true;
+      reads_coordinates_ |= input.texture.vector.source != TexCoordSource::UV;
     }
   };
   auto note = [&](const auto& input) { note_input(note_input, input, 0); };
@@ -513,8 +557,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         note(n.roughness);
         note(n.ior);
         features_ |= kFeatureGlossy | kFeatureTransmission;
-        if (may_be_delta(n.roughness) || has_texture(n.ior) ||
-            std::fabs(n.ior.value - 1.0f) < 1e-4f)
+        if (may_be_delta(n.roughness) || varies(n.ior) || std::fabs(n.ior.value - 1.0f) < 1e-4f)
           features_ |= kFeatureDelta;
         return;
       case ShaderNodeKind::Transparent:
@@ -524,8 +567,8 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       case ShaderNodeKind::Emission:
         note(n.color);
         note(n.strength);
-        if ((has_texture(n.color) || !is_black(n.color.value)) &&
-            (has_texture(n.strength) || n.strength.value != 0.0f))
+        if ((varies(n.color) || !is_black(n.color.value)) &&
+            (varies(n.strength) || n.strength.value != 0.0f))
           features_ |= kFeatureEmission;
         return;
       case ShaderNodeKind::Principled: {
@@ -541,19 +584,19 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         note(n.alpha);
         note(n.emission);
         note(n.emission_strength);
-        const bool specular = has_texture(n.specular) || has_texture(n.metallic) ||
-                              n.specular.value > 0.0f || n.metallic.value > 0.0f;
-        const bool transmission = (has_texture(n.transmission) || n.transmission.value > 0.0f) &&
-                                  (has_texture(n.metallic) || n.metallic.value < 1.0f);
+        const bool specular = varies(n.specular) || varies(n.metallic) || n.specular.value > 0.0f ||
+                              n.metallic.value > 0.0f;
+        const bool transmission = (varies(n.transmission) || n.transmission.value > 0.0f) &&
+                                  (varies(n.metallic) || n.metallic.value < 1.0f);
         if (specular || transmission) {
           features_ |= kFeatureGlossy;
           if (may_be_delta(n.roughness)) features_ |= kFeatureDelta;
         }
         if (transmission) features_ |= kFeatureTransmission;
-        if (has_texture(n.alpha) || n.alpha.value < 1.0f)
+        if (varies(n.alpha) || n.alpha.value < 1.0f)
           features_ |= kFeatureTransparent | kFeatureDelta;
-        if ((has_texture(n.emission) || !is_black(n.emission.value)) &&
-            (has_texture(n.emission_strength) || n.emission_strength.value != 0.0f))
+        if ((varies(n.emission) || !is_black(n.emission.value)) &&
+            (varies(n.emission_strength) || n.emission_strength.value != 0.0f))
           features_ |= kFeatureEmission;
         return;
       }
@@ -570,7 +613,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
     means[i] = textures[i].mean();
   }
   if (features_ & kFeatureEmission)
-    average_emission_ = walk(nodes_, root_, AverageInputs{&means, inputs_, true}, nullptr);
+    average_emission_ = walk(nodes_, root_, AverageInputs{&means, inputs_}, nullptr);
   cache_if_constant();
 }
 
@@ -580,8 +623,9 @@ void Material::cache_if_constant() {
   for (int side = 0; side < 2; ++side) {
     ClosureSet& set = constant_closures_[side];
     set.clear();
-    set.add_emission(
-        walk(nodes_, root_, PointInputs{textures_, inputs_, Vec2f(0.0f, 0.0f), side == 1}, &set));
+    set.add_emission(walk(nodes_, root_,
+                          PointInputs{textures_, inputs_, ShadingContext{{0.0f, 0.0f}, side == 1}},
+                          &set));
   }
   constant_ = true;
 }
@@ -592,31 +636,24 @@ void Material::evaluate(const ShadingContext& ctx, ClosureSet& out) const {
     return;
   }
   out.clear();
-  const Spectrum e = walk(
-      nodes_, root_, PointInputs{textures_, inputs_, ctx.uv, ctx.front_facing, ctx.color}, &out);
+  const Spectrum e = walk(nodes_, root_, PointInputs{textures_, inputs_, ctx}, &out);
   out.add_emission(e);
 }
 
 Spectrum Material::emission(const ShadingContext& ctx) const {
   if (!(features_ & kFeatureEmission)) return Spectrum(0.0f);
-  return walk(nodes_, root_, PointInputs{textures_, inputs_, ctx.uv, ctx.front_facing, ctx.color},
-              nullptr);
+  return walk(nodes_, root_, PointInputs{textures_, inputs_, ctx}, nullptr);
 }
 
-Vec3f Material::normal_map_direction(Vec2f uv) const {
-  const Spectrum c = PointInputs{textures_, inputs_, uv, true}.color(normal_map_.color);
+Vec3f Material::normal_map_direction(const ShadingContext& at) const {
+  const Spectrum c = PointInputs{textures_, inputs_, at}.color(normal_map_.color);
   const float s = normal_map_.strength;
   return {2.0f * (c.x - 0.5f) * s, 2.0f * (c.y - 0.5f) * s,
           1.0f + (2.0f * (c.z - 0.5f) - 1.0f) * std::clamp(s, 0.0f, 1.0f)};
 }
 
-void Material::bump_heights(Vec2f uv, const Vec3f* color, float du, float h[3]) const {
-  for (int i = 0; i < 3; ++i) {
-    const Vec2f at(uv.x + (i == 1 ? du : 0.0f), uv.y + (i == 2 ? du : 0.0f));
-    PointInputs in{textures_, inputs_, at, true};
-    in.attribute = color;
-    h[i] = in.scalar(bump_.height);
-  }
+float Material::bump_height(const ShadingContext& at) const {
+  return PointInputs{textures_, inputs_, at}.scalar(bump_.height);
 }
 
 }  // namespace gdpt

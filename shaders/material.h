@@ -41,17 +41,18 @@ class Material {
   // Emission averaged over textures (for sampling emissive triangles by power).
   Spectrum average_emission() const { return average_emission_; }
   uint32_t features() const { return features_; }
-  // Normal Map node (NormalMapDesc): the tangent-space direction at `uv`, strength applied, not
+  // Normal Map node (NormalMapDesc): the tangent-space direction at a point, strength applied, not
   // normalised (x tangent, y bitangent, z normal).
   bool has_normal_map() const { return normal_map_.enabled; }
-  // Bump node (BumpDesc): heights at uv and one step `du` along u and along v (forward
-  // differences).
+  Vec3f normal_map_direction(const ShadingContext& at) const;
+  // Bump node (BumpDesc): its height at a point (the caller differentiates).
   bool has_bump() const { return bump_.enabled; }
   const BumpDesc& bump() const { return bump_; }
-  void bump_heights(Vec2f uv, const Vec3f* color, float du, float h[3]) const;
+  float bump_height(const ShadingContext& at) const;
   // Some input reads the mesh's colour attribute (ShadingContext::color).
   bool reads_color_attribute() const { return reads_color_attribute_; }
-  Vec3f normal_map_direction(Vec2f uv) const;
+  // Some texture reads Generated or Object coordinates (ShadingContext::coords).
+  bool reads_coordinates() const { return reads_coordinates_; }
 
  private:
   void cache_if_constant();
@@ -68,6 +69,7 @@ class Material {
   NormalMapDesc normal_map_;
   BumpDesc bump_;
   bool reads_color_attribute_ = false;
+  bool reads_coordinates_ = false;
   Spectrum average_emission_{0.0f, 0.0f, 0.0f};
 };
 

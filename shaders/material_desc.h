@@ -14,10 +14,21 @@
 
 namespace gdpt {
 
-// Texture lookup: Scene::images[image] sampled at the mesh UV, through an optional Mapping node.
+// Blender's Texture Coordinate outputs a texture can read (Cycles' names): UV is (u, v, 0) of the
+// mesh's UV map; Object the object-space position; Generated the object-space position mapped
+// from the mesh's texture space (Mesh::texspace_*) to [0, 1]^3.
+enum class TexCoordSource : uint8_t { UV, Generated, Object };
+
+// The vector a texture reads: a coordinate source through an optional Mapping node.
+struct TextureVector {
+  TexCoordSource source = TexCoordSource::UV;
+  Transform mapping;  // Blender's Mapping node (Point / Texture type) applied to the coordinates
+};
+
+// Texture lookup: Scene::images[image] sampled at (x, y) of its vector (Image Texture, Flat).
 struct TextureLookup {
-  int32_t image = -1;    // -1: no texture, use the constant
-  Transform uv_mapping;  // applied to (u, v, 0): Blender Mapping node (Point type)
+  int32_t image = -1;  // -1: no texture, use the constant
+  TextureVector vector;
   enum class Interpolation : uint8_t { Linear, Closest } interpolation = Interpolation::Linear;
   enum class Extension : uint8_t { Repeat, Extend, Clip } extension = Extension::Repeat;
 };
@@ -58,6 +69,11 @@ enum class InputNodeKind : uint8_t {
   Clamp,           // value_a clamped to [value_b, value_c] (Min Max; swapped bounds: Range)
   ToBw,            // luminance of a, as grey (RGB to BW)
   Attribute,       // the mesh's colour attribute (Color Attribute node; ShadingContext::color)
+  Checker,         // Checker Texture at `vector` x scale value_a: colour a or b (svm_checker)
+  Noise,           // 3D Noise Texture at `vector` x scale value_a: detail value_b, roughness
+                   // value_c, distortion fac (Blender 3.4's fBm of Perlin noise, noise_texture_3d)
+  Coordinates,     // `vector` itself as a colour (a Texture Coordinate / Mapping output plugged
+                   // into a colour or float input)
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -92,6 +108,8 @@ struct InputNode {
   bool ramp_interpolate = true;
   bool ramp_alpha = false;
   bool clamp_range = false;  // Clamp: Range type (swapped bounds clamp to [max, min])
+  TextureVector vector;      // Checker, Noise: where they are read; Coordinates: the value
+  bool fac_output = false;   // Checker, Noise: the Fac output (grey) instead of Color
 };
 
 enum class ShaderNodeKind : uint8_t {

@@ -2,8 +2,9 @@
 #
 # Walks from the active Material Output's Surface input. Supported shader nodes: Principled BSDF,
 # Diffuse, Glossy, Glass, Emission, Transparent, Mix Shader, Add Shader. Inputs may be constants,
-# RGB / Value nodes, or an Image Texture read at the active UV map, optionally through a Mapping
-# node (Point type) fed by a UV Map / Texture Coordinate UV output. Reroutes and muted nodes are
+# RGB / Value nodes, colour / math nodes, Image / Checker / Noise (3D) textures read at UV,
+# Generated or Object coordinates (Texture Coordinate, UV Map), optionally through a Mapping node
+# (Point / Texture type). Reroutes and muted nodes are
 # followed. Anything else is reported once per material (naming the node) and followed through its
 # mute pass-through link when it has one; otherwise a magenta diffuse (shaders) or the socket's
 # own value (inputs) stands in, so the render still completes.
@@ -21,7 +22,8 @@ _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
-                'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE'}
+                'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
+                'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -281,7 +283,8 @@ class _Translator:
         """Index of a Mix / MixRGB / Math / Invert / Color Ramp node's output `out` in
         self.inputs (translated once), or None (with a warning) for a mode Gradient PT does not
         model."""
-        per_output = node.type in {'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR'}
+        per_output = node.type in {'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR', 'TEX_CHECKER',
+                                   'TEX_NOISE', 'TEX_COORD', 'SEPXYZ'}
         key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
@@ -315,7 +318,8 @@ class _Translator:
             d = {"kind": "RAMP", "fac": self.value(node.inputs["Fac"]), "ramp": table,
                  "ramp_interpolate": ramp.interpolation != 'CONSTANT',
                  "ramp_alpha": out.name == "Alpha"}
-        elif node.type == 'SEPRGB' or (node.type == 'SEPARATE_COLOR' and node.mode == 'RGB'):
+        elif node.type == 'SEPRGB' or node.type == 'SEPXYZ' or (
+                node.type == 'SEPARATE_COLOR' and node.mode == 'RGB'):
             channel = [o.name for o in node.outputs].index(out.name)
             d = {"kind": "SEPARATE", "a": self.color(node.inputs[0]), "channel": channel}
         elif node.type == 'COMBRGB' or (node.type == 'COMBINE_COLOR' and node.mode == 'RGB'):
@@ -352,6 +356,24 @@ class _Translator:
             if self.color_attribute is None:
                 self.color_attribute = name
             d = {"kind": "ATTRIBUTE"}
+        elif node.type == 'TEX_CHECKER':
+            d = {"kind": "CHECKER", "a": self.color(node.inputs["Color1"]),
+                 "b": self.color(node.inputs["Color2"]),
+                 "value_a": self.value(node.inputs["Scale"]),
+                 "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
+                 "fac_output": out.name == "Fac"}
+        elif node.type == 'TEX_NOISE' and node.noise_dimensions == '3D':
+            d = {"kind": "NOISE", "value_a": self.value(node.inputs["Scale"]),
+                 "value_b": self.value(node.inputs["Detail"]),
+                 "value_c": self.value(node.inputs["Roughness"]),
+                 "fac": self.value(node.inputs["Distortion"]),
+                 "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
+                 "fac_output": out.name == "Fac"}
+        elif (node.type == 'TEX_COORD' and out.name in {"UV", "Generated", "Object"}) or \
+                node.type == 'UVMAP' or \
+                (node.type == 'MAPPING' and node.vector_type in {'POINT', 'TEXTURE'}):
+            # A coordinate used as a colour or value (e.g. through Separate XYZ).
+            d = {"kind": "COORDINATES", "vector": self._vector_of(out)}
         elif node.type == 'RGBTOBW':
             d = {"kind": "RGB_TO_BW", "a": self.color(node.inputs["Color"])}
         elif node.type == 'BRIGHTCONTRAST':
@@ -360,7 +382,8 @@ class _Translator:
                  "value_b": self.value(node.inputs["Contrast"])}
         if d is None:
             mode = (getattr(node, "blend_type", None) or getattr(node, "operation", None) or
-                    getattr(node, "mode", None) or getattr(node, "interpolation_type", None))
+                    getattr(node, "mode", None) or getattr(node, "interpolation_type", None) or
+                    getattr(node, "noise_dimensions", None))
             self.warn(node, f"mode {mode} of the input node" if mode else "input node")
             return None
         self.inputs.append(d)
@@ -388,21 +411,34 @@ class _Translator:
         d["interpolation"] = 'Closest' if node.interpolation == 'Closest' else 'Linear'
         d["extension"] = node.extension if node.extension in {'REPEAT', 'EXTEND', 'CLIP'} \
             else 'REPEAT'
-        d["mapping"] = self._uv_mapping(node.inputs["Vector"])
+        vector = self._vector(node.inputs["Vector"])
+        d["mapping"], d["coordinates"] = vector["mapping"], vector["coordinates"]
 
-    def _uv_mapping(self, socket):
-        """Row-major 3x4 transform applied to (u, v, 0) for a Vector input: identity for the
-        default UVs, a Mapping node's Point transform when it is fed by UVs."""
+    def _vector(self, socket, default='UV'):
+        """{coordinates, mapping} of a texture's Vector input: a Texture Coordinate output (UV,
+        Generated, Object), a UV Map node, or a Mapping node (Point / Texture) over one of them;
+        unlinked, the texture's own default (UV for Image Texture, Generated for procedural
+        textures). mapping is a row-major 3x4 transform of the coordinates."""
         out = self._source(socket)
         if out is None:
-            return IDENTITY12
+            return {"coordinates": default, "mapping": IDENTITY12}
+        return self._vector_of(out, default)
+
+    def _vector_of(self, out, default='UV'):
+        """_vector() of the output socket `out` (a Texture Coordinate, UV Map or Mapping
+        output)."""
+        plain = {"coordinates": default, "mapping": IDENTITY12}
         node = out.node
-        if node.type == 'UVMAP' or (node.type == 'TEX_COORD' and out.name == "UV"):
-            if node.type == 'UVMAP' and node.uv_map:
+        if node.type == 'UVMAP':
+            if node.uv_map:
                 self.warn(node, "UV map other than the active render UV map in")
-            return IDENTITY12
+            return {"coordinates": 'UV', "mapping": IDENTITY12}
+        if node.type == 'TEX_COORD' and out.name in {"UV", "Generated", "Object"}:
+            if out.name == "Object" and node.object is not None:
+                self.warn(node, "Object output relative to another object of")
+            return {"coordinates": out.name.upper(), "mapping": IDENTITY12}
         if node.type == 'MAPPING' and node.vector_type in {'POINT', 'TEXTURE'}:
-            inner = self._uv_mapping(node.inputs["Vector"])
+            inner = self._vector(node.inputs["Vector"], default)
             loc = node.inputs["Location"].default_value
             rot = node.inputs["Rotation"].default_value
             scale = node.inputs["Scale"].default_value
@@ -413,10 +449,12 @@ class _Translator:
                  @ Matrix.Diagonal((scale[0], scale[1], scale[2], 1.0)))
             if node.vector_type == 'TEXTURE':
                 m = m.inverted_safe()
-            inner_m = Matrix([inner[0:4], inner[4:8], inner[8:12], [0, 0, 0, 1]])
-            return _matrix12(m @ inner_m)
-        self.warn(node, "texture coordinate node")
-        return IDENTITY12
+            im = inner["mapping"]
+            inner_m = Matrix([im[0:4], im[4:8], im[8:12], [0, 0, 0, 1]])
+            return {"coordinates": inner["coordinates"], "mapping": _matrix12(m @ inner_m)}
+        self.warn(node, f"output {out.name} of the texture coordinate node"
+                  if node.type == 'TEX_COORD' else "texture coordinate node")
+        return plain
 
 
 def _output_node(tree):

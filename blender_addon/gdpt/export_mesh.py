@@ -186,17 +186,21 @@ def add_mesh(builder, mesh, tangents=False, warn=print, color_attribute=None):
     poly_material = _poly_material(mesh)
     if loop_total.min() >= 3 and loop_total.max() <= 4:
         loop_start = _int_field(mesh.polygons, 0, "loop_start")  # MPoly.loopstart
-        return builder.add_mesh_polys(positions, loop_vertex, loop_start, loop_total, normals,
-                                      per_loop, loop_uvs, poly_material, loop_tangents,
-                                      loop_colors)
-    # N-gons: Blender's ear clipping, through its loop triangles (slower reads).
-    corner_loops, tri_poly = _corner_loops_slow(mesh)
-    if len(corner_loops) == 0:
-        return -1
-    tri_material = poly_material[tri_poly] if len(poly_material) else poly_material
-    return builder.add_mesh_loops(positions, loop_vertex, corner_loops, normals, per_loop,
-                                  loop_uvs, np.ascontiguousarray(tri_material), loop_tangents,
-                                  loop_colors)
+        index = builder.add_mesh_polys(positions, loop_vertex, loop_start, loop_total, normals,
+                                       per_loop, loop_uvs, poly_material, loop_tangents,
+                                       loop_colors)
+    else:
+        # N-gons: Blender's ear clipping, through its loop triangles (slower reads).
+        corner_loops, tri_poly = _corner_loops_slow(mesh)
+        if len(corner_loops) == 0:
+            return -1
+        tri_material = poly_material[tri_poly] if len(poly_material) else poly_material
+        index = builder.add_mesh_loops(positions, loop_vertex, corner_loops, normals, per_loop,
+                                       loop_uvs, np.ascontiguousarray(tri_material),
+                                       loop_tangents, loop_colors)
+    # Texture space for Generated coordinates (Blender computes the automatic one on access).
+    builder.set_mesh_texspace(index, tuple(mesh.texspace_location), tuple(mesh.texspace_size))
+    return index
 
 
 # Object > Visibility > Ray Visibility -> the core's RayKind bits (integrator/scene.h).

@@ -106,6 +106,8 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("set_camera", &SceneBuilder::set_camera)
       .def("set_world", &SceneBuilder::set_world)
       .def("mesh_arrays", &SceneBuilder::mesh_arrays, py::arg("index"))
+      .def("set_mesh_texspace", &SceneBuilder::set_mesh_texspace, py::arg("index"),
+           py::arg("location"), py::arg("size"))
       .def_property_readonly("mesh_count", &SceneBuilder::mesh_count)
       .def_property_readonly("instance_count", &SceneBuilder::instance_count)
       .def_property_readonly("triangle_count", &SceneBuilder::triangle_count);

@@ -56,9 +56,23 @@ std::string get_str(const py::dict& d, const char* key, const std::string& fallb
 
 // --- Material inputs ---------------------------------------------------------------------------
 
+// {coordinates: 'UV' | 'GENERATED' | 'OBJECT', mapping: 12 floats}
+void read_vector(const py::dict& d, TextureVector& v) {
+  get_transform(d, "mapping", v.mapping);
+  const std::string source = get_str(d, "coordinates", "UV");
+  if (source == "UV")
+    v.source = TexCoordSource::UV;
+  else if (source == "GENERATED")
+    v.source = TexCoordSource::Generated;
+  else if (source == "OBJECT")
+    v.source = TexCoordSource::Object;
+  else
+    bad_enum("texture coordinates", source);
+}
+
 void read_lookup(const py::dict& d, TextureLookup& t) {
   get(d, "image", t.image);
-  get_transform(d, "mapping", t.uv_mapping);
+  read_vector(d, t.vector);
   const std::string interp = get_str(d, "interpolation", "Linear");
   if (interp == "Closest")
     t.interpolation = TextureLookup::Interpolation::Closest;
@@ -132,6 +146,12 @@ InputNode read_input_node(const py::dict& d) {
     n.kind = InputNodeKind::ToBw;
   else if (kind == "ATTRIBUTE")
     n.kind = InputNodeKind::Attribute;
+  else if (kind == "CHECKER")
+    n.kind = InputNodeKind::Checker;
+  else if (kind == "NOISE")
+    n.kind = InputNodeKind::Noise;
+  else if (kind == "COORDINATES")
+    n.kind = InputNodeKind::Coordinates;
   else
     bad_enum("input node kind", kind);
   const std::string blend = get_str(d, "blend", "MIX");
@@ -178,6 +198,8 @@ InputNode read_input_node(const py::dict& d) {
   get(d, "ramp_interpolate", n.ramp_interpolate);
   get(d, "ramp_alpha", n.ramp_alpha);
   get(d, "clamp_range", n.clamp_range);
+  if (d.contains("vector")) read_vector(d["vector"].cast<py::dict>(), n.vector);
+  get(d, "fac_output", n.fac_output);
   return n;
 }
 
@@ -531,6 +553,19 @@ int SceneBuilder::add_mesh_polys(const FloatArray& positions, const IntArray& lo
   }
   scene_.meshes.push_back(std::move(mesh));
   return int(scene_.meshes.size()) - 1;
+}
+
+void SceneBuilder::set_mesh_texspace(int index, const py::sequence& location,
+                                     const py::sequence& size) {
+  if (index < 0 || size_t(index) >= scene_.meshes.size())
+    throw std::invalid_argument("set_mesh_texspace: mesh index out of range");
+  if (py::len(location) != 3 || py::len(size) != 3)
+    throw std::invalid_argument("set_mesh_texspace: expected 3 values each");
+  Mesh& m = scene_.meshes[size_t(index)];
+  for (int k = 0; k < 3; ++k) {
+    m.texspace_location[k] = location[k].cast<float>();
+    m.texspace_size[k] = size[k].cast<float>();
+  }
 }
 
 py::dict SceneBuilder::mesh_arrays(int index) const {

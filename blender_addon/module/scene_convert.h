@@ -15,9 +15,11 @@
 //   material: name, root, nodes: list of dicts {kind: 'DIFFUSE'|'GLOSSY'|'GLASS'|'PRINCIPLED'|
 //             'EMISSION'|'TRANSPARENT'|'MIX'|'ADD', a, b, and inputs color, roughness, ior,
 //             strength, fac, metallic, specular, specular_tint, transmission, alpha, emission,
-//             emission_strength}; a colour input is {value: (3), image, mapping (12), interpolation
-//             'Linear'|'Closest', extension 'REPEAT'|'EXTEND'|'CLIP'}, a float input the same with
-//             a scalar value and channel 'LUMINANCE'|'RED'|'ALPHA'.
+//             emission_strength}; a colour input is {value: (3), image, mapping (12), coordinates
+//             'UV'|'GENERATED'|'OBJECT', interpolation 'Linear'|'Closest', extension
+//             'REPEAT'|'EXTEND'|'CLIP', node}, a float input the same with a scalar value and
+//             channel 'LUMINANCE'|'RED'|'ALPHA'; input nodes (inputs) {kind, ..., vector:
+//             {coordinates, mapping} for 'CHECKER' / 'NOISE', fac_output}.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -87,6 +89,9 @@ class SceneBuilder {
   // positions (n, 3), indices (m, 3), corner_normals (m, 3, 3) or empty, vertex_normals (n, 3) or
   // empty, corner_uvs (m, 3, 2) or empty, material_slot (m,) or empty.
   py::dict mesh_arrays(int index) const;
+  // Blender's texture space of mesh `index` (Mesh.texspace_location / texspace_size), for
+  // Generated texture coordinates.
+  void set_mesh_texspace(int index, const py::sequence& location, const py::sequence& size);
   size_t mesh_count() const { return scene_.meshes.size(); }
   size_t instance_count() const { return scene_.instances.size(); }
   size_t triangle_count() const;

@@ -448,6 +448,50 @@ def case_bump(scene):
     return 3
 
 
+def case_procedural_textures(scene):
+    # Procedural textures and texture coordinates: the floor's colour is the Color of a 3D Noise
+    # Texture at its default (Generated) coordinates; the back wall's Principled base colour is
+    # a Noise Color at Object coordinates (detail 3.5, distortion 0.3) and its roughness the same
+    # node's Fac; the ball (no UVs) is coloured by a Checker Texture (Generated); the left wall
+    # shows a grid image at Generated coordinates through a Mapping node. (Bumps by procedural
+    # heights are tested analytically, Render.BumpDifferentiatesObjectSpaceCoordinates: Cycles'
+    # bumps of noise are weaker than the exact gradient, docs/shaders.md.)
+    material, assign = grid_room(scene)
+    m, nt, bsdf, tex = material("noisy_floor", "ShaderNodeBsdfDiffuse")
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = 4.0
+    nt.links.new(noise.outputs["Color"], bsdf.inputs["Color"])
+    assign("floor", m)
+
+    m, nt, bsdf, tex = material("noisy_wall", "ShaderNodeBsdfPrincipled", distribution='GGX')
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    for name, v in (("Scale", 1.5), ("Detail", 3.5), ("Roughness", 0.55), ("Distortion", 0.3)):
+        noise.inputs[name].default_value = v
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    nt.links.new(coords.outputs["Object"], noise.inputs["Vector"])
+    nt.links.new(noise.outputs["Color"], bsdf.inputs["Base Color"])
+    nt.links.new(noise.outputs["Fac"], bsdf.inputs["Roughness"])
+    assign("back", m)
+
+    m, nt, bsdf, tex = material("generated_grid", "ShaderNodeBsdfDiffuse")
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    mapping = nt.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Scale"].default_value = (2.0, 3.0, 1.0)
+    nt.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    nt.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    nt.links.new(tex.outputs["Color"], bsdf.inputs["Color"])
+    assign("left", m)
+
+    m, nt, bsdf, tex = material("checker_ball", "ShaderNodeBsdfDiffuse")
+    checker = nt.nodes.new("ShaderNodeTexChecker")
+    checker.inputs["Scale"].default_value = 4.0
+    checker.inputs["Color1"].default_value = (0.9, 0.6, 0.2, 1.0)
+    checker.inputs["Color2"].default_value = (0.1, 0.2, 0.6, 1.0)
+    nt.links.new(checker.outputs["Color"], bsdf.inputs["Color"])
+    S.uv_sphere("ball", 0.8, (0.3, 0.2, 0.8), m)
+    return 3
+
+
 def case_dof(scene):
     lit_room(scene)
     area_ceiling()

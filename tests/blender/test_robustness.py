@@ -71,6 +71,37 @@ def test_unsupported_node(out):
     check(right[..., 2].mean() > right[..., 0].mean(), "pass-through kept the RGB colour")
 
 
+def test_texture_limits(out):
+    """Textures Gradient PT does not model are reported once each and the render finishes: a 4D
+    Noise Texture (3D only), a Checker read at the Texture Coordinate node's Normal output, a
+    Voronoi Texture."""
+    scene = S.clear()
+    basic_scene(scene)
+    m, nt, outn = S._material("textures")
+    bsdf = nt.nodes.new("ShaderNodeBsdfPrincipled")
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    noise.name = "My 4D Noise"
+    noise.noise_dimensions = '4D'
+    nt.links.new(noise.outputs["Fac"], bsdf.inputs["Roughness"])
+    checker = nt.nodes.new("ShaderNodeTexChecker")
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    coords.name = "My Coordinates"
+    nt.links.new(coords.outputs["Normal"], checker.inputs["Vector"])
+    nt.links.new(checker.outputs["Color"], bsdf.inputs["Base Color"])
+    voronoi = nt.nodes.new("ShaderNodeTexVoronoi")
+    voronoi.name = "My Voronoi"
+    nt.links.new(voronoi.outputs["Distance"], bsdf.inputs["Metallic"])
+    nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
+    S.uv_sphere("ball", 0.6, (0, 0.3, 0.6), m)
+    path, warnings = render_finished(scene, os.path.join(out, "texture_limits.exr"))
+    for needle, what in (("mode 4D of the input node 'My 4D Noise'", "the 4D noise"),
+                         ("output Normal of the texture coordinate node 'My Coordinates'",
+                          "the Normal coordinates"),
+                         ("input node 'My Voronoi'", "the Voronoi texture")):
+        check(sum(needle in w for w in warnings) == 1, f"one warning names {what}")
+    check(S.read_rgb(path).mean() > 0.01, "the image was written")
+
+
 def test_normal_map_limits(out):
     """Normal maps and attributes Gradient PT cannot apply are reported, and the render still
     finishes: a normal-mapped mesh without a UV map, one with a 5-sided face (Blender computes no
@@ -229,6 +260,7 @@ def main():
     out = S.args()["out"]
     os.makedirs(out, exist_ok=True)
     test_unsupported_node(out)
+    test_texture_limits(out)
     test_normal_map_limits(out)
     test_no_camera(out)
     test_time_limit(out)

@@ -329,6 +329,104 @@ TEST(Render, BumpTiltsTheNormalAgainstTheHeightGradient) {
     }
 }
 
+// An emitter whose colour is its texture coordinate (a Texture Coordinate output used as a
+// colour): Object is the object-space position (through a Mapping that adds 1, so it stays
+// positive), Generated the position mapped from the mesh's bounding box (+-1 in x and y, flat
+// in z, whose size Blender sets to 1) to [0, 1], both independent of where the instance is.
+// The camera sees world x in [0, 1], y in [-0.5, 0.5] of a quad moved by +0.5 in x.
+TEST(Render, TextureCoordinatesAreObjectSpace) {
+  for (const TexCoordSource source : {TexCoordSource::Object, TexCoordSource::Generated}) {
+    MaterialDesc m = emission(Spectrum(0.0f), 1.0f);
+    InputNode coords;
+    coords.kind = InputNodeKind::Coordinates;
+    coords.vector.source = source;
+    if (source == TexCoordSource::Object)
+      for (int r = 0; r < 3; ++r) coords.vector.mapping.m[r][3] = 1.0f;
+    m.inputs = {coords};
+    m.nodes[0].color.node = 0;
+    Scene scene;
+    scene.meshes.push_back(quad(1.0f));
+    scene.materials.push_back(m);
+    scene.instances.push_back(place(0, 0, translation({0.5f, 0.0f, 0.0f})));
+    scene.world.color = Spectrum(0.0f);
+    scene.camera = top_camera(8, 1.0f);
+    scene.camera.camera_to_world = translation({0.5f, 0.0f, 10.0f});
+    const Image img = render(scene, pt(64));
+    // Object-space x of pixel column i: (i + 0.5) / 8 - 0.5; y of row j likewise (either
+    // orientation: compared through means and spans).
+    const bool object = source == TexCoordSource::Object;
+    auto expect = [&](float p) { return object ? p + 1.0f : (p + 1.0f) * 0.5f; };
+    double mean[3] = {0, 0, 0};
+    for (int y = 0; y < img.h; ++y)
+      for (int x = 0; x < img.w; ++x)
+        for (int c = 0; c < 3; ++c) mean[c] += img.emission[size_t(y * img.w + x) * 3 + c];
+    for (double& v : mean) v /= img.w * img.h;
+    EXPECT_NEAR(mean[0], expect(0.0f), 1e-3) << "object " << object;
+    EXPECT_NEAR(mean[1], expect(0.0f), 1e-3) << "object " << object;
+    EXPECT_NEAR(mean[2], object ? 1.0 : 0.5, 1e-4) << "object " << object;
+    // Last column (row) against the first, each averaged over the image.
+    const float span = expect(7.0f / 8.0f) - expect(0.0f);
+    double dx = 0.0, dy = 0.0;
+    auto at = [&](int x, int y, int c) { return img.emission[size_t(y * img.w + x) * 3 + c]; };
+    for (int k = 0; k < 8; ++k) {
+      dx += (at(7, k, 0) - at(0, k, 0)) / 8.0;
+      dy += (at(k, 7, 1) - at(k, 0, 1)) / 8.0;
+    }
+    EXPECT_NEAR(std::fabs(dx), span, 2e-3) << "object " << object;
+    EXPECT_NEAR(std::fabs(dy), span, 2e-3) << "object " << object;
+  }
+}
+
+// A bump whose height is linear in a texture coordinate: Object x (also on an instance stretched
+// 2x along x, which halves the world-space slope) and Generated x (the plane's 100 m bounding box
+// maps x to (x + 50) / 100), with UVs and without (differences along the triangle's edges). The
+// height h = k * coordinate tilts the normal to normalize(N - distance grad h) exactly, as in the
+// image-ramp test above.
+TEST(Render, BumpDifferentiatesObjectSpaceCoordinates) {
+  struct Case {
+    TexCoordSource source;
+    float scale_x, k;
+    bool uvs;
+    double cosine;
+  };
+  for (const Case& c :
+       {Case{TexCoordSource::Object, 1.0f, 0.02f, true, 1.0 / std::sqrt(1.04)},
+        Case{TexCoordSource::Object, 2.0f, 0.02f, true, 1.0 / std::sqrt(1.01)},
+        Case{TexCoordSource::Generated, 1.0f, 2.0f, true, 1.0 / std::sqrt(1.04)},
+        Case{TexCoordSource::Object, 2.0f, 0.02f, false, 1.0 / std::sqrt(1.01)},
+        Case{TexCoordSource::Generated, 1.0f, 2.0f, false, 1.0 / std::sqrt(1.04)}}) {
+    Mesh plane = quad(50.0f);
+    if (c.uvs) plane.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
+    MaterialDesc m = diffuse(Spectrum(0.5f));
+    InputNode coords;
+    coords.kind = InputNodeKind::Coordinates;
+    coords.vector.source = c.source;
+    InputNode x;
+    x.kind = InputNodeKind::Separate;
+    x.a.node = 0;
+    InputNode height;
+    height.kind = InputNodeKind::Math;
+    height.math = MathOp::Multiply;
+    height.value_a.node = 1;
+    height.value_b = FloatInput(c.k);
+    m.inputs = {coords, x, height};
+    m.bump.enabled = true;
+    m.bump.height.node = 2;
+    m.bump.distance = 10.0f;
+    Transform stretch;
+    stretch.m[0][0] = c.scale_x;
+    Scene scene = sunlit_plane(plane, m, 0.0f, stretch);
+    RenderSettings s = pt(4);
+    s.max_bounces = 0;
+    const Image img = render(scene, s);
+    double sum = 0.0;
+    for (float v : img.primal) sum += v;
+    const double expect = 0.5 * 3.0 * c.cosine / kPi;
+    EXPECT_NEAR(sum / img.primal.size(), expect, 1e-3 * expect)
+        << "source " << int(c.source) << " scale " << c.scale_x << " uvs " << c.uvs;
+  }
+}
+
 TEST(Render, SoftSunOnLambertPlane) {
   sun_test(0.6f, 0.02f);  // a 1.1-degree disc: cos varies by < 1e-4 over it
 }

@@ -97,7 +97,7 @@ TEST(Material, TexturedInputsGoThroughTheMapping) {
   d.nodes[0].fac.texture.interpolation = TextureLookup::Interpolation::Closest;
   d.nodes[0].fac.channel = FloatInput::Channel::Red;
   // Mapping: uv -> (uv.x + 0.5, uv.y): the lookup at u = 0.25 reads pixel x = 1.
-  d.nodes[0].fac.texture.uv_mapping.m[0][3] = 0.5f;
+  d.nodes[0].fac.texture.vector.mapping.m[0][3] = 0.5f;
   d.nodes[0].a = 1;
   d.nodes[0].b = 2;
   d.nodes.push_back(node(ShaderNodeKind::Diffuse));

@@ -1,0 +1,84 @@
+// Procedural textures (shaders/procedural_texture.h). That they are Cycles' own patterns is
+// checked against Cycles renders (blender.agreement_materials, case procedural_textures); here
+// the properties that hold for any correct implementation.
+#include "shaders/procedural_texture.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace gdpt {
+namespace {
+
+TEST(ProceduralTexture, PerlinNoiseVanishesOnTheLattice) {
+  for (int x = -3; x <= 3; ++x)
+    for (int y = -3; y <= 3; ++y)
+      for (int z = -3; z <= 3; ++z)
+        EXPECT_EQ(signed_noise(Vec3f(float(x), float(y), float(z))), 0.0f) << x << y << z;
+}
+
+TEST(ProceduralTexture, NoiseIsBoundedCenteredAndContinuous) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-50.0f, 50.0f);
+  double sum = 0.0;
+  constexpr int kN = 20000;
+  for (int i = 0; i < kN; ++i) {
+    const Vec3f p(u(rng), u(rng), u(rng));
+    const float n = signed_noise(p);
+    ASSERT_LE(std::fabs(n), 1.0f) << p.x << " " << p.y << " " << p.z;
+    sum += n;
+    // Lipschitz: the gradient of Perlin noise is bounded (well below 4 per unit here).
+    const float step = 1e-3f;
+    EXPECT_LE(std::fabs(signed_noise(p + Vec3f(step, 0.0f, 0.0f)) - n), 4.0f * step);
+    const NoiseTextureResult t = noise_texture(p, 2.0f, 0.5f, 0.0f, true);
+    ASSERT_GE(t.fac, 0.0f);
+    ASSERT_LE(t.fac, 1.0f);
+    EXPECT_EQ(t.color.x, t.fac);
+  }
+  EXPECT_NEAR(sum / kN, 0.0, 0.01);
+}
+
+// Blender 3.4's fractal noise: detail n gives n + 1 octaves normalised by the amplitude sum, a
+// fractional detail blends the two neighbouring integer details linearly, and roughness 0
+// leaves only the first octave.
+TEST(ProceduralTexture, FractalDetailAndRoughness) {
+  const Vec3f p(0.37f, -1.21f, 2.72f);
+  auto fac = [&](float detail, float roughness) {
+    return noise_texture(p, detail, roughness, 0.0f, false).fac;
+  };
+  EXPECT_NEAR(fac(0.0f, 0.5f), 0.5f * signed_noise(p) + 0.5f, 1e-7f);
+  const float one = fac(1.0f, 0.5f), two = fac(2.0f, 0.5f);
+  EXPECT_NEAR(fac(1.25f, 0.5f), 0.75f * one + 0.25f * two, 1e-6f);
+  // Detail 1, roughness 0.5: (n(p) + 0.5 n(2p)) / 1.5 of the unsigned noise.
+  const float n1 = 0.5f * signed_noise(p) + 0.5f, n2 = 0.5f * signed_noise(p * 2.0f) + 0.5f;
+  EXPECT_NEAR(one, (n1 + 0.5f * n2) / 1.5f, 1e-6f);
+  EXPECT_EQ(fac(5.0f, 0.0f), fac(0.0f, 0.0f));
+  // Clamps: detail to [0, 15], roughness to [0, 1].
+  EXPECT_EQ(fac(40.0f, 0.5f), fac(15.0f, 0.5f));
+  EXPECT_EQ(fac(2.0f, 3.0f), fac(2.0f, 1.0f));
+  // Distortion moves the lookup; the colour's channels are independent fBm evaluations.
+  EXPECT_NE(noise_texture(p, 2.0f, 0.5f, 1.0f, false).fac, fac(2.0f, 0.5f));
+  const NoiseTextureResult c = noise_texture(p, 2.0f, 0.5f, 0.0f, true);
+  EXPECT_NE(c.color.y, c.color.x);
+  EXPECT_NE(c.color.z, c.color.y);
+}
+
+// Cells of side 1: Color1 where the cell indices' parities are (even, even, odd) and the like,
+// Color2 at the origin's cell; points on a cell border are nudged inwards as Cycles does.
+TEST(ProceduralTexture, CheckerCells) {
+  EXPECT_EQ(checker_texture(Vec3f(0.5f, 0.5f, 0.5f)), 0.0f);
+  EXPECT_EQ(checker_texture(Vec3f(1.5f, 0.5f, 0.5f)), 1.0f);
+  EXPECT_EQ(checker_texture(Vec3f(0.5f, 1.5f, 0.5f)), 1.0f);
+  EXPECT_EQ(checker_texture(Vec3f(0.5f, 0.5f, 1.5f)), 1.0f);
+  EXPECT_EQ(checker_texture(Vec3f(1.5f, 1.5f, 0.5f)), 0.0f);
+  EXPECT_EQ(checker_texture(Vec3f(1.5f, 1.5f, 1.5f)), 1.0f);
+  // Mirrored about 0 by |floor|: cell -1 has index 1.
+  EXPECT_EQ(checker_texture(Vec3f(-0.5f, 0.5f, 0.5f)), 1.0f);
+  // A unit plane at scale 1: its corners' coordinates 0 and 1 stay in the first cell.
+  EXPECT_EQ(checker_texture(Vec3f(0.0f, 0.0f, 0.5f)), 0.0f);
+  EXPECT_EQ(checker_texture(Vec3f(0.999999f, 0.999999f, 0.5f)), 0.0f);
+}
+
+}  // namespace
+}  // namespace gdpt
