@@ -25,6 +25,7 @@
 
 #include "integrator/features.h"
 #include "integrator/math/frame.h"
+#include "integrator/math/valid_reflection.h"
 #include "integrator/path_tracer.h"
 #include "integrator/russian_roulette.h"
 #include "integrator/sampler.h"
@@ -168,7 +169,9 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   }
   const Vec3f wi_world = -dir;
   v.ng = hit.front_facing ? hit.geometric_normal : -hit.geometric_normal;
-  Vec3f ns = hit.front_facing ? hit.shading_normal : -hit.shading_normal;
+  // The shading normal as Cycles sets it (valid_reflection_normal), as in PT.
+  Vec3f ns = valid_reflection_normal(hit.front_facing ? hit.shading_normal : -hit.shading_normal,
+                                     v.ng, wi_world);
   if (dot(ns, wi_world) <= 1e-4f) ns = v.ng;
   v.frame = Frame(ns);
   v.wi = v.frame.to_local(wi_world);

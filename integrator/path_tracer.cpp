@@ -10,6 +10,7 @@
 #include "integrator/data_passes.h"
 #include "integrator/features.h"
 #include "integrator/math/frame.h"
+#include "integrator/math/valid_reflection.h"
 #include "integrator/russian_roulette.h"
 #include "integrator/sampler.h"
 #include "integrator/scene_context.h"
@@ -22,18 +23,6 @@ namespace {
 constexpr uint32_t kSpecialised =
     kSceneDoF | kSceneWorld | kSceneAnalyticLights | kSceneEmissiveTriangles | kFeatureTransparent;
 constexpr float kInf = std::numeric_limits<float>::infinity();
-
-// Shading normal ns (unit) tilted towards wi until dot(ns, wi) >= kMinCos; ng if that degenerates.
-inline Vec3f bend_shading_normal(Vec3f ns, Vec3f ng, Vec3f wi) {
-  constexpr float kMinCos = 0.01f;
-  const float c = dot(ns, wi);
-  if (c >= kMinCos) return ns;
-  const Vec3f bent = ns + wi * (kMinCos - c) * 2.0f;  // 2x: normalisation shrinks the gain
-  const float l2 = length_squared(bent);
-  if (!(l2 > 1e-12f)) return ng;
-  const Vec3f n = bent / std::sqrt(l2);
-  return dot(n, wi) > 0.0f && dot(n, ng) > 0.0f ? n : ng;
-}
 
 // Radiance of one camera sample, split as the film stores it.
 struct PathResult {
@@ -232,12 +221,12 @@ class PathTracer final : public Integrator {
       if (!closures.has_bsdf()) break;
 
       // Frame facing the incoming ray (Cycles flips N and Ng for back faces; materials learn the
-      // side from ShadingContext::front_facing). A shading normal that puts the incoming direction
-      // below (or nearly at) its horizon is tilted towards wi just enough to see it, which keeps
+      // side from ShadingContext::front_facing). A shading normal that would mirror wi below the
+      // surface is rotated towards ng as Cycles does (valid_reflection_normal), which keeps
       // smooth shading continuous at silhouettes, instead of snapping to the flat normal.
       const Vec3f wi_world = -ray.direction;
       const Vec3f ng = hit.front_facing ? hit.geometric_normal : -hit.geometric_normal;
-      const Vec3f ns = bend_shading_normal(
+      const Vec3f ns = valid_reflection_normal(
           hit.front_facing ? hit.shading_normal : -hit.shading_normal, ng, wi_world);
       const Frame frame(ns);
       const Vec3f wi = frame.to_local(wi_world);

@@ -242,13 +242,16 @@ Mesh uv_sphere(float radius, int segments, int rings) {
           Vec3f(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)) * radius);
     }
   }
-  // Blender's quads (a, b, b + seg, a + seg) split along a - (b + seg), with smooth corner normals.
+  // Blender's quads (a, b, b + seg, a + seg) split along a - (b + seg), with smooth corner normals,
+  // wound so that the geometric normal points outwards as the corner normals do (Blender's
+  // meshes are consistent; the winding (a, b, c) made every hit back-facing with the shading
+  // normal inside until the tenth session).
   for (int i = 0; i < rings; ++i)
     for (int j = 0; j < segments; ++j) {
       const uint32_t a = uint32_t(i * segments + j),
                      b = uint32_t(i * segments + (j + 1) % segments);
       const uint32_t c = b + uint32_t(segments), d = a + uint32_t(segments);
-      for (uint32_t v : {a, b, c, a, c, d}) {
+      for (uint32_t v : {a, c, b, a, d, c}) {
         m.indices.push_back(v);
         m.corner_normals.push_back(normalize(m.positions[v]));
       }

@@ -492,6 +492,26 @@ def case_procedural_textures(scene):
     return 3
 
 
+def case_smooth_silhouettes(scene):
+    # Smooth shading on coarse meshes, where interpolated normals mirror the view below the
+    # surface near silhouettes: a 10x6-segment GGX sphere and an 8x4 diffuse one, smooth-shaded,
+    # under a sun from the camera's side and a grey world (Cycles' ensure_valid_reflection,
+    # integrator/math/valid_reflection.h).
+    S.camera((0, -4, 0.5), (0, 0, 0), lens=35)
+    for name, kind, segments, rings, x, inputs in (
+            ("glossy", "ShaderNodeBsdfGlossy", 10, 6, -0.9, {"Roughness": 0.3,
+                                                            "distribution": 'GGX'}),
+            ("diffuse", "ShaderNodeBsdfDiffuse", 8, 4, 0.9, {})):
+        m = S.shader_material(name, kind, Color=(0.8, 0.8, 0.8, 1.0), **inputs)
+        bpy.ops.mesh.primitive_uv_sphere_add(segments=segments, ring_count=rings, radius=0.8,
+                                             location=(x, 0, 0))
+        bpy.ops.object.shade_smooth()
+        bpy.context.active_object.data.materials.append(m)
+    S.light('SUN', (2, -3, 1), 3.0, target=(0, 0, 0))
+    scene.world.color = (0.3, 0.3, 0.3)
+    return 1
+
+
 def case_dof(scene):
     lit_room(scene)
     area_ceiling()

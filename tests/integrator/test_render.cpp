@@ -189,14 +189,25 @@ Scene sunlit_plane(Mesh plane, MaterialDesc material, float theta, Transform pla
   return scene;
 }
 
+// Radiance of sunlit_plane's albedo-0.5 plane when cos(normal, sun) = cosine: 0.5 E cos / pi.
+double lambert_radiance(double cosine) {
+  return 0.5 * 3.0 * cosine / kPi;
+}
+
+// Mean primal of a render of direct light only.
+double mean_direct(const Scene& scene, RenderSettings s) {
+  s.max_bounces = 0;
+  const Image img = render(scene, s);
+  double sum = 0.0;
+  for (float v : img.primal) sum += v;
+  return sum / double(img.primal.size());
+}
+
 // Plane of albedo 0.5 under a sun of irradiance E at angle theta: L = albedo E cos(theta) / pi.
 void sun_test(float theta, float sun_angle) {
   const Scene scene = sunlit_plane(quad(50.0f), diffuse(Spectrum(0.5f)), theta, {}, sun_angle);
-  const Image img = render(scene, pt(16));
-  const double expect = 0.5 * 3.0 * std::cos(theta) / kPi;
-  double sum = 0.0;
-  for (float v : img.primal) sum += v;
-  EXPECT_NEAR(sum / img.primal.size(), expect, 0.01 * expect) << "theta " << theta;
+  const double expect = lambert_radiance(std::cos(theta));
+  EXPECT_NEAR(mean_direct(scene, pt(16)), expect, 0.01 * expect) << "theta " << theta;
 }
 
 TEST(Render, SunOnLambertPlane) {
@@ -240,12 +251,8 @@ TEST(Render, NormalMapTiltsTheShadingNormalAsCycles) {
       const Scene scene = sunlit_plane(plane, m, c.sun_theta, rot);
       RenderSettings s = pt(16);
       s.mode = mode;
-      s.max_bounces = 0;
-      const Image img = render(scene, s);
-      const double expect = 0.5 * 3.0 * c.cosine / kPi;
-      double sum = 0.0;
-      for (float v : img.primal) sum += v;
-      EXPECT_NEAR(sum / img.primal.size(), expect, 0.005 * expect)
+      const double expect = lambert_radiance(c.cosine);
+      EXPECT_NEAR(mean_direct(scene, s), expect, 0.005 * expect)
           << "strength " << c.strength << " rotation " << c.rotate_z << " G-PT "
           << (mode == RenderSettings::Mode::GPT);
     }
@@ -318,12 +325,8 @@ TEST(Render, BumpTiltsTheNormalAgainstTheHeightGradient) {
       scene.images.push_back(ramp);
       RenderSettings s = pt(4);
       s.mode = mode;
-      s.max_bounces = 0;
-      const Image img = render(scene, s);
-      double sum = 0.0;
-      for (float v : img.primal) sum += v;
-      const double expect = 0.5 * 3.0 * c.cosine / kPi;
-      EXPECT_NEAR(sum / img.primal.size(), expect, 1e-3 * expect)
+      const double expect = lambert_radiance(c.cosine);
+      EXPECT_NEAR(mean_direct(scene, s), expect, 1e-3 * expect)
           << "strength " << c.strength << " invert " << c.invert << " G-PT "
           << (mode == RenderSettings::Mode::GPT);
     }
@@ -415,14 +418,9 @@ TEST(Render, BumpDifferentiatesObjectSpaceCoordinates) {
     m.bump.distance = 10.0f;
     Transform stretch;
     stretch.m[0][0] = c.scale_x;
-    Scene scene = sunlit_plane(plane, m, 0.0f, stretch);
-    RenderSettings s = pt(4);
-    s.max_bounces = 0;
-    const Image img = render(scene, s);
-    double sum = 0.0;
-    for (float v : img.primal) sum += v;
-    const double expect = 0.5 * 3.0 * c.cosine / kPi;
-    EXPECT_NEAR(sum / img.primal.size(), expect, 1e-3 * expect)
+    const Scene scene = sunlit_plane(plane, m, 0.0f, stretch);
+    const double expect = lambert_radiance(c.cosine);
+    EXPECT_NEAR(mean_direct(scene, pt(4)), expect, 1e-3 * expect)
         << "source " << int(c.source) << " scale " << c.scale_x << " uvs " << c.uvs;
   }
 }
