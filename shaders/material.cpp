@@ -223,6 +223,26 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
     case InputNodeKind::Coordinates:
       r = in.vector(n.vector);
       break;
+    case InputNodeKind::Voronoi: {
+      if (Inputs::kAverage) {
+        r = Spectrum(0.5f);
+        break;
+      }
+      const float scale = in.scalar(n.value_a);
+      const VoronoiResult v =
+          voronoi_f1(in.vector(n.vector) * scale, saturate(in.scalar(n.value_b)), n.voronoi_metric,
+                     in.scalar(n.value_c));
+      // Position back in the input's units (safe_divide_float3_float: 0 for scale 0).
+      r = n.fac_output        ? Spectrum(v.distance)
+          : n.position_output ? (scale != 0.0f ? v.position / scale : Vec3f(0.0f))
+                              : v.color;
+      break;
+    }
+    case InputNodeKind::Gradient:
+      r = Spectrum(Inputs::kAverage
+                       ? 0.5f
+                       : saturate(gradient_texture(in.vector(n.vector), n.gradient_type)));
+      break;
     case InputNodeKind::Noise: {
       if (Inputs::kAverage) {
         r = Spectrum(0.5f);
@@ -249,11 +269,13 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
 template <class Inputs>
 float input_node_scalar(const InputNode& n, const Inputs& in) {
   const Spectrum r = input_node_result(n, in);
-  const bool grey =
-      n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
-      n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
-      n.kind == InputNodeKind::ToBw || (n.kind == InputNodeKind::Ramp && n.ramp_alpha) ||
-      ((n.kind == InputNodeKind::Checker || n.kind == InputNodeKind::Noise) && n.fac_output);
+  const bool grey = n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
+                    n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
+                    n.kind == InputNodeKind::ToBw ||
+                    (n.kind == InputNodeKind::Ramp && n.ramp_alpha) ||
+                    ((n.kind == InputNodeKind::Checker || n.kind == InputNodeKind::Noise ||
+                      n.kind == InputNodeKind::Voronoi || n.kind == InputNodeKind::Gradient) &&
+                     n.fac_output);
   return grey ? r.x : luminance(r);
 }
 
@@ -508,7 +530,8 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         reads_color_attribute_ = true;
       }
       if (n.kind == InputNodeKind::Checker || n.kind == InputNodeKind::Noise ||
-          n.kind == InputNodeKind::Coordinates) {
+          n.kind == InputNodeKind::Coordinates || n.kind == InputNodeKind::Voronoi ||
+          n.kind == InputNodeKind::Gradient) {
         features_ |= kFeatureTextures;
         reads_coordinates_ |= n.vector.source != TexCoordSource::UV;
       }

@@ -11,6 +11,7 @@
 
 #include "integrator/math/transform.h"
 #include "integrator/math/vec.h"
+#include "shaders/procedural_texture.h"
 
 namespace gdpt {
 
@@ -74,6 +75,10 @@ enum class InputNodeKind : uint8_t {
                    // value_c, distortion fac (Blender 3.4's fBm of Perlin noise, noise_texture_3d)
   Coordinates,     // `vector` itself as a colour (a Texture Coordinate / Mapping output plugged
                    // into a colour or float input)
+  Voronoi,         // 3D Voronoi Texture, F1, at `vector` x scale value_a: randomness value_b,
+                   // Minkowski exponent value_c, metric `voronoi_metric`; Distance (fac_output),
+                   // Color or Position (position_output) (voronoi_f1_3d)
+  Gradient,        // Gradient Texture of type `gradient_type` at `vector`, clamped to [0, 1]
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -107,9 +112,12 @@ struct InputNode {
   std::array<float, 4> bounds{0.0f, 1.0f, 0.0f, 1.0f};
   bool ramp_interpolate = true;
   bool ramp_alpha = false;
-  bool clamp_range = false;  // Clamp: Range type (swapped bounds clamp to [max, min])
-  TextureVector vector;      // Checker, Noise: where they are read; Coordinates: the value
-  bool fac_output = false;   // Checker, Noise: the Fac output (grey) instead of Color
+  bool clamp_range = false;      // Clamp: Range type (swapped bounds clamp to [max, min])
+  TextureVector vector;          // Checker, Noise: where they are read; Coordinates: the value
+  bool fac_output = false;       // Checker, Noise, Voronoi (Distance), Gradient: the grey output
+  bool position_output = false;  // Voronoi: the Position output
+  VoronoiMetric voronoi_metric = VoronoiMetric::Euclidean;
+  GradientType gradient_type = GradientType::Linear;
 };
 
 enum class ShaderNodeKind : uint8_t {

@@ -32,6 +32,56 @@ constexpr uint32_t final_mix(uint32_t a, uint32_t b, uint32_t c) {
   return c;
 }
 
+// lookup3's mixing of (a, b, c) between blocks of three words.
+constexpr void mix(uint32_t& a, uint32_t& b, uint32_t& c) {
+  a -= c;
+  a ^= rotate(c, 4);
+  c += b;
+  b -= a;
+  b ^= rotate(a, 6);
+  a += c;
+  c -= b;
+  c ^= rotate(b, 8);
+  b += a;
+  a -= c;
+  a ^= rotate(c, 16);
+  c += b;
+  b -= a;
+  b ^= rotate(a, 19);
+  a += c;
+  c -= b;
+  c ^= rotate(b, 4);
+  b += a;
+}
+
+constexpr float kHashScale = 1.0f / float(0xFFFFFFFFu);
+
+// A cell's random point in [0, 1)^3 (Cycles' hash_float3_to_float3).
+Vec3f cell_random(Vec3f k) {
+  const uint32_t x = std::bit_cast<uint32_t>(k.x), y = std::bit_cast<uint32_t>(k.y),
+                 z = std::bit_cast<uint32_t>(k.z);
+  return {float(hash_words(x, y, z)) * kHashScale,
+          float(hash_words(x, y, z, std::bit_cast<uint32_t>(1.0f))) * kHashScale,
+          float(hash_words(x, y, z, std::bit_cast<uint32_t>(2.0f))) * kHashScale};
+}
+
+float voronoi_distance(Vec3f a, Vec3f b, VoronoiMetric metric, float exponent) {
+  const Vec3f d = a - b;
+  switch (metric) {
+    case VoronoiMetric::Euclidean:
+      return length(d);
+    case VoronoiMetric::Manhattan:
+      return std::fabs(d.x) + std::fabs(d.y) + std::fabs(d.z);
+    case VoronoiMetric::Chebyshev:
+      return std::max(std::fabs(d.x), std::max(std::fabs(d.y), std::fabs(d.z)));
+    case VoronoiMetric::Minkowski:
+      return std::pow(std::pow(std::fabs(d.x), exponent) + std::pow(std::fabs(d.y), exponent) +
+                          std::pow(std::fabs(d.z), exponent),
+                      1.0f / exponent);
+  }
+  return length(d);
+}
+
 // Quintic fade 6t^5 - 15t^4 + 10t^3, in Cycles' evaluation order.
 inline float fade(float t) {
   return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f);
@@ -111,6 +161,64 @@ uint32_t hash_words(uint32_t a, uint32_t b) {
 uint32_t hash_words(uint32_t a, uint32_t b, uint32_t c) {
   const uint32_t init = 0xdeadbeefu + (3u << 2) + 13u;
   return final_mix(init + a, init + b, init + c);
+}
+
+uint32_t hash_words(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
+  const uint32_t init = 0xdeadbeefu + (4u << 2) + 13u;
+  uint32_t x = init + a, y = init + b, z = init + c;
+  mix(x, y, z);
+  x += d;
+  return final_mix(x, y, z);
+}
+
+VoronoiResult voronoi_f1(Vec3f p, float randomness, VoronoiMetric metric, float exponent) {
+  const Vec3f cell(std::floor(p.x), std::floor(p.y), std::floor(p.z));
+  const Vec3f local = p - cell;
+  VoronoiResult r;
+  float nearest = 8.0f;
+  Vec3f nearest_offset(0.0f), nearest_point(0.0f);
+  for (int k = -1; k <= 1; ++k)
+    for (int j = -1; j <= 1; ++j)
+      for (int i = -1; i <= 1; ++i) {
+        const Vec3f offset{float(i), float(j), float(k)};
+        const Vec3f point = offset + cell_random(cell + offset) * randomness;
+        const float d = voronoi_distance(point, local, metric, exponent);
+        if (d < nearest) {
+          nearest = d;
+          nearest_offset = offset;
+          nearest_point = point;
+        }
+      }
+  r.distance = nearest;
+  r.color = cell_random(cell + nearest_offset);
+  r.position = nearest_point + cell;
+  return r;
+}
+
+float gradient_texture(Vec3f p, GradientType type) {
+  switch (type) {
+    case GradientType::Linear:
+      return p.x;
+    case GradientType::Quadratic: {
+      const float r = std::max(p.x, 0.0f);
+      return r * r;
+    }
+    case GradientType::Easing: {
+      const float r = std::clamp(p.x, 0.0f, 1.0f), t = r * r;
+      return 3.0f * t - 2.0f * t * r;
+    }
+    case GradientType::Diagonal:
+      return (p.x + p.y) * 0.5f;
+    case GradientType::Radial:
+      return std::atan2(p.y, p.x) / (2.0f * 3.14159265358979f) + 0.5f;
+    case GradientType::Spherical:
+    case GradientType::QuadraticSphere: {
+      // Just below 1, as Cycles: a point on the unit sphere gives exactly 0.
+      const float r = std::max(0.999999f - length(p), 0.0f);
+      return type == GradientType::Spherical ? r : r * r;
+    }
+  }
+  return p.x;
 }
 
 float signed_noise(Vec3f p) {

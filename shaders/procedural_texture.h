@@ -2,8 +2,12 @@
 // fractal_noise.h, noisetex.h), so that a scene textured with them renders as in Cycles:
 // - Checker: alternating cells of side 1 (before the node's Scale);
 // - Noise (3D): fractal Brownian motion of Perlin's improved gradient noise, hashed with Bob
-//   Jenkins' lookup3 as Cycles does, so the pattern itself (not only its statistics) matches.
+//   Jenkins' lookup3 as Cycles does, so the pattern itself (not only its statistics) matches;
+// - Voronoi (3D, F1): the nearest jittered cell point, with the same hashes;
+// - Gradient: the seven profiles.
 #pragma once
+
+#include <cstdint>
 
 #include "integrator/math/vec.h"
 
@@ -25,8 +29,32 @@ struct NoiseTextureResult {
 NoiseTextureResult noise_texture(Vec3f p, float detail, float roughness, float distortion,
                                  bool color);
 
-// Bob Jenkins' lookup3 hashes of 2 and 3 words (Cycles' hash_uint2 / hash_uint3).
+// The 3D Voronoi Texture's F1 feature at p (already scaled): the nearest of one jittered point
+// per unit cell (jitter = randomness, in [0, 1]) by the metric, its distance, its cell's random
+// colour and its position (Cycles' voronoi_f1_3d).
+enum class VoronoiMetric : uint8_t { Euclidean, Manhattan, Chebyshev, Minkowski };
+struct VoronoiResult {
+  float distance = 0.0f;
+  Spectrum color{0.0f};
+  Vec3f position{0.0f};
+};
+VoronoiResult voronoi_f1(Vec3f p, float randomness, VoronoiMetric metric, float exponent);
+
+// The Gradient Texture's value at p, before the node's clamp to [0, 1] (Cycles' svm_gradient).
+enum class GradientType : uint8_t {
+  Linear,
+  Quadratic,
+  Easing,
+  Diagonal,
+  Spherical,
+  QuadraticSphere,
+  Radial
+};
+float gradient_texture(Vec3f p, GradientType type);
+
+// Bob Jenkins' lookup3 hashes of 2, 3 and 4 words (Cycles' hash_uint2 / 3 / 4).
 uint32_t hash_words(uint32_t a, uint32_t b);
 uint32_t hash_words(uint32_t a, uint32_t b, uint32_t c);
+uint32_t hash_words(uint32_t a, uint32_t b, uint32_t c, uint32_t d);
 
 }  // namespace gdpt

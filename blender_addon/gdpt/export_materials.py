@@ -23,7 +23,7 @@ _GGX_LIKE = {'GGX', 'SHARP'}
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
                 'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
-                'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ'}
+                'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -284,7 +284,8 @@ class _Translator:
         self.inputs (translated once), or None (with a warning) for a mode Gradient PT does not
         model."""
         per_output = node.type in {'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR', 'TEX_CHECKER',
-                                   'TEX_NOISE', 'TEX_COORD', 'SEPXYZ'}
+                                   'TEX_NOISE', 'TEX_COORD', 'SEPXYZ', 'TEX_VORONOI',
+                                   'TEX_GRADIENT'}
         key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
@@ -369,6 +370,17 @@ class _Translator:
                  "fac": self.value(node.inputs["Distortion"]),
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
                  "fac_output": out.name == "Fac"}
+        elif node.type == 'TEX_VORONOI' and node.voronoi_dimensions == '3D' and \
+                node.feature == 'F1' and out.name in {"Distance", "Color", "Position"}:
+            d = {"kind": "VORONOI", "value_a": self.value(node.inputs["Scale"]),
+                 "value_b": self.value(node.inputs["Randomness"]),
+                 "value_c": self.value(node.inputs["Exponent"]), "metric": node.distance,
+                 "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
+                 "fac_output": out.name == "Distance", "position_output": out.name == "Position"}
+        elif node.type == 'TEX_GRADIENT':
+            d = {"kind": "GRADIENT", "gradient": node.gradient_type,
+                 "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
+                 "fac_output": out.name == "Fac"}
         elif (node.type == 'TEX_COORD' and out.name in {"UV", "Generated", "Object"}) or \
                 node.type == 'UVMAP' or \
                 (node.type == 'MAPPING' and node.vector_type in {'POINT', 'TEXTURE'}):
@@ -383,7 +395,9 @@ class _Translator:
         if d is None:
             mode = (getattr(node, "blend_type", None) or getattr(node, "operation", None) or
                     getattr(node, "mode", None) or getattr(node, "interpolation_type", None) or
-                    getattr(node, "noise_dimensions", None))
+                    getattr(node, "noise_dimensions", None) or
+                    (f"{node.voronoi_dimensions} {node.feature}" if node.type == 'TEX_VORONOI'
+                     else None))
             self.warn(node, f"mode {mode} of the input node" if mode else "input node")
             return None
         self.inputs.append(d)

@@ -152,6 +152,10 @@ InputNode read_input_node(const py::dict& d) {
     n.kind = InputNodeKind::Noise;
   else if (kind == "COORDINATES")
     n.kind = InputNodeKind::Coordinates;
+  else if (kind == "VORONOI")
+    n.kind = InputNodeKind::Voronoi;
+  else if (kind == "GRADIENT")
+    n.kind = InputNodeKind::Gradient;
   else
     bad_enum("input node kind", kind);
   const std::string blend = get_str(d, "blend", "MIX");
@@ -200,6 +204,27 @@ InputNode read_input_node(const py::dict& d) {
   get(d, "clamp_range", n.clamp_range);
   if (d.contains("vector")) read_vector(d["vector"].cast<py::dict>(), n.vector);
   get(d, "fac_output", n.fac_output);
+  get(d, "position_output", n.position_output);
+  const std::string metric = get_str(d, "metric", "EUCLIDEAN");
+  static const std::pair<const char*, VoronoiMetric> kMetrics[] = {
+      {"EUCLIDEAN", VoronoiMetric::Euclidean},
+      {"MANHATTAN", VoronoiMetric::Manhattan},
+      {"CHEBYCHEV", VoronoiMetric::Chebyshev},  // Blender's spelling
+      {"MINKOWSKI", VoronoiMetric::Minkowski}};
+  found = false;
+  for (const auto& [name, value] : kMetrics)
+    if (metric == name) n.voronoi_metric = value, found = true;
+  if (!found) bad_enum("voronoi metric", metric);
+  const std::string gradient = get_str(d, "gradient", "LINEAR");
+  static const std::pair<const char*, GradientType> kGradients[] = {
+      {"LINEAR", GradientType::Linear},       {"QUADRATIC", GradientType::Quadratic},
+      {"EASING", GradientType::Easing},       {"DIAGONAL", GradientType::Diagonal},
+      {"SPHERICAL", GradientType::Spherical}, {"QUADRATIC_SPHERE", GradientType::QuadraticSphere},
+      {"RADIAL", GradientType::Radial}};
+  found = false;
+  for (const auto& [name, value] : kGradients)
+    if (gradient == name) n.gradient_type = value, found = true;
+  if (!found) bad_enum("gradient type", gradient);
   return n;
 }
 

@@ -453,7 +453,8 @@ def case_procedural_textures(scene):
     # Texture at its default (Generated) coordinates; the back wall's Principled base colour is
     # a Noise Color at Object coordinates (detail 3.5, distortion 0.3) and its roughness the same
     # node's Fac; the ball (no UVs) is coloured by a Checker Texture (Generated); the left wall
-    # shows a grid image at Generated coordinates through a Mapping node. (Bumps by procedural
+    # shows a grid image at Generated coordinates through a Mapping node; the right wall's colour
+    # is a 3D Voronoi Texture's Color (F1, Manhattan, Object), the ceiling's a radial Gradient. (Bumps by procedural
     # heights are tested analytically, Render.BumpDifferentiatesObjectSpaceCoordinates: Cycles'
     # bumps of noise are weaker than the exact gradient, docs/shaders.md.)
     material, assign = grid_room(scene)
@@ -489,6 +490,23 @@ def case_procedural_textures(scene):
     checker.inputs["Color2"].default_value = (0.1, 0.2, 0.6, 1.0)
     nt.links.new(checker.outputs["Color"], bsdf.inputs["Color"])
     S.uv_sphere("ball", 0.8, (0.3, 0.2, 0.8), m)
+
+    m, nt, bsdf, tex = material("cells", "ShaderNodeBsdfDiffuse")
+    voronoi = nt.nodes.new("ShaderNodeTexVoronoi")
+    voronoi.distance = 'MANHATTAN'
+    voronoi.inputs["Scale"].default_value = 3.0
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    nt.links.new(coords.outputs["Object"], voronoi.inputs["Vector"])
+    nt.links.new(voronoi.outputs["Color"], bsdf.inputs["Color"])
+    assign("right", m)
+
+    m, nt, bsdf, tex = material("radial", "ShaderNodeBsdfDiffuse")
+    gradient = nt.nodes.new("ShaderNodeTexGradient")
+    gradient.gradient_type = 'RADIAL'
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    nt.links.new(coords.outputs["Object"], gradient.inputs["Vector"])
+    nt.links.new(gradient.outputs["Fac"], bsdf.inputs["Color"])
+    assign("ceiling", m)
     return 3
 
 

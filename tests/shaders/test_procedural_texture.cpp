@@ -80,5 +80,54 @@ TEST(ProceduralTexture, CheckerCells) {
   EXPECT_EQ(checker_texture(Vec3f(0.999999f, 0.999999f, 0.5f)), 0.0f);
 }
 
+// With randomness 0 every cell's point is its corner: F1 is the nearest lattice point, exactly,
+// under each metric.
+TEST(ProceduralTexture, VoronoiWithoutJitterFindsTheNearestLatticePoint) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-20.0f, 20.0f);
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3f p(u(rng), u(rng), u(rng));
+    const Vec3f nearest(std::round(p.x), std::round(p.y), std::round(p.z));
+    const Vec3f d = p - nearest;
+    const VoronoiResult e = voronoi_f1(p, 0.0f, VoronoiMetric::Euclidean, 1.0f);
+    EXPECT_NEAR(e.distance, length(d), 1e-5f);
+    EXPECT_EQ(e.position, nearest);
+    const VoronoiResult c = voronoi_f1(p, 0.0f, VoronoiMetric::Chebyshev, 1.0f);
+    EXPECT_NEAR(c.distance, std::max(std::fabs(d.x), std::max(std::fabs(d.y), std::fabs(d.z))),
+                1e-5f);
+    // Minkowski with exponent 1 is Manhattan.
+    const VoronoiResult m = voronoi_f1(p, 0.0f, VoronoiMetric::Minkowski, 1.0f);
+    EXPECT_NEAR(m.distance, voronoi_f1(p, 0.0f, VoronoiMetric::Manhattan, 1.0f).distance, 1e-4f);
+    // The colour is the cell's: the same anywhere near the same point.
+    EXPECT_EQ(e.color, voronoi_f1(nearest + d * 0.5f, 0.0f, VoronoiMetric::Euclidean, 1.0f).color);
+    for (float v : {e.color.x, e.color.y, e.color.z}) {
+      EXPECT_GE(v, 0.0f);
+      EXPECT_LE(v, 1.0f);
+    }
+  }
+  // Jittered points stay within their cells: F1 is never farther than a cell diagonal.
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3f p(u(rng), u(rng), u(rng));
+    const VoronoiResult r = voronoi_f1(p, 1.0f, VoronoiMetric::Euclidean, 1.0f);
+    EXPECT_LE(r.distance, std::sqrt(3.0f));
+    EXPECT_NEAR(length(r.position - p), r.distance, 1e-4f);
+  }
+}
+
+TEST(ProceduralTexture, GradientProfiles) {
+  const Vec3f p(0.6f, 0.2f, 0.1f);
+  EXPECT_FLOAT_EQ(gradient_texture(p, GradientType::Linear), 0.6f);
+  EXPECT_FLOAT_EQ(gradient_texture(p, GradientType::Quadratic), 0.36f);
+  EXPECT_FLOAT_EQ(gradient_texture(Vec3f(-0.5f, 0, 0), GradientType::Quadratic), 0.0f);
+  EXPECT_FLOAT_EQ(gradient_texture(p, GradientType::Easing), 3 * 0.36f - 2 * 0.216f);
+  EXPECT_FLOAT_EQ(gradient_texture(p, GradientType::Diagonal), 0.4f);
+  const float r = 0.999999f - std::sqrt(0.41f);
+  EXPECT_FLOAT_EQ(gradient_texture(p, GradientType::Spherical), r);
+  EXPECT_FLOAT_EQ(gradient_texture(p, GradientType::QuadraticSphere), r * r);
+  EXPECT_FLOAT_EQ(gradient_texture(Vec3f(0, 1, 0), GradientType::Spherical), 0.0f);
+  EXPECT_FLOAT_EQ(gradient_texture(Vec3f(0, 1, 0), GradientType::Radial), 0.75f);
+  EXPECT_FLOAT_EQ(gradient_texture(Vec3f(-1, -1e-9f, 0), GradientType::Radial), 0.0f);
+}
+
 }  // namespace
 }  // namespace gdpt
