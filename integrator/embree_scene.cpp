@@ -368,8 +368,12 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
                        ? d.slot_materials[size_t(slot)]
                        : default_material_;
   }
-  if (d.perturbs_normal) [[unlikely]]
+  hit.perturbed = false;
+  if (d.perturbs_normal) [[unlikely]] {
+    hit.unperturbed_normal = hit.shading_normal;
     perturb_normal(d, primitive, u, v, hit);
+    hit.perturbed = !(hit.shading_normal == hit.unperturbed_normal);
+  }
 }
 
 namespace {
@@ -425,8 +429,7 @@ void EmbreeScene::perturb_normal(const InstanceData& d, uint32_t primitive, floa
 // along dP/du and dP/dv with a step in UV when the mesh has UVs, else along the triangle's edges
 // with a step in barycentrics. Every coordinate moves with the step (UV, and object-space
 // coordinates along the object-space image of the direction), so image and procedural heights
-// both differentiate. Cycles works with the normal facing the ray: on back faces the tilt flips
-// with it.
+// both differentiate.
 void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
                               const Material& material) const {
   const uint32_t* idx = d.indices + size_t(primitive) * 3;
@@ -482,8 +485,9 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
   }
   const Vec3f grad = (g0 * (h[1] - h[0]) + g1 * (h[2] - h[0])) / kStep;
   const BumpDesc& b = material.bump();
-  float distance = b.invert ? -b.distance : b.distance;
-  if (!hit.front_facing) distance = -distance;
+  // The tilt belongs to the surface, not to the side it is seen from: a back face shows the
+  // same bumped normal, flipped (as Cycles 3.4 renders inside-out meshes).
+  const float distance = b.invert ? -b.distance : b.distance;
   const Vec3f n = hit.shading_normal;
   Vec3f bumped;
   if (!set_unit(n - grad * distance, bumped)) return;

@@ -33,6 +33,10 @@ struct SurfaceHit {
   Vec3f color;       // colour attribute (Mesh::corner_colors), 0 when the mesh has none; only set
                      // on instances that have one or whose materials read one
   TexCoords coords;  // object-space coordinates; only set on instances whose materials read them
+  // A normal map or bump replaced shading_normal; unperturbed_normal is the interpolated one
+  // (for the bump shadowing of diffuse lobes, ClosureSet::set_bump_shadowing).
+  bool perturbed = false;
+  Vec3f unperturbed_normal;
   uint32_t instance = 0, primitive = 0;  // index in Scene::instances, triangle in its mesh
   int32_t material = -1;     // index into SceneContext::materials() (always valid after hit())
   bool front_facing = true;  // the ray came from the side geometric_normal points to

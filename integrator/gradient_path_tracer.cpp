@@ -175,6 +175,10 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   if (dot(ns, wi_world) <= 1e-4f) ns = v.ng;
   v.frame = Frame(ns);
   v.wi = v.frame.to_local(wi_world);
+  // Bump shadowing of the diffuse lobes, as in PT (perturbing materials evaluate per hit).
+  if (hit.perturbed && v.closures == &v.own) [[unlikely]]
+    v.own.set_bump_shadowing(
+        v.frame.to_local(hit.front_facing ? hit.unperturbed_normal : -hit.unperturbed_normal));
   v.origin_set = false;
 }
 

@@ -230,6 +230,11 @@ class PathTracer final : public Integrator {
           hit.front_facing ? hit.shading_normal : -hit.shading_normal, ng, wi_world);
       const Frame frame(ns);
       const Vec3f wi = frame.to_local(wi_world);
+      // Bump shadowing of the diffuse lobes where a normal map or bump replaced the normal (its
+      // materials always evaluate into the scratch set).
+      if (hit.perturbed && &closures == &closure_scratch) [[unlikely]]
+        closure_scratch.set_bump_shadowing(
+            frame.to_local(hit.front_facing ? hit.unperturbed_normal : -hit.unperturbed_normal));
 
       // --- Next-event estimation ---
       if (has_lights) {

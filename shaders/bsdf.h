@@ -20,12 +20,24 @@ class ClosureSet {
   void clear() {
     count_ = 0;
     emission_ = Spectrum(0.0f);
+    shadowing_ = false;
   }
   // Becomes a copy of `other` (only its live lobes are copied: cheaper than assignment).
   void assign(const ClosureSet& other) {
     count_ = other.count_;
     for (int i = 0; i < count_; ++i) closures_[i] = other.closures_[i];
     emission_ = other.emission_;
+    shadowing_ = other.shadowing_;
+    unperturbed_ = other.unperturbed_;
+  }
+  // Cycles' bump shadowing (Conty Estevez et al. 2019, Cycles 3.4's bump_shadowing_term): at a
+  // point whose shading normal a normal map or bump replaced, the diffuse lobes' values (not
+  // their densities) are scaled by a smooth cut-off of directions that the unperturbed normal
+  // would see at a grazing angle, which hides the bump terminator. `unperturbed`: the interpolated
+  // normal in the local frame (the perturbed one is +z).
+  void set_bump_shadowing(Vec3f unperturbed) {
+    shadowing_ = true;
+    unperturbed_ = unperturbed;
   }
   // Adds a lobe; weights that are zero are dropped; a full set drops the lobe of least weight.
   void add(const Closure& c);
@@ -47,6 +59,8 @@ class ClosureSet {
   Spectrum eval(Vec3f wi, Vec3f wo) const {
     return single_lambert() ? lambert::eval(closures_[0], wi, wo) : eval_mixture(wi, wo);
   }
+  // The bump shadowing factor of direction wo (1 without set_bump_shadowing).
+  float diffuse_shadowing(Vec3f wo) const;
   float pdf(Vec3f wi, Vec3f wo) const {
     return single_lambert() ? lambert::pdf(closures_[0], wi, wo) : pdf_mixture(wi, wo);
   }
@@ -72,7 +86,10 @@ class ClosureSet {
   bool has_delta() const;
 
  private:
-  bool single_lambert() const { return count_ == 1 && closures_[0].type == ClosureType::Lambert; }
+  // The inline fast path (bump shadowing goes through the mixture code).
+  bool single_lambert() const {
+    return count_ == 1 && closures_[0].type == ClosureType::Lambert && !shadowing_;
+  }
   // Any set (the same values as the fast path for a single Lambert lobe).
   Spectrum eval_mixture(Vec3f wi, Vec3f wo) const;
   float pdf_mixture(Vec3f wi, Vec3f wo) const;
@@ -82,6 +99,8 @@ class ClosureSet {
   Closure closures_[kMaxClosures];
   int count_ = 0;
   Spectrum emission_{0.0f, 0.0f, 0.0f};
+  bool shadowing_ = false;
+  Vec3f unperturbed_{0.0f, 0.0f, 1.0f};
 };
 
 }  // namespace gdpt

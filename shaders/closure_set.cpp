@@ -98,9 +98,27 @@ void ClosureSet::add(const Closure& c) {
     closures_[weakest] = c;
 }
 
+float ClosureSet::diffuse_shadowing(Vec3f wo) const {
+  if (!shadowing_) return 1.0f;
+  // g = cos(unperturbed, wo) / (cos(perturbed, wo) cos(unperturbed, perturbed)); 1 from g = 1 on,
+  // 0 below 0, the cubic -g^3 + g^2 + g between (C1 at g = 1).
+  const float den = wo.z * unperturbed_.z;
+  const float g = den != 0.0f ? dot(unperturbed_, wo) / den : 0.0f;
+  if (g >= 1.0f) return 1.0f;
+  if (g < 0.0f) return 0.0f;
+  const float g2 = g * g;
+  return -g2 * g + g2 + g;
+}
+
+// A lobe's value with the bump shadowing of diffuse lobes applied (`shadowing` = its factor).
+inline Spectrum shadowed(const Closure& c, Spectrum value, float shadowing) {
+  return shadowing != 1.0f && lobe_is_diffuse(c) ? value * shadowing : value;
+}
+
 Spectrum ClosureSet::eval_mixture(Vec3f wi, Vec3f wo) const {
+  const float sh = diffuse_shadowing(wo);
   Spectrum f(0.0f);
-  for (int i = 0; i < count_; ++i) f += lobe_eval(closures_[i], wi, wo);
+  for (int i = 0; i < count_; ++i) f += shadowed(closures_[i], lobe_eval(closures_[i], wi, wo), sh);
   return f;
 }
 
@@ -116,9 +134,10 @@ float ClosureSet::pdf_mixture(Vec3f wi, Vec3f wo) const {
 }
 
 Spectrum ClosureSet::eval_pdf_mixture(Vec3f wi, Vec3f wo, float& pdf_out) const {
+  const float sh = diffuse_shadowing(wo);
   if (count_ == 1) {
     pdf_out = lobe_pdf(closures_[0], wi, wo);
-    return lobe_eval(closures_[0], wi, wo);
+    return shadowed(closures_[0], lobe_eval(closures_[0], wi, wo), sh);
   }
   // The loops of eval() and pdf() merged, each sum in the same order: identical values.
   float w[kMaxClosures];
@@ -126,7 +145,7 @@ Spectrum ClosureSet::eval_pdf_mixture(Vec3f wi, Vec3f wo, float& pdf_out) const 
   Spectrum f(0.0f);
   float p = 0.0f;
   for (int i = 0; i < count_; ++i) {
-    f += lobe_eval(closures_[i], wi, wo);
+    f += shadowed(closures_[i], lobe_eval(closures_[i], wi, wo), sh);
     if (w[i] > 0.0f) p += w[i] * lobe_pdf(closures_[i], wi, wo);
   }
   pdf_out = total > 0.0f ? p / total : 0.0f;
@@ -135,7 +154,11 @@ Spectrum ClosureSet::eval_pdf_mixture(Vec3f wi, Vec3f wo, float& pdf_out) const 
 
 BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
   if (count_ == 0) return {};
-  if (count_ == 1) return lobe_sample(closures_[0], wi, u_lobe, u);
+  if (count_ == 1) {
+    BsdfSample s = lobe_sample(closures_[0], wi, u_lobe, u);
+    if (s.valid && shadowing_) s.value = shadowed(closures_[0], s.value, diffuse_shadowing(s.wo));
+    return s;
+  }
 
   // --- Pick a lobe; the leftover of u_lobe within its interval drives the lobe's own choice.
   float w[kMaxClosures];
@@ -160,11 +183,12 @@ BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
   }
 
   // --- One-sample MIS: the mixture's value and density at the sampled direction.
-  Spectrum value = s.value;
+  const float sh = diffuse_shadowing(s.wo);
+  Spectrum value = shadowed(closures_[k], s.value, sh);
   float pdf = w[k] * s.pdf;
   for (int i = 0; i < count_; ++i) {
     if (i == k) continue;
-    value += lobe_eval(closures_[i], wi, s.wo);
+    value += shadowed(closures_[i], lobe_eval(closures_[i], wi, s.wo), sh);
     if (w[i] > 0.0f) pdf += w[i] * lobe_pdf(closures_[i], wi, s.wo);
   }
   s.value = value;

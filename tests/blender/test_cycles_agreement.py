@@ -452,11 +452,11 @@ def case_procedural_textures(scene):
     # Procedural textures and texture coordinates: the floor's colour is the Color of a 3D Noise
     # Texture at its default (Generated) coordinates; the back wall's Principled base colour is
     # a Noise Color at Object coordinates (detail 3.5, distortion 0.3) and its roughness the same
-    # node's Fac; the ball (no UVs) is coloured by a Checker Texture (Generated); the left wall
-    # shows a grid image at Generated coordinates through a Mapping node; the right wall's colour
-    # is a 3D Voronoi Texture's Color (F1, Manhattan, Object), the ceiling's a radial Gradient. (Bumps by procedural
-    # heights are tested analytically, Render.BumpDifferentiatesObjectSpaceCoordinates: Cycles'
-    # bumps of noise are weaker than the exact gradient, docs/shaders.md.)
+    # node's Fac; the ball (no UVs) is coloured by a Checker Texture (Generated) and bumped by a
+    # Noise Fac (scale 4, distance 0.5: differences along the triangles' edges, and Cycles' bump
+    # shadowing of diffuse lobes); the left wall shows a grid image at Generated coordinates
+    # through a Mapping node; the right wall's colour is a 3D Voronoi Texture's Color (F1,
+    # Manhattan, Object), the ceiling's a radial Gradient.
     material, assign = grid_room(scene)
     m, nt, bsdf, tex = material("noisy_floor", "ShaderNodeBsdfDiffuse")
     noise = nt.nodes.new("ShaderNodeTexNoise")
@@ -489,6 +489,12 @@ def case_procedural_textures(scene):
     checker.inputs["Color1"].default_value = (0.9, 0.6, 0.2, 1.0)
     checker.inputs["Color2"].default_value = (0.1, 0.2, 0.6, 1.0)
     nt.links.new(checker.outputs["Color"], bsdf.inputs["Color"])
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = 4.0
+    bump = nt.nodes.new("ShaderNodeBump")
+    bump.inputs["Distance"].default_value = 0.5
+    nt.links.new(noise.outputs["Fac"], bump.inputs["Height"])
+    nt.links.new(bump.outputs["Normal"], bsdf.inputs["Normal"])
     S.uv_sphere("ball", 0.8, (0.3, 0.2, 0.8), m)
 
     m, nt, bsdf, tex = material("cells", "ShaderNodeBsdfDiffuse")

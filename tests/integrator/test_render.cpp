@@ -332,6 +332,48 @@ TEST(Render, BumpTiltsTheNormalAgainstTheHeightGradient) {
     }
 }
 
+// The bump belongs to the surface: seen from its back (the quad wound the other way), a height
+// ramp along v gives the same world-space tilt of the surface's normal, flipped towards the
+// viewer, as Cycles 3.4 renders inside-out meshes. With the sun tilted towards -y the two sides'
+// cosines differ: normalize(z -+ 0.2 y) against (0, -sin t, cos t). The front side also shows
+// Cycles' bump shadowing: g = cos(z, sun) / (cos(n, sun) cos(z, n)) < 1 scales the diffuse value
+// by -g^3 + g^2 + g (the back side's g > 1: no change).
+TEST(Render, BumpOnABackFaceKeepsTheSurfacesTilt) {
+  ImageDesc ramp;
+  ramp.name = "ramp";
+  ramp.width = 1;
+  ramp.height = 2;
+  ramp.rgba = {0, 0, 0, 1, 1, 1, 1, 1};
+  constexpr float kTheta = 0.5f;
+  for (const bool back : {false, true}) {
+    Mesh plane = quad(50.0f);
+    plane.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
+    if (back) {
+      plane.indices = {0, 2, 1, 0, 3, 2};
+      plane.corner_uvs = {{0, 0}, {1, 1}, {1, 0}, {0, 0}, {0, 1}, {1, 1}};
+    }
+    MaterialDesc m = diffuse(Spectrum(0.5f));
+    m.bump.enabled = true;
+    m.bump.height.texture.image = 0;
+    m.bump.height.texture.extension = TextureLookup::Extension::Extend;
+    m.bump.height.channel = FloatInput::Channel::Red;
+    m.bump.distance = 10.0f;
+    Scene scene = sunlit_plane(plane, m, kTheta);
+    scene.images.push_back(ramp);
+    // Height h = v / 100 over the 100 m quad: tilt 0.2 along -y (front) or +y (back, facing).
+    const double ny = back ? 0.2 : -0.2;
+    const double cosine = (-ny * std::sin(kTheta) + std::cos(kTheta)) / std::sqrt(1.04);
+    const double g = std::min(std::cos(kTheta) / (cosine / std::sqrt(1.04)), 1.0);
+    const double expect = lambert_radiance(cosine) * (-g * g * g + g * g + g);
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      EXPECT_NEAR(mean_direct(scene, s), expect, 2e-3 * expect)
+          << "back " << back << " G-PT " << (mode == RenderSettings::Mode::GPT);
+    }
+  }
+}
+
 // An emitter whose colour is its texture coordinate (a Texture Coordinate output used as a
 // colour): Object is the object-space position (through a Mapping that adds 1, so it stays
 // positive), Generated the position mapped from the mesh's bounding box (+-1 in x and y, flat

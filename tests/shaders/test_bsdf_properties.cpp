@@ -296,6 +296,45 @@ TEST(ClosureSet, SampleReportsLobeFlagsEtaAndRoughness) {
   EXPECT_NEAR(t.weight().x, 0.5f, 1e-7f);
 }
 
+// Bump shadowing scales the diffuse lobes' values by Cycles' term of g = cos(n0, wo) / (cos(n,
+// wo) cos(n0, n)) (n = +z) and leaves glossy lobes and all densities alone; sampling returns the
+// same values as evaluation.
+TEST(ClosureSet, BumpShadowingScalesDiffuseValuesOnly) {
+  const Vec3f n0 = normalize(Vec3f(0.3f, 0.0f, 1.0f));  // the unperturbed normal
+  auto term = [&](Vec3f wo) {
+    const float g = dot(n0, wo) / (wo.z * n0.z);
+    return g >= 1.0f ? 1.0f : g < 0.0f ? 0.0f : -g * g * g + g * g + g;
+  };
+  for (const bool single : {true, false}) {
+    const ClosureSet plain =
+        single ? set_of({lambert(Spectrum(0.7f))}) : set_of({lambert(Spectrum(0.7f)), ggx(0.3f)});
+    ClosureSet bumped = plain;
+    bumped.set_bump_shadowing(n0);
+    const ClosureSet glossy = set_of({ggx(0.3f)});
+    Pcg32 rng(3);
+    int scaled = 0;
+    for (int i = 0; i < 500; ++i) {
+      const Vec3f wi = incident(0.2f + 0.8f * rng.uniform());
+      const float phi = 6.2831853f * rng.uniform(), z = rng.uniform();
+      const Vec3f wo(std::sqrt(1 - z * z) * std::cos(phi), std::sqrt(1 - z * z) * std::sin(phi), z);
+      float pdf_plain, pdf_bumped;
+      const Spectrum f = plain.eval_pdf(wi, wo, pdf_plain);
+      const Spectrum fb = bumped.eval_pdf(wi, wo, pdf_bumped);
+      const Spectrum fg = single ? Spectrum(0.0f) : glossy.eval(wi, wo);
+      EXPECT_NEAR(fb.x, (f.x - fg.x) * term(wo) + fg.x, 1e-5f * (1 + f.x));
+      EXPECT_FLOAT_EQ(pdf_bumped, pdf_plain);
+      scaled += term(wo) < 1.0f;
+      const BsdfSample s = bumped.sample(wi, rng.uniform(), Vec2f(rng.uniform(), rng.uniform()));
+      if (!s.valid) continue;
+      float pdf;
+      const Spectrum e = bumped.eval_pdf(wi, s.wo, pdf);
+      EXPECT_NEAR(s.value.x, e.x, 1e-4f * (1 + e.x));
+      EXPECT_NEAR(s.pdf, pdf, 1e-4f * (1 + pdf));
+    }
+    EXPECT_GT(scaled, 50);
+  }
+}
+
 // Degenerate inputs: zero roughness, exactly grazing wi (z = 0), wo = -wi, wo = wi, poles.
 TEST(BsdfRobustness, NoNaNOrInfInDegenerateConfigurations) {
   std::vector<Closure> lobes = {lambert(), oren_nayar(1.0f), principled_diffuse(1.0f),
