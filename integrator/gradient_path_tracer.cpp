@@ -13,6 +13,7 @@
 // included), adds w (C' - C) to the gradient half of that offset, w = shift::mis_weight_over_pdf.
 #include "integrator/gradient_path_tracer.h"
 #include "integrator/bounce_limits.h"
+#include "integrator/bump_shadowing.h"
 #include "integrator/data_passes.h"
 
 #include <algorithm>
@@ -170,15 +171,17 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   const Vec3f wi_world = -dir;
   v.ng = hit.front_facing ? hit.geometric_normal : -hit.geometric_normal;
   // The shading normal as Cycles sets it (valid_reflection_normal), as in PT.
+  bool rotated;
   Vec3f ns = valid_reflection_normal(hit.front_facing ? hit.shading_normal : -hit.shading_normal,
-                                     v.ng, wi_world);
-  if (dot(ns, wi_world) <= 1e-4f) ns = v.ng;
+                                     v.ng, wi_world, rotated);
+  if (dot(ns, wi_world) <= 1e-4f) {
+    ns = v.ng;
+    rotated = true;
+  }
   v.frame = Frame(ns);
   v.wi = v.frame.to_local(wi_world);
-  // Bump shadowing of the diffuse lobes, as in PT (perturbing materials evaluate per hit).
-  if (hit.perturbed && v.closures == &v.own) [[unlikely]]
-    v.own.set_bump_shadowing(
-        v.frame.to_local(hit.front_facing ? hit.unperturbed_normal : -hit.unperturbed_normal));
+  // With bump shadowing where the normal is not the interpolated one, as in PT.
+  v.closures = &shading_closures(*v.closures, v.own, hit, v.frame, rotated);
   v.origin_set = false;
 }
 

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "integrator/bounce_limits.h"
+#include "integrator/bump_shadowing.h"
 #include "integrator/data_passes.h"
 #include "integrator/features.h"
 #include "integrator/math/frame.h"
@@ -216,9 +217,9 @@ class PathTracer final : public Integrator {
         }
       }
       if (last) break;
-      const ClosureSet& closures = material.closures(sc, closure_scratch);
-      if (camera_path && data_.active()) data_.at_surface(hit, closures, beta, out.data);
-      if (!closures.has_bsdf()) break;
+      const ClosureSet& material_closures = material.closures(sc, closure_scratch);
+      if (camera_path && data_.active()) data_.at_surface(hit, material_closures, beta, out.data);
+      if (!material_closures.has_bsdf()) break;
 
       // Frame facing the incoming ray (Cycles flips N and Ng for back faces; materials learn the
       // side from ShadingContext::front_facing). A shading normal that would mirror wi below the
@@ -226,15 +227,14 @@ class PathTracer final : public Integrator {
       // smooth shading continuous at silhouettes, instead of snapping to the flat normal.
       const Vec3f wi_world = -ray.direction;
       const Vec3f ng = hit.front_facing ? hit.geometric_normal : -hit.geometric_normal;
+      bool rotated;
       const Vec3f ns = valid_reflection_normal(
-          hit.front_facing ? hit.shading_normal : -hit.shading_normal, ng, wi_world);
+          hit.front_facing ? hit.shading_normal : -hit.shading_normal, ng, wi_world, rotated);
       const Frame frame(ns);
       const Vec3f wi = frame.to_local(wi_world);
-      // Bump shadowing of the diffuse lobes where a normal map or bump replaced the normal (its
-      // materials always evaluate into the scratch set).
-      if (hit.perturbed && &closures == &closure_scratch) [[unlikely]]
-        closure_scratch.set_bump_shadowing(
-            frame.to_local(hit.front_facing ? hit.unperturbed_normal : -hit.unperturbed_normal));
+      // With bump shadowing where the normal is not the interpolated one (bump_shadowing.h).
+      const ClosureSet& closures =
+          shading_closures(material_closures, closure_scratch, hit, frame, rotated);
 
       // --- Next-event estimation ---
       if (has_lights) {

@@ -642,8 +642,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
 
 void Material::cache_if_constant() {
   constant_ = false;
-  // Perturbed normals take per-hit closures (their bump shadowing is per hit).
-  if ((features_ & kFeatureTextures) || normal_map_.enabled || bump_.enabled) return;
+  if (features_ & kFeatureTextures) return;
   for (int side = 0; side < 2; ++side) {
     ClosureSet& set = constant_closures_[side];
     set.clear();

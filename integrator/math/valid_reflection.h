@@ -56,12 +56,19 @@ namespace gdpt {
 // ns: unit shading normal; ng: unit geometric normal facing wi; wi: unit direction to the viewer.
 // Returns ns when its reflection of wi is valid, else the rotated normal (ng when no rotation
 // works).
-[[gnu::always_inline]] inline Vec3f valid_reflection_normal(Vec3f ns, Vec3f ng, Vec3f wi) {
+// `rotated` is set when the result is not ns.
+[[gnu::always_inline]] inline Vec3f valid_reflection_normal(Vec3f ns, Vec3f ng, Vec3f wi,
+                                                            bool& rotated) {
   const float iz = dot(wi, ng);
   const float t = std::min(0.9f * iz, 0.01f);
-  if (dot(ng, ns * (2.0f * dot(ns, wi)) - wi) >= t) [[likely]]
+  rotated = !(dot(ng, ns * (2.0f * dot(ns, wi)) - wi) >= t);
+  if (!rotated) [[likely]]
     return ns;
   return rotate_to_valid_reflection(ns, ng, wi, iz, t);
+}
+inline Vec3f valid_reflection_normal(Vec3f ns, Vec3f ng, Vec3f wi) {
+  bool rotated;
+  return valid_reflection_normal(ns, ng, wi, rotated);
 }
 
 }  // namespace gdpt
