@@ -13,45 +13,38 @@ constexpr uint32_t rotate(uint32_t x, int k) {
   return (x << k) | (x >> (32 - k));
 }
 
+// lookup3's two kinds of rounds: x -= z, x ^= rot(z, k), z += y (mix) and x ^= y, x -= rot(y, k)
+// (final).
+constexpr void mix_round(uint32_t& x, uint32_t y, uint32_t& z, int k) {
+  x -= z;
+  x ^= rotate(z, k);
+  z += y;
+}
+constexpr void final_round(uint32_t& x, uint32_t y, int k) {
+  x ^= y;
+  x -= rotate(y, k);
+}
+
 // lookup3's final mixing of (a, b, c); the hash is c.
 constexpr uint32_t final_mix(uint32_t a, uint32_t b, uint32_t c) {
-  c ^= b;
-  c -= rotate(b, 14);
-  a ^= c;
-  a -= rotate(c, 11);
-  b ^= a;
-  b -= rotate(a, 25);
-  c ^= b;
-  c -= rotate(b, 16);
-  a ^= c;
-  a -= rotate(c, 4);
-  b ^= a;
-  b -= rotate(a, 14);
-  c ^= b;
-  c -= rotate(b, 24);
+  final_round(c, b, 14);
+  final_round(a, c, 11);
+  final_round(b, a, 25);
+  final_round(c, b, 16);
+  final_round(a, c, 4);
+  final_round(b, a, 14);
+  final_round(c, b, 24);
   return c;
 }
 
 // lookup3's mixing of (a, b, c) between blocks of three words.
 constexpr void mix(uint32_t& a, uint32_t& b, uint32_t& c) {
-  a -= c;
-  a ^= rotate(c, 4);
-  c += b;
-  b -= a;
-  b ^= rotate(a, 6);
-  a += c;
-  c -= b;
-  c ^= rotate(b, 8);
-  b += a;
-  a -= c;
-  a ^= rotate(c, 16);
-  c += b;
-  b -= a;
-  b ^= rotate(a, 19);
-  a += c;
-  c -= b;
-  c ^= rotate(b, 4);
-  b += a;
+  mix_round(a, b, c, 4);
+  mix_round(b, c, a, 6);
+  mix_round(c, a, b, 8);
+  mix_round(a, b, c, 16);
+  mix_round(b, c, a, 19);
+  mix_round(c, a, b, 4);
 }
 
 constexpr float kHashScale = 1.0f / float(0xFFFFFFFFu);

@@ -288,17 +288,41 @@ TEST(Render, ColorAttributeIsTheInterpolatedCornerColour) {
     }
 }
 
+// The 100 m quad with UVs spanning [0, 1]^2.
+Mesh uv_quad() {
+  Mesh plane = quad(50.0f);
+  plane.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
+  return plane;
+}
+
+// A two-texel image, black then white: a height ramp along u (2 x 1) or v (1 x 2).
+ImageDesc ramp_image(int width, int height) {
+  ImageDesc ramp;
+  ramp.name = "ramp";
+  ramp.width = width;
+  ramp.height = height;
+  ramp.rgba = {0, 0, 0, 1, 1, 1, 1, 1};
+  return ramp;
+}
+
+// Albedo 0.5, bumped by the red channel of image 0 (a ramp), distance 10.
+MaterialDesc ramp_bumped() {
+  MaterialDesc m = diffuse(Spectrum(0.5f));
+  m.bump.enabled = true;
+  m.bump.height.texture.image = 0;
+  m.bump.height.texture.extension = TextureLookup::Extension::Extend;
+  m.bump.height.channel = FloatInput::Channel::Red;
+  m.bump.distance = 10.0f;
+  return m;
+}
+
 // A Bump node whose height rises linearly along u (a 2x1 texture 0 -> 1, bilinear: slope 2 per
 // unit of u between the pixel centres) on a 100 m plane mapped to [0, 1]^2: grad h = 0.02 / m
 // along x, so with distance 10 the normal tilts to normalize(0, 0, 1) - (0.2, 0, 0)) and the sun
 // straight above lights it with cos = 1 / sqrt(1.04); strength 0.5 mixes it half-way back
 // towards the normal; invert tilts the other way (same cosine). PT and G-PT.
 TEST(Render, BumpTiltsTheNormalAgainstTheHeightGradient) {
-  ImageDesc ramp;
-  ramp.name = "ramp";
-  ramp.width = 2;
-  ramp.height = 1;
-  ramp.rgba = {0, 0, 0, 1, 1, 1, 1, 1};
+  const ImageDesc ramp = ramp_image(2, 1);
   const double tilted = 1.0 / std::sqrt(1.04);
   // Strength 0.5: normalize(0.5 n' + 0.5 n), n' = (-0.2, 0, 1) / sqrt(1.04).
   const double hx = 0.5 * -0.2 / std::sqrt(1.04), hz = 0.5 / std::sqrt(1.04) + 0.5;
@@ -311,17 +335,10 @@ TEST(Render, BumpTiltsTheNormalAgainstTheHeightGradient) {
   for (const Case& c :
        {Case{1.0f, false, tilted}, Case{0.5f, false, half}, Case{1.0f, true, tilted}})
     for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
-      Mesh plane = quad(50.0f);
-      plane.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
-      MaterialDesc m = diffuse(Spectrum(0.5f));
-      m.bump.enabled = true;
-      m.bump.height.texture.image = 0;
-      m.bump.height.texture.extension = TextureLookup::Extension::Extend;
-      m.bump.height.channel = FloatInput::Channel::Red;
-      m.bump.distance = 10.0f;
+      MaterialDesc m = ramp_bumped();
       m.bump.strength = c.strength;
       m.bump.invert = c.invert;
-      Scene scene = sunlit_plane(plane, m, 0.0f);
+      Scene scene = sunlit_plane(uv_quad(), m, 0.0f);
       scene.images.push_back(ramp);
       RenderSettings s = pt(4);
       s.mode = mode;
@@ -339,26 +356,15 @@ TEST(Render, BumpTiltsTheNormalAgainstTheHeightGradient) {
 // Cycles' bump shadowing: g = cos(z, sun) / (cos(n, sun) cos(z, n)) < 1 scales the diffuse value
 // by -g^3 + g^2 + g (the back side's g > 1: no change).
 TEST(Render, BumpOnABackFaceKeepsTheSurfacesTilt) {
-  ImageDesc ramp;
-  ramp.name = "ramp";
-  ramp.width = 1;
-  ramp.height = 2;
-  ramp.rgba = {0, 0, 0, 1, 1, 1, 1, 1};
+  const ImageDesc ramp = ramp_image(1, 2);
   constexpr float kTheta = 0.5f;
   for (const bool back : {false, true}) {
-    Mesh plane = quad(50.0f);
-    plane.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
+    Mesh plane = uv_quad();
     if (back) {
       plane.indices = {0, 2, 1, 0, 3, 2};
       plane.corner_uvs = {{0, 0}, {1, 1}, {1, 0}, {0, 0}, {0, 1}, {1, 1}};
     }
-    MaterialDesc m = diffuse(Spectrum(0.5f));
-    m.bump.enabled = true;
-    m.bump.height.texture.image = 0;
-    m.bump.height.texture.extension = TextureLookup::Extension::Extend;
-    m.bump.height.channel = FloatInput::Channel::Red;
-    m.bump.distance = 10.0f;
-    Scene scene = sunlit_plane(plane, m, kTheta);
+    Scene scene = sunlit_plane(plane, ramp_bumped(), kTheta);
     scene.images.push_back(ramp);
     // Height h = v / 100 over the 100 m quad: tilt 0.2 along -y (front) or +y (back, facing).
     const double ny = back ? 0.2 : -0.2;
@@ -440,8 +446,7 @@ TEST(Render, BumpDifferentiatesObjectSpaceCoordinates) {
         Case{TexCoordSource::Generated, 1.0f, 2.0f, true, 1.0 / std::sqrt(1.04)},
         Case{TexCoordSource::Object, 2.0f, 0.02f, false, 1.0 / std::sqrt(1.01)},
         Case{TexCoordSource::Generated, 1.0f, 2.0f, false, 1.0 / std::sqrt(1.04)}}) {
-    Mesh plane = quad(50.0f);
-    if (c.uvs) plane.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
+    Mesh plane = c.uvs ? uv_quad() : quad(50.0f);
     MaterialDesc m = diffuse(Spectrum(0.5f));
     InputNode coords;
     coords.kind = InputNodeKind::Coordinates;
