@@ -130,6 +130,21 @@ Spectrum hsv_to_rgb(Vec3f hsv) {
   return {v, p, q};
 }
 
+// Input nodes that read InputNode::vector: procedural textures and coordinates.
+bool reads_vector(InputNodeKind kind) {
+  switch (kind) {
+    case InputNodeKind::Checker:
+    case InputNodeKind::Noise:
+    case InputNodeKind::Coordinates:
+    case InputNodeKind::Voronoi:
+    case InputNodeKind::Gradient:
+    case InputNodeKind::Wave:
+      return true;
+    default:
+      return false;
+  }
+}
+
 // One input node's result from its operands, read through `in` (PointInputs or AverageInputs,
 // which come back here for nested nodes; the tree is acyclic and shallow, checked at load).
 template <class Inputs>
@@ -238,6 +253,13 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
                               : v.color;
       break;
     }
+    case InputNodeKind::Wave:
+      r = Spectrum(Inputs::kAverage ? 0.5f
+                                    : wave_texture(in.vector(n.vector) * in.scalar(n.value_a),
+                                                   n.wave, in.scalar(n.value_b),
+                                                   in.scalar(n.value_c), in.scalar(n.value_d),
+                                                   in.scalar(n.value_e), in.scalar(n.value_f)));
+      break;
     case InputNodeKind::Gradient:
       r = Spectrum(Inputs::kAverage
                        ? 0.5f
@@ -273,9 +295,7 @@ float input_node_scalar(const InputNode& n, const Inputs& in) {
                     n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
                     n.kind == InputNodeKind::ToBw ||
                     (n.kind == InputNodeKind::Ramp && n.ramp_alpha) ||
-                    ((n.kind == InputNodeKind::Checker || n.kind == InputNodeKind::Noise ||
-                      n.kind == InputNodeKind::Voronoi || n.kind == InputNodeKind::Gradient) &&
-                     n.fac_output);
+                    n.fac_output;  // a texture's Fac / Distance
   return grey ? r.x : luminance(r);
 }
 
@@ -529,9 +549,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         features_ |= kFeatureTextures;
         reads_color_attribute_ = true;
       }
-      if (n.kind == InputNodeKind::Checker || n.kind == InputNodeKind::Noise ||
-          n.kind == InputNodeKind::Coordinates || n.kind == InputNodeKind::Voronoi ||
-          n.kind == InputNodeKind::Gradient) {
+      if (reads_vector(n.kind)) {
         features_ |= kFeatureTextures;
         reads_coordinates_ |= n.vector.source != TexCoordSource::UV;
       }
@@ -539,7 +557,8 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         throw std::invalid_argument(where + "colour ramp table of " +
                                     std::to_string(n.ramp.size()) +
                                     " floats (expected 4 per entry, at least 2 entries)");
-      for (const FloatInput* f : {&n.fac, &n.value_a, &n.value_b, &n.value_c})
+      for (const FloatInput* f :
+           {&n.fac, &n.value_a, &n.value_b, &n.value_c, &n.value_d, &n.value_e, &n.value_f})
         self(self, *f, depth + 1);
       for (const ColorInput* c : {&n.a, &n.b}) self(self, *c, depth + 1);
       return;

@@ -79,6 +79,8 @@ enum class InputNodeKind : uint8_t {
                    // Minkowski exponent value_c, metric `voronoi_metric`; Distance (fac_output),
                    // Color or Position (position_output) (voronoi_f1_3d)
   Gradient,        // Gradient Texture of type `gradient_type` at `vector`, clamped to [0, 1]
+  Wave,            // Wave Texture `wave` at `vector` x scale value_a: distortion value_b, detail
+                   // value_c, detail scale value_d, detail roughness value_e, phase value_f
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -103,7 +105,8 @@ struct InputNode {
   ColorInput a, b;              // Mix (a, b), Invert (a)
   FloatInput value_a, value_b;  // Math, Gamma (a), Bright / Contrast (a, b), Combine (a, b)
   FloatInput value_c;           // Combine
-  uint8_t channel = 0;          // Separate: 0 red, 1 green, 2 blue
+  FloatInput value_d, value_e, value_f;  // Wave
+  uint8_t channel = 0;                   // Separate: 0 red, 1 green, 2 blue
   // Ramp: RGBA at fac = i / (n - 1), i < n (Blender's ColorRamp.evaluate, as Cycles bakes it),
   // interpolated linearly between entries unless the ramp is Constant; the result is the colour,
   // or the alpha as grey for the node's Alpha output.
@@ -112,12 +115,13 @@ struct InputNode {
   std::array<float, 4> bounds{0.0f, 1.0f, 0.0f, 1.0f};
   bool ramp_interpolate = true;
   bool ramp_alpha = false;
-  bool clamp_range = false;      // Clamp: Range type (swapped bounds clamp to [max, min])
-  TextureVector vector;          // Checker, Noise: where they are read; Coordinates: the value
-  bool fac_output = false;       // Checker, Noise, Voronoi (Distance), Gradient: the grey output
+  bool clamp_range = false;  // Clamp: Range type (swapped bounds clamp to [max, min])
+  TextureVector vector;      // Checker, Noise: where they are read; Coordinates: the value
+  bool fac_output = false;   // a texture's grey output (Fac; Voronoi: Distance) instead of Color
   bool position_output = false;  // Voronoi: the Position output
   VoronoiMetric voronoi_metric = VoronoiMetric::Euclidean;
   GradientType gradient_type = GradientType::Linear;
+  WaveDesc wave;
 };
 
 enum class ShaderNodeKind : uint8_t {

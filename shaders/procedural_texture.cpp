@@ -214,6 +214,41 @@ float gradient_texture(Vec3f p, GradientType type) {
   return p.x;
 }
 
+float wave_texture(Vec3f p, const WaveDesc& wave, float distortion, float detail,
+                   float detail_scale, float detail_roughness, float phase) {
+  constexpr float kPi = 3.14159265358979f;
+  // Nudged off unit coordinates, as Cycles does.
+  p = (p + Vec3f(0.000001f)) * 0.999999f;
+  using D = WaveDesc::Direction;
+  float n;
+  if (wave.type == WaveDesc::Type::Bands) {
+    n = wave.direction == D::X   ? p.x * 20.0f
+        : wave.direction == D::Y ? p.y * 20.0f
+        : wave.direction == D::Z ? p.z * 20.0f
+                                 : (p.x + p.y + p.z) * 10.0f;
+  } else {
+    Vec3f r = p;  // rings around an axis drop that axis; spherical rings keep all three
+    if (wave.direction == D::X) r.x = 0.0f;
+    if (wave.direction == D::Y) r.y = 0.0f;
+    if (wave.direction == D::Z) r.z = 0.0f;
+    n = length(r) * 20.0f;
+  }
+  n += phase;
+  if (distortion != 0.0f)
+    n += distortion * (fractal_noise(p * detail_scale, detail, detail_roughness) * 2.0f - 1.0f);
+  switch (wave.profile) {
+    case WaveDesc::Profile::Sine:
+      return 0.5f + 0.5f * std::sin(n - 0.5f * kPi);
+    case WaveDesc::Profile::Saw:
+      n /= 2.0f * kPi;
+      return n - std::floor(n);
+    case WaveDesc::Profile::Triangle:
+      n /= 2.0f * kPi;
+      return std::fabs(n - std::floor(n + 0.5f)) * 2.0f;
+  }
+  return 0.0f;
+}
+
 float signed_noise(Vec3f p) {
   const float r = perlin(p.x, p.y, p.z);
   return 0.9820f * (std::isfinite(r) ? r : 0.0f);

@@ -4,7 +4,8 @@
 // - Noise (3D): fractal Brownian motion of Perlin's improved gradient noise, hashed with Bob
 //   Jenkins' lookup3 as Cycles does, so the pattern itself (not only its statistics) matches;
 // - Voronoi (3D, F1): the nearest jittered cell point, with the same hashes;
-// - Gradient: the seven profiles.
+// - Gradient: the seven profiles;
+// - Wave: bands and rings with the three profiles and noise distortion.
 #pragma once
 
 #include <cstdint>
@@ -51,6 +52,18 @@ enum class GradientType : uint8_t {
   Radial
 };
 float gradient_texture(Vec3f p, GradientType type);
+
+// The Wave Texture at p (already scaled): bands along an axis or the diagonal, or rings around an
+// axis or a point, phase-shifted, distorted by fractal noise, through a sine, saw or triangle
+// profile (Cycles' svm_wave).
+struct WaveDesc {
+  enum class Type : uint8_t { Bands, Rings } type = Type::Bands;
+  // Bands: X, Y, Z, Diagonal; rings: X, Y, Z, Spherical.
+  enum class Direction : uint8_t { X, Y, Z, Other } direction = Direction::X;
+  enum class Profile : uint8_t { Sine, Saw, Triangle } profile = Profile::Sine;
+};
+float wave_texture(Vec3f p, const WaveDesc& wave, float distortion, float detail,
+                   float detail_scale, float detail_roughness, float phase);
 
 // Bob Jenkins' lookup3 hashes of 2, 3 and 4 words (Cycles' hash_uint2 / 3 / 4).
 uint32_t hash_words(uint32_t a, uint32_t b);

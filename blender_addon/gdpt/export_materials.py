@@ -23,7 +23,8 @@ _GGX_LIKE = {'GGX', 'SHARP'}
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
                 'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
-                'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT'}
+                'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
+                'TEX_WAVE'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -285,7 +286,7 @@ class _Translator:
         model."""
         per_output = node.type in {'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR', 'TEX_CHECKER',
                                    'TEX_NOISE', 'TEX_COORD', 'SEPXYZ', 'TEX_VORONOI',
-                                   'TEX_GRADIENT'}
+                                   'TEX_GRADIENT', 'TEX_WAVE'}
         key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
@@ -377,6 +378,19 @@ class _Translator:
                  "value_c": self.value(node.inputs["Exponent"]), "metric": node.distance,
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
                  "fac_output": out.name == "Distance", "position_output": out.name == "Position"}
+        elif node.type == 'TEX_WAVE':
+            bands = node.wave_type == 'BANDS'
+            d = {"kind": "WAVE", "wave_type": node.wave_type,
+                 "direction": node.bands_direction if bands else node.rings_direction,
+                 "profile": node.wave_profile,
+                 "value_a": self.value(node.inputs["Scale"]),
+                 "value_b": self.value(node.inputs["Distortion"]),
+                 "value_c": self.value(node.inputs["Detail"]),
+                 "value_d": self.value(node.inputs["Detail Scale"]),
+                 "value_e": self.value(node.inputs["Detail Roughness"]),
+                 "value_f": self.value(node.inputs["Phase Offset"]),
+                 "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
+                 "fac_output": out.name == "Fac"}
         elif node.type == 'TEX_GRADIENT':
             d = {"kind": "GRADIENT", "gradient": node.gradient_type,
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),

@@ -156,6 +156,8 @@ InputNode read_input_node(const py::dict& d) {
     n.kind = InputNodeKind::Voronoi;
   else if (kind == "GRADIENT")
     n.kind = InputNodeKind::Gradient;
+  else if (kind == "WAVE")
+    n.kind = InputNodeKind::Wave;
   else
     bad_enum("input node kind", kind);
   const std::string blend = get_str(d, "blend", "MIX");
@@ -189,6 +191,9 @@ InputNode read_input_node(const py::dict& d) {
   read_float(d, "value_a", n.value_a);
   read_float(d, "value_b", n.value_b);
   read_float(d, "value_c", n.value_c);
+  read_float(d, "value_d", n.value_d);
+  read_float(d, "value_e", n.value_e);
+  read_float(d, "value_f", n.value_f);
   int channel = 0;
   get(d, "channel", channel);
   if (channel < 0 || channel > 2) throw std::invalid_argument("separate: channel out of range");
@@ -225,6 +230,31 @@ InputNode read_input_node(const py::dict& d) {
   for (const auto& [name, value] : kGradients)
     if (gradient == name) n.gradient_type = value, found = true;
   if (!found) bad_enum("gradient type", gradient);
+  if (kind == "WAVE") {
+    const std::string type = get_str(d, "wave_type", "BANDS");
+    if (type != "BANDS" && type != "RINGS") bad_enum("wave type", type);
+    n.wave.type = type == "BANDS" ? WaveDesc::Type::Bands : WaveDesc::Type::Rings;
+    const std::string dir = get_str(d, "direction", "X");
+    static const std::pair<const char*, WaveDesc::Direction> kDirections[] = {
+        {"X", WaveDesc::Direction::X},
+        {"Y", WaveDesc::Direction::Y},
+        {"Z", WaveDesc::Direction::Z},
+        {"DIAGONAL", WaveDesc::Direction::Other},
+        {"SPHERICAL", WaveDesc::Direction::Other}};
+    found = false;
+    for (const auto& [name, value] : kDirections)
+      if (dir == name) n.wave.direction = value, found = true;
+    if (!found) bad_enum("wave direction", dir);
+    const std::string profile = get_str(d, "profile", "SIN");
+    static const std::pair<const char*, WaveDesc::Profile> kProfiles[] = {
+        {"SIN", WaveDesc::Profile::Sine},
+        {"SAW", WaveDesc::Profile::Saw},
+        {"TRI", WaveDesc::Profile::Triangle}};
+    found = false;
+    for (const auto& [name, value] : kProfiles)
+      if (profile == name) n.wave.profile = value, found = true;
+    if (!found) bad_enum("wave profile", profile);
+  }
   return n;
 }
 

@@ -455,8 +455,9 @@ def case_procedural_textures(scene):
     # node's Fac; the ball (no UVs) is coloured by a Checker Texture (Generated) and bumped by a
     # Noise Fac (scale 4, distance 0.5: differences along the triangles' edges, and Cycles' bump
     # shadowing of diffuse lobes); the left wall shows a grid image at Generated coordinates
-    # through a Mapping node; the right wall's colour is a 3D Voronoi Texture's Color (F1,
-    # Manhattan, Object), the ceiling's a radial Gradient.
+    # through a Mapping node times a distorted triangle-profile Wave Texture (rings); the right
+    # wall's colour is a 3D Voronoi Texture's Color (F1, Manhattan, Object), the ceiling's a
+    # radial Gradient.
     material, assign = grid_room(scene)
     m, nt, bsdf, tex = material("noisy_floor", "ShaderNodeBsdfDiffuse")
     noise = nt.nodes.new("ShaderNodeTexNoise")
@@ -480,7 +481,16 @@ def case_procedural_textures(scene):
     mapping.inputs["Scale"].default_value = (2.0, 3.0, 1.0)
     nt.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
     nt.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
-    nt.links.new(tex.outputs["Color"], bsdf.inputs["Color"])
+    wave = nt.nodes.new("ShaderNodeTexWave")
+    wave.wave_type = 'RINGS'
+    wave.wave_profile = 'TRI'
+    wave.inputs["Distortion"].default_value = 2.0
+    multiply = nt.nodes.new("ShaderNodeMixRGB")
+    multiply.blend_type = 'MULTIPLY'
+    multiply.inputs["Fac"].default_value = 1.0
+    nt.links.new(tex.outputs["Color"], multiply.inputs["Color1"])
+    nt.links.new(wave.outputs["Color"], multiply.inputs["Color2"])
+    nt.links.new(multiply.outputs["Color"], bsdf.inputs["Color"])
     assign("left", m)
 
     m, nt, bsdf, tex = material("checker_ball", "ShaderNodeBsdfDiffuse")

@@ -129,5 +129,33 @@ TEST(ProceduralTexture, GradientProfiles) {
   EXPECT_FLOAT_EQ(gradient_texture(Vec3f(-1, -1e-9f, 0), GradientType::Radial), 0.0f);
 }
 
+// Bands along x: n = 20 x' + phase with x' = (x + 1e-6) 0.999999 (Cycles' nudge), through the
+// three profiles; rings around z: n = 20 |(x', y')|; distortion 0 leaves them exact.
+TEST(ProceduralTexture, WaveProfiles) {
+  constexpr float kPi = 3.14159265358979f;
+  const Vec3f p(0.13f, 0.4f, 0.7f);
+  const Vec3f q = (p + Vec3f(0.000001f)) * 0.999999f;
+  WaveDesc bands;
+  const float n = 20.0f * q.x + 0.3f;
+  EXPECT_NEAR(wave_texture(p, bands, 0.0f, 2.0f, 1.0f, 0.5f, 0.3f),
+              0.5f + 0.5f * std::sin(n - 0.5f * kPi), 1e-5f);
+  bands.profile = WaveDesc::Profile::Saw;
+  const float t = n / (2.0f * kPi);
+  EXPECT_NEAR(wave_texture(p, bands, 0.0f, 2.0f, 1.0f, 0.5f, 0.3f), t - std::floor(t), 1e-5f);
+  bands.profile = WaveDesc::Profile::Triangle;
+  EXPECT_NEAR(wave_texture(p, bands, 0.0f, 2.0f, 1.0f, 0.5f, 0.3f),
+              2.0f * std::fabs(t - std::floor(t + 0.5f)), 1e-5f);
+  WaveDesc rings;
+  rings.type = WaveDesc::Type::Rings;
+  rings.direction = WaveDesc::Direction::Z;
+  EXPECT_NEAR(wave_texture(p, rings, 0.0f, 2.0f, 1.0f, 0.5f, 0.0f),
+              0.5f + 0.5f * std::sin(20.0f * std::hypot(q.x, q.y) - 0.5f * kPi), 1e-5f);
+  // Distortion adds distortion * (2 fBm - 1) to n: the same fBm as the Noise Texture's Fac.
+  const float fbm = noise_texture(q * 1.5f, 2.0f, 0.5f, 0.0f, false).fac;
+  bands.profile = WaveDesc::Profile::Saw;
+  const float td = (n + 0.8f * (2.0f * fbm - 1.0f)) / (2.0f * kPi);
+  EXPECT_NEAR(wave_texture(p, bands, 0.8f, 2.0f, 1.5f, 0.5f, 0.3f), td - std::floor(td), 1e-5f);
+}
+
 }  // namespace
 }  // namespace gdpt
