@@ -139,6 +139,7 @@ bool reads_vector(InputNodeKind kind) {
     case InputNodeKind::Voronoi:
     case InputNodeKind::Gradient:
     case InputNodeKind::Wave:
+    case InputNodeKind::Musgrave:
       return true;
     default:
       return false;
@@ -259,6 +260,13 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
                                                    n.wave, in.scalar(n.value_b),
                                                    in.scalar(n.value_c), in.scalar(n.value_d),
                                                    in.scalar(n.value_e), in.scalar(n.value_f)));
+      break;
+    case InputNodeKind::Musgrave:
+      r = Spectrum(Inputs::kAverage ? 0.5f
+                                    : musgrave_texture(in.vector(n.vector) * in.scalar(n.value_a),
+                                                       n.musgrave_type, in.scalar(n.value_b),
+                                                       in.scalar(n.value_c), in.scalar(n.value_d),
+                                                       in.scalar(n.value_e), in.scalar(n.value_f)));
       break;
     case InputNodeKind::Gradient:
       r = Spectrum(Inputs::kAverage

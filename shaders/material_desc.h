@@ -81,6 +81,8 @@ enum class InputNodeKind : uint8_t {
   Gradient,        // Gradient Texture of type `gradient_type` at `vector`, clamped to [0, 1]
   Wave,            // Wave Texture `wave` at `vector` x scale value_a: distortion value_b, detail
                    // value_c, detail scale value_d, detail roughness value_e, phase value_f
+  Musgrave,        // 3D Musgrave Texture `musgrave_type` at `vector` x scale value_a: detail
+                   // value_b, dimension value_c, lacunarity value_d, offset value_e, gain value_f
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -105,7 +107,7 @@ struct InputNode {
   ColorInput a, b;              // Mix (a, b), Invert (a)
   FloatInput value_a, value_b;  // Math, Gamma (a), Bright / Contrast (a, b), Combine (a, b)
   FloatInput value_c;           // Combine
-  FloatInput value_d, value_e, value_f;  // Wave
+  FloatInput value_d, value_e, value_f;  // Wave, Musgrave
   uint8_t channel = 0;                   // Separate: 0 red, 1 green, 2 blue
   // Ramp: RGBA at fac = i / (n - 1), i < n (Blender's ColorRamp.evaluate, as Cycles bakes it),
   // interpolated linearly between entries unless the ramp is Constant; the result is the colour,
@@ -122,6 +124,7 @@ struct InputNode {
   VoronoiMetric voronoi_metric = VoronoiMetric::Euclidean;
   GradientType gradient_type = GradientType::Linear;
   WaveDesc wave;
+  MusgraveType musgrave_type = MusgraveType::Fbm;
 };
 
 enum class ShaderNodeKind : uint8_t {

@@ -249,6 +249,85 @@ float wave_texture(Vec3f p, const WaveDesc& wave, float distortion, float detail
   return 0.0f;
 }
 
+float musgrave_texture(Vec3f p, MusgraveType type, float detail, float dimension, float lacunarity,
+                       float offset, float gain) {
+  dimension = std::max(dimension, 1e-5f);
+  detail = std::clamp(detail, 0.0f, 15.0f);
+  lacunarity = std::max(lacunarity, 1e-5f);
+  const int octaves = int(detail);
+  const float rest = detail - std::floor(detail);
+  const float step = std::pow(lacunarity, -dimension);  // amplitude ratio between octaves
+  switch (type) {
+    case MusgraveType::Fbm: {
+      float value = 0.0f, amplitude = 1.0f;
+      for (int i = 0; i < octaves; ++i) {
+        value += signed_noise(p) * amplitude;
+        amplitude *= step;
+        p *= lacunarity;
+      }
+      if (rest != 0.0f) value += rest * signed_noise(p) * amplitude;
+      return value;
+    }
+    case MusgraveType::Multifractal: {
+      float value = 1.0f, amplitude = 1.0f;
+      for (int i = 0; i < octaves; ++i) {
+        value *= amplitude * signed_noise(p) + 1.0f;
+        amplitude *= step;
+        p *= lacunarity;
+      }
+      if (rest != 0.0f) value *= rest * amplitude * signed_noise(p) + 1.0f;
+      return value;
+    }
+    case MusgraveType::HeteroTerrain: {
+      // The first octave unscaled, later ones scaled by the value so far.
+      float amplitude = step;
+      float value = offset + signed_noise(p);
+      p *= lacunarity;
+      for (int i = 1; i < octaves; ++i) {
+        value += (signed_noise(p) + offset) * amplitude * value;
+        amplitude *= step;
+        p *= lacunarity;
+      }
+      if (rest != 0.0f) value += rest * ((signed_noise(p) + offset) * amplitude * value);
+      return value;
+    }
+    case MusgraveType::HybridMultifractal: {
+      float amplitude = step;
+      float value = signed_noise(p) + offset;
+      float weight = gain * value;
+      p *= lacunarity;
+      for (int i = 1; weight > 0.001f && i < octaves; ++i) {
+        weight = std::min(weight, 1.0f);
+        const float signal = (signed_noise(p) + offset) * amplitude;
+        amplitude *= step;
+        value += weight * signal;
+        weight *= gain * signal;
+        p *= lacunarity;
+      }
+      if (rest != 0.0f && weight > 0.001f)
+        value += rest * std::min(weight, 1.0f) * ((signed_noise(p) + offset) * amplitude);
+      return value;
+    }
+    case MusgraveType::RidgedMultifractal: {
+      float amplitude = step;
+      float signal = offset - std::fabs(signed_noise(p));
+      signal *= signal;
+      float value = signal;
+      for (int i = 1; i < octaves; ++i) {
+        p *= lacunarity;
+        const float weight = std::clamp(signal * gain, 0.0f, 1.0f);
+        signal = offset - std::fabs(signed_noise(p));
+        signal *= signal;
+        signal *= weight;
+        value += signal * amplitude;
+        amplitude *= step;
+      }
+      return value;
+    }
+  }
+  return 0.0f;
+}
+
 float signed_noise(Vec3f p) {
   const float r = perlin(p.x, p.y, p.z);
   return 0.9820f * (std::isfinite(r) ? r : 0.0f);

@@ -5,7 +5,8 @@
 //   Jenkins' lookup3 as Cycles does, so the pattern itself (not only its statistics) matches;
 // - Voronoi (3D, F1): the nearest jittered cell point, with the same hashes;
 // - Gradient: the seven profiles;
-// - Wave: bands and rings with the three profiles and noise distortion.
+// - Wave: bands and rings with the three profiles and noise distortion;
+// - Musgrave (3D): the five fractal types.
 #pragma once
 
 #include <cstdint>
@@ -64,6 +65,19 @@ struct WaveDesc {
 };
 float wave_texture(Vec3f p, const WaveDesc& wave, float distortion, float detail,
                    float detail_scale, float detail_roughness, float phase);
+
+// The 3D Musgrave Texture at p (already scaled): Musgrave's fractals of Perlin noise with
+// roughness exponent `dimension` (H), lacunarity, detail octaves, offset and gain (Cycles 3.4's
+// noise_musgrave_*_3d, before Blender 4.1 folded them into the Noise Texture).
+enum class MusgraveType : uint8_t {
+  Fbm,
+  Multifractal,
+  HeteroTerrain,
+  HybridMultifractal,
+  RidgedMultifractal
+};
+float musgrave_texture(Vec3f p, MusgraveType type, float detail, float dimension, float lacunarity,
+                       float offset, float gain);
 
 // Bob Jenkins' lookup3 hashes of 2, 3 and 4 words (Cycles' hash_uint2 / 3 / 4).
 uint32_t hash_words(uint32_t a, uint32_t b);

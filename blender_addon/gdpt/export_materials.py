@@ -24,7 +24,7 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
                 'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
-                'TEX_WAVE'}
+                'TEX_WAVE', 'TEX_MUSGRAVE'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -286,7 +286,7 @@ class _Translator:
         model."""
         per_output = node.type in {'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR', 'TEX_CHECKER',
                                    'TEX_NOISE', 'TEX_COORD', 'SEPXYZ', 'TEX_VORONOI',
-                                   'TEX_GRADIENT', 'TEX_WAVE'}
+                                   'TEX_GRADIENT', 'TEX_WAVE', 'TEX_MUSGRAVE'}
         key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
@@ -391,6 +391,16 @@ class _Translator:
                  "value_f": self.value(node.inputs["Phase Offset"]),
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
                  "fac_output": out.name == "Fac"}
+        elif node.type == 'TEX_MUSGRAVE' and node.musgrave_dimensions == '3D':
+            d = {"kind": "MUSGRAVE", "musgrave_type": node.musgrave_type,
+                 "value_a": self.value(node.inputs["Scale"]),
+                 "value_b": self.value(node.inputs["Detail"]),
+                 "value_c": self.value(node.inputs["Dimension"]),
+                 "value_d": self.value(node.inputs["Lacunarity"]),
+                 "value_e": self.value(node.inputs["Offset"]),
+                 "value_f": self.value(node.inputs["Gain"]),
+                 "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
+                 "fac_output": True}
         elif node.type == 'TEX_GRADIENT':
             d = {"kind": "GRADIENT", "gradient": node.gradient_type,
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
@@ -410,6 +420,7 @@ class _Translator:
             mode = (getattr(node, "blend_type", None) or getattr(node, "operation", None) or
                     getattr(node, "mode", None) or getattr(node, "interpolation_type", None) or
                     getattr(node, "noise_dimensions", None) or
+                    getattr(node, "musgrave_dimensions", None) or
                     (f"{node.voronoi_dimensions} {node.feature}" if node.type == 'TEX_VORONOI'
                      else None))
             self.warn(node, f"mode {mode} of the input node" if mode else "input node")

@@ -158,6 +158,8 @@ InputNode read_input_node(const py::dict& d) {
     n.kind = InputNodeKind::Gradient;
   else if (kind == "WAVE")
     n.kind = InputNodeKind::Wave;
+  else if (kind == "MUSGRAVE")
+    n.kind = InputNodeKind::Musgrave;
   else
     bad_enum("input node kind", kind);
   const std::string blend = get_str(d, "blend", "MIX");
@@ -230,6 +232,19 @@ InputNode read_input_node(const py::dict& d) {
   for (const auto& [name, value] : kGradients)
     if (gradient == name) n.gradient_type = value, found = true;
   if (!found) bad_enum("gradient type", gradient);
+  if (kind == "MUSGRAVE") {
+    const std::string type = get_str(d, "musgrave_type", "FBM");
+    static const std::pair<const char*, MusgraveType> kTypes[] = {
+        {"FBM", MusgraveType::Fbm},
+        {"MULTIFRACTAL", MusgraveType::Multifractal},
+        {"HETERO_TERRAIN", MusgraveType::HeteroTerrain},
+        {"HYBRID_MULTIFRACTAL", MusgraveType::HybridMultifractal},
+        {"RIDGED_MULTIFRACTAL", MusgraveType::RidgedMultifractal}};
+    found = false;
+    for (const auto& [name, value] : kTypes)
+      if (type == name) n.musgrave_type = value, found = true;
+    if (!found) bad_enum("musgrave type", type);
+  }
   if (kind == "WAVE") {
     const std::string type = get_str(d, "wave_type", "BANDS");
     if (type != "BANDS" && type != "RINGS") bad_enum("wave type", type);

@@ -450,7 +450,7 @@ def case_bump(scene):
 
 def case_procedural_textures(scene):
     # Procedural textures and texture coordinates: the floor's colour is the Color of a 3D Noise
-    # Texture at its default (Generated) coordinates; the back wall's Principled base colour is
+    # Texture at its default (Generated) coordinates times a ridged Musgrave Texture; the back wall's Principled base colour is
     # a Noise Color at Object coordinates (detail 3.5, distortion 0.3) and its roughness the same
     # node's Fac; the ball (no UVs) is coloured by a Checker Texture (Generated) and bumped by a
     # Noise Fac (scale 4, distance 0.5: differences along the triangles' edges, and Cycles' bump
@@ -462,7 +462,15 @@ def case_procedural_textures(scene):
     m, nt, bsdf, tex = material("noisy_floor", "ShaderNodeBsdfDiffuse")
     noise = nt.nodes.new("ShaderNodeTexNoise")
     noise.inputs["Scale"].default_value = 4.0
-    nt.links.new(noise.outputs["Color"], bsdf.inputs["Color"])
+    musgrave = nt.nodes.new("ShaderNodeTexMusgrave")
+    musgrave.musgrave_type = 'RIDGED_MULTIFRACTAL'
+    musgrave.inputs["Scale"].default_value = 3.0
+    multiply = nt.nodes.new("ShaderNodeMixRGB")
+    multiply.blend_type = 'MULTIPLY'
+    multiply.inputs["Fac"].default_value = 1.0
+    nt.links.new(noise.outputs["Color"], multiply.inputs["Color1"])
+    nt.links.new(musgrave.outputs["Fac"], multiply.inputs["Color2"])
+    nt.links.new(multiply.outputs["Color"], bsdf.inputs["Color"])
     assign("floor", m)
 
     m, nt, bsdf, tex = material("noisy_wall", "ShaderNodeBsdfPrincipled", distribution='GGX')

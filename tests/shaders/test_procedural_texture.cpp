@@ -157,5 +157,32 @@ TEST(ProceduralTexture, WaveProfiles) {
   EXPECT_NEAR(wave_texture(p, bands, 0.8f, 2.0f, 1.5f, 0.5f, 0.3f), td - std::floor(td), 1e-5f);
 }
 
+// Musgrave's fractals in closed form for one and two octaves (noise n = signed_noise, octave
+// amplitude ratio s = lacunarity^-dimension), and a fractional detail blending the next octave.
+TEST(ProceduralTexture, MusgraveFractals) {
+  const Vec3f p(0.31f, -0.77f, 1.9f);
+  const float lac = 2.1f, dim = 1.2f, off = 0.8f, gain = 1.3f;
+  const float s = std::pow(lac, -dim);
+  const float n1 = signed_noise(p), n2 = signed_noise(p * lac);
+  auto m = [&](MusgraveType t, float detail) {
+    return musgrave_texture(p, t, detail, dim, lac, off, gain);
+  };
+  EXPECT_NEAR(m(MusgraveType::Fbm, 1.0f), n1, 1e-6f);
+  EXPECT_NEAR(m(MusgraveType::Fbm, 2.0f), n1 + s * n2, 1e-6f);
+  EXPECT_NEAR(m(MusgraveType::Fbm, 1.5f), n1 + 0.5f * s * n2, 1e-6f);
+  EXPECT_NEAR(m(MusgraveType::Multifractal, 2.0f), (n1 + 1.0f) * (s * n2 + 1.0f), 1e-6f);
+  const float hetero1 = off + n1;
+  EXPECT_NEAR(m(MusgraveType::HeteroTerrain, 1.0f), hetero1, 1e-6f);
+  EXPECT_NEAR(m(MusgraveType::HeteroTerrain, 2.0f), hetero1 + (n2 + off) * s * hetero1, 1e-6f);
+  const float hybrid1 = n1 + off, weight = std::min(gain * hybrid1, 1.0f);
+  EXPECT_NEAR(m(MusgraveType::HybridMultifractal, 2.0f),
+              hybrid1 + (gain * hybrid1 > 0.001f ? weight * (n2 + off) * s : 0.0f), 1e-6f);
+  const float r1 = (off - std::fabs(n1)) * (off - std::fabs(n1));
+  const float r2 =
+      (off - std::fabs(n2)) * (off - std::fabs(n2)) * std::clamp(r1 * gain, 0.0f, 1.0f);
+  EXPECT_NEAR(m(MusgraveType::RidgedMultifractal, 1.0f), r1, 1e-6f);
+  EXPECT_NEAR(m(MusgraveType::RidgedMultifractal, 2.0f), r1 + r2 * s, 1e-6f);
+}
+
 }  // namespace
 }  // namespace gdpt
