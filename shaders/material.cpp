@@ -140,6 +140,7 @@ bool reads_vector(InputNodeKind kind) {
     case InputNodeKind::Gradient:
     case InputNodeKind::Wave:
     case InputNodeKind::Musgrave:
+    case InputNodeKind::WhiteNoise:
       return true;
     default:
       return false;
@@ -261,6 +262,15 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
                                                    in.scalar(n.value_c), in.scalar(n.value_d),
                                                    in.scalar(n.value_e), in.scalar(n.value_f)));
       break;
+    case InputNodeKind::WhiteNoise: {
+      if (Inputs::kAverage) {
+        r = Spectrum(0.5f);
+        break;
+      }
+      const Vec3f p = in.vector(n.vector);
+      r = n.fac_output ? Spectrum(white_noise(p)) : white_noise_color(p);
+      break;
+    }
     case InputNodeKind::Musgrave:
       r = Spectrum(Inputs::kAverage ? 0.5f
                                     : musgrave_texture(in.vector(n.vector) * in.scalar(n.value_a),
@@ -324,7 +334,8 @@ struct PointInputs {
     if (v.source != TexCoordSource::UV)
       p = !at.coords                              ? Vec3f(0.0f)
           : v.source == TexCoordSource::Generated ? at.coords->generated
-                                                  : at.coords->object;
+          : v.source == TexCoordSource::Object    ? at.coords->object
+                                                  : at.coords->position;
     return v.mapping.point(p);
   }
   Rgba fetch(const TextureLookup& t) const {

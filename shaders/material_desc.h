@@ -17,8 +17,9 @@ namespace gdpt {
 
 // Blender's Texture Coordinate outputs a texture can read (Cycles' names): UV is (u, v, 0) of the
 // mesh's UV map; Object the object-space position; Generated the object-space position mapped
-// from the mesh's texture space (Mesh::texspace_*) to [0, 1]^3.
-enum class TexCoordSource : uint8_t { UV, Generated, Object };
+// from the mesh's texture space (Mesh::texspace_*) to [0, 1]^3; Position the world-space position
+// (the Geometry node's Position output).
+enum class TexCoordSource : uint8_t { UV, Generated, Object, Position };
 
 // The vector a texture reads: a coordinate source through an optional Mapping node.
 struct TextureVector {
@@ -81,6 +82,8 @@ enum class InputNodeKind : uint8_t {
   Gradient,        // Gradient Texture of type `gradient_type` at `vector`, clamped to [0, 1]
   Wave,            // Wave Texture `wave` at `vector` x scale value_a: distortion value_b, detail
                    // value_c, detail scale value_d, detail roughness value_e, phase value_f
+  WhiteNoise,      // 3D White Noise Texture at `vector`: a hash of its bits, Value (fac_output)
+                   // or Color
   Musgrave,        // 3D Musgrave Texture `musgrave_type` at `vector` x scale value_a: detail
                    // value_b, dimension value_c, lacunarity value_d, offset value_e, gain value_f
 };

@@ -328,6 +328,13 @@ float musgrave_texture(Vec3f p, MusgraveType type, float detail, float dimension
   return 0.0f;
 }
 
+float white_noise(Vec3f p) {
+  return cell_random(p).x;
+}
+Spectrum white_noise_color(Vec3f p) {
+  return cell_random(p);
+}
+
 float signed_noise(Vec3f p) {
   const float r = perlin(p.x, p.y, p.z);
   return 0.9820f * (std::isfinite(r) ? r : 0.0f);

@@ -79,6 +79,11 @@ enum class MusgraveType : uint8_t {
 float musgrave_texture(Vec3f p, MusgraveType type, float detail, float dimension, float lacunarity,
                        float offset, float gain);
 
+// The 3D White Noise Texture at p: a value and a colour in [0, 1] hashed from p's float bits
+// (Cycles' hash_float3_to_float and hash_float3_to_float3).
+float white_noise(Vec3f p);
+Spectrum white_noise_color(Vec3f p);
+
 // Bob Jenkins' lookup3 hashes of 2, 3 and 4 words (Cycles' hash_uint2 / 3 / 4).
 uint32_t hash_words(uint32_t a, uint32_t b);
 uint32_t hash_words(uint32_t a, uint32_t b, uint32_t c);

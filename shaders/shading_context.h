@@ -9,6 +9,7 @@ namespace gdpt {
 struct TexCoords {
   Vec3f generated;  // TexCoordSource::Generated
   Vec3f object;     // TexCoordSource::Object
+  Vec3f position;   // TexCoordSource::Position (world space)
 };
 
 struct ShadingContext {

@@ -24,7 +24,7 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
                 'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
-                'TEX_WAVE', 'TEX_MUSGRAVE'}
+                'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -286,7 +286,8 @@ class _Translator:
         model."""
         per_output = node.type in {'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR', 'TEX_CHECKER',
                                    'TEX_NOISE', 'TEX_COORD', 'SEPXYZ', 'TEX_VORONOI',
-                                   'TEX_GRADIENT', 'TEX_WAVE', 'TEX_MUSGRAVE'}
+                                   'TEX_GRADIENT', 'TEX_WAVE', 'TEX_MUSGRAVE',
+                                   'TEX_WHITE_NOISE', 'NEW_GEOMETRY'}
         key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
@@ -401,11 +402,18 @@ class _Translator:
                  "value_f": self.value(node.inputs["Gain"]),
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
                  "fac_output": True}
+        elif node.type == 'TEX_WHITE_NOISE' and node.noise_dimensions == '3D':
+            socket = node.inputs["Vector"]
+            # Unlinked, Cycles 3.4 reads the socket's value (0, 0, 0): a constant vector.
+            vector = self._vector(socket) if self._source(socket) is not None else \
+                {"coordinates": 'UV', "mapping": [0.0] * 12}
+            d = {"kind": "WHITE_NOISE", "vector": vector, "fac_output": out.name == "Value"}
         elif node.type == 'TEX_GRADIENT':
             d = {"kind": "GRADIENT", "gradient": node.gradient_type,
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
                  "fac_output": out.name == "Fac"}
         elif (node.type == 'TEX_COORD' and out.name in {"UV", "Generated", "Object"}) or \
+                (node.type == 'NEW_GEOMETRY' and out.name == "Position") or \
                 node.type == 'UVMAP' or \
                 (node.type == 'MAPPING' and node.vector_type in {'POINT', 'TEXTURE'}):
             # A coordinate used as a colour or value (e.g. through Separate XYZ).
@@ -476,6 +484,8 @@ class _Translator:
             if out.name == "Object" and node.object is not None:
                 self.warn(node, "Object output relative to another object of")
             return {"coordinates": out.name.upper(), "mapping": IDENTITY12}
+        if node.type == 'NEW_GEOMETRY' and out.name == "Position":
+            return {"coordinates": 'POSITION', "mapping": IDENTITY12}
         if node.type == 'MAPPING' and node.vector_type in {'POINT', 'TEXTURE'}:
             inner = self._vector(node.inputs["Vector"], default)
             loc = node.inputs["Location"].default_value

@@ -56,7 +56,7 @@ std::string get_str(const py::dict& d, const char* key, const std::string& fallb
 
 // --- Material inputs ---------------------------------------------------------------------------
 
-// {coordinates: 'UV' | 'GENERATED' | 'OBJECT', mapping: 12 floats}
+// {coordinates: 'UV' | 'GENERATED' | 'OBJECT' | 'POSITION', mapping: 12 floats}
 void read_vector(const py::dict& d, TextureVector& v) {
   get_transform(d, "mapping", v.mapping);
   const std::string source = get_str(d, "coordinates", "UV");
@@ -66,6 +66,8 @@ void read_vector(const py::dict& d, TextureVector& v) {
     v.source = TexCoordSource::Generated;
   else if (source == "OBJECT")
     v.source = TexCoordSource::Object;
+  else if (source == "POSITION")
+    v.source = TexCoordSource::Position;
   else
     bad_enum("texture coordinates", source);
 }
@@ -160,6 +162,8 @@ InputNode read_input_node(const py::dict& d) {
     n.kind = InputNodeKind::Wave;
   else if (kind == "MUSGRAVE")
     n.kind = InputNodeKind::Musgrave;
+  else if (kind == "WHITE_NOISE")
+    n.kind = InputNodeKind::WhiteNoise;
   else
     bad_enum("input node kind", kind);
   const std::string blend = get_str(d, "blend", "MIX");

@@ -383,15 +383,18 @@ TEST(Render, BumpOnABackFaceKeepsTheSurfacesTilt) {
 // An emitter whose colour is its texture coordinate (a Texture Coordinate output used as a
 // colour): Object is the object-space position (through a Mapping that adds 1, so it stays
 // positive), Generated the position mapped from the mesh's bounding box (+-1 in x and y, flat
-// in z, whose size Blender sets to 1) to [0, 1], both independent of where the instance is.
+// in z, whose size Blender sets to 1) to [0, 1], both independent of where the instance is;
+// Position (plus 1) the world-space position.
 // The camera sees world x in [0, 1], y in [-0.5, 0.5] of a quad moved by +0.5 in x.
 TEST(Render, TextureCoordinatesAreObjectSpace) {
-  for (const TexCoordSource source : {TexCoordSource::Object, TexCoordSource::Generated}) {
+  for (const TexCoordSource source :
+       {TexCoordSource::Object, TexCoordSource::Generated, TexCoordSource::Position}) {
     MaterialDesc m = emission(Spectrum(0.0f), 1.0f);
     InputNode coords;
     coords.kind = InputNodeKind::Coordinates;
     coords.vector.source = source;
-    if (source == TexCoordSource::Object)
+    const bool generated = source == TexCoordSource::Generated;
+    if (!generated)
       for (int r = 0; r < 3; ++r) coords.vector.mapping.m[r][3] = 1.0f;
     m.inputs = {coords};
     m.nodes[0].color.node = 0;
@@ -403,28 +406,29 @@ TEST(Render, TextureCoordinatesAreObjectSpace) {
     scene.camera = top_camera(8, 1.0f);
     scene.camera.camera_to_world = translation({0.5f, 0.0f, 10.0f});
     const Image img = render(scene, pt(64));
-    // Object-space x of pixel column i: (i + 0.5) / 8 - 0.5; y of row j likewise (either
-    // orientation: compared through means and spans).
-    const bool object = source == TexCoordSource::Object;
-    auto expect = [&](float p) { return object ? p + 1.0f : (p + 1.0f) * 0.5f; };
+    // Object-space x of pixel column i: (i + 0.5) / 8 - 0.5, world x 0.5 more; y of row j like
+    // the object-space x (either orientation: compared through means and spans).
+    const double shift = source == TexCoordSource::Position ? 0.5 : 0.0;
+    auto expect = [&](double p) { return generated ? (p + 1.0) * 0.5 : p + 1.0; };
     double mean[3] = {0, 0, 0};
     for (int y = 0; y < img.h; ++y)
       for (int x = 0; x < img.w; ++x)
         for (int c = 0; c < 3; ++c) mean[c] += img.emission[size_t(y * img.w + x) * 3 + c];
     for (double& v : mean) v /= img.w * img.h;
-    EXPECT_NEAR(mean[0], expect(0.0f), 1e-3) << "object " << object;
-    EXPECT_NEAR(mean[1], expect(0.0f), 1e-3) << "object " << object;
-    EXPECT_NEAR(mean[2], object ? 1.0 : 0.5, 1e-4) << "object " << object;
+    const int src = int(source);
+    EXPECT_NEAR(mean[0], expect(shift), 1e-3) << "source " << src;
+    EXPECT_NEAR(mean[1], expect(0.0), 1e-3) << "source " << src;
+    EXPECT_NEAR(mean[2], generated ? 0.5 : 1.0, 1e-4) << "source " << src;
     // Last column (row) against the first, each averaged over the image.
-    const float span = expect(7.0f / 8.0f) - expect(0.0f);
+    const double span = expect(7.0 / 8.0) - expect(0.0);
     double dx = 0.0, dy = 0.0;
     auto at = [&](int x, int y, int c) { return img.emission[size_t(y * img.w + x) * 3 + c]; };
     for (int k = 0; k < 8; ++k) {
       dx += (at(7, k, 0) - at(0, k, 0)) / 8.0;
       dy += (at(k, 7, 1) - at(k, 0, 1)) / 8.0;
     }
-    EXPECT_NEAR(std::fabs(dx), span, 2e-3) << "object " << object;
-    EXPECT_NEAR(std::fabs(dy), span, 2e-3) << "object " << object;
+    EXPECT_NEAR(std::fabs(dx), span, 2e-3) << "source " << src;
+    EXPECT_NEAR(std::fabs(dy), span, 2e-3) << "source " << src;
   }
 }
 
