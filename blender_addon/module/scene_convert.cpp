@@ -54,22 +54,27 @@ std::string get_str(const py::dict& d, const char* key, const std::string& fallb
   throw std::invalid_argument(std::string("unknown ") + what + " '" + value + "'");
 }
 
+// d[key] (or `fallback` when missing) looked up by name in `table`; an unknown name is an error.
+template <typename E, size_t N>
+E get_enum(const py::dict& d, const char* key, const char* fallback,
+           const std::pair<const char*, E> (&table)[N], const char* what) {
+  const std::string name = get_str(d, key, fallback);
+  for (const auto& [n, value] : table)
+    if (name == n) return value;
+  bad_enum(what, name);
+}
+
 // --- Material inputs ---------------------------------------------------------------------------
 
 // {coordinates: 'UV' | 'GENERATED' | 'OBJECT' | 'POSITION', mapping: 12 floats}
 void read_vector(const py::dict& d, TextureVector& v) {
   get_transform(d, "mapping", v.mapping);
-  const std::string source = get_str(d, "coordinates", "UV");
-  if (source == "UV")
-    v.source = TexCoordSource::UV;
-  else if (source == "GENERATED")
-    v.source = TexCoordSource::Generated;
-  else if (source == "OBJECT")
-    v.source = TexCoordSource::Object;
-  else if (source == "POSITION")
-    v.source = TexCoordSource::Position;
-  else
-    bad_enum("texture coordinates", source);
+  static const std::pair<const char*, TexCoordSource> kSources[] = {
+      {"UV", TexCoordSource::UV},
+      {"GENERATED", TexCoordSource::Generated},
+      {"OBJECT", TexCoordSource::Object},
+      {"POSITION", TexCoordSource::Position}};
+  v.source = get_enum(d, "coordinates", "UV", kSources, "texture coordinates");
 }
 
 void read_lookup(const py::dict& d, TextureLookup& t) {
@@ -121,52 +126,29 @@ void read_float(const py::dict& node, const char* key, FloatInput& out) {
 // "value_b" (float inputs)}.
 InputNode read_input_node(const py::dict& d) {
   InputNode n;
-  const std::string kind = get_str(d, "kind", "MIX");
-  if (kind == "MIX")
-    n.kind = InputNodeKind::Mix;
-  else if (kind == "MATH")
-    n.kind = InputNodeKind::Math;
-  else if (kind == "INVERT")
-    n.kind = InputNodeKind::Invert;
-  else if (kind == "RAMP")
-    n.kind = InputNodeKind::Ramp;
-  else if (kind == "SEPARATE")
-    n.kind = InputNodeKind::Separate;
-  else if (kind == "COMBINE")
-    n.kind = InputNodeKind::Combine;
-  else if (kind == "GAMMA")
-    n.kind = InputNodeKind::Gamma;
-  else if (kind == "BRIGHT_CONTRAST")
-    n.kind = InputNodeKind::BrightContrast;
-  else if (kind == "HUE_SAT")
-    n.kind = InputNodeKind::HueSaturation;
-  else if (kind == "MAP_RANGE")
-    n.kind = InputNodeKind::MapRange;
-  else if (kind == "CLAMP")
-    n.kind = InputNodeKind::Clamp;
-  else if (kind == "RGB_TO_BW")
-    n.kind = InputNodeKind::ToBw;
-  else if (kind == "ATTRIBUTE")
-    n.kind = InputNodeKind::Attribute;
-  else if (kind == "CHECKER")
-    n.kind = InputNodeKind::Checker;
-  else if (kind == "NOISE")
-    n.kind = InputNodeKind::Noise;
-  else if (kind == "COORDINATES")
-    n.kind = InputNodeKind::Coordinates;
-  else if (kind == "VORONOI")
-    n.kind = InputNodeKind::Voronoi;
-  else if (kind == "GRADIENT")
-    n.kind = InputNodeKind::Gradient;
-  else if (kind == "WAVE")
-    n.kind = InputNodeKind::Wave;
-  else if (kind == "MUSGRAVE")
-    n.kind = InputNodeKind::Musgrave;
-  else if (kind == "WHITE_NOISE")
-    n.kind = InputNodeKind::WhiteNoise;
-  else
-    bad_enum("input node kind", kind);
-  const std::string blend = get_str(d, "blend", "MIX");
+  static const std::pair<const char*, InputNodeKind> kKinds[] = {
+      {"MIX", InputNodeKind::Mix},
+      {"MATH", InputNodeKind::Math},
+      {"INVERT", InputNodeKind::Invert},
+      {"RAMP", InputNodeKind::Ramp},
+      {"SEPARATE", InputNodeKind::Separate},
+      {"COMBINE", InputNodeKind::Combine},
+      {"GAMMA", InputNodeKind::Gamma},
+      {"BRIGHT_CONTRAST", InputNodeKind::BrightContrast},
+      {"HUE_SAT", InputNodeKind::HueSaturation},
+      {"MAP_RANGE", InputNodeKind::MapRange},
+      {"CLAMP", InputNodeKind::Clamp},
+      {"RGB_TO_BW", InputNodeKind::ToBw},
+      {"ATTRIBUTE", InputNodeKind::Attribute},
+      {"CHECKER", InputNodeKind::Checker},
+      {"NOISE", InputNodeKind::Noise},
+      {"COORDINATES", InputNodeKind::Coordinates},
+      {"VORONOI", InputNodeKind::Voronoi},
+      {"GRADIENT", InputNodeKind::Gradient},
+      {"WAVE", InputNodeKind::Wave},
+      {"MUSGRAVE", InputNodeKind::Musgrave},
+      {"WHITE_NOISE", InputNodeKind::WhiteNoise}};
+  n.kind = get_enum(d, "kind", "MIX", kKinds, "input node kind");
   static const std::pair<const char*, MixBlend> kBlends[] = {{"MIX", MixBlend::Mix},
                                                              {"ADD", MixBlend::Add},
                                                              {"MULTIPLY", MixBlend::Multiply},
@@ -176,19 +158,12 @@ InputNode read_input_node(const py::dict& d) {
                                                              {"DIFFERENCE", MixBlend::Difference},
                                                              {"DARKEN", MixBlend::Darken},
                                                              {"LIGHTEN", MixBlend::Lighten}};
-  bool found = false;
-  for (const auto& [name, value] : kBlends)
-    if (blend == name) n.blend = value, found = true;
-  if (!found) bad_enum("mix blend", blend);
-  const std::string op = get_str(d, "op", "ADD");
+  n.blend = get_enum(d, "blend", "MIX", kBlends, "mix blend");
   static const std::pair<const char*, MathOp> kOps[] = {
       {"ADD", MathOp::Add},        {"SUBTRACT", MathOp::Subtract}, {"MULTIPLY", MathOp::Multiply},
       {"DIVIDE", MathOp::Divide},  {"POWER", MathOp::Power},       {"MINIMUM", MathOp::Minimum},
       {"MAXIMUM", MathOp::Maximum}};
-  found = false;
-  for (const auto& [name, value] : kOps)
-    if (op == name) n.math = value, found = true;
-  if (!found) bad_enum("math operation", op);
+  n.math = get_enum(d, "op", "ADD", kOps, "math operation");
   get(d, "clamp_factor", n.clamp_factor);
   get(d, "clamp_result", n.clamp_result);
   read_float(d, "fac", n.fac);
@@ -216,63 +191,43 @@ InputNode read_input_node(const py::dict& d) {
   if (d.contains("vector")) read_vector(d["vector"].cast<py::dict>(), n.vector);
   get(d, "fac_output", n.fac_output);
   get(d, "position_output", n.position_output);
-  const std::string metric = get_str(d, "metric", "EUCLIDEAN");
   static const std::pair<const char*, VoronoiMetric> kMetrics[] = {
       {"EUCLIDEAN", VoronoiMetric::Euclidean},
       {"MANHATTAN", VoronoiMetric::Manhattan},
       {"CHEBYCHEV", VoronoiMetric::Chebyshev},  // Blender's spelling
       {"MINKOWSKI", VoronoiMetric::Minkowski}};
-  found = false;
-  for (const auto& [name, value] : kMetrics)
-    if (metric == name) n.voronoi_metric = value, found = true;
-  if (!found) bad_enum("voronoi metric", metric);
-  const std::string gradient = get_str(d, "gradient", "LINEAR");
+  n.voronoi_metric = get_enum(d, "metric", "EUCLIDEAN", kMetrics, "voronoi metric");
   static const std::pair<const char*, GradientType> kGradients[] = {
       {"LINEAR", GradientType::Linear},       {"QUADRATIC", GradientType::Quadratic},
       {"EASING", GradientType::Easing},       {"DIAGONAL", GradientType::Diagonal},
       {"SPHERICAL", GradientType::Spherical}, {"QUADRATIC_SPHERE", GradientType::QuadraticSphere},
       {"RADIAL", GradientType::Radial}};
-  found = false;
-  for (const auto& [name, value] : kGradients)
-    if (gradient == name) n.gradient_type = value, found = true;
-  if (!found) bad_enum("gradient type", gradient);
-  if (kind == "MUSGRAVE") {
-    const std::string type = get_str(d, "musgrave_type", "FBM");
+  n.gradient_type = get_enum(d, "gradient", "LINEAR", kGradients, "gradient type");
+  if (n.kind == InputNodeKind::Musgrave) {
     static const std::pair<const char*, MusgraveType> kTypes[] = {
         {"FBM", MusgraveType::Fbm},
         {"MULTIFRACTAL", MusgraveType::Multifractal},
         {"HETERO_TERRAIN", MusgraveType::HeteroTerrain},
         {"HYBRID_MULTIFRACTAL", MusgraveType::HybridMultifractal},
         {"RIDGED_MULTIFRACTAL", MusgraveType::RidgedMultifractal}};
-    found = false;
-    for (const auto& [name, value] : kTypes)
-      if (type == name) n.musgrave_type = value, found = true;
-    if (!found) bad_enum("musgrave type", type);
+    n.musgrave_type = get_enum(d, "musgrave_type", "FBM", kTypes, "musgrave type");
   }
-  if (kind == "WAVE") {
-    const std::string type = get_str(d, "wave_type", "BANDS");
-    if (type != "BANDS" && type != "RINGS") bad_enum("wave type", type);
-    n.wave.type = type == "BANDS" ? WaveDesc::Type::Bands : WaveDesc::Type::Rings;
-    const std::string dir = get_str(d, "direction", "X");
+  if (n.kind == InputNodeKind::Wave) {
+    static const std::pair<const char*, WaveDesc::Type> kWaveTypes[] = {
+        {"BANDS", WaveDesc::Type::Bands}, {"RINGS", WaveDesc::Type::Rings}};
+    n.wave.type = get_enum(d, "wave_type", "BANDS", kWaveTypes, "wave type");
     static const std::pair<const char*, WaveDesc::Direction> kDirections[] = {
         {"X", WaveDesc::Direction::X},
         {"Y", WaveDesc::Direction::Y},
         {"Z", WaveDesc::Direction::Z},
         {"DIAGONAL", WaveDesc::Direction::Other},
         {"SPHERICAL", WaveDesc::Direction::Other}};
-    found = false;
-    for (const auto& [name, value] : kDirections)
-      if (dir == name) n.wave.direction = value, found = true;
-    if (!found) bad_enum("wave direction", dir);
-    const std::string profile = get_str(d, "profile", "SIN");
+    n.wave.direction = get_enum(d, "direction", "X", kDirections, "wave direction");
     static const std::pair<const char*, WaveDesc::Profile> kProfiles[] = {
         {"SIN", WaveDesc::Profile::Sine},
         {"SAW", WaveDesc::Profile::Saw},
         {"TRI", WaveDesc::Profile::Triangle}};
-    found = false;
-    for (const auto& [name, value] : kProfiles)
-      if (profile == name) n.wave.profile = value, found = true;
-    if (!found) bad_enum("wave profile", profile);
+    n.wave.profile = get_enum(d, "profile", "SIN", kProfiles, "wave profile");
   }
   return n;
 }
