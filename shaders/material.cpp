@@ -288,9 +288,10 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
         r = Spectrum(0.5f);
         break;
       }
-      const Vec3f p = in.vector(n.vector) * in.scalar(n.value_a);
-      const NoiseTextureResult t = noise_texture(p, in.scalar(n.value_b), in.scalar(n.value_c),
-                                                 in.scalar(n.fac), !n.fac_output);
+      const float scale = in.scalar(n.value_a);
+      const NoiseTextureResult t = noise_texture(
+          n.noise_dimensions, in.vector(n.vector) * scale, in.scalar(n.value_d) * scale,
+          in.scalar(n.value_b), in.scalar(n.value_c), in.scalar(n.fac), !n.fac_output);
       r = n.fac_output ? Spectrum(t.fac) : t.color;
       break;
     }

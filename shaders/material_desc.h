@@ -72,8 +72,9 @@ enum class InputNodeKind : uint8_t {
   ToBw,            // luminance of a, as grey (RGB to BW)
   Attribute,       // the mesh's colour attribute (Color Attribute node; ShadingContext::color)
   Checker,         // Checker Texture at `vector` x scale value_a: colour a or b (svm_checker)
-  Noise,           // 3D Noise Texture at `vector` x scale value_a: detail value_b, roughness
-                   // value_c, distortion fac (Blender 3.4's fBm of Perlin noise, noise_texture_3d)
+  Noise,           // Noise Texture of `noise_dimensions` at `vector` and W value_d, both x scale
+                   // value_a: detail value_b, roughness value_c, distortion fac (Blender 3.4's fBm
+                   // of Perlin noise, noise_texture_Nd)
   Coordinates,     // `vector` itself as a colour (a Texture Coordinate / Mapping output plugged
                    // into a colour or float input)
   Voronoi,         // 3D Voronoi Texture, F1, at `vector` x scale value_a: randomness value_b,
@@ -127,6 +128,7 @@ struct InputNode {
   VoronoiMetric voronoi_metric = VoronoiMetric::Euclidean;
   GradientType gradient_type = GradientType::Linear;
   WaveDesc wave;
+  uint8_t noise_dimensions = 3;  // Noise: 1, 2, 3 or 4
   MusgraveType musgrave_type = MusgraveType::Fbm;
 };
 

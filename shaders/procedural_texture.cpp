@@ -144,7 +144,126 @@ Vec3f seed_offset(float seed) {
   return {h(0.0f), h(1.0f), h(2.0f)};
 }
 
+// --- Noise in 1, 2 and 4 dimensions (the 3D one above is the common case) ---
+
+// A point of up to four coordinates.
+struct Point4 {
+  float v[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+};
+
+// Dot product of (x, y) with one of Perlin's 2D gradients (8 entries, Cycles' grad2).
+inline float gradient2(uint32_t hash, float x, float y) {
+  const uint32_t h = hash & 7u;
+  const float u = h < 4 ? x : y, v = 2.0f * (h < 4 ? y : x);
+  return ((h & 1u) ? -u : u) + ((h & 2u) ? -v : v);
+}
+
+// Dot product with one of the 4D gradients (32 entries, Cycles' grad4).
+inline float gradient4(uint32_t hash, float x, float y, float z, float w) {
+  const uint32_t h = hash & 31u;
+  const float u = h < 24 ? x : y, v = h < 16 ? y : z, s = h < 8 ? z : w;
+  return ((h & 1u) ? -u : u) + ((h & 2u) ? -v : v) + ((h & 4u) ? -s : s);
+}
+
+inline float lerp(float a, float b, float t) {
+  return (1.0f - t) * a + t * b;
+}
+
+// Perlin noise of dimension n (1, 2 or 4) at p, unscaled.
+float perlin_n(int n, const Point4& p) {
+  int c[4];
+  float f[4], fade_f[4];
+  for (int k = 0; k < n; ++k) {
+    f[k] = cell(p.v[k], c[k]);
+    fade_f[k] = fade(f[k]);
+  }
+  if (n == 1) {
+    auto g = [&](int d) {
+      const uint32_t h = hash_words(uint32_t(c[0] + d)) & 15u;
+      const float grad = float(1 + (h & 7u));
+      return ((h & 8u) ? -grad : grad) * (f[0] - float(d));
+    };
+    return g(0) + fade_f[0] * (g(1) - g(0));
+  }
+  if (n == 2) {
+    auto g = [&](int dx, int dy) {
+      return gradient2(hash_words(uint32_t(c[0] + dx), uint32_t(c[1] + dy)), f[0] - float(dx),
+                       f[1] - float(dy));
+    };
+    const float u = fade_f[0], v = fade_f[1];
+    return lerp(lerp(g(0, 0), g(1, 0), u), lerp(g(0, 1), g(1, 1), u), v);
+  }
+  // 4D: two trilinear blends of 8 corners each, blended along w.
+  auto g = [&](int dx, int dy, int dz, int dw) {
+    return gradient4(hash_words(uint32_t(c[0] + dx), uint32_t(c[1] + dy), uint32_t(c[2] + dz),
+                                uint32_t(c[3] + dw)),
+                     f[0] - float(dx), f[1] - float(dy), f[2] - float(dz), f[3] - float(dw));
+  };
+  const float u = fade_f[0], v = fade_f[1], t = fade_f[2];
+  auto tri = [&](int dw) {
+    return lerp(
+        lerp(lerp(g(0, 0, 0, dw), g(1, 0, 0, dw), u), lerp(g(0, 1, 0, dw), g(1, 1, 0, dw), u), v),
+        lerp(lerp(g(0, 0, 1, dw), g(1, 0, 1, dw), u), lerp(g(0, 1, 1, dw), g(1, 1, 1, dw), u), v),
+        t);
+  };
+  return lerp(tri(0), tri(1), fade_f[3]);
+}
+
+// Cycles' noise_scale1 / 2 / 4, non-finite results as 0.
+float signed_noise_n(int n, const Point4& p) {
+  const float scale = n == 1 ? 0.25f : n == 2 ? 0.6616f : 0.8344f;
+  const float r = perlin_n(n, p);
+  return scale * (std::isfinite(r) ? r : 0.0f);
+}
+
+Point4 scaled(int n, Point4 p, float s) {
+  for (int k = 0; k < n; ++k) p.v[k] *= s;
+  return p;
+}
+
+Point4 added(int n, Point4 p, const Point4& q) {
+  for (int k = 0; k < n; ++k) p.v[k] += q.v[k];
+  return p;
+}
+
+// fractal_noise() in dimension n.
+float fractal_noise_n(int n, const Point4& p, float detail, float roughness) {
+  float scale = 1.0f, amplitude = 1.0f, total = 0.0f, sum = 0.0f;
+  detail = std::clamp(detail, 0.0f, 15.0f);
+  roughness = std::clamp(roughness, 0.0f, 1.0f);
+  const int octaves = int(detail);
+  for (int i = 0; i <= octaves; ++i) {
+    sum += (0.5f * signed_noise_n(n, scaled(n, p, scale)) + 0.5f) * amplitude;
+    total += amplitude;
+    amplitude *= roughness;
+    scale *= 2.0f;
+  }
+  const float rest = detail - std::floor(detail);
+  if (rest == 0.0f) return sum / total;
+  const float more = sum + (0.5f * signed_noise_n(n, scaled(n, p, scale)) + 0.5f) * amplitude;
+  return (1.0f - rest) * (sum / total) + rest * (more / (total + amplitude));
+}
+
+// Cycles' random_float_offset / random_float2_offset / random_float4_offset of `seed`.
+Point4 seed_offset_n(int n, float seed) {
+  const uint32_t s = std::bit_cast<uint32_t>(seed);
+  Point4 o;
+  if (n == 1) {
+    o.v[0] = 100.0f + float(hash_words(s)) / float(0xFFFFFFFFu) * 100.0f;
+    return o;
+  }
+  for (int k = 0; k < n; ++k)
+    o.v[k] = 100.0f +
+             float(hash_words(s, std::bit_cast<uint32_t>(float(k)))) / float(0xFFFFFFFFu) * 100.0f;
+  return o;
+}
+
 }  // namespace
+
+uint32_t hash_words(uint32_t a) {
+  const uint32_t init = 0xdeadbeefu + (1u << 2) + 13u;
+  return final_mix(init + a, init, init);
+}
 
 uint32_t hash_words(uint32_t a, uint32_t b) {
   const uint32_t init = 0xdeadbeefu + (2u << 2) + 13u;
@@ -362,6 +481,37 @@ NoiseTextureResult noise_texture(Vec3f p, float detail, float roughness, float d
   if (color)
     r.color = {r.fac, fractal_noise(p + seed_offset(3.0f), detail, roughness),
                fractal_noise(p + seed_offset(4.0f), detail, roughness)};
+  return r;
+}
+
+NoiseTextureResult noise_texture(int dimensions, Vec3f p, float w, float detail, float roughness,
+                                 float distortion, bool color) {
+  if (dimensions == 3) return noise_texture(p, detail, roughness, distortion, color);
+  const int n = dimensions == 1 ? 1 : dimensions == 2 ? 2 : 4;
+  Point4 q;
+  if (n == 1) {
+    q.v[0] = w;
+  } else {
+    q.v[0] = p.x;
+    q.v[1] = p.y;
+    q.v[2] = p.z;
+    q.v[3] = w;
+  }
+  // Distortion: each coordinate displaced by noise at its own seed offset (0, 1, ...); the
+  // Color's other channels read the fractal at the next two seeds.
+  if (distortion != 0.0f) {
+    Point4 d;
+    for (int k = 0; k < n; ++k)
+      d.v[k] = signed_noise_n(n, added(n, q, seed_offset_n(n, float(k)))) * distortion;
+    q = added(n, q, d);
+  }
+  NoiseTextureResult r;
+  r.fac = fractal_noise_n(n, q, detail, roughness);
+  r.color = Spectrum(r.fac);
+  if (color)
+    r.color = {r.fac,
+               fractal_noise_n(n, added(n, q, seed_offset_n(n, float(n))), detail, roughness),
+               fractal_noise_n(n, added(n, q, seed_offset_n(n, float(n + 1))), detail, roughness)};
   return r;
 }
 

@@ -31,6 +31,12 @@ struct NoiseTextureResult {
 NoiseTextureResult noise_texture(Vec3f p, float detail, float roughness, float distortion,
                                  bool color);
 
+// The Noise Texture in `dimensions` 1, 2, 3 or 4 (Blender's Dimensions): it reads w alone (1D),
+// (p.x, p.y) (2D), p (3D, as noise_texture) or (p, w) (4D), all already scaled; Perlin noise of
+// that dimension with Cycles' hashes and scales, the same fractal sum, distortion and Color.
+NoiseTextureResult noise_texture(int dimensions, Vec3f p, float w, float detail, float roughness,
+                                 float distortion, bool color);
+
 // The 3D Voronoi Texture's F1 feature at p (already scaled): the nearest of one jittered point
 // per unit cell (jitter = randomness, in [0, 1]) by the metric, its distance, its cell's random
 // colour and its position (Cycles' voronoi_f1_3d).
@@ -84,7 +90,8 @@ float musgrave_texture(Vec3f p, MusgraveType type, float detail, float dimension
 float white_noise(Vec3f p);
 Spectrum white_noise_color(Vec3f p);
 
-// Bob Jenkins' lookup3 hashes of 2, 3 and 4 words (Cycles' hash_uint2 / 3 / 4).
+// Bob Jenkins' lookup3 hashes of 1 to 4 words (Cycles' hash_uint, hash_uint2 / 3 / 4).
+uint32_t hash_words(uint32_t a);
 uint32_t hash_words(uint32_t a, uint32_t b);
 uint32_t hash_words(uint32_t a, uint32_t b, uint32_t c);
 uint32_t hash_words(uint32_t a, uint32_t b, uint32_t c, uint32_t d);

@@ -365,8 +365,10 @@ class _Translator:
                  "value_a": self.value(node.inputs["Scale"]),
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
                  "fac_output": out.name == "Fac"}
-        elif node.type == 'TEX_NOISE' and node.noise_dimensions == '3D':
-            d = {"kind": "NOISE", "value_a": self.value(node.inputs["Scale"]),
+        elif node.type == 'TEX_NOISE':
+            d = {"kind": "NOISE", "dimensions": int(node.noise_dimensions[0]),
+                 "value_d": self.value(node.inputs["W"]),
+                 "value_a": self.value(node.inputs["Scale"]),
                  "value_b": self.value(node.inputs["Detail"]),
                  "value_c": self.value(node.inputs["Roughness"]),
                  "fac": self.value(node.inputs["Distortion"]),

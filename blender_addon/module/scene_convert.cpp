@@ -191,6 +191,10 @@ InputNode read_input_node(const py::dict& d) {
   if (d.contains("vector")) read_vector(d["vector"].cast<py::dict>(), n.vector);
   get(d, "fac_output", n.fac_output);
   get(d, "position_output", n.position_output);
+  int dimensions = 3;
+  get(d, "dimensions", dimensions);
+  if (dimensions < 1 || dimensions > 4) throw std::invalid_argument("noise: dimensions 1 to 4");
+  n.noise_dimensions = uint8_t(dimensions);
   static const std::pair<const char*, VoronoiMetric> kMetrics[] = {
       {"EUCLIDEAN", VoronoiMetric::Euclidean},
       {"MANHATTAN", VoronoiMetric::Manhattan},

@@ -72,17 +72,17 @@ def test_unsupported_node(out):
 
 
 def test_texture_limits(out):
-    """Textures Gradient PT does not model are reported once each and the render finishes: a 4D
-    Noise Texture (3D only), a Checker read at the Texture Coordinate node's Normal output, a
+    """Textures Gradient PT does not model are reported once each and the render finishes: a 2D
+    Musgrave Texture (3D only), a Checker read at the Texture Coordinate node's Normal output, a
     Voronoi Texture's F2 feature (F1 only), a Magic Texture."""
     scene = S.clear()
     basic_scene(scene)
     m, nt, outn = S._material("textures")
     bsdf = nt.nodes.new("ShaderNodeBsdfPrincipled")
-    noise = nt.nodes.new("ShaderNodeTexNoise")
-    noise.name = "My 4D Noise"
-    noise.noise_dimensions = '4D'
-    nt.links.new(noise.outputs["Fac"], bsdf.inputs["Roughness"])
+    musgrave = nt.nodes.new("ShaderNodeTexMusgrave")
+    musgrave.name = "My 2D Musgrave"
+    musgrave.musgrave_dimensions = '2D'
+    nt.links.new(musgrave.outputs["Fac"], bsdf.inputs["Roughness"])
     checker = nt.nodes.new("ShaderNodeTexChecker")
     coords = nt.nodes.new("ShaderNodeTexCoord")
     coords.name = "My Coordinates"
@@ -98,7 +98,7 @@ def test_texture_limits(out):
     nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
     S.uv_sphere("ball", 0.6, (0, 0.3, 0.6), m)
     path, warnings = render_finished(scene, os.path.join(out, "texture_limits.exr"))
-    for needle, what in (("mode 4D of the input node 'My 4D Noise'", "the 4D noise"),
+    for needle, what in (("mode 2D of the input node 'My 2D Musgrave'", "the 2D Musgrave"),
                          ("output Normal of the texture coordinate node 'My Coordinates'",
                           "the Normal coordinates"),
                          ("mode 3D F2 of the input node 'My Voronoi'", "the Voronoi F2"),

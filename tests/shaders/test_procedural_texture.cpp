@@ -205,5 +205,37 @@ TEST(ProceduralTexture, WhiteNoiseIsCyclesHash) {
   EXPECT_NEAR(sum / 10000.0, 0.5, 0.01);
 }
 
+// Noise in 1, 2 and 4 dimensions: zero on the integer lattice (Fac 0.5 at detail 0), bounded,
+// the 3D case identical to noise_texture(p, ...), 1D reading only w and 2D only (x, y).
+TEST(ProceduralTexture, NoiseDimensions) {
+  for (int dims : {1, 2, 4})
+    for (int i = -2; i <= 2; ++i)
+      EXPECT_EQ(noise_texture(dims, Vec3f(float(i), float(-i), 3.0f), float(i + 1), 0.0f, 0.5f,
+                              0.0f, false)
+                    .fac,
+                0.5f)
+          << dims;
+  const Vec3f p(0.37f, -1.21f, 2.72f);
+  EXPECT_EQ(noise_texture(3, p, 0.9f, 2.5f, 0.6f, 0.3f, true).color,
+            noise_texture(p, 2.5f, 0.6f, 0.3f, true).color);
+  EXPECT_EQ(noise_texture(1, p, 0.9f, 2.0f, 0.5f, 0.0f, false).fac,
+            noise_texture(1, Vec3f(5.0f, 6.0f, 7.0f), 0.9f, 2.0f, 0.5f, 0.0f, false).fac);
+  EXPECT_EQ(noise_texture(2, p, 0.9f, 2.0f, 0.5f, 0.0f, false).fac,
+            noise_texture(2, Vec3f(p.x, p.y, 9.0f), -4.0f, 2.0f, 0.5f, 0.0f, false).fac);
+  EXPECT_NE(noise_texture(4, p, 0.9f, 2.0f, 0.5f, 0.0f, false).fac,
+            noise_texture(4, p, 0.4f, 2.0f, 0.5f, 0.0f, false).fac);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> u(-30.0f, 30.0f);
+  for (int dims : {1, 2, 4})
+    for (int i = 0; i < 3000; ++i) {
+      const NoiseTextureResult r =
+          noise_texture(dims, Vec3f(u(rng), u(rng), u(rng)), u(rng), 3.0f, 0.7f, 0.5f, true);
+      for (float v : {r.color.x, r.color.y, r.color.z}) {
+        ASSERT_GE(v, 0.0f) << dims;
+        ASSERT_LE(v, 1.0f) << dims;
+      }
+    }
+}
+
 }  // namespace
 }  // namespace gdpt
