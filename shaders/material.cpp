@@ -141,6 +141,7 @@ bool reads_vector(InputNodeKind kind) {
     case InputNodeKind::Wave:
     case InputNodeKind::Musgrave:
     case InputNodeKind::WhiteNoise:
+    case InputNodeKind::Magic:
       return true;
     default:
       return false;
@@ -262,6 +263,16 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
                                                    in.scalar(n.value_c), in.scalar(n.value_d),
                                                    in.scalar(n.value_e), in.scalar(n.value_f)));
       break;
+    case InputNodeKind::Magic: {
+      if (Inputs::kAverage) {
+        r = Spectrum(0.5f);
+        break;
+      }
+      const Spectrum c = magic_texture(in.vector(n.vector) * in.scalar(n.value_a), n.magic_depth,
+                                       in.scalar(n.value_b));
+      r = n.fac_output ? Spectrum((c.x + c.y + c.z) / 3.0f) : c;
+      break;
+    }
     case InputNodeKind::WhiteNoise: {
       if (Inputs::kAverage) {
         r = Spectrum(0.5f);

@@ -85,6 +85,8 @@ enum class InputNodeKind : uint8_t {
                    // value_c, detail scale value_d, detail roughness value_e, phase value_f
   WhiteNoise,      // 3D White Noise Texture at `vector`: a hash of its bits, Value (fac_output)
                    // or Color
+  Magic,           // Magic Texture at `vector` x scale value_a, distortion value_b, depth
+                   // `magic_depth`; Fac (the colour's mean) or Color
   Musgrave,        // 3D Musgrave Texture `musgrave_type` at `vector` x scale value_a: detail
                    // value_b, dimension value_c, lacunarity value_d, offset value_e, gain value_f
 };
@@ -129,6 +131,7 @@ struct InputNode {
   GradientType gradient_type = GradientType::Linear;
   WaveDesc wave;
   uint8_t noise_dimensions = 3;  // Noise: 1, 2, 3 or 4
+  uint8_t magic_depth = 2;       // Magic: 0 to 10
   MusgraveType musgrave_type = MusgraveType::Fbm;
 };
 

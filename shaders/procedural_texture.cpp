@@ -447,6 +447,59 @@ float musgrave_texture(Vec3f p, MusgraveType type, float detail, float dimension
   return 0.0f;
 }
 
+Spectrum magic_texture(Vec3f p, int depth, float distortion) {
+  const float d = distortion;
+  float x = std::sin((p.x + p.y + p.z) * 5.0f);
+  float y = std::cos((-p.x + p.y - p.z) * 5.0f);
+  float z = -std::cos((-p.x - p.y + p.z) * 5.0f);
+  if (depth > 0) {
+    x *= d;
+    y *= d;
+    z *= d;
+  }
+  // Each level rewrites one coordinate from all three (Cycles' fixed sequence), then scales it.
+  for (int level = 1; level <= std::min(depth, 10); ++level) {
+    switch (level) {
+      case 1:
+        y = -std::cos(x - y + z) * d;
+        break;
+      case 2:
+        x = std::cos(x - y - z) * d;
+        break;
+      case 3:
+        z = std::sin(-x - y - z) * d;
+        break;
+      case 4:
+        x = -std::cos(-x + y - z) * d;
+        break;
+      case 5:
+        y = -std::sin(-x + y + z) * d;
+        break;
+      case 6:
+        y = -std::cos(-x + y + z) * d;
+        break;
+      case 7:
+        x = std::cos(x + y + z) * d;
+        break;
+      case 8:
+        z = std::sin(x + y - z) * d;
+        break;
+      case 9:
+        x = -std::cos(-x - y + z) * d;
+        break;
+      default:
+        y = -std::sin(x - y + z) * d;
+        break;
+    }
+  }
+  if (d != 0.0f) {
+    x /= 2.0f * d;
+    y /= 2.0f * d;
+    z /= 2.0f * d;
+  }
+  return {0.5f - x, 0.5f - y, 0.5f - z};
+}
+
 float white_noise(Vec3f p) {
   return cell_random(p).x;
 }

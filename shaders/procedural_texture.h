@@ -6,7 +6,8 @@
 // - Voronoi (3D, F1): the nearest jittered cell point, with the same hashes;
 // - Gradient: the seven profiles;
 // - Wave: bands and rings with the three profiles and noise distortion;
-// - Musgrave (3D): the five fractal types.
+// - Musgrave (3D): the five fractal types;
+// - Magic and White Noise (3D).
 #pragma once
 
 #include <cstdint>
@@ -89,6 +90,10 @@ float musgrave_texture(Vec3f p, MusgraveType type, float detail, float dimension
 // (Cycles' hash_float3_to_float and hash_float3_to_float3).
 float white_noise(Vec3f p);
 Spectrum white_noise_color(Vec3f p);
+
+// The Magic Texture at p (already scaled): sines and cosines of the coordinates, folded `depth`
+// (0 to 10) more times into each other, scaled by distortion (Cycles' svm_magic).
+Spectrum magic_texture(Vec3f p, int depth, float distortion);
 
 // Bob Jenkins' lookup3 hashes of 1 to 4 words (Cycles' hash_uint, hash_uint2 / 3 / 4).
 uint32_t hash_words(uint32_t a);

@@ -24,7 +24,7 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
                 'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
-                'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE'}
+                'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -287,7 +287,7 @@ class _Translator:
         per_output = node.type in {'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR', 'TEX_CHECKER',
                                    'TEX_NOISE', 'TEX_COORD', 'SEPXYZ', 'TEX_VORONOI',
                                    'TEX_GRADIENT', 'TEX_WAVE', 'TEX_MUSGRAVE',
-                                   'TEX_WHITE_NOISE', 'NEW_GEOMETRY'}
+                                   'TEX_WHITE_NOISE', 'NEW_GEOMETRY', 'TEX_MAGIC'}
         key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
@@ -410,6 +410,12 @@ class _Translator:
             vector = self._vector(socket) if self._source(socket) is not None else \
                 {"coordinates": 'UV', "mapping": [0.0] * 12}
             d = {"kind": "WHITE_NOISE", "vector": vector, "fac_output": out.name == "Value"}
+        elif node.type == 'TEX_MAGIC':
+            d = {"kind": "MAGIC", "depth": int(node.turbulence_depth),
+                 "value_a": self.value(node.inputs["Scale"]),
+                 "value_b": self.value(node.inputs["Distortion"]),
+                 "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
+                 "fac_output": out.name == "Fac"}
         elif node.type == 'TEX_GRADIENT':
             d = {"kind": "GRADIENT", "gradient": node.gradient_type,
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),

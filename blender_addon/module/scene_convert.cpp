@@ -147,7 +147,8 @@ InputNode read_input_node(const py::dict& d) {
       {"GRADIENT", InputNodeKind::Gradient},
       {"WAVE", InputNodeKind::Wave},
       {"MUSGRAVE", InputNodeKind::Musgrave},
-      {"WHITE_NOISE", InputNodeKind::WhiteNoise}};
+      {"WHITE_NOISE", InputNodeKind::WhiteNoise},
+      {"MAGIC", InputNodeKind::Magic}};
   n.kind = get_enum(d, "kind", "MIX", kKinds, "input node kind");
   static const std::pair<const char*, MixBlend> kBlends[] = {{"MIX", MixBlend::Mix},
                                                              {"ADD", MixBlend::Add},
@@ -195,6 +196,9 @@ InputNode read_input_node(const py::dict& d) {
   get(d, "dimensions", dimensions);
   if (dimensions < 1 || dimensions > 4) throw std::invalid_argument("noise: dimensions 1 to 4");
   n.noise_dimensions = uint8_t(dimensions);
+  int depth = 2;
+  get(d, "depth", depth);
+  n.magic_depth = uint8_t(std::clamp(depth, 0, 10));
   static const std::pair<const char*, VoronoiMetric> kMetrics[] = {
       {"EUCLIDEAN", VoronoiMetric::Euclidean},
       {"MANHATTAN", VoronoiMetric::Manhattan},

@@ -456,8 +456,8 @@ def case_procedural_textures(scene):
     # Noise Fac (scale 4, distance 0.5: differences along the triangles' edges, and Cycles' bump
     # shadowing of diffuse lobes); the left wall shows a grid image at Generated coordinates
     # through a Mapping node times a distorted triangle-profile Wave Texture (rings); the right
-    # wall's colour is a 3D Voronoi Texture's Color (F1, Manhattan, Object), the ceiling's a
-    # radial Gradient.
+    # wall's colour is a 3D Voronoi Texture's Color (F1, Manhattan, Object) times a Magic
+    # Texture (depth 4), the ceiling's a radial Gradient.
     material, assign = grid_room(scene)
     m, nt, bsdf, tex = material("noisy_floor", "ShaderNodeBsdfDiffuse")
     noise = nt.nodes.new("ShaderNodeTexNoise")
@@ -521,7 +521,15 @@ def case_procedural_textures(scene):
     voronoi.inputs["Scale"].default_value = 3.0
     coords = nt.nodes.new("ShaderNodeTexCoord")
     nt.links.new(coords.outputs["Object"], voronoi.inputs["Vector"])
-    nt.links.new(voronoi.outputs["Color"], bsdf.inputs["Color"])
+    magic = nt.nodes.new("ShaderNodeTexMagic")
+    magic.turbulence_depth = 4
+    magic.inputs["Distortion"].default_value = 1.5
+    multiply = nt.nodes.new("ShaderNodeMixRGB")
+    multiply.blend_type = 'MULTIPLY'
+    multiply.inputs["Fac"].default_value = 1.0
+    nt.links.new(voronoi.outputs["Color"], multiply.inputs["Color1"])
+    nt.links.new(magic.outputs["Color"], multiply.inputs["Color2"])
+    nt.links.new(multiply.outputs["Color"], bsdf.inputs["Color"])
     assign("right", m)
 
     m, nt, bsdf, tex = material("radial", "ShaderNodeBsdfDiffuse")

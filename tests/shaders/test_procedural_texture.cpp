@@ -237,5 +237,23 @@ TEST(ProceduralTexture, NoiseDimensions) {
     }
 }
 
+// Magic: at depth 0 the three waves divided by 2 distortion; one fold rewrites y; distortion 0
+// flattens every depth above 0 to grey.
+TEST(ProceduralTexture, MagicFolds) {
+  const Vec3f p(0.21f, -0.4f, 0.33f);
+  const float d = 1.5f;
+  const float x = std::sin((p.x + p.y + p.z) * 5.0f) * d;
+  const float y = std::cos((-p.x + p.y - p.z) * 5.0f) * d;
+  const float z = -std::cos((-p.x - p.y + p.z) * 5.0f) * d;
+  const Spectrum c0 = magic_texture(p, 0, d);
+  EXPECT_NEAR(c0.x, 0.5f - x / d / (2.0f * d), 1e-6f);
+  EXPECT_NEAR(c0.z, 0.5f - z / d / (2.0f * d), 1e-6f);
+  const Spectrum c1 = magic_texture(p, 1, d);
+  EXPECT_NEAR(c1.x, 0.5f - x / (2.0f * d), 1e-6f);
+  EXPECT_NEAR(c1.y, 0.5f + std::cos(x - y + z) * d / (2.0f * d), 1e-6f);
+  EXPECT_NEAR(c1.z, 0.5f - z / (2.0f * d), 1e-6f);
+  EXPECT_EQ(magic_texture(p, 3, 0.0f), Spectrum(0.5f));
+}
+
 }  // namespace
 }  // namespace gdpt
