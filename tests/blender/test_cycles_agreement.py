@@ -448,6 +448,16 @@ def case_bump(scene):
     return 3
 
 
+def multiply(nt, a, b, target):
+    """A MixRGB node multiplying outputs a and b (factor 1) into the input `target`."""
+    node = nt.nodes.new("ShaderNodeMixRGB")
+    node.blend_type = 'MULTIPLY'
+    node.inputs["Fac"].default_value = 1.0
+    nt.links.new(a, node.inputs["Color1"])
+    nt.links.new(b, node.inputs["Color2"])
+    nt.links.new(node.outputs["Color"], target)
+
+
 def case_procedural_textures(scene):
     # Procedural textures and texture coordinates: the floor's colour is the Color of a 3D Noise
     # Texture at its default (Generated) coordinates times a ridged Musgrave Texture; the back wall's Principled base colour is
@@ -465,12 +475,7 @@ def case_procedural_textures(scene):
     musgrave = nt.nodes.new("ShaderNodeTexMusgrave")
     musgrave.musgrave_type = 'RIDGED_MULTIFRACTAL'
     musgrave.inputs["Scale"].default_value = 3.0
-    multiply = nt.nodes.new("ShaderNodeMixRGB")
-    multiply.blend_type = 'MULTIPLY'
-    multiply.inputs["Fac"].default_value = 1.0
-    nt.links.new(noise.outputs["Color"], multiply.inputs["Color1"])
-    nt.links.new(musgrave.outputs["Fac"], multiply.inputs["Color2"])
-    nt.links.new(multiply.outputs["Color"], bsdf.inputs["Color"])
+    multiply(nt, noise.outputs["Color"], musgrave.outputs["Fac"], bsdf.inputs["Color"])
     assign("floor", m)
 
     m, nt, bsdf, tex = material("noisy_wall", "ShaderNodeBsdfPrincipled", distribution='GGX')
@@ -493,12 +498,7 @@ def case_procedural_textures(scene):
     wave.wave_type = 'RINGS'
     wave.wave_profile = 'TRI'
     wave.inputs["Distortion"].default_value = 2.0
-    multiply = nt.nodes.new("ShaderNodeMixRGB")
-    multiply.blend_type = 'MULTIPLY'
-    multiply.inputs["Fac"].default_value = 1.0
-    nt.links.new(tex.outputs["Color"], multiply.inputs["Color1"])
-    nt.links.new(wave.outputs["Color"], multiply.inputs["Color2"])
-    nt.links.new(multiply.outputs["Color"], bsdf.inputs["Color"])
+    multiply(nt, tex.outputs["Color"], wave.outputs["Color"], bsdf.inputs["Color"])
     assign("left", m)
 
     m, nt, bsdf, tex = material("checker_ball", "ShaderNodeBsdfDiffuse")
@@ -524,12 +524,7 @@ def case_procedural_textures(scene):
     magic = nt.nodes.new("ShaderNodeTexMagic")
     magic.turbulence_depth = 4
     magic.inputs["Distortion"].default_value = 1.5
-    multiply = nt.nodes.new("ShaderNodeMixRGB")
-    multiply.blend_type = 'MULTIPLY'
-    multiply.inputs["Fac"].default_value = 1.0
-    nt.links.new(voronoi.outputs["Color"], multiply.inputs["Color1"])
-    nt.links.new(magic.outputs["Color"], multiply.inputs["Color2"])
-    nt.links.new(multiply.outputs["Color"], bsdf.inputs["Color"])
+    multiply(nt, voronoi.outputs["Color"], magic.outputs["Color"], bsdf.inputs["Color"])
     assign("right", m)
 
     m, nt, bsdf, tex = material("radial", "ShaderNodeBsdfDiffuse")
