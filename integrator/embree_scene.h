@@ -142,10 +142,11 @@ class EmbreeScene {
   void intersect_stream(const Ray* rays, const bool* valid, int n, bool* found,
                         SurfaceHit* hits) const;
 
-  // The scene's materials (indexed as SurfaceHit::material), for Normal Map and Bump nodes and
-  // colour attributes. Decides per instance whether its hits perturb the shading normal (some
-  // material has a normal map or bump) and carry a colour attribute (the mesh has one, or some
-  // material reads one: black then); other hits skip both. Unset: neither.
+  // The scene's materials (indexed as SurfaceHit::material), for Normal Map and Bump nodes,
+  // colour attributes and texture coordinates. Decides per instance whether its hits perturb
+  // the shading normal (some material has a normal map or bump), carry a colour attribute (the
+  // mesh has one, or some material reads one: black then) and carry object-space coordinates
+  // (some material reads them); other hits skip all three. Unset: none.
   void set_materials(std::span<const Material> materials);
 
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
@@ -197,7 +198,7 @@ class EmbreeScene {
     uint32_t corner_color_tris = 0;
     bool writes_color = false;     // hits fill SurfaceHit::color (set_materials)
     bool perturbs_normal = false;  // some material has a normal map or a bump (set_materials)
-    bool writes_coords = false;    // some material reads Generated / Object (set_materials)
+    bool writes_coords = false;    // some material reads Generated / Object / Position coordinates
     const Vec3f* object_positions = nullptr;  // the Mesh's own (object-space) positions
     // Generated coordinates = object position * generated_scale + generated_offset (lanes).
     alignas(16) float generated_scale[4] = {};

@@ -152,6 +152,12 @@ bool reads_vector(InputNodeKind kind) {
 // which come back here for nested nodes; the tree is acyclic and shallow, checked at load).
 template <class Inputs>
 Spectrum input_node_result(const InputNode& n, const Inputs& in) {
+  // Over a whole surface (AverageInputs: power estimates) the noise-like patterns average to
+  // mid grey.
+  if constexpr (Inputs::kAverage)
+    if (reads_vector(n.kind) && n.kind != InputNodeKind::Checker &&
+        n.kind != InputNodeKind::Coordinates)
+      return Spectrum(0.5f);
   Spectrum r;
   switch (n.kind) {
     case InputNodeKind::Mix: {
@@ -242,10 +248,6 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       r = in.vector(n.vector);
       break;
     case InputNodeKind::Voronoi: {
-      if (Inputs::kAverage) {
-        r = Spectrum(0.5f);
-        break;
-      }
       const float scale = in.scalar(n.value_a);
       const VoronoiResult v =
           voronoi_f1(in.vector(n.vector) * scale, saturate(in.scalar(n.value_b)), n.voronoi_metric,
@@ -257,48 +259,30 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       break;
     }
     case InputNodeKind::Wave:
-      r = Spectrum(Inputs::kAverage ? 0.5f
-                                    : wave_texture(in.vector(n.vector) * in.scalar(n.value_a),
-                                                   n.wave, in.scalar(n.value_b),
-                                                   in.scalar(n.value_c), in.scalar(n.value_d),
-                                                   in.scalar(n.value_e), in.scalar(n.value_f)));
+      r = Spectrum(wave_texture(in.vector(n.vector) * in.scalar(n.value_a), n.wave,
+                                in.scalar(n.value_b), in.scalar(n.value_c), in.scalar(n.value_d),
+                                in.scalar(n.value_e), in.scalar(n.value_f)));
       break;
     case InputNodeKind::Magic: {
-      if (Inputs::kAverage) {
-        r = Spectrum(0.5f);
-        break;
-      }
       const Spectrum c = magic_texture(in.vector(n.vector) * in.scalar(n.value_a), n.magic_depth,
                                        in.scalar(n.value_b));
       r = n.fac_output ? Spectrum((c.x + c.y + c.z) / 3.0f) : c;
       break;
     }
     case InputNodeKind::WhiteNoise: {
-      if (Inputs::kAverage) {
-        r = Spectrum(0.5f);
-        break;
-      }
       const Vec3f p = in.vector(n.vector);
       r = n.fac_output ? Spectrum(white_noise(p)) : white_noise_color(p);
       break;
     }
     case InputNodeKind::Musgrave:
-      r = Spectrum(Inputs::kAverage ? 0.5f
-                                    : musgrave_texture(in.vector(n.vector) * in.scalar(n.value_a),
-                                                       n.musgrave_type, in.scalar(n.value_b),
-                                                       in.scalar(n.value_c), in.scalar(n.value_d),
-                                                       in.scalar(n.value_e), in.scalar(n.value_f)));
+      r = Spectrum(musgrave_texture(
+          in.vector(n.vector) * in.scalar(n.value_a), n.musgrave_type, in.scalar(n.value_b),
+          in.scalar(n.value_c), in.scalar(n.value_d), in.scalar(n.value_e), in.scalar(n.value_f)));
       break;
     case InputNodeKind::Gradient:
-      r = Spectrum(Inputs::kAverage
-                       ? 0.5f
-                       : saturate(gradient_texture(in.vector(n.vector), n.gradient_type)));
+      r = Spectrum(saturate(gradient_texture(in.vector(n.vector), n.gradient_type)));
       break;
     case InputNodeKind::Noise: {
-      if (Inputs::kAverage) {
-        r = Spectrum(0.5f);
-        break;
-      }
       const float scale = in.scalar(n.value_a);
       const NoiseTextureResult t = noise_texture(
           n.noise_dimensions, in.vector(n.vector) * scale, in.scalar(n.value_d) * scale,

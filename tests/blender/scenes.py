@@ -83,6 +83,17 @@ def shader_material(name, node_type, **inputs):
     return m
 
 
+def feed(material, node_type, output, socket):
+    """A new `node_type` node of `material` whose `output` feeds input `socket` of the material's
+    shader (the node on its output's Surface); returns the new node."""
+    nt = material.node_tree
+    out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
+    shader = out.inputs["Surface"].links[0].from_node
+    node = nt.nodes.new(node_type)
+    nt.links.new(node.outputs[output], shader.inputs[socket])
+    return node
+
+
 def diffuse(name, color):
     return shader_material(name, "ShaderNodeBsdfDiffuse", Color=(*color, 1.0))
 

@@ -122,21 +122,13 @@ def test_normal_map_limits(out):
                                (1, 0, 0.01)], [(0, 1, 2, 3, 4)], tangent)
     obj_space = S.normal_mapped("object_space", "ShaderNodeBsdfDiffuse", img, 1.0)
     next(n for n in obj_space.node_tree.nodes if n.type == 'NORMAL_MAP').space = 'OBJECT'
-    m, nt, outn = S._material("geometry_normal")
-    geometry = nt.nodes.new("ShaderNodeNewGeometry")
-    geometry.name = "My Geometry"
-    bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
-    nt.links.new(geometry.outputs["Normal"], bsdf.inputs["Normal"])
-    nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
+    m = S.shader_material("geometry_normal", "ShaderNodeBsdfDiffuse")
+    S.feed(m, "ShaderNodeNewGeometry", "Normal", "Normal").name = "My Geometry"
     S.uv_sphere("ball", 0.5, (-0.8, 0.3, 0.5), obj_space)
     S.uv_sphere("ball2", 0.5, (0.8, 0.3, 0.5), m)
     # A Color Attribute node on a mesh without that attribute: reported, read as black.
-    painted, nt, outn = S._material("painted")
-    attr = nt.nodes.new("ShaderNodeVertexColor")
-    attr.layer_name = "Missing"
-    bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
-    nt.links.new(attr.outputs["Color"], bsdf.inputs["Color"])
-    nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
+    painted = S.shader_material("painted", "ShaderNodeBsdfDiffuse")
+    S.feed(painted, "ShaderNodeVertexColor", "Color", "Color").layer_name = "Missing"
     S.uv_sphere("unpainted", 0.4, (0, 1.0, 0.4), painted)
     path, warnings = render_finished(scene, os.path.join(out, "normal_map_limits.exr"))
     for needle, what in (("'no_uvs'", "the mesh without UVs"), ("'pentagon'", "the 5-sided face"),
