@@ -181,7 +181,9 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   v.frame = Frame(ns);
   v.wi = v.frame.to_local(wi_world);
   // With bump shadowing where the normal is not the interpolated one, as in PT.
-  v.closures = &shading_closures(*v.closures, v.own, hit, v.frame, rotated);
+  v.closures = &shading_closures(*v.closures, v.own, hit, v.frame, v.ng, wi_world, rotated);
+  // A lobe about its own normal reads more of wi than the side (same_side()).
+  if (v.closures->has_own_frames()) v.lambert = false;
   v.origin_set = false;
 }
 
@@ -541,8 +543,7 @@ class GradientPathTracer final : public Integrator {
   // hemispheres disagree (the path tracer's leak test).
   static bool local_dir(const Vertex& v, Vec3f dir, Vec3f& wo) {
     wo = v.frame.to_local(dir);
-    const float cos_ng = dot(dir, v.ng);
-    return cos_ng != 0.0f && (cos_ng > 0.0f) == (wo.z > 0.0f);
+    return v.closures->side_ok(wo, dot(dir, v.ng));
   }
 
   // Squared distance of two unit normals of the same surface point evaluated from two
@@ -907,7 +908,7 @@ class GradientPathTracer final : public Integrator {
       if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;
       const Vec3f wo_world = base.frame.to_world(bs.wo);
       const float cos_ng = dot(wo_world, base.ng);
-      if ((cos_ng > 0.0f) != (bs.wo.z > 0.0f) || cos_ng == 0.0f) break;
+      if (!bc.side_ok(bs.wo, cos_ng)) break;
       const bool delta = bs.is_delta();
       // Classification of x_d for the BSDF step: a sampled delta lobe makes it specular.
       const VertexType xd_type = delta ? VertexType::Specular : base_type;
@@ -1273,7 +1274,7 @@ class GradientPathTracer final : public Integrator {
     }
     const Vec3f dir = normalize(y.frame.to_world(wo));
     const float cos_ng = dot(dir, y.ng);
-    if ((cos_ng > 0.0f) != (wo.z > 0.0f) || cos_ng == 0.0f) {
+    if (!y.closures->side_ok(wo, cos_ng)) {
       o.shift = Shift::Failed;
       return;
     }

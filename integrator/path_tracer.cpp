@@ -234,7 +234,7 @@ class PathTracer final : public Integrator {
       const Vec3f wi = frame.to_local(wi_world);
       // With bump shadowing where the normal is not the interpolated one (bump_shadowing.h).
       const ClosureSet& closures =
-          shading_closures(material_closures, closure_scratch, hit, frame, rotated);
+          shading_closures(material_closures, closure_scratch, hit, frame, ng, wi_world, rotated);
 
       // --- Next-event estimation ---
       if (has_lights) {
@@ -247,7 +247,7 @@ class PathTracer final : public Integrator {
           const Vec3f wo = frame.to_local(ls.direction);
           const float cos_ng = dot(ls.direction, ng);
           // The geometric and shading hemispheres must agree, or light leaks through the surface.
-          if ((cos_ng > 0.0f) == (wo.z > 0.0f) && cos_ng != 0.0f) {
+          if (closures.side_ok(wo, cos_ng)) {
             float bsdf_pdf;
             const Spectrum f = closures.eval_pdf(wi, wo, bsdf_pdf);
             if (!is_black(f)) {
@@ -286,7 +286,7 @@ class PathTracer final : public Integrator {
       if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;
       const Vec3f wo_world = frame.to_world(bs.wo);
       const float cos_ng = dot(wo_world, ng);
-      if ((cos_ng > 0.0f) != (bs.wo.z > 0.0f) || cos_ng == 0.0f) break;
+      if (!closures.side_ok(bs.wo, cos_ng)) break;
       beta *= bs.value / bs.pdf;
       // A transparent crossing (straight through, eta 1) is not a bounce, keeps the camera-path
       // status and keeps the MIS state of the last real scattering vertex: shadow rays see

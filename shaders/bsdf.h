@@ -21,6 +21,7 @@ class ClosureSet {
     count_ = 0;
     emission_ = Spectrum(0.0f);
     shadowing_ = false;
+    own_frames_ = false;
   }
   // Becomes a copy of `other` (only its live lobes are copied: cheaper than assignment).
   void assign(const ClosureSet& other) {
@@ -29,6 +30,8 @@ class ClosureSet {
     emission_ = other.emission_;
     shadowing_ = other.shadowing_;
     unperturbed_ = other.unperturbed_;
+    own_frames_ = other.own_frames_;
+    ng_ = other.ng_;
   }
   // Cycles' bump shadowing (Conty Estevez et al. 2019, Cycles 3.4's bump_shadowing_term): at a
   // point whose shading normal a normal map or bump replaced, the diffuse lobes' values (not
@@ -38,6 +41,37 @@ class ClosureSet {
   void set_bump_shadowing(Vec3f unperturbed) {
     shadowing_ = true;
     unperturbed_ = unperturbed;
+  }
+  // Whether a lobe keeps the interpolated normal under a normal map or bump
+  // (Closure::interpolated_normal).
+  bool has_interpolated_normal_lobes() const {
+    for (int i = 0; i < count_; ++i)
+      if (closures_[i].interpolated_normal) return true;
+    return false;
+  }
+  // Gives those lobes their own frame about `n` (unit, local: the shading frame's +z is the
+  // perturbed normal); `ng`: the geometric normal facing wi, local. From then on each lobe
+  // decides reflection against transmission about its own normal and contributes only where
+  // that agrees with the side of the geometric surface wo is on (Cycles decides per closure),
+  // and side_ok() leaves the decision to the lobes.
+  void set_interpolated_normal(Vec3f n, Vec3f ng) {
+    for (int i = 0; i < count_; ++i)
+      if (closures_[i].interpolated_normal) {
+        closures_[i].own_frame = true;
+        closures_[i].normal = n;
+      }
+    own_frames_ = true;
+    ng_ = ng;
+  }
+  bool has_own_frames() const { return own_frames_; }
+  // Whether wo (local; cos_ng: its cosine with the geometric normal facing wi) may carry light:
+  // reflection and transmission must agree between the shading frame and the geometric
+  // surface, or light leaks through it. Integrators test this before eval() and after sample().
+  bool side_ok(Vec3f wo, float cos_ng) const {
+    if (cos_ng == 0.0f) return false;
+    if (own_frames_) [[unlikely]]
+      return true;  // per lobe, inside eval / pdf / sample
+    return (cos_ng > 0.0f) == (wo.z > 0.0f);
   }
   // Adds a lobe; weights that are zero are dropped; a full set drops the lobe of least weight.
   void add(const Closure& c);
@@ -88,8 +122,10 @@ class ClosureSet {
  private:
   // The inline fast path (bump shadowing goes through the mixture code).
   bool single_lambert() const {
-    return count_ == 1 && closures_[0].type == ClosureType::Lambert && !shadowing_;
+    return count_ == 1 && closures_[0].type == ClosureType::Lambert && !shadowing_ && !own_frames_;
   }
+  // With own frames: whether lobe c may carry light towards wo (see set_interpolated_normal).
+  bool lobe_side_ok(const Closure& c, Vec3f wi, Vec3f wo) const;
   // Any set (the same values as the fast path for a single Lambert lobe).
   Spectrum eval_mixture(Vec3f wi, Vec3f wo) const;
   float pdf_mixture(Vec3f wi, Vec3f wo) const;
@@ -101,6 +137,8 @@ class ClosureSet {
   Spectrum emission_{0.0f, 0.0f, 0.0f};
   bool shadowing_ = false;
   Vec3f unperturbed_{0.0f, 0.0f, 1.0f};
+  bool own_frames_ = false;
+  Vec3f ng_{0.0f, 0.0f, 1.0f};
 };
 
 }  // namespace gdpt

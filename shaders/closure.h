@@ -27,6 +27,7 @@ enum class ClosureType : uint8_t {
   PrincipledSheen,    // Cycles' Principled v1 sheen (grazing retro-reflection)
   GGXReflection,  // GGX with Fresnel mode below (Glossy: none; Principled specular: Schlick mix)
   GGXDielectric,  // GGX glass: reflection + refraction by dielectric Fresnel; alpha 0 = smooth
+  Clearcoat,      // Cycles' Principled v1 clearcoat: GTR1, fixed masking, Fresnel of IOR 1.5
   Transparent,    // straight through, delta
 };
 
@@ -49,7 +50,14 @@ struct Closure {
   // GGXDielectric: extra factor on the refracted part only (Principled transmission: base colour;
   // the reflected part is weight * Fresnel colour). Glass BSDF: 1 (its colour is in weight).
   Spectrum transmission_tint{1.0f, 1.0f, 1.0f};
-  Vec3f normal{0.0f, 0.0f, 1.0f};  // local-frame normal of the lobe (reserved; +z today)
+  // The lobe keeps the interpolated normal where the material's normal map or bump tilts the
+  // others (a BSDF whose Normal input is unlinked, Principled clearcoat with its Clearcoat Normal
+  // unlinked: Cycles gives those sd->N). Material data; the integrators act on it per hit.
+  bool interpolated_normal = false;
+  // Per hit (shading_closures): the lobe is evaluated about its own unit `normal`, given in the
+  // shading frame, instead of about +z.
+  bool own_frame = false;
+  Vec3f normal{0.0f, 0.0f, 1.0f};
 };
 
 enum LobeFlags : uint8_t {

@@ -6,7 +6,9 @@
 // eval() / pdf() (delta lobes excepted: they return their own value and s_k * probability).
 #include <algorithm>
 
+#include "integrator/math/frame.h"
 #include "shaders/bsdf.h"
+#include "shaders/bsdf_clearcoat.h"
 #include "shaders/bsdf_ggx_dielectric.h"
 #include "shaders/bsdf_ggx_reflection.h"
 #include "shaders/bsdf_lambert.h"
@@ -34,20 +36,61 @@ namespace {
       return ggx_reflection::call;       \
     case ClosureType::GGXDielectric:     \
       return ggx_dielectric::call;       \
+    case ClosureType::Clearcoat:         \
+      return clearcoat::call;            \
     case ClosureType::Transparent:       \
       return transparent::call;          \
   }                                      \
   return {};
 
-Spectrum lobe_eval(const Closure& c, Vec3f wi, Vec3f wo) {
+// A lobe with its own normal (Closure::own_frame) sees wi and wo in the frame of that normal.
+Spectrum lobe_eval_local(const Closure& c, Vec3f wi, Vec3f wo) {
   GDPT_DISPATCH(c, eval(c, wi, wo))
 }
-float lobe_pdf(const Closure& c, Vec3f wi, Vec3f wo){GDPT_DISPATCH(c, pdf(c, wi, wo))} BsdfSample
-    lobe_sample(const Closure& c, Vec3f wi, float u_choice, Vec2f u) {
+float lobe_pdf_local(const Closure& c, Vec3f wi,
+                     Vec3f wo){GDPT_DISPATCH(c, pdf(c, wi, wo))} BsdfSample
+    lobe_sample_local(const Closure& c, Vec3f wi, float u_choice, Vec2f u) {
   GDPT_DISPATCH(c, sample(c, wi, u_choice, u))
 }
+float lobe_albedo_hint_local(const Closure& c, Vec3f wi){GDPT_DISPATCH(c, albedo_hint(c, wi))}
+
+Spectrum lobe_eval(const Closure& c, Vec3f wi, Vec3f wo) {
+  if (c.own_frame) [[unlikely]] {
+    const Frame f(c.normal);
+    return lobe_eval_local(c, f.to_local(wi), f.to_local(wo));
+  }
+  return lobe_eval_local(c, wi, wo);
+}
+float lobe_pdf(const Closure& c, Vec3f wi, Vec3f wo) {
+  if (c.own_frame) [[unlikely]] {
+    const Frame f(c.normal);
+    return lobe_pdf_local(c, f.to_local(wi), f.to_local(wo));
+  }
+  return lobe_pdf_local(c, wi, wo);
+}
+BsdfSample lobe_sample(const Closure& c, Vec3f wi, float u_choice, Vec2f u) {
+  if (c.own_frame) [[unlikely]] {
+    const Frame f(c.normal);
+    const Vec3f wi_local = f.to_local(wi);
+    BsdfSample s = lobe_sample_local(c, wi_local, u_choice, u);
+    if (!s.valid) return s;
+    s.wo = f.to_world(s.wo);
+    // Value and density of the direction as returned, rounded through the frame, so that they
+    // equal eval() and pdf() there (near the lobe's horizon G1 magnifies the rounding).
+    if (!s.is_delta()) {
+      const Vec3f wo_local = f.to_local(s.wo);
+      s.value = lobe_eval_local(c, wi_local, wo_local);
+      s.pdf = lobe_pdf_local(c, wi_local, wo_local);
+      s.valid = s.pdf > 0.0f;
+    }
+    return s;
+  }
+  return lobe_sample_local(c, wi, u_choice, u);
+}
 float lobe_albedo_hint(const Closure& c, Vec3f wi) {
-  GDPT_DISPATCH(c, albedo_hint(c, wi))
+  if (c.own_frame) [[unlikely]]
+    return lobe_albedo_hint_local(c, Frame(c.normal).to_local(wi));
+  return lobe_albedo_hint_local(c, wi);
 }
 #undef GDPT_DISPATCH
 
@@ -56,6 +99,7 @@ bool lobe_is_delta(const Closure& c) {
     case ClosureType::Transparent:
       return true;
     case ClosureType::GGXReflection:
+    case ClosureType::Clearcoat:
       return is_delta_alpha(c.alpha);
     case ClosureType::GGXDielectric:
       // An index-matched rough interface still has a (zero-weight) glossy reflection; its
@@ -111,31 +155,51 @@ float ClosureSet::diffuse_shadowing(Vec3f wo) const {
 }
 
 // A lobe's value with the bump shadowing of diffuse lobes applied (`shadowing` = its factor).
+// Lobes about their own (interpolated) normal are not shadowed: Cycles shadows the closures whose
+// normal is not the interpolated one.
 inline Spectrum shadowed(const Closure& c, Spectrum value, float shadowing) {
-  return shadowing != 1.0f && lobe_is_diffuse(c) ? value * shadowing : value;
+  return shadowing != 1.0f && lobe_is_diffuse(c) && !c.own_frame ? value * shadowing : value;
+}
+
+bool ClosureSet::lobe_side_ok(const Closure& c, Vec3f wi, Vec3f wo) const {
+  const float cos_ng = dot(ng_, wo);
+  if (cos_ng == 0.0f) return false;
+  const bool reflection = c.own_frame ? dot(c.normal, wi) * dot(c.normal, wo) > 0.0f : wo.z > 0.0f;
+  return (cos_ng > 0.0f) == reflection;
 }
 
 Spectrum ClosureSet::eval_mixture(Vec3f wi, Vec3f wo) const {
   const float sh = diffuse_shadowing(wo);
   Spectrum f(0.0f);
-  for (int i = 0; i < count_; ++i) f += shadowed(closures_[i], lobe_eval(closures_[i], wi, wo), sh);
+  for (int i = 0; i < count_; ++i) {
+    if (own_frames_ && !lobe_side_ok(closures_[i], wi, wo)) continue;
+    f += shadowed(closures_[i], lobe_eval(closures_[i], wi, wo), sh);
+  }
   return f;
 }
 
 float ClosureSet::pdf_mixture(Vec3f wi, Vec3f wo) const {
-  if (count_ == 1) return lobe_pdf(closures_[0], wi, wo);
+  if (count_ == 1)
+    return own_frames_ && !lobe_side_ok(closures_[0], wi, wo) ? 0.0f
+                                                              : lobe_pdf(closures_[0], wi, wo);
   float w[kMaxClosures];
   const float total = selection_weights(closures_, count_, wi, w);
   if (!(total > 0.0f)) return 0.0f;
   float p = 0.0f;
-  for (int i = 0; i < count_; ++i)
+  for (int i = 0; i < count_; ++i) {
+    if (own_frames_ && !lobe_side_ok(closures_[i], wi, wo)) continue;
     if (w[i] > 0.0f) p += w[i] * lobe_pdf(closures_[i], wi, wo);
+  }
   return p / total;
 }
 
 Spectrum ClosureSet::eval_pdf_mixture(Vec3f wi, Vec3f wo, float& pdf_out) const {
   const float sh = diffuse_shadowing(wo);
   if (count_ == 1) {
+    if (own_frames_ && !lobe_side_ok(closures_[0], wi, wo)) {
+      pdf_out = 0.0f;
+      return Spectrum(0.0f);
+    }
     pdf_out = lobe_pdf(closures_[0], wi, wo);
     return shadowed(closures_[0], lobe_eval(closures_[0], wi, wo), sh);
   }
@@ -145,6 +209,7 @@ Spectrum ClosureSet::eval_pdf_mixture(Vec3f wi, Vec3f wo, float& pdf_out) const 
   Spectrum f(0.0f);
   float p = 0.0f;
   for (int i = 0; i < count_; ++i) {
+    if (own_frames_ && !lobe_side_ok(closures_[i], wi, wo)) continue;
     f += shadowed(closures_[i], lobe_eval(closures_[i], wi, wo), sh);
     if (w[i] > 0.0f) p += w[i] * lobe_pdf(closures_[i], wi, wo);
   }
@@ -156,6 +221,7 @@ BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
   if (count_ == 0) return {};
   if (count_ == 1) {
     BsdfSample s = lobe_sample(closures_[0], wi, u_lobe, u);
+    if (s.valid && own_frames_ && !lobe_side_ok(closures_[0], wi, s.wo)) return {};
     if (s.valid && shadowing_) s.value = shadowed(closures_[0], s.value, diffuse_shadowing(s.wo));
     return s;
   }
@@ -175,6 +241,7 @@ BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
   const float u_choice = std::clamp((target - cdf) / w[k], 0.0f, 0.99999994f);
   BsdfSample s = lobe_sample(closures_[k], wi, u_choice, u);
   if (!s.valid) return s;
+  if (own_frames_ && !lobe_side_ok(closures_[k], wi, s.wo)) return {};
 
   const float sel_k = w[k] / total;
   if (s.is_delta()) {
@@ -187,7 +254,7 @@ BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
   Spectrum value = shadowed(closures_[k], s.value, sh);
   float pdf = w[k] * s.pdf;
   for (int i = 0; i < count_; ++i) {
-    if (i == k) continue;
+    if (i == k || (own_frames_ && !lobe_side_ok(closures_[i], wi, s.wo))) continue;
     value += shadowed(closures_[i], lobe_eval(closures_[i], wi, s.wo), sh);
     if (w[i] > 0.0f) pdf += w[i] * lobe_pdf(closures_[i], wi, s.wo);
   }

@@ -379,6 +379,7 @@ struct AverageInputs {
 template <class Inputs>
 void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
   Closure c;
+  c.interpolated_normal = !n.normal_linked;
   switch (n.kind) {
     case ShaderNodeKind::Diffuse: {
       const float r = saturate(in.scalar(n.roughness));
@@ -431,9 +432,13 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       p.transmission = in.scalar(n.transmission);
       p.sheen = in.scalar(n.sheen);
       p.sheen_tint = in.scalar(n.sheen_tint);
+      p.clearcoat = in.scalar(n.clearcoat);
+      p.clearcoat_roughness = in.scalar(n.clearcoat_roughness);
       p.alpha = in.scalar(n.alpha);
       p.emission = in.color(n.emission) * in.scalar(n.emission_strength);
       p.front_facing = in.front_facing();
+      p.interpolated_normal = !n.normal_linked;
+      p.clearcoat_interpolated_normal = !n.clearcoat_normal_linked;
       add_principled_closures(p, w, out);
       return;
     }
@@ -638,6 +643,8 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         note(n.transmission);
         note(n.sheen);
         note(n.sheen_tint);
+        note(n.clearcoat);
+        note(n.clearcoat_roughness);
         note(n.alpha);
         note(n.emission);
         note(n.emission_strength);
@@ -645,10 +652,10 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
                               n.metallic.value > 0.0f;
         const bool transmission = (varies(n.transmission) || n.transmission.value > 0.0f) &&
                                   (varies(n.metallic) || n.metallic.value < 1.0f);
-        if (specular || transmission) {
-          features_ |= kFeatureGlossy;
-          if (may_be_delta(n.roughness)) features_ |= kFeatureDelta;
-        }
+        const bool clearcoat = varies(n.clearcoat) || n.clearcoat.value > 0.0f;
+        if (specular || transmission || clearcoat) features_ |= kFeatureGlossy;
+        if ((specular || transmission) && may_be_delta(n.roughness)) features_ |= kFeatureDelta;
+        if (clearcoat && may_be_delta(n.clearcoat_roughness)) features_ |= kFeatureDelta;
         if (transmission) features_ |= kFeatureTransmission;
         if (varies(n.alpha) || n.alpha.value < 1.0f)
           features_ |= kFeatureTransparent | kFeatureDelta;

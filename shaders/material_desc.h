@@ -154,6 +154,10 @@ struct ShaderNode {
   FloatInput strength{1.0f};  // Emission
   FloatInput fac{0.5f};       // Mix
   int32_t a = -1, b = -1;     // Mix / Add children (indices into Material::nodes)
+  // Whether the BSDF's Normal input (Principled: also its Clearcoat Normal) takes the material's
+  // normal map or bump; false: the interpolated normal, which Cycles gives an unlinked input.
+  bool normal_linked = true;
+  bool clearcoat_normal_linked = true;
 
   // Principled BSDF v1 inputs beyond colour / roughness / ior (subsurface is ignored with a
   // warning).
@@ -163,6 +167,10 @@ struct ShaderNode {
   FloatInput transmission{0.0f};
   FloatInput sheen{0.0f};
   FloatInput sheen_tint{0.5f};
+  // Clearcoat (Cycles 3.4, shaders/bsdf_clearcoat.h): weight 0.25 clearcoat, on top of the
+  // other lobes.
+  FloatInput clearcoat{0.0f};
+  FloatInput clearcoat_roughness{0.03f};
   FloatInput alpha{1.0f};
   ColorInput emission{Spectrum(0.0f)};
   FloatInput emission_strength{1.0f};

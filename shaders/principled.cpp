@@ -40,6 +40,7 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
     d.type = ClosureType::PrincipledDiffuse;
     d.weight = base * (w * diffuse_weight);
     d.alpha = roughness;
+    d.interpolated_normal = p.interpolated_normal;
     out.add(d);
   }
 
@@ -52,6 +53,7 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
     Closure s;
     s.type = ClosureType::PrincipledSheen;
     s.weight = (Spectrum(1.0f - p.sheen_tint) + hue * p.sheen_tint) * (w * sheen * diffuse_weight);
+    s.interpolated_normal = p.interpolated_normal;
     out.add(s);
   }
 
@@ -70,6 +72,7 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
     const Spectrum hue = lum > 0.0f ? base / lum : Spectrum(1.0f);
     const Spectrum tint = Spectrum(1.0f - specular_tint) + hue * specular_tint;
     s.f0 = saturate(tint * (specular * 0.08f * (1.0f - metallic)) + base * metallic);
+    s.interpolated_normal = p.interpolated_normal;
     out.add(s);
   }
 
@@ -84,7 +87,18 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
     g.ior = p.front_facing ? ior : 1.0f / ior;
     g.f0 = saturate(base * specular_tint + Spectrum(1.0f - specular_tint));
     g.transmission_tint = base;
+    g.interpolated_normal = p.interpolated_normal;
     out.add(g);
+  }
+
+  // --- Clearcoat (bsdf_clearcoat.h).
+  if (p.clearcoat > kWeightCutoff) {
+    Closure c;
+    c.type = ClosureType::Clearcoat;
+    c.weight = Spectrum(w * 0.25f * p.clearcoat);
+    c.alpha = saturate(p.clearcoat_roughness * p.clearcoat_roughness);
+    c.interpolated_normal = p.clearcoat_interpolated_normal;
+    out.add(c);
   }
 }
 

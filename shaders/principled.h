@@ -11,9 +11,11 @@
 //                tinted by base
 //   sheen        PrincipledSheen, weight sheen mix(1, base / lum(base), sheen_tint)
 //                (1 - metallic)(1 - transmission), lum the scene-linear Rec.709 luminance
+//   clearcoat    Clearcoat (GTR1 of alpha clearcoat_roughness^2, the Fresnel of IOR 1.5),
+//                weight 0.25 clearcoat; added on top, nothing below is attenuated
 //   emission     emission * emission_strength
 //   alpha        everything above times alpha, plus Transparent (white) times 1 - alpha
-// Subsurface, clearcoat, anisotropy and the multiscatter GGX variant are not modelled.
+// Subsurface, anisotropy and the multiscatter GGX variant are not modelled.
 // All weights are multiplied by `mix_weight` (the Mix/Add tree weight).
 #pragma once
 
@@ -31,9 +33,14 @@ struct PrincipledParams {
   float transmission = 0.0f;
   float sheen = 0.0f;
   float sheen_tint = 0.5f;
+  float clearcoat = 0.0f;
+  float clearcoat_roughness = 0.03f;
   float alpha = 1.0f;
   Spectrum emission{0.0f};   // colour * strength
   bool front_facing = true;  // false: the transmission closure gets 1 / ior (leaving the object)
+  // Closure::interpolated_normal of the base lobes and of the clearcoat.
+  bool interpolated_normal = false;
+  bool clearcoat_interpolated_normal = false;
 };
 
 void add_principled_closures(const PrincipledParams& p, float mix_weight, ClosureSet& out);

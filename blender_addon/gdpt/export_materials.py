@@ -12,6 +12,9 @@
 from mathutils import Euler, Matrix
 
 MAGENTA = (1.0, 0.0, 1.0)
+# A second Normal Map / Bump node in one material: its input keeps the interpolated normal.
+_SECOND_PERTURBATION = "second normal perturbation (only the first is modelled; this input gets " \
+    "the interpolated normal) in"
 IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 
 _SHADERS = {
@@ -115,13 +118,11 @@ class _Translator:
             self.warn(n, f"distribution {n.distribution} of")
         if i["Subsurface"].is_linked or i["Subsurface"].default_value > 0.0:
             self.warn(n, "subsurface scattering of")
-        if i["Clearcoat"].is_linked or i["Clearcoat"].default_value > 0.0:
-            self.warn(n, "clearcoat of")
-        self.normal(i["Normal"])
-        for name in ("Clearcoat Normal", "Tangent"):
-            if i[name].is_linked:
-                self.warn(self._source(i[name]).node if self._source(i[name]) else n,
-                          "normal / tangent input node")
+        normal_linked = self.normal(i["Normal"])
+        clearcoat_normal_linked = self.normal(i["Clearcoat Normal"])
+        if i["Tangent"].is_linked:
+            self.warn(self._source(i["Tangent"]).node if self._source(i["Tangent"]) else n,
+                      "normal / tangent input node")
         return self._add({
             "kind": "PRINCIPLED",
             "color": self.color(i["Base Color"]),
@@ -133,35 +134,41 @@ class _Translator:
             "transmission": self.value(i["Transmission"]),
             "sheen": self.value(i["Sheen"]),
             "sheen_tint": self.value(i["Sheen Tint"]),
+            "clearcoat": self.value(i["Clearcoat"]),
+            "clearcoat_roughness": self.value(i["Clearcoat Roughness"]),
+            "normal_linked": normal_linked,
+            "clearcoat_normal_linked": clearcoat_normal_linked,
             "emission": self.color(i["Emission"]),
             "emission_strength": self.value(i["Emission Strength"]),
             "alpha": self.value(i["Alpha"]),
         })
 
     def _bsdf_diffuse(self, n):
-        self.normal(n.inputs["Normal"])
+        linked = self.normal(n.inputs["Normal"])
         return self._add({"kind": "DIFFUSE", "color": self.color(n.inputs["Color"]),
-                          "roughness": self.value(n.inputs["Roughness"])})
+                          "roughness": self.value(n.inputs["Roughness"]),
+                          "normal_linked": linked})
 
     def _bsdf_glossy(self, n):
         if n.distribution not in _GGX_LIKE:
             self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
-        self.normal(n.inputs["Normal"])
+        linked = self.normal(n.inputs["Normal"])
         roughness = self.value(n.inputs["Roughness"])
         if n.distribution == 'SHARP':
             roughness = {"value": 0.0}
         return self._add({"kind": "GLOSSY", "color": self.color(n.inputs["Color"]),
-                          "roughness": roughness})
+                          "roughness": roughness, "normal_linked": linked})
 
     def _bsdf_glass(self, n):
         if n.distribution not in _GGX_LIKE:
             self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
-        self.normal(n.inputs["Normal"])
+        linked = self.normal(n.inputs["Normal"])
         roughness = self.value(n.inputs["Roughness"])
         if n.distribution == 'SHARP':
             roughness = {"value": 0.0}
         return self._add({"kind": "GLASS", "color": self.color(n.inputs["Color"]),
-                          "roughness": roughness, "ior": self.value(n.inputs["IOR"])})
+                          "roughness": roughness, "ior": self.value(n.inputs["IOR"]),
+                          "normal_linked": linked})
 
     def _emission(self, n):
         return self._add({"kind": "EMISSION", "color": self.color(n.inputs["Color"]),
@@ -184,39 +191,45 @@ class _Translator:
     # --- inputs ------------------------------------------------------------------------------
 
     def normal(self, socket):
-        """A BSDF's Normal input: a tangent-space Normal Map node becomes the material's normal
-        map (one per material: the first found; another one is reported and ignored)."""
+        """A BSDF's Normal (or Clearcoat Normal) input: a tangent-space Normal Map node or a Bump
+        node becomes the material's normal perturbation (one per material: the first found;
+        another one is reported and its input gets the interpolated normal). Returns whether
+        the input takes the material's perturbation (an unlinked input keeps the interpolated
+        normal, as in Cycles)."""
         out = self._source(socket)
         if out is None:
-            return
+            return False
         node = out.node
         if node.type == 'BUMP':
-            self._bump(node)
-            return
+            return self._bump(node)
         if node.type != 'NORMAL_MAP':
             self.warn(node, "normal / tangent input node")
-            return
+            return False
         if node.space != 'TANGENT':
             self.warn(node, f"{node.space.lower()}-space normal map")
-            return
+            return False
         if self.normal_map is not None or self.bump is not None:
             if self.normal_map is None or self.normal_map[0] != node:
-                self.warn(node, "second normal perturbation (the first one is used) in")
-            return
+                self.warn(node, _SECOND_PERTURBATION)
+                return False
+            return True
         if node.uv_map:
             self.warn(node, "UV map other than the active render UV map in")
         if node.inputs["Strength"].is_linked:
             self.warn(node, "linked Strength (its default value is used) of")
         self.normal_map = (node, {"color": self.color(node.inputs["Color"]),
                                   "strength": float(node.inputs["Strength"].default_value)})
+        return True
 
     def _bump(self, node):
         """A Bump node on a BSDF's Normal input: the material's bump (one per material, not
-        with a normal map; its own Normal input is not followed)."""
+        with a normal map; its own Normal input is not followed). Returns whether it is the
+        material's perturbation."""
         if self.normal_map is not None or self.bump is not None:
             if self.bump is None or self.bump[0] != node:
-                self.warn(node, "second normal perturbation (the first one is used) in")
-            return
+                self.warn(node, _SECOND_PERTURBATION)
+                return False
+            return True
         for name in ("Strength", "Distance"):
             if node.inputs[name].is_linked:
                 self.warn(node, f"linked {name} (its default value is used) of")
@@ -226,6 +239,7 @@ class _Translator:
                             "strength": float(node.inputs["Strength"].default_value),
                             "distance": float(node.inputs["Distance"].default_value),
                             "invert": bool(node.invert)})
+        return True
 
     def color(self, socket):
         d = {"value": self._default_rgb(socket)}

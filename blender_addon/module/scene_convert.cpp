@@ -680,6 +680,10 @@ int SceneBuilder::add_material(const py::dict& material) {
       read_float(d, "transmission", node.transmission);
       read_float(d, "sheen", node.sheen);
       read_float(d, "sheen_tint", node.sheen_tint);
+      read_float(d, "clearcoat", node.clearcoat);
+      read_float(d, "clearcoat_roughness", node.clearcoat_roughness);
+      get(d, "normal_linked", node.normal_linked);
+      get(d, "clearcoat_normal_linked", node.clearcoat_normal_linked);
       read_float(d, "alpha", node.alpha);
       read_color(d, "emission", node.emission);
       read_float(d, "emission_strength", node.emission_strength);
@@ -715,8 +719,8 @@ int SceneBuilder::add_material(const py::dict& material) {
          {&node.color.texture, &node.roughness.texture, &node.ior.texture, &node.strength.texture,
           &node.fac.texture, &node.metallic.texture, &node.specular.texture,
           &node.specular_tint.texture, &node.transmission.texture, &node.sheen.texture,
-          &node.sheen_tint.texture, &node.alpha.texture, &node.emission.texture,
-          &node.emission_strength.texture}) {
+          &node.sheen_tint.texture, &node.clearcoat.texture, &node.clearcoat_roughness.texture,
+          &node.alpha.texture, &node.emission.texture, &node.emission_strength.texture}) {
       if (t->image >= int32_t(scene_.images.size()))
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
     }

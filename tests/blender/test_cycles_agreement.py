@@ -670,6 +670,26 @@ def case_normal_map(scene):
     return 3
 
 
+def case_clearcoat(scene):
+    # Principled clearcoat, seen where it dominates: a near-black lacquered floor at a low angle
+    # reflecting a blue sky and a low sun. The floor's base is normal-mapped while its coat,
+    # Clearcoat Normal unlinked, stays smooth (one clean sun highlight over a bumpy base); a
+    # coated ball on a half-metallic base stands on it.
+    img = S.normal_map_image("bumps")
+    floor = S.normal_mapped("lacquer", "ShaderNodeBsdfPrincipled", img, 1.0, **{
+        "Base Color": (0.04, 0.01, 0.01, 1.0), "Roughness": 0.5, "Clearcoat": 1.0,
+        "Clearcoat Roughness": 0.15, "distribution": 'GGX'})
+    S.plane("floor", 40.0, (0, 0, 0), material=floor)
+    ball = S.shader_material("coated", "ShaderNodeBsdfPrincipled", **{
+        "Base Color": (0.1, 0.3, 0.6, 1.0), "Metallic": 0.5, "Roughness": 0.45,
+        "Clearcoat": 0.8, "Clearcoat Roughness": 0.25, "distribution": 'GGX'})
+    S.uv_sphere("ball", 0.6, (0.8, 2.0, 0.6), ball)
+    S.camera((0, -5.0, 0.8), (0, 3.0, 0.0), lens=35)
+    S.light('SUN', (0, 20.0, 5.0), 3.0, target=(0, 0, 0))
+    scene.world.color = (0.3, 0.45, 0.8)
+    return 3
+
+
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
 
 # Cases whose noise floor at the default counts lies near the threshold render more samples on
@@ -698,7 +718,7 @@ KIND_LIMITS = {"bounce_limits": (1, 2, 3)}
 
 # Cases whose GDPT side is also rendered in PT mode (Combined = Primal + Emission): what the
 # camera sees directly must not depend on the integrator.
-BOTH_MODES = {"normal_map", "area_visible", "area_camera_visible", "ray_visibility", "holdout",
+BOTH_MODES = {"normal_map", "clearcoat", "area_visible", "area_camera_visible", "ray_visibility", "holdout",
               "bounce_limits", "no_shadow", "transparent_shadow"}
 
 

@@ -380,6 +380,79 @@ TEST(Render, BumpOnABackFaceKeepsTheSurfacesTilt) {
   }
 }
 
+// Lobes whose normal input is not linked to the material's bump keep the interpolated normal
+// (Cycles gives an unlinked input sd->N), seen from straight above under a sun from
+// (0, -sin t, cos t):
+//  - a Diffuse with its Normal unlinked is lit with cos t, without bump shadowing;
+//  - a Principled clearcoat alone (black base, no specular) reflects
+//    L = E 0.25 F(wo.h, 1.5) D(h.n) G1(wi) G1(wo) / (4 wi.n) about n = +z when its Clearcoat
+//    Normal is unlinked and about the bumped normal when it is linked (Cycles 3.4's coat: D the
+//    GTR1 of alpha, G1 the GGX masking of alpha 0.25).
+// Two set-ups: the ramp of the tests above along u (normal tilted to normalize(-0.2, 0, 1)) with
+// t = 0.5, and the ramp along v (normalize(0, -0.2, 1)) with a sun 6 degrees above the horizon
+// on the other side (t = -1.45), below the bumped normal's horizon: the unlinked lobes must still
+// see it (each lobe decides reflection about its own normal), the linked coat must not. PT, G-PT.
+TEST(Render, UnlinkedNormalInputsKeepTheInterpolatedNormal) {
+  constexpr double kE = 3.0, kAlpha = 0.09;  // clearcoat roughness 0.3
+  struct Setup {
+    float theta;
+    bool along_u;
+    Vec3f bumped;
+  };
+  for (const Setup& setup : {Setup{0.5f, true, normalize(Vec3f(-0.2f, 0.0f, 1.0f))},
+                             Setup{-1.45f, false, normalize(Vec3f(0.0f, -0.2f, 1.0f))}}) {
+    const Vec3f sun(0.0f, -std::sin(setup.theta), std::cos(setup.theta)), view(0, 0, 1);
+    auto coat = [&](Vec3f n) {
+      if (dot(sun, n) <= 0.0f) return 0.0;
+      auto g1 = [&](Vec3f w) {
+        const double c = dot(w, n), t2 = (1.0 - c * c) / (c * c);
+        return 2.0 / (1.0 + std::sqrt(1.0 + 0.0625 * t2));
+      };
+      const Vec3f h = normalize(sun + view);
+      const double ch = dot(h, n), a2 = kAlpha * kAlpha;
+      const double d = (a2 - 1.0) / (kPi * std::log(a2) * (1.0 + (a2 - 1.0) * ch * ch));
+      const double ci = dot(sun, h), st2 = (1.0 - ci * ci) / 2.25, ct = std::sqrt(1.0 - st2);
+      const double rs = (ci - 1.5 * ct) / (ci + 1.5 * ct), rp = (1.5 * ci - ct) / (1.5 * ci + ct);
+      const double f = 0.5 * (rs * rs + rp * rp);
+      return kE * 0.25 * f * d * g1(view) * g1(sun) / (4.0 * double(dot(view, n)));
+    };
+    struct Case {
+      const char* name;
+      MaterialDesc material;
+      double expect;
+    };
+    MaterialDesc unlinked_diffuse = ramp_bumped();
+    unlinked_diffuse.nodes[0].normal_linked = false;
+    auto coated = [&](bool linked) {
+      MaterialDesc m = ramp_bumped();
+      ShaderNode& n = m.nodes[0];
+      n.kind = ShaderNodeKind::Principled;
+      n.color = ColorInput(Spectrum(0.0f));
+      n.specular = FloatInput(0.0f);
+      n.clearcoat = FloatInput(1.0f);
+      n.clearcoat_roughness = FloatInput(0.3f);
+      n.clearcoat_normal_linked = linked;
+      return m;
+    };
+    const Case cases[] = {
+        {"diffuse, Normal unlinked", unlinked_diffuse, lambert_radiance(std::cos(setup.theta))},
+        {"clearcoat, Clearcoat Normal unlinked", coated(false), coat(view)},
+        {"clearcoat, Clearcoat Normal linked", coated(true), coat(setup.bumped)},
+    };
+    EXPECT_GT(std::fabs(coat(view) - coat(setup.bumped)), 0.2 * coat(view));  // they differ
+    for (const Case& c : cases)
+      for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+        Scene scene = sunlit_plane(uv_quad(), c.material, setup.theta);
+        scene.images.push_back(setup.along_u ? ramp_image(2, 1) : ramp_image(1, 2));
+        RenderSettings s = pt(4);
+        s.mode = mode;
+        EXPECT_NEAR(mean_direct(scene, s), c.expect, 2e-3 * c.expect + 1e-6)
+            << c.name << " theta " << setup.theta << " G-PT "
+            << (mode == RenderSettings::Mode::GPT);
+      }
+  }
+}
+
 // An emitter whose colour is its texture coordinate (a Texture Coordinate output used as a
 // colour): Object is the object-space position (through a Mapping that adds 1, so it stays
 // positive), Generated the position mapped from the mesh's bounding box (+-1 in x and y, flat

@@ -50,6 +50,13 @@ inline Closure ggx_principled(float alpha, float ior, Spectrum cspec0) {
   k.f0 = cspec0;
   return k;
 }
+inline Closure clearcoat(float alpha, Spectrum c = Spectrum(1.0f)) {
+  Closure k;
+  k.type = ClosureType::Clearcoat;
+  k.weight = c;
+  k.alpha = alpha;
+  return k;
+}
 inline Closure glass(float alpha, float ior, Spectrum c = Spectrum(1.0f)) {
   Closure k;
   k.type = ClosureType::GGXDielectric;
@@ -64,6 +71,15 @@ inline Closure transparent(Spectrum c = Spectrum(1.0f)) {
   k.type = ClosureType::Transparent;
   k.weight = c;
   return k;
+}
+
+// `c` about its own unit normal `n` (shading-frame coordinates), as shading_closures sets a lobe
+// that keeps the interpolated normal under a bump.
+inline Closure about(Closure c, Vec3f n) {
+  c.interpolated_normal = true;
+  c.own_frame = true;
+  c.normal = normalize(n);
+  return c;
 }
 
 inline ClosureSet set_of(std::initializer_list<Closure> cs) {

@@ -30,6 +30,7 @@ std::vector<Case> lobe_cases() {
     cases.push_back(
         {"GGXPrincipled" + s, set_of({ggx_principled(a, 1.5f, Spectrum(0.9f, 0.5f, 0.1f))})});
     cases.push_back({"Glass" + s, set_of({glass(a, 1.5f)})});
+    cases.push_back({"Clearcoat" + s, set_of({clearcoat(a)})});
   }
   // Principled-like glass: tinted refraction, Fresnel-coloured reflection.
   {
@@ -50,6 +51,12 @@ std::vector<Case> lobe_cases() {
   cases.push_back(
       {"MixOrenGGXSmoothGlass", set_of({oren_nayar(0.7f, Spectrum(0.5f)), ggx(0.5f, Spectrum(0.5f)),
                                         glass(0.0f, 1.5f, Spectrum(0.5f))})});
+  // Lobes about their own normal (a clearcoat on the interpolated normal under a bump), alone
+  // and mixed with a lobe about the shading normal.
+  cases.push_back({"GGXOwnNormal20", set_of({about(ggx(0.2f), Vec3f(0.4f, -0.2f, 0.9f))})});
+  cases.push_back(
+      {"MixDiffuseCoatOwnNormal", set_of({principled_diffuse(0.5f, Spectrum(0.4f, 0.3f, 0.2f)),
+                                          about(clearcoat(0.05f), Vec3f(-0.3f, 0.1f, 0.95f))})});
   return cases;
 }
 

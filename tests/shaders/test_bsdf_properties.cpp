@@ -82,12 +82,10 @@ TEST(BsdfEnergy, GgxWhiteFurnaceLossIsSmallForSmoothAndLargerForRough) {
 }
 
 TEST(BsdfReciprocity, ReflectionLobesAreSymmetric) {
-  const Closure lobes[] = {lambert(),
-                           oren_nayar(0.6f),
-                           principled_diffuse(0.8f),
-                           principled_sheen(),
-                           ggx(0.3f),
-                           ggx_principled(0.15f, 1.6f, Spectrum(0.7f, 0.4f, 0.2f))};
+  const Closure lobes[] = {
+      lambert(),          oren_nayar(0.6f), principled_diffuse(0.8f),
+      principled_sheen(), ggx(0.3f),        ggx_principled(0.15f, 1.6f, Spectrum(0.7f, 0.4f, 0.2f)),
+      clearcoat(0.1f)};
   Pcg32 rng(3);
   for (const Closure& c : lobes) {
     const ClosureSet set = set_of({c});
@@ -335,6 +333,47 @@ TEST(ClosureSet, BumpShadowingScalesDiffuseValuesOnly) {
   }
 }
 
+// A lobe about its own normal n (Closure::own_frame) is the same lobe seen in a rotated frame:
+// for isotropic lobes any rotation taking n to +z gives the same value and density. The rotation
+// here is built independently of Frame (Rodrigues' formula, then a turn about z), and a diffuse
+// lobe about its own normal is not bump-shadowed (its normal is the interpolated one).
+TEST(ClosureSet, LobeAboutItsOwnNormalIsTheRotatedLobe) {
+  const Vec3f n = normalize(Vec3f(0.5f, -0.3f, 0.8f));
+  // Rodrigues: rotate n onto z about axis n x z, then by 0.7 rad about z.
+  const Vec3f axis = normalize(cross(n, Vec3f(0, 0, 1)));
+  const float angle = std::acos(n.z);
+  auto rotate = [&](Vec3f v) {
+    const float c = std::cos(angle), s = std::sin(angle);
+    const Vec3f r = v * c + cross(axis, v) * s + axis * (dot(axis, v) * (1 - c));
+    const float c2 = std::cos(0.7f), s2 = std::sin(0.7f);
+    return Vec3f(c2 * r.x - s2 * r.y, s2 * r.x + c2 * r.y, r.z);
+  };
+  EXPECT_NEAR(rotate(n).z, 1.0f, 1e-6f);
+  for (const Closure& lobe : {ggx(0.3f), ggx_principled(0.1f, 1.5f, Spectrum(0.04f)),
+                              principled_diffuse(0.4f), lambert()}) {
+    ClosureSet own = set_of({about(lobe, n)});
+    own.set_bump_shadowing(normalize(Vec3f(0.2f, 0.1f, 1.0f)));  // must not touch it
+    const ClosureSet plain = set_of({lobe});
+    Pcg32 rng(11);
+    int nonzero = 0;
+    for (int i = 0; i < 300; ++i) {
+      const Vec3f wi = direction(0.1 + 0.9 * rng.uniform(), 2 * M_PI * rng.uniform());
+      const Vec3f wo = direction(-0.3 + 1.3 * rng.uniform(), 2 * M_PI * rng.uniform());
+      float p_own, p_plain;
+      const Spectrum f_own = own.eval_pdf(wi, wo, p_own);
+      const Spectrum f_plain = plain.eval_pdf(rotate(wi), rotate(wo), p_plain);
+      EXPECT_NEAR(f_own.y, f_plain.y, 2e-5f * (1 + f_plain.y)) << int(lobe.type);
+      EXPECT_NEAR(p_own, p_plain, 2e-5f * (1 + p_plain)) << int(lobe.type);
+      nonzero += f_plain.y > 0.0f;
+      const BsdfSample s = own.sample(wi, 0.5f, Vec2f(rng.uniform(), rng.uniform()));
+      if (s.valid) {
+        EXPECT_GT(dot(s.wo, n) * dot(wi, n), 0.0f) << "sampled about n";
+      }
+    }
+    EXPECT_GT(nonzero, 100);
+  }
+}
+
 // Degenerate inputs: zero roughness, exactly grazing wi (z = 0), wo = -wi, wo = wi, poles.
 TEST(BsdfRobustness, NoNaNOrInfInDegenerateConfigurations) {
   std::vector<Closure> lobes = {lambert(), oren_nayar(1.0f), principled_diffuse(1.0f),
@@ -344,6 +383,8 @@ TEST(BsdfRobustness, NoNaNOrInfInDegenerateConfigurations) {
     lobes.push_back(ggx_principled(a, 1.5f, Spectrum(0.5f)));
     lobes.push_back(glass(a, 1.5f));
     lobes.push_back(glass(a, 1.00001f));
+    lobes.push_back(clearcoat(a));
+    lobes.push_back(about(clearcoat(a), Vec3f(0.3f, 0.2f, 0.9f)));
   }
   const Vec3f wis[] = {Vec3f(1, 0, 0),  Vec3f(0, 0, 1),   Vec3f(0, 0, -1),
                        incident(1e-7f), incident(-1e-7f), normalize(Vec3f(1, 1, 0))};

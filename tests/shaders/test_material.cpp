@@ -3,6 +3,7 @@
 // feature flags, average emission, and malformed trees.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <vector>
 
@@ -204,6 +205,58 @@ TEST(Material, PrincipledSheenFollowsCycles) {
   expect_spectrum(c->weight, tint * (0.8f * 0.8f * 0.5f), 1e-6f);
   EXPECT_FALSE(sheen_of(0.0f, 0.2f).has_value());
   EXPECT_FALSE(sheen_of(0.8f, 1.0f).has_value());
+}
+
+// Clearcoat: a Clearcoat lobe of alpha clearcoat_roughness^2, weight 0.25 clearcoat (times alpha
+// and the mix weight, not reduced by metallic or transmission), whose Fresnel is the dielectric
+// one of IOR 1.5: a smooth coat reflects 0.25 F(cos_i) of the light at every incidence. Lobes
+// inherit whether their normal input is linked to the material's perturbation.
+TEST(Material, PrincipledClearcoatFollowsCycles) {
+  MaterialDesc d;
+  ShaderNode n = node(ShaderNodeKind::Principled, Spectrum(0.5f, 0.4f, 0.3f));
+  n.metallic = FloatInput(1.0f);
+  n.clearcoat = FloatInput(0.6f);
+  n.clearcoat_roughness = FloatInput(0.2f);
+  n.alpha = FloatInput(0.5f);
+  n.normal_linked = true;
+  n.clearcoat_normal_linked = false;
+  d.nodes.push_back(n);
+  d.root = 0;
+  const ClosureSet s = eval(Material(d, {}));
+  ASSERT_EQ(s.count(), 3);  // transparent, metal, clearcoat
+  const Closure& coat = s[2];
+  EXPECT_EQ(coat.type, ClosureType::Clearcoat);
+  expect_spectrum(coat.weight, Spectrum(0.25f * 0.6f * 0.5f));
+  EXPECT_FLOAT_EQ(coat.alpha, 0.04f);
+  EXPECT_TRUE(coat.interpolated_normal);
+  EXPECT_FALSE(s[1].interpolated_normal);
+  EXPECT_EQ(Material(d, {}).features() & kFeatureGlossy, uint32_t(kFeatureGlossy));
+
+  // Smooth coat alone (black base, no specular): delta reflection of value 0.25 F(cos_i, 1.5).
+  ShaderNode smooth = node(ShaderNodeKind::Principled, Spectrum(0.0f));
+  smooth.specular = FloatInput(0.0f);
+  smooth.clearcoat = FloatInput(1.0f);
+  smooth.clearcoat_roughness = FloatInput(0.0f);
+  MaterialDesc ds;
+  ds.nodes.push_back(smooth);
+  ds.root = 0;
+  const Material ms(ds, {});
+  EXPECT_EQ(ms.features() & kFeatureDelta, uint32_t(kFeatureDelta));
+  const ClosureSet c = eval(ms);
+  ASSERT_EQ(c.count(), 1);
+  for (float cos_i : {1.0f, 0.7f, 0.3f, 0.05f}) {
+    const Vec3f wi(std::sqrt(1.0f - cos_i * cos_i), 0.0f, cos_i);
+    const BsdfSample b = c.sample(wi, 0.5f, Vec2f(0.3f, 0.6f));
+    ASSERT_TRUE(b.valid && b.is_delta());
+    // Dielectric Fresnel of 1.5 in double.
+    const double ci = cos_i, st2 = (1.0 - ci * ci) / 2.25, ct = std::sqrt(1.0 - st2);
+    const double rs = (ci - 1.5 * ct) / (ci + 1.5 * ct), rp = (1.5 * ci - ct) / (1.5 * ci + ct);
+    EXPECT_NEAR(b.weight().y, 0.25 * 0.5 * (rs * rs + rp * rp), 1e-6) << cos_i;
+  }
+  // No coat at clearcoat 0.
+  smooth.clearcoat = FloatInput(0.0f);
+  ds.nodes[0] = smooth;
+  EXPECT_EQ(eval(Material(ds, {})).count(), 0);
 }
 
 TEST(Material, GlassNodes) {
