@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "shaders/math_node.h"
 #include "shaders/microfacet.h"
 #include "shaders/principled.h"
 #include "shaders/procedural_texture.h"
@@ -70,28 +71,6 @@ Spectrum mix_blend(MixBlend blend, float t, Spectrum a, Spectrum b) {
       return lerp(a, Spectrum(std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)), t);
   }
   return a;
-}
-
-// Cycles' svm_math for the supported operations (safe division and power: 0 where undefined).
-float math_op(MathOp op, float a, float b) {
-  switch (op) {
-    case MathOp::Add:
-      return a + b;
-    case MathOp::Subtract:
-      return a - b;
-    case MathOp::Multiply:
-      return a * b;
-    case MathOp::Divide:
-      return b != 0.0f ? a / b : 0.0f;
-    case MathOp::Power:
-      if (a < 0.0f && b != std::floor(b)) return 0.0f;
-      return std::pow(a, b);
-    case MathOp::Minimum:
-      return std::min(a, b);
-    case MathOp::Maximum:
-      return std::max(a, b);
-  }
-  return 0.0f;
 }
 
 // Cycles' rgb_to_hsv / hsv_to_rgb (util/color.h).
@@ -167,7 +146,8 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       break;
     }
     case InputNodeKind::Math:
-      r = Spectrum(math_op(n.math, in.scalar(n.value_a), in.scalar(n.value_b)));
+      r = Spectrum(
+          math_node(n.math, in.scalar(n.value_a), in.scalar(n.value_b), in.scalar(n.value_c)));
       break;
     case InputNodeKind::Invert: {
       const Spectrum a = in.color(n.a);

@@ -11,6 +11,7 @@
 
 #include "integrator/math/transform.h"
 #include "integrator/math/vec.h"
+#include "shaders/math_node.h"
 #include "shaders/procedural_texture.h"
 
 namespace gdpt {
@@ -101,7 +102,6 @@ enum class MixBlend : uint8_t {
   Darken,
   Lighten,
 };
-enum class MathOp : uint8_t { Add, Subtract, Multiply, Divide, Power, Minimum, Maximum };
 
 struct InputNode {
   InputNodeKind kind = InputNodeKind::Mix;

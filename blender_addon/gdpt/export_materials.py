@@ -31,7 +31,13 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
-_MATH_OPS = {'ADD', 'SUBTRACT', 'MULTIPLY', 'DIVIDE', 'POWER', 'MINIMUM', 'MAXIMUM'}
+# Every operation of Blender 3.4's Math node (shaders/math_node.h).
+_MATH_OPS = {'ADD', 'SUBTRACT', 'MULTIPLY', 'DIVIDE', 'MULTIPLY_ADD', 'POWER', 'LOGARITHM', 'SQRT',
+             'INVERSE_SQRT', 'ABSOLUTE', 'EXPONENT', 'MINIMUM', 'MAXIMUM', 'LESS_THAN',
+             'GREATER_THAN', 'SIGN', 'COMPARE', 'SMOOTH_MIN', 'SMOOTH_MAX', 'ROUND', 'FLOOR',
+             'CEIL', 'TRUNC', 'FRACT', 'MODULO', 'WRAP', 'SNAP', 'PINGPONG', 'SINE', 'COSINE',
+             'TANGENT', 'ARCSINE', 'ARCCOSINE', 'ARCTANGENT', 'ARCTAN2', 'SINH', 'COSH', 'TANH',
+             'RADIANS', 'DEGREES'}
 
 
 def _matrix12(m):
@@ -322,7 +328,8 @@ class _Translator:
                  "fac": self.value(node.inputs[0]), "a": self.color(a), "b": self.color(b)}
         elif node.type == 'MATH' and node.operation in _MATH_OPS:
             d = {"kind": "MATH", "op": node.operation, "clamp_result": bool(node.use_clamp),
-                 "value_a": self.value(node.inputs[0]), "value_b": self.value(node.inputs[1])}
+                 "value_a": self.value(node.inputs[0]), "value_b": self.value(node.inputs[1]),
+                 "value_c": self.value(node.inputs[2])}
         elif node.type == 'INVERT':
             d = {"kind": "INVERT", "fac": self.value(node.inputs["Fac"]),
                  "a": self.color(node.inputs["Color"])}

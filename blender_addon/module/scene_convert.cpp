@@ -160,10 +160,47 @@ InputNode read_input_node(const py::dict& d) {
                                                              {"DARKEN", MixBlend::Darken},
                                                              {"LIGHTEN", MixBlend::Lighten}};
   n.blend = get_enum(d, "blend", "MIX", kBlends, "mix blend");
-  static const std::pair<const char*, MathOp> kOps[] = {
-      {"ADD", MathOp::Add},        {"SUBTRACT", MathOp::Subtract}, {"MULTIPLY", MathOp::Multiply},
-      {"DIVIDE", MathOp::Divide},  {"POWER", MathOp::Power},       {"MINIMUM", MathOp::Minimum},
-      {"MAXIMUM", MathOp::Maximum}};
+  // Blender's Math node operation identifiers (bpy ShaderNodeMath.operation).
+  static const std::pair<const char*, MathOp> kOps[] = {{"ADD", MathOp::Add},
+                                                        {"SUBTRACT", MathOp::Subtract},
+                                                        {"MULTIPLY", MathOp::Multiply},
+                                                        {"DIVIDE", MathOp::Divide},
+                                                        {"MULTIPLY_ADD", MathOp::MultiplyAdd},
+                                                        {"POWER", MathOp::Power},
+                                                        {"LOGARITHM", MathOp::Logarithm},
+                                                        {"SQRT", MathOp::Sqrt},
+                                                        {"INVERSE_SQRT", MathOp::InverseSqrt},
+                                                        {"ABSOLUTE", MathOp::Absolute},
+                                                        {"EXPONENT", MathOp::Exponent},
+                                                        {"MINIMUM", MathOp::Minimum},
+                                                        {"MAXIMUM", MathOp::Maximum},
+                                                        {"LESS_THAN", MathOp::LessThan},
+                                                        {"GREATER_THAN", MathOp::GreaterThan},
+                                                        {"SIGN", MathOp::Sign},
+                                                        {"COMPARE", MathOp::Compare},
+                                                        {"SMOOTH_MIN", MathOp::SmoothMin},
+                                                        {"SMOOTH_MAX", MathOp::SmoothMax},
+                                                        {"ROUND", MathOp::Round},
+                                                        {"FLOOR", MathOp::Floor},
+                                                        {"CEIL", MathOp::Ceil},
+                                                        {"TRUNC", MathOp::Trunc},
+                                                        {"FRACT", MathOp::Fract},
+                                                        {"MODULO", MathOp::Modulo},
+                                                        {"WRAP", MathOp::Wrap},
+                                                        {"SNAP", MathOp::Snap},
+                                                        {"PINGPONG", MathOp::PingPong},
+                                                        {"SINE", MathOp::Sine},
+                                                        {"COSINE", MathOp::Cosine},
+                                                        {"TANGENT", MathOp::Tangent},
+                                                        {"ARCSINE", MathOp::Arcsine},
+                                                        {"ARCCOSINE", MathOp::Arccosine},
+                                                        {"ARCTANGENT", MathOp::Arctangent},
+                                                        {"ARCTAN2", MathOp::Arctan2},
+                                                        {"SINH", MathOp::Sinh},
+                                                        {"COSH", MathOp::Cosh},
+                                                        {"TANH", MathOp::Tanh},
+                                                        {"RADIANS", MathOp::Radians},
+                                                        {"DEGREES", MathOp::Degrees}};
   n.math = get_enum(d, "op", "ADD", kOps, "math operation");
   get(d, "clamp_factor", n.clamp_factor);
   get(d, "clamp_result", n.clamp_result);
