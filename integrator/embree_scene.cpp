@@ -478,6 +478,7 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
     TexCoords shifted = base;
     if (d.writes_coords) {
       shifted.object = base.object + o[k] * kStep;
+      shifted.position = base.position + a[k] * kStep;
       for (int c = 0; c < 3; ++c)
         shifted.generated[c] = base.generated[c] + o[k][c] * kStep * d.generated_scale[c];
     }

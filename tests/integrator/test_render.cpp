@@ -506,8 +506,9 @@ TEST(Render, TextureCoordinatesAreObjectSpace) {
 }
 
 // A bump whose height is linear in a texture coordinate: Object x (also on an instance stretched
-// 2x along x, which halves the world-space slope) and Generated x (the plane's 100 m bounding box
-// maps x to (x + 50) / 100), with UVs and without (differences along the triangle's edges). The
+// 2x along x, which halves the world-space slope), Generated x (the plane's 100 m bounding box
+// maps x to (x + 50) / 100) and the Geometry node's world Position x (a stretch leaves its slope
+// alone), with UVs and without (differences along the triangle's edges). The
 // height h = k * coordinate tilts the normal to normalize(N - distance grad h) exactly, as in the
 // image-ramp test above.
 TEST(Render, BumpDifferentiatesObjectSpaceCoordinates) {
@@ -522,7 +523,9 @@ TEST(Render, BumpDifferentiatesObjectSpaceCoordinates) {
         Case{TexCoordSource::Object, 2.0f, 0.02f, true, 1.0 / std::sqrt(1.01)},
         Case{TexCoordSource::Generated, 1.0f, 2.0f, true, 1.0 / std::sqrt(1.04)},
         Case{TexCoordSource::Object, 2.0f, 0.02f, false, 1.0 / std::sqrt(1.01)},
-        Case{TexCoordSource::Generated, 1.0f, 2.0f, false, 1.0 / std::sqrt(1.04)}}) {
+        Case{TexCoordSource::Generated, 1.0f, 2.0f, false, 1.0 / std::sqrt(1.04)},
+        Case{TexCoordSource::Position, 1.0f, 0.02f, true, 1.0 / std::sqrt(1.04)},
+        Case{TexCoordSource::Position, 2.0f, 0.02f, false, 1.0 / std::sqrt(1.04)}}) {
     Mesh plane = c.uvs ? uv_quad() : quad(50.0f);
     MaterialDesc m = diffuse(Spectrum(0.5f));
     InputNode coords;
