@@ -149,6 +149,13 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       r = Spectrum(
           math_node(n.math, in.scalar(n.value_a), in.scalar(n.value_b), in.scalar(n.value_c)));
       break;
+    case InputNodeKind::VectorMath: {
+      float value;
+      r = vector_math_node(n.vector_math, in.color(n.a), in.color(n.b), in.color(n.c),
+                           in.scalar(n.value_a), value);
+      if (n.fac_output) r = Spectrum(value);
+      break;
+    }
     case InputNodeKind::Invert: {
       const Spectrum a = in.color(n.a);
       r = lerp(a, Spectrum(1.0f) - a, in.scalar(n.fac));
@@ -281,10 +288,14 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
   return n.clamp_result ? saturate(r) : r;
 }
 
-// A float socket fed by a node: Math results directly, colours by their luminance.
+// A float socket fed by a node: Math results directly, colours by their luminance, vectors (a
+// coordinate, a Vector Math Vector) by the mean of their components, as Cycles converts them.
 template <class Inputs>
 float input_node_scalar(const InputNode& n, const Inputs& in) {
   const Spectrum r = input_node_result(n, in);
+  if ((n.kind == InputNodeKind::Coordinates || n.kind == InputNodeKind::VectorMath) &&
+      !n.fac_output)
+    return (r.x + r.y + r.z) * (1.0f / 3.0f);
   const bool grey = n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
                     n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
                     n.kind == InputNodeKind::ToBw ||
@@ -307,7 +318,9 @@ struct PointInputs {
   // mapping.
   Vec3f vector(const TextureVector& v) const {
     Vec3f p(at.uv.x, at.uv.y, 0.0f);
-    if (v.source != TexCoordSource::UV)
+    if (v.source == TexCoordSource::Node)
+      p = input_node_result(nodes[size_t(v.node)], *this);
+    else if (v.source != TexCoordSource::UV)
       p = !at.coords                              ? Vec3f(0.0f)
           : v.source == TexCoordSource::Generated ? at.coords->generated
           : v.source == TexCoordSource::Object    ? at.coords->object
@@ -533,6 +546,16 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
   // --- Validate the reachable tree (indices, depth, cycles) and collect features. Recursion is
   // fine here: this runs once at scene load, the per-hit walk uses the explicit stack.
   std::vector<bool> uses_image(textures.size(), false);
+  // A texture's vector: its coordinates, or the input node it comes from (through note_fn).
+  auto note_vector = [&](auto&& note_fn, const TextureVector& v, int depth) {
+    if (v.source != TexCoordSource::Node) {
+      reads_coordinates_ |= v.source != TexCoordSource::UV;
+      return;
+    }
+    ColorInput via;  // a missing index is out of range: reported below
+    via.node = v.node >= 0 ? v.node : int32_t(inputs_.size());
+    note_fn(note_fn, via, depth + 1);
+  };
   // An input: its texture, or its input node's operands (depth-limited: no cycles).
   auto note_input = [&](auto&& self, const auto& input, int depth) -> void {
     if (input.node >= 0) {
@@ -551,7 +574,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       }
       if (reads_vector(n.kind)) {
         features_ |= kFeatureTextures;
-        reads_coordinates_ |= n.vector.source != TexCoordSource::UV;
+        note_vector(self, n.vector, depth);
       }
       if (n.kind == InputNodeKind::Ramp && (n.ramp.size() < 8 || n.ramp.size() % 4 != 0))
         throw std::invalid_argument(where + "colour ramp table of " +
@@ -560,14 +583,14 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       for (const FloatInput* f :
            {&n.fac, &n.value_a, &n.value_b, &n.value_c, &n.value_d, &n.value_e, &n.value_f})
         self(self, *f, depth + 1);
-      for (const ColorInput* c : {&n.a, &n.b}) self(self, *c, depth + 1);
+      for (const ColorInput* c : {&n.a, &n.b, &n.c}) self(self, *c, depth + 1);
       return;
     }
     check_lookup(input.texture);
     if (input.texture.image >= 0) {
       features_ |= kFeatureTextures;
       uses_image[size_t(input.texture.image)] = true;
-      reads_coordinates_ |= input.texture.vector.source != TexCoordSource::UV;
+      note_vector(self, input.texture.vector, depth);
     }
   };
   auto note = [&](const auto& input) { note_input(note_input, input, 0); };

@@ -13,18 +13,21 @@
 #include "integrator/math/vec.h"
 #include "shaders/math_node.h"
 #include "shaders/procedural_texture.h"
+#include "shaders/vector_math_node.h"
 
 namespace gdpt {
 
 // Blender's Texture Coordinate outputs a texture can read (Cycles' names): UV is (u, v, 0) of the
 // mesh's UV map; Object the object-space position; Generated the object-space position mapped
 // from the mesh's texture space (Mesh::texspace_*) to [0, 1]^3; Position the world-space position
-// (the Geometry node's Position output).
-enum class TexCoordSource : uint8_t { UV, Generated, Object, Position };
+// (the Geometry node's Position output); Node the result of an input node (InputNode), e.g. a
+// Vector Math node or coordinates distorted by a Noise Texture's colour.
+enum class TexCoordSource : uint8_t { UV, Generated, Object, Position, Node };
 
 // The vector a texture reads: a coordinate source through an optional Mapping node.
 struct TextureVector {
   TexCoordSource source = TexCoordSource::UV;
+  int32_t node = -1;  // Node: index into MaterialDesc::inputs
   Transform mapping;  // Blender's Mapping node (Point / Texture type) applied to the coordinates
 };
 
@@ -90,6 +93,8 @@ enum class InputNodeKind : uint8_t {
                    // `magic_depth`; Fac (the colour's mean) or Color
   Musgrave,        // 3D Musgrave Texture `musgrave_type` at `vector` x scale value_a: detail
                    // value_b, dimension value_c, lacunarity value_d, offset value_e, gain value_f
+  VectorMath,      // Vector Math `vector_math` of vectors a, b, c and scale value_a: the Vector,
+                   // or the Value (fac_output, as grey)
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -107,10 +112,12 @@ struct InputNode {
   InputNodeKind kind = InputNodeKind::Mix;
   MixBlend blend = MixBlend::Mix;
   MathOp math = MathOp::Add;
-  bool clamp_factor = true;     // Mix: fac clamped to [0, 1] first
-  bool clamp_result = false;    // result clamped to [0, 1] per channel
-  FloatInput fac{0.5f};         // Mix, Invert
-  ColorInput a, b;              // Mix (a, b), Invert (a)
+  bool clamp_factor = true;   // Mix: fac clamped to [0, 1] first
+  bool clamp_result = false;  // result clamped to [0, 1] per channel
+  FloatInput fac{0.5f};       // Mix, Invert
+  ColorInput a, b;            // Mix (a, b), Invert (a), Vector Math (vectors a, b)
+  ColorInput c;               // Vector Math (vector c)
+  VectorMathOp vector_math = VectorMathOp::Add;
   FloatInput value_a, value_b;  // Math, Gamma (a), Bright / Contrast (a, b), Combine (a, b)
   FloatInput value_c;           // Combine
   FloatInput value_d, value_e, value_f;  // Wave, Musgrave

@@ -27,7 +27,7 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
                 'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
-                'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC'}
+                'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -307,7 +307,8 @@ class _Translator:
         per_output = node.type in {'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR', 'TEX_CHECKER',
                                    'TEX_NOISE', 'TEX_COORD', 'SEPXYZ', 'TEX_VORONOI',
                                    'TEX_GRADIENT', 'TEX_WAVE', 'TEX_MUSGRAVE',
-                                   'TEX_WHITE_NOISE', 'NEW_GEOMETRY', 'TEX_MAGIC'}
+                                   'TEX_WHITE_NOISE', 'NEW_GEOMETRY', 'TEX_MAGIC',
+                                   'VECT_MATH'}
         key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
@@ -330,6 +331,12 @@ class _Translator:
             d = {"kind": "MATH", "op": node.operation, "clamp_result": bool(node.use_clamp),
                  "value_a": self.value(node.inputs[0]), "value_b": self.value(node.inputs[1]),
                  "value_c": self.value(node.inputs[2])}
+        elif node.type == 'VECT_MATH':
+            # Inputs: three vectors and the float Scale (IOR for Refract).
+            d = {"kind": "VECTOR_MATH", "op": node.operation,
+                 "a": self.color(node.inputs[0]), "b": self.color(node.inputs[1]),
+                 "c": self.color(node.inputs[2]), "value_a": self.value(node.inputs[3]),
+                 "fac_output": out.name == "Value"}
         elif node.type == 'INVERT':
             d = {"kind": "INVERT", "fac": self.value(node.inputs["Fac"]),
                  "a": self.color(node.inputs["Color"])}
@@ -487,14 +494,16 @@ class _Translator:
         d["interpolation"] = 'Closest' if node.interpolation == 'Closest' else 'Linear'
         d["extension"] = node.extension if node.extension in {'REPEAT', 'EXTEND', 'CLIP'} \
             else 'REPEAT'
-        vector = self._vector(node.inputs["Vector"])
-        d["mapping"], d["coordinates"] = vector["mapping"], vector["coordinates"]
+        d.update(self._vector(node.inputs["Vector"]))
 
     def _vector(self, socket, default='UV'):
-        """{coordinates, mapping} of a texture's Vector input: a Texture Coordinate output (UV,
-        Generated, Object), a UV Map node, or a Mapping node (Point / Texture) over one of them;
-        unlinked, the texture's own default (UV for Image Texture, Generated for procedural
-        textures). mapping is a row-major 3x4 transform of the coordinates."""
+        """{coordinates, mapping[, vector_node]} of a texture's Vector input: a Texture
+        Coordinate output (UV, Generated, Object), a UV Map node, the Geometry node's Position,
+        any input node's result (coordinates 'NODE', e.g. a Vector Math node or coordinates
+        mixed with a Noise Texture's colour; vector_node its index), or a Mapping node (Point /
+        Texture) over one of them; unlinked, the texture's own default (UV for Image Texture,
+        Generated for procedural textures). mapping is a row-major 3x4 transform of the
+        coordinates."""
         out = self._source(socket)
         if out is None:
             return {"coordinates": default, "mapping": IDENTITY12}
@@ -529,7 +538,12 @@ class _Translator:
                 m = m.inverted_safe()
             im = inner["mapping"]
             inner_m = Matrix([im[0:4], im[4:8], im[8:12], [0, 0, 0, 1]])
-            return {"coordinates": inner["coordinates"], "mapping": _matrix12(m @ inner_m)}
+            return dict(inner, mapping=_matrix12(m @ inner_m))
+        if node.type in _INPUT_NODES and node.type not in {'TEX_COORD', 'MAPPING'}:
+            index = self._input_node(node, out)  # warns itself when it cannot
+            if index is not None:
+                return {"coordinates": 'NODE', "vector_node": index, "mapping": IDENTITY12}
+            return plain
         self.warn(node, f"output {out.name} of the texture coordinate node"
                   if node.type == 'TEX_COORD' else "texture coordinate node")
         return plain

@@ -66,15 +66,18 @@ E get_enum(const py::dict& d, const char* key, const char* fallback,
 
 // --- Material inputs ---------------------------------------------------------------------------
 
-// {coordinates: 'UV' | 'GENERATED' | 'OBJECT' | 'POSITION', mapping: 12 floats}
+// {coordinates: 'UV' | 'GENERATED' | 'OBJECT' | 'POSITION' | 'NODE', vector_node: input node
+// index (NODE), mapping: 12 floats}
 void read_vector(const py::dict& d, TextureVector& v) {
   get_transform(d, "mapping", v.mapping);
   static const std::pair<const char*, TexCoordSource> kSources[] = {
       {"UV", TexCoordSource::UV},
       {"GENERATED", TexCoordSource::Generated},
       {"OBJECT", TexCoordSource::Object},
-      {"POSITION", TexCoordSource::Position}};
+      {"POSITION", TexCoordSource::Position},
+      {"NODE", TexCoordSource::Node}};
   v.source = get_enum(d, "coordinates", "UV", kSources, "texture coordinates");
+  get(d, "vector_node", v.node);
 }
 
 void read_lookup(const py::dict& d, TextureLookup& t) {
@@ -148,7 +151,8 @@ InputNode read_input_node(const py::dict& d) {
       {"WAVE", InputNodeKind::Wave},
       {"MUSGRAVE", InputNodeKind::Musgrave},
       {"WHITE_NOISE", InputNodeKind::WhiteNoise},
-      {"MAGIC", InputNodeKind::Magic}};
+      {"MAGIC", InputNodeKind::Magic},
+      {"VECTOR_MATH", InputNodeKind::VectorMath}};
   n.kind = get_enum(d, "kind", "MIX", kKinds, "input node kind");
   static const std::pair<const char*, MixBlend> kBlends[] = {{"MIX", MixBlend::Mix},
                                                              {"ADD", MixBlend::Add},
@@ -201,12 +205,45 @@ InputNode read_input_node(const py::dict& d) {
                                                         {"TANH", MathOp::Tanh},
                                                         {"RADIANS", MathOp::Radians},
                                                         {"DEGREES", MathOp::Degrees}};
-  n.math = get_enum(d, "op", "ADD", kOps, "math operation");
+  // Blender's Vector Math operation identifiers (bpy ShaderNodeVectorMath.operation).
+  static const std::pair<const char*, VectorMathOp> kVectorOps[] = {
+      {"ADD", VectorMathOp::Add},
+      {"SUBTRACT", VectorMathOp::Subtract},
+      {"MULTIPLY", VectorMathOp::Multiply},
+      {"DIVIDE", VectorMathOp::Divide},
+      {"MULTIPLY_ADD", VectorMathOp::MultiplyAdd},
+      {"CROSS_PRODUCT", VectorMathOp::CrossProduct},
+      {"PROJECT", VectorMathOp::Project},
+      {"REFLECT", VectorMathOp::Reflect},
+      {"REFRACT", VectorMathOp::Refract},
+      {"FACEFORWARD", VectorMathOp::Faceforward},
+      {"DOT_PRODUCT", VectorMathOp::DotProduct},
+      {"DISTANCE", VectorMathOp::Distance},
+      {"LENGTH", VectorMathOp::Length},
+      {"SCALE", VectorMathOp::Scale},
+      {"NORMALIZE", VectorMathOp::Normalize},
+      {"SNAP", VectorMathOp::Snap},
+      {"FLOOR", VectorMathOp::Floor},
+      {"CEIL", VectorMathOp::Ceil},
+      {"MODULO", VectorMathOp::Modulo},
+      {"WRAP", VectorMathOp::Wrap},
+      {"FRACTION", VectorMathOp::Fraction},
+      {"ABSOLUTE", VectorMathOp::Absolute},
+      {"MINIMUM", VectorMathOp::Minimum},
+      {"MAXIMUM", VectorMathOp::Maximum},
+      {"SINE", VectorMathOp::Sine},
+      {"COSINE", VectorMathOp::Cosine},
+      {"TANGENT", VectorMathOp::Tangent}};
+  if (n.kind == InputNodeKind::VectorMath)
+    n.vector_math = get_enum(d, "op", "ADD", kVectorOps, "vector math operation");
+  else
+    n.math = get_enum(d, "op", "ADD", kOps, "math operation");
   get(d, "clamp_factor", n.clamp_factor);
   get(d, "clamp_result", n.clamp_result);
   read_float(d, "fac", n.fac);
   read_color(d, "a", n.a);
   read_color(d, "b", n.b);
+  read_color(d, "c", n.c);
   read_float(d, "value_a", n.value_a);
   read_float(d, "value_b", n.value_b);
   read_float(d, "value_c", n.value_c);
@@ -767,8 +804,8 @@ int SceneBuilder::add_material(const py::dict& material) {
     throw std::invalid_argument("material '" + desc.name + "': image index out of range");
   for (const InputNode& node : desc.inputs)
     for (const TextureLookup* t :
-         {&node.fac.texture, &node.a.texture, &node.b.texture, &node.value_a.texture,
-          &node.value_b.texture, &node.value_c.texture})
+         {&node.fac.texture, &node.a.texture, &node.b.texture, &node.c.texture,
+          &node.value_a.texture, &node.value_b.texture, &node.value_c.texture})
       if (t->image >= int32_t(scene_.images.size()))
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
   scene_.materials.push_back(std::move(desc));

@@ -768,6 +768,128 @@ def math_regions(image):
     return regions
 
 
+VECTOR_OPS = ['ADD', 'SUBTRACT', 'MULTIPLY', 'DIVIDE', 'MULTIPLY_ADD', 'CROSS_PRODUCT', 'PROJECT',
+              'REFLECT', 'REFRACT', 'FACEFORWARD', 'DOT_PRODUCT', 'DISTANCE', 'LENGTH', 'SCALE',
+              'NORMALIZE', 'SNAP', 'FLOOR', 'CEIL', 'MODULO', 'WRAP', 'FRACTION', 'ABSOLUTE',
+              'MINIMUM', 'MAXIMUM', 'SINE', 'COSINE', 'TANGENT']
+VECTOR_EXTRAS = ['checker at noise-distorted coordinates', 'image at a Vector Math vector',
+                 'strength from a vector', 'gradient through a Mapping of a node vector']
+VECTOR_RESOLUTION = (256, 256)  # 21 x 21 m seen
+VECTOR_ROWS = 16
+
+
+def _vector_strip(k):
+    """Centre (x, y) of strip k of the vector_math case: two columns of VECTOR_ROWS."""
+    column, row = divmod(k, VECTOR_ROWS)
+    return (-5.25 if column == 0 else 5.25), (row - (VECTOR_ROWS - 1) / 2) * 1.05
+
+
+def case_vector_math(scene):
+    # Vector Math and textures read at node-made vectors, on emissive strips seen head-on (two
+    # columns): strip k < 27 shows |VECTOR_OPS[k](A, B, C, scale 1.3)| * 0.3 as a colour (a
+    # Value as grey), A = Generated * (6, 6, 0) + (-3, -3, 0.7) (itself a Multiply Add),
+    # B = (1.3, -0.7, 0.9), C = (1.0, 0.5, -0.4); then VECTOR_EXTRAS.
+    img = bpy.data.images.new("grid", 64, 64)
+    img.generated_type = 'COLOR_GRID'
+
+    def strip(k, build):
+        m = S.shader_material(f"vector{k}", "ShaderNodeEmission", Strength=1.0)
+        nt = m.node_tree
+        emit = next(node for node in nt.nodes if node.type == 'EMISSION')
+        coords = nt.nodes.new("ShaderNodeTexCoord")
+        build(nt, emit, coords.outputs["Generated"])
+        x, y = _vector_strip(k)
+        obj = S.plane(f"strip{k}", 1.0, (x, y, 0.0), material=m)
+        obj.scale = (9.5, 1.0, 1.0)
+
+    def vmath(nt, op, a, b=None, c=None, scale=1.3):
+        node = nt.nodes.new("ShaderNodeVectorMath")
+        node.operation = op
+        for i, v in enumerate((a, b, c)):
+            if v is None:
+                continue
+            if isinstance(v, tuple):
+                node.inputs[i].default_value = v
+            else:
+                nt.links.new(v, node.inputs[i])
+        node.inputs[3].default_value = scale
+        return node
+
+    def op_strip(op):
+        def build(nt, emit, generated):
+            # The Tangent's A is scaled by 0.45, short of its poles.
+            k = 0.45 if op == 'TANGENT' else 1.0
+            a = vmath(nt, 'MULTIPLY_ADD', generated, (6.0 * k, 6.0 * k, 0.0),
+                      (-3.0 * k, -3.0 * k, 0.7))
+            node = vmath(nt, op, a.outputs["Vector"], (1.3, -0.7, 0.9), (1.0, 0.5, -0.4))
+            out = node.outputs["Value" if op in ('DOT_PRODUCT', 'DISTANCE', 'LENGTH')
+                               else "Vector"]
+            positive = vmath(nt, 'ABSOLUTE', out)
+            shown = vmath(nt, 'SCALE', positive.outputs["Vector"], scale=0.3)
+            nt.links.new(shown.outputs["Vector"], emit.inputs["Color"])
+        return build
+
+    for k, op in enumerate(VECTOR_OPS):
+        strip(k, op_strip(op))
+
+    def distorted_checker(nt, emit, generated):
+        noise = nt.nodes.new("ShaderNodeTexNoise")
+        noise.inputs["Scale"].default_value = 2.0
+        mix = nt.nodes.new("ShaderNodeMixRGB")
+        mix.inputs["Fac"].default_value = 0.4
+        nt.links.new(generated, mix.inputs["Color1"])
+        nt.links.new(noise.outputs["Color"], mix.inputs["Color2"])
+        checker = nt.nodes.new("ShaderNodeTexChecker")
+        checker.inputs["Scale"].default_value = 6.0
+        nt.links.new(mix.outputs["Color"], checker.inputs["Vector"])
+        nt.links.new(checker.outputs["Color"], emit.inputs["Color"])
+
+    def image_at_vector(nt, emit, generated):
+        tex = nt.nodes.new("ShaderNodeTexImage")
+        tex.image = img
+        tex.interpolation = 'Closest'
+        scaled = vmath(nt, 'MULTIPLY', generated, (3.0, 0.7, 1.0))
+        nt.links.new(scaled.outputs["Vector"], tex.inputs["Vector"])
+        nt.links.new(tex.outputs["Color"], emit.inputs["Color"])
+
+    def strength_from_vector(nt, emit, generated):
+        emit.inputs["Color"].default_value = (0.8, 0.6, 0.4, 1.0)
+        v = vmath(nt, 'MULTIPLY_ADD', generated, (2.0, 1.0, 0.0), (0.1, 0.2, 0.3))
+        nt.links.new(v.outputs["Vector"], emit.inputs["Strength"])
+
+    def mapped_gradient(nt, emit, generated):
+        v = vmath(nt, 'MULTIPLY_ADD', generated, (1.0, 4.0, 1.0), (0.0, -2.0, 0.0))
+        mapping = nt.nodes.new("ShaderNodeMapping")
+        mapping.inputs["Rotation"].default_value = (0.0, 0.0, 0.5)
+        mapping.inputs["Scale"].default_value = (1.5, 1.0, 1.0)
+        nt.links.new(v.outputs["Vector"], mapping.inputs["Vector"])
+        gradient = nt.nodes.new("ShaderNodeTexGradient")
+        gradient.gradient_type = 'QUADRATIC_SPHERE'
+        nt.links.new(mapping.outputs["Vector"], gradient.inputs["Vector"])
+        nt.links.new(gradient.outputs["Color"], emit.inputs["Color"])
+
+    for k, build in enumerate((distorted_checker, image_at_vector, strength_from_vector,
+                               mapped_gradient)):
+        strip(len(VECTOR_OPS) + k, build)
+    S.camera((0, 0, 10), (0, 0, 0), ortho_scale=21.0)
+    scene.world.color = (0, 0, 0)
+    scene.render.resolution_x, scene.render.resolution_y = VECTOR_RESOLUTION
+    return 1
+
+
+def vector_regions(image):
+    """(label, pixels) of each strip of the vector_math case, 2 pixels inside its edges."""
+    ppm = VECTOR_RESOLUTION[0] / 21.0
+    regions = []
+    for k, label in enumerate(VECTOR_OPS + VECTOR_EXTRAS):
+        x, y = _vector_strip(k)
+        x, y = x + 10.5, y + 10.5
+        rows = slice(int((y - 0.5) * ppm) + 2, int((y + 0.5) * ppm) - 2)
+        cols = slice(int((x - 4.75) * ppm) + 2, int((x + 4.75) * ppm) - 2)
+        regions.append((label, image[rows, cols, :]))
+    return regions
+
+
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
 
 # Cases whose noise floor at the default counts lies near the threshold render more samples on
@@ -791,10 +913,11 @@ SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map
 
 # Cases whose image holds many independent features, each of which must agree on its own (one
 # wrong feature can hide in the relMSE of the whole image): name -> function(image) returning
-# (label, pixels) pairs, held to REGION_THRESHOLD. math_nodes measured at most 4e-6 per
-# operation (Inverse Sqrt, near its pole).
-REGIONS = {"math_nodes": math_regions}
-REGION_THRESHOLD = 1e-4
+# (label, pixels) pairs, each held to the case's bound. math_nodes measured at most 4e-6 per
+# operation (Inverse Sqrt, near its pole); vector_math's strips with discontinuities (Refract's
+# total internal reflection, the distorted checker's edges) carry anti-aliasing noise, 1e-4 - 2e-4
+# at half the default counts.
+REGIONS = {"math_nodes": (math_regions, 1e-4), "vector_math": (vector_regions, 5e-4)}
 
 
 # Per-kind bounce limits (diffuse, glossy, transmission) set on both engines after the common
@@ -842,11 +965,14 @@ def run_case(name, out_dir, mode=None):
           f"{t_gdpt:.1f} s, Cycles {cycles_samples} spp {t_cycles:.1f} s)", flush=True)
     bad_regions = []
     if name in REGIONS:
-        for (label, ra), (_, rb) in zip(REGIONS[name](a), REGIONS[name](b)):
+        regions, bound = REGIONS[name]
+        worst = 0.0
+        for (label, ra), (_, rb) in zip(regions(a), regions(b)):
             e = S.rel_mse(ra, rb)
-            if not e < REGION_THRESHOLD:
+            worst = max(worst, e)
+            if not e < bound:
                 bad_regions.append(f"{label} {e:.2e}")
-        print(f"  {len(REGIONS[name](a))} regions, over {REGION_THRESHOLD:g}: "
+        print(f"  {len(regions(a))} regions, worst relMSE {worst:.2e}, over {bound:g}: "
               f"{', '.join(bad_regions) or 'none'}", flush=True)
     return err, ratio, bad_regions
 

@@ -292,6 +292,64 @@ TEST(Material, GlassNodes) {
   EXPECT_EQ(s[0].type, ClosureType::Transparent);
 }
 
+// A texture's vector can be any input node's result (TexCoordSource::Node): a Checker read at
+// Vector Math (UV + (0.3, 0, 0)) equals a Checker read at UV through a Mapping that adds the
+// same; a vector (a coordinate, a Vector Math Vector) read by a float socket is the mean of its
+// components (Cycles' vector-to-float conversion), a Value output is itself.
+TEST(Material, TexturesReadVectorsFromInputNodes) {
+  InputNode uv;
+  uv.kind = InputNodeKind::Coordinates;
+  InputNode shift;
+  shift.kind = InputNodeKind::VectorMath;
+  shift.vector_math = VectorMathOp::Add;
+  shift.a.node = 0;
+  shift.b = ColorInput(Spectrum(0.3f, 0.0f, 0.0f));
+  InputNode checker;
+  checker.kind = InputNodeKind::Checker;
+  checker.value_a = FloatInput(4.0f);
+  checker.a = ColorInput(Spectrum(0.9f));
+  checker.b = ColorInput(Spectrum(0.1f));
+  InputNode via_node = checker, via_mapping = checker;
+  via_node.vector.source = TexCoordSource::Node;
+  via_node.vector.node = 1;
+  via_mapping.vector.mapping.m[0][3] = 0.3f;
+  auto material = [&](const InputNode& tex) {
+    MaterialDesc d;
+    d.inputs = {uv, shift, tex};
+    ShaderNode n = node(ShaderNodeKind::Diffuse);
+    n.color.node = 2;
+    d.nodes.push_back(n);
+    d.root = 0;
+    return Material(d, {});
+  };
+  const Material a = material(via_node), b = material(via_mapping);
+  int dark = 0;
+  for (float u = 0.01f; u < 1.0f; u += 0.0731f)
+    for (float v = 0.02f; v < 1.0f; v += 0.0917f) {
+      const float ca = eval(a, {u, v})[0].weight.x, cb = eval(b, {u, v})[0].weight.x;
+      EXPECT_FLOAT_EQ(ca, cb) << u << "," << v;
+      dark += ca < 0.5f;
+    }
+  EXPECT_GT(dark, 20);  // both colours seen
+
+  // Float sockets: roughness from the shifted vector (mean), from the Length of the UV (itself).
+  InputNode length = shift;
+  length.vector_math = VectorMathOp::Length;
+  length.fac_output = true;
+  MaterialDesc d;
+  d.inputs = {uv, shift, length};
+  ShaderNode n = node(ShaderNodeKind::Diffuse);
+  n.roughness.node = 1;
+  d.nodes = {n};
+  d.root = 0;
+  EXPECT_NEAR(eval(Material(d, {}), {0.2f, 0.6f})[0].alpha, (0.5f + 0.6f) / 3.0f, 1e-6f);
+  d.nodes[0].roughness.node = 2;
+  EXPECT_NEAR(eval(Material(d, {}), {0.2f, 0.6f})[0].alpha, std::sqrt(0.04f + 0.36f), 1e-6f);
+  // A vector from a node that does not exist is an error at load.
+  via_node.vector.node = 7;
+  EXPECT_THROW(material(via_node), std::invalid_argument);
+}
+
 TEST(Material, AverageEmissionUsesTextureMeans) {
   ImageDesc img;
   img.width = 2;
