@@ -178,6 +178,7 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       r = Spectrum(in.color(n.a)[std::min<int>(n.channel, 2)]);
       break;
     case InputNodeKind::Combine:
+    case InputNodeKind::CombineXyz:
       r = Spectrum(in.scalar(n.value_a), in.scalar(n.value_b), in.scalar(n.value_c));
       break;
     case InputNodeKind::Gamma: {
@@ -293,7 +294,8 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
 template <class Inputs>
 float input_node_scalar(const InputNode& n, const Inputs& in) {
   const Spectrum r = input_node_result(n, in);
-  if ((n.kind == InputNodeKind::Coordinates || n.kind == InputNodeKind::VectorMath) &&
+  if ((n.kind == InputNodeKind::Coordinates || n.kind == InputNodeKind::VectorMath ||
+       n.kind == InputNodeKind::CombineXyz) &&
       !n.fac_output)
     return (r.x + r.y + r.z) * (1.0f / 3.0f);
   const bool grey = n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||

@@ -61,13 +61,14 @@ struct FloatInput {
 // Colour and math nodes between textures / constants and shader inputs, with Cycles' semantics
 // (kernel/svm/mix.h, math_util.h, invert.h). Results are colours (a Math result is grey).
 enum class InputNodeKind : uint8_t {
-  Mix,       // Blender's Mix (colour) / MixRGB: blend of a and b by fac, `blend` below
-  Math,      // Blender's Math on value_a, value_b: `math` below
-  Invert,    // mix(a, 1 - a, fac)
-  Ramp,      // Blender's Color Ramp read at fac: `ramp` table, Cycles' lookup (rgb_ramp_lookup)
-  Separate,  // one channel (`channel`) of a, as grey (Separate RGB / Separate Color in RGB)
-  Combine,   // (value_a, value_b, value_c) (Combine RGB / Combine Color in RGB)
-  Gamma,     // a^value_a per positive channel; 1 for gamma 0 (svm_math_gamma_color)
+  Mix,         // Blender's Mix (colour) / MixRGB: blend of a and b by fac, `blend` below
+  Math,        // Blender's Math on value_a, value_b: `math` below
+  Invert,      // mix(a, 1 - a, fac)
+  Ramp,        // Blender's Color Ramp read at fac: `ramp` table, Cycles' lookup (rgb_ramp_lookup)
+  Separate,    // one channel (`channel`) of a, as grey (Separate RGB / Separate Color in RGB)
+  Combine,     // (value_a, value_b, value_c) (Combine RGB / Combine Color in RGB)
+  CombineXyz,  // the vector (value_a, value_b, value_c) (Combine XYZ)
+  Gamma,       // a^value_a per positive channel; 1 for gamma 0 (svm_math_gamma_color)
   BrightContrast,  // max((1 + c) a + b - c / 2, 0), b = value_a, c = value_b
   HueSaturation,   // Hue/Saturation/Value of a: hue value_a, saturation value_b, value value_c,
                    // blended by fac (svm_node_hsv)

@@ -27,7 +27,7 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
                 'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
-                'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH'}
+                'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH', 'COMBXYZ'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -355,6 +355,9 @@ class _Translator:
             d = {"kind": "SEPARATE", "a": self.color(node.inputs[0]), "channel": channel}
         elif node.type == 'COMBRGB' or (node.type == 'COMBINE_COLOR' and node.mode == 'RGB'):
             d = {"kind": "COMBINE", "value_a": self.value(node.inputs[0]),
+                 "value_b": self.value(node.inputs[1]), "value_c": self.value(node.inputs[2])}
+        elif node.type == 'COMBXYZ':
+            d = {"kind": "COMBINE_XYZ", "value_a": self.value(node.inputs[0]),
                  "value_b": self.value(node.inputs[1]), "value_c": self.value(node.inputs[2])}
         elif node.type == 'GAMMA':
             d = {"kind": "GAMMA", "a": self.color(node.inputs["Color"]),

@@ -136,6 +136,7 @@ InputNode read_input_node(const py::dict& d) {
       {"RAMP", InputNodeKind::Ramp},
       {"SEPARATE", InputNodeKind::Separate},
       {"COMBINE", InputNodeKind::Combine},
+      {"COMBINE_XYZ", InputNodeKind::CombineXyz},
       {"GAMMA", InputNodeKind::Gamma},
       {"BRIGHT_CONTRAST", InputNodeKind::BrightContrast},
       {"HUE_SAT", InputNodeKind::HueSaturation},

@@ -773,7 +773,8 @@ VECTOR_OPS = ['ADD', 'SUBTRACT', 'MULTIPLY', 'DIVIDE', 'MULTIPLY_ADD', 'CROSS_PR
               'NORMALIZE', 'SNAP', 'FLOOR', 'CEIL', 'MODULO', 'WRAP', 'FRACTION', 'ABSOLUTE',
               'MINIMUM', 'MAXIMUM', 'SINE', 'COSINE', 'TANGENT']
 VECTOR_EXTRAS = ['checker at noise-distorted coordinates', 'image at a Vector Math vector',
-                 'strength from a vector', 'gradient through a Mapping of a node vector']
+                 'strength from a vector', 'gradient through a Mapping of a node vector',
+                 'Combine XYZ as a vector and a strength']
 VECTOR_RESOLUTION = (256, 256)  # 21 x 21 m seen
 VECTOR_ROWS = 16
 
@@ -868,8 +869,21 @@ def case_vector_math(scene):
         nt.links.new(mapping.outputs["Vector"], gradient.inputs["Vector"])
         nt.links.new(gradient.outputs["Color"], emit.inputs["Color"])
 
+    def combined_xyz(nt, emit, generated):
+        xyz = nt.nodes.new("ShaderNodeSeparateXYZ")
+        nt.links.new(generated, xyz.inputs["Vector"])
+        combine = nt.nodes.new("ShaderNodeCombineXYZ")
+        nt.links.new(xyz.outputs["Y"], combine.inputs["X"])
+        nt.links.new(xyz.outputs["X"], combine.inputs["Y"])
+        combine.inputs["Z"].default_value = 0.3
+        wave = nt.nodes.new("ShaderNodeTexWave")
+        wave.inputs["Scale"].default_value = 3.0
+        nt.links.new(combine.outputs["Vector"], wave.inputs["Vector"])
+        nt.links.new(wave.outputs["Color"], emit.inputs["Color"])
+        nt.links.new(combine.outputs["Vector"], emit.inputs["Strength"])
+
     for k, build in enumerate((distorted_checker, image_at_vector, strength_from_vector,
-                               mapped_gradient)):
+                               mapped_gradient, combined_xyz)):
         strip(len(VECTOR_OPS) + k, build)
     S.camera((0, 0, 10), (0, 0, 0), ortho_scale=21.0)
     scene.world.color = (0, 0, 0)
