@@ -338,6 +338,7 @@ class GradientPathTracer final : public Integrator {
       : ctx_(ctx),
         settings_(settings),
         has_world_(ctx.lights().has_environment()),
+        has_camera_world_(ctx.lights().has_camera_environment()),
         has_visible_lamps_(ctx.lights().has_camera_visible_lights()),
         has_dof_(ctx.camera().has_dof()),
         has_emissive_((ctx.features() & kSceneEmissiveTriangles) != 0),
@@ -681,8 +682,8 @@ class GradientPathTracer final : public Integrator {
     if (!camera_found) {
       if (settings_.transparent_background)
         out.alpha = 0.0f;
-      else if (has_world_ && !holdout)
-        out.emission += lights.environment(cam_ray.direction);
+      else if (has_camera_world_ && !holdout)
+        out.emission += lights.camera_environment(cam_ray.direction);
       for (Vec3d& g : out.grad) g = Vec3d();
       return;
     }
@@ -941,7 +942,9 @@ class GradientPathTracer final : public Integrator {
         kinds.add(ray.kind);
       }
       camera_path = camera_path && crossing;
-      const bool world_seen = has_world_ && !(camera_path && settings_.transparent_background);
+      // A camera path (transparent crossings only) sees the world as camera rays do.
+      const bool world_seen =
+          camera_path ? has_camera_world_ && !settings_.transparent_background : has_world_;
       // The hit goes straight into the next vertex. Its end point only ends the path at the last
       // bounce: no vertex set-up there (the offsets' shifts need its classification alone), and
       // no hit record either when no offset shifts and no triangle emits (as PT).
@@ -1072,8 +1075,9 @@ class GradientPathTracer final : public Integrator {
         if (!found) {
           if (camera_path && settings_.transparent_background) out.alpha = uncovered_alpha(beta);
           if (world_seen && !base_holdout) {
-            le = lights.environment(ray.direction);
-            if (!delta && !is_black(le)) pl = lights.pdf_environment(ray.direction);
+            le = camera_path ? lights.camera_environment(ray.direction)
+                             : lights.environment(ray.direction);
+            if (!delta && !camera_path && !is_black(le)) pl = lights.pdf_environment(ray.direction);
           }
         } else {
           le = triangle_le(next, base.hit.position);
@@ -1095,7 +1099,8 @@ class GradientPathTracer final : public Integrator {
           PathDensities d_off{0.0, 0.0, 0.0};
           const float pl_pair = o.nee_on ? pl : 0.0f;
           if (o.alive)
-            end_event(o, found, world_seen, next, le, pl_pair, !delta && o.nee_on, co, d_off);
+            end_event(o, found, world_seen, camera_path, next, le, pl_pair, !delta && o.nee_on, co,
+                      d_off);
           if (is_zero(cb) && is_zero(co)) continue;
           const double w =
               shift::mis_weight_over_pdf(PathDensities{pb, pl_pair, pdf_b}, d_off, pdf_b);
@@ -1364,9 +1369,10 @@ class GradientPathTracer final : public Integrator {
   // (world when !found, emissive triangle `next` otherwise). `nee_on`: the pair shifts light
   // sampling here, so the offset's own light density counts.
   // `world_seen`: the world emits into this segment (not with a transparent background on the
-  // camera path).
-  void end_event(const Offset& o, bool found, bool world_seen, const SurfaceHit& next, Spectrum le,
-                 float pl_pair, bool nee_on, Vec3d& co, PathDensities& d_off) const {
+  // camera path); `camera_path`: the segment is still a camera ray's (it sees the camera view).
+  void end_event(const Offset& o, bool found, bool world_seen, bool camera_path,
+                 const SurfaceHit& next, Spectrum le, float pl_pair, bool nee_on, Vec3d& co,
+                 PathDensities& d_off) const {
     const LightSampler& lights = ctx_.lights();
     switch (o.shift) {
       case Shift::Follow:
@@ -1397,7 +1403,9 @@ class GradientPathTracer final : public Integrator {
         Spectrum le_o(0.0f);
         float pl_o = 0.0f;
         if (!found) {
-          if (world_seen && !o.holdout_end) le_o = lights.environment(o.ray.direction);
+          if (world_seen && !o.holdout_end)
+            le_o = camera_path ? lights.camera_environment(o.ray.direction)
+                               : lights.environment(o.ray.direction);
           if (nee_on && !is_black(le_o)) pl_o = lights.pdf_environment(o.ray.direction);
         } else {
           le_o = triangle_le(o.next_hit, o.v.hit.position);
@@ -1449,6 +1457,7 @@ class GradientPathTracer final : public Integrator {
   const SceneContext& ctx_;
   RenderSettings settings_;
   bool has_world_ = false;
+  bool has_camera_world_ = false;  // LightSampler::has_camera_environment
   bool has_visible_lamps_ = false;
   bool has_dof_ = false;
   bool has_emissive_ = false;

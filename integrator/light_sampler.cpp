@@ -85,6 +85,12 @@ struct LightSampler::Impl {
   Spectrum world_radiance(Vec3f d) const {
     return environment ? environment->eval(d) : world_constant;
   }
+
+  // World::camera_view, when set: a constant or an environment map (never sampled as a light).
+  bool camera_view = false;
+  bool camera_enabled = false;  // non-black
+  Spectrum camera_constant{0.0f, 0.0f, 0.0f};
+  std::optional<EnvironmentMap> camera_environment;
   float world_pdf(Vec3f d) const { return environment ? environment->pdf(d) : kInv4Pi; }
 };
 
@@ -216,6 +222,19 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
       weights.push_back(p);
     } else {
       I.world_constant = Spectrum(0.0f);
+    }
+  }
+
+  if (w.camera_view) {
+    const World::CameraView& v = *w.camera_view;
+    I.camera_view = true;
+    if (v.image >= 0 && size_t(v.image) < scene.images.size()) {
+      I.camera_environment.emplace(scene.images[size_t(v.image)], v.rotation, v.strength);
+      I.camera_enabled = !I.camera_environment->black();
+    } else {
+      I.camera_constant = max(v.color * v.strength, Spectrum(0.0f));
+      I.camera_enabled =
+          !is_black(I.camera_constant) && std::isfinite(luminance(I.camera_constant));
     }
   }
 
@@ -394,6 +413,18 @@ bool LightSampler::intersect_any(Vec3f origin, Vec3f direction, float t_max, Lig
 Spectrum LightSampler::environment(Vec3f direction) const {
   const Impl& I = *impl_;
   return I.world_enabled ? I.world_radiance(direction) : Spectrum(0.0f);
+}
+
+Spectrum LightSampler::camera_environment(Vec3f direction) const {
+  const Impl& I = *impl_;
+  if (!I.camera_view) return environment(direction);
+  if (!I.camera_enabled) return Spectrum(0.0f);
+  return I.camera_environment ? I.camera_environment->eval(direction) : I.camera_constant;
+}
+
+bool LightSampler::has_camera_environment() const {
+  const Impl& I = *impl_;
+  return I.camera_view ? I.camera_enabled : I.world_enabled;
 }
 
 float LightSampler::pdf_environment(Vec3f direction) const {

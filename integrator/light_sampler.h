@@ -56,6 +56,9 @@ class LightSampler {
   Spectrum environment(Vec3f direction) const;
   float pdf_environment(Vec3f direction) const;
   bool has_environment() const;
+  // The world as camera rays see it (World::camera_view, else the lighting world above).
+  Spectrum camera_environment(Vec3f direction) const;
+  bool has_camera_environment() const;
   // Some analytic lamp is visible to camera rays (Light::camera_visible).
   bool has_camera_visible_lights() const;  // world is non-black
 

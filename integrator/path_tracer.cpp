@@ -176,10 +176,10 @@ class PathTracer final : public Integrator {
       if (!found) {
         if (camera_path && settings_.transparent_background) out.alpha = uncovered_alpha(beta);
         if constexpr (kWorld) {
-          const Spectrum le = lights.environment(ray.direction);
-          if (camera_path) {
-            if (!settings_.transparent_background) out.emission += beta * le;
-          } else if (!is_black(le)) {
+          if (camera_path) {  // the world as camera rays see it (World::camera_view)
+            if (!settings_.transparent_background)
+              out.emission += beta * lights.camera_environment(ray.direction);
+          } else if (const Spectrum le = lights.environment(ray.direction); !is_black(le)) {
             const float w = prev_delta
                                 ? 1.0f
                                 : power_heuristic(prev_pdf, lights.pdf_environment(ray.direction));

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -118,6 +119,16 @@ struct World {
   float strength = 1.0f;
   int32_t image = -1;  // equirectangular environment in Scene::images; -1 = constant colour
   Transform rotation;  // world direction -> environment lookup direction (Mapping node rotation)
+  // What camera rays see of the world instead, when its node tree gives them their own
+  // background (a Mix Shader by Light Path's Is Camera Ray): the same fields. The background
+  // above lights the scene (every other ray).
+  struct CameraView {
+    Spectrum color{0.0f, 0.0f, 0.0f};
+    float strength = 1.0f;
+    int32_t image = -1;
+    Transform rotation;
+  };
+  std::optional<CameraView> camera_view;
 };
 
 struct Scene {

@@ -52,6 +52,8 @@ void validate(const Scene& scene, std::vector<std::string>& warnings) {
                                   std::to_string(size_t(img.width) * img.height * 4));
   if (scene.world.image >= int32_t(scene.images.size()))
     throw std::invalid_argument("scene: world image index out of range");
+  if (scene.world.camera_view && scene.world.camera_view->image >= int32_t(scene.images.size()))
+    throw std::invalid_argument("scene: camera-view world image index out of range");
 }
 
 }  // namespace
@@ -92,7 +94,7 @@ SceneContext::SceneContext(const Scene& scene, const RenderSettings& settings) :
   if (f & kFeatureEmission) f |= kSceneEmissiveTriangles;
   if (scene.camera.aperture_radius > 0.0f) f |= kSceneDoF;
   if (scene.camera.projection == Camera::Projection::Orthographic) f |= kSceneOrthographic;
-  if (lights_->has_environment()) f |= kSceneWorld;
+  if (lights_->has_environment() || lights_->has_camera_environment()) f |= kSceneWorld;
   if (scene.world.image >= 0) f |= kSceneWorldImage | kSceneWorld;
   for (const Light& l : scene.lights) {
     switch (l.type) {

@@ -1,5 +1,6 @@
 # The world -> Scene::World dict: a constant colour, or an equirectangular Environment Texture
-# (optionally rotated by a Mapping node), times the Background strength.
+# (optionally rotated by a Mapping node), times the Background strength; optionally a second
+# such Background that camera rays see (Light Path's Is Camera Ray).
 import numpy as np
 from mathutils import Euler
 
@@ -21,23 +22,55 @@ def _source(socket):
     return None
 
 
+BLACK = {"color": (0.0, 0.0, 0.0), "strength": 0.0}
+
+
 def world_dict(world, images, warn):
+    """The world's Background (colour or environment texture, strength); with "camera": the
+    Background camera rays see instead, when the Surface is a Mix Shader whose factor is Light
+    Path's Is Camera Ray (the lighting one on its first shader input, the camera's on the
+    second)."""
     if world is None:
-        return {"color": (0.0, 0.0, 0.0), "strength": 0.0}
+        return dict(BLACK)
     if not world.use_nodes or world.node_tree is None:
         return {"color": tuple(world.color), "strength": 1.0}
     outputs = [n for n in world.node_tree.nodes
                if n.type == 'OUTPUT_WORLD' and n.is_active_output and not n.mute]
     if not outputs:
-        return {"color": (0.0, 0.0, 0.0), "strength": 0.0}
+        return dict(BLACK)
     out = _source(outputs[0].inputs["Surface"])
     if out is None:
-        return {"color": (0.0, 0.0, 0.0), "strength": 0.0}
-    background = out.node
-    if background.type != 'BACKGROUND':
-        warn(f"world '{world.name}': node '{background.name}' ({background.bl_idname}) is not "
+        return dict(BLACK)
+    node = out.node
+    if node.type == 'MIX_SHADER':
+        fac = _source(node.inputs[0])
+        if fac is not None and fac.node.type == 'LIGHT_PATH' and fac.name == "Is Camera Ray":
+            d = _background_of(world, node.inputs[1], images, warn)
+            d["camera"] = _background_of(world, node.inputs[2], images, warn)
+            return d
+        warn(f"world '{world.name}': a Mix Shader is supported with Light Path's Is Camera Ray "
+             f"as its factor only; using its first shader")
+        return _background_of(world, node.inputs[1], images, warn)
+    if node.type != 'BACKGROUND':
+        warn(f"world '{world.name}': node '{node.name}' ({node.bl_idname}) is not "
              f"supported by Gradient PT; using the world colour")
         return {"color": tuple(world.color), "strength": 1.0}
+    return _background(world, node, images, warn)
+
+
+def _background_of(world, socket, images, warn):
+    """_background() of the Background node feeding a shader socket (none: black)."""
+    out = _source(socket)
+    if out is None:
+        return dict(BLACK)
+    if out.node.type != 'BACKGROUND':
+        warn(f"world '{world.name}': node '{out.node.name}' ({out.node.bl_idname}) is not "
+             f"supported by Gradient PT; using black")
+        return dict(BLACK)
+    return _background(world, out.node, images, warn)
+
+
+def _background(world, background, images, warn):
     d = {
         "color": tuple(background.inputs["Color"].default_value)[:3],
         "strength": float(background.inputs["Strength"].default_value),

@@ -918,6 +918,18 @@ void SceneBuilder::set_world(const py::dict& d) {
   if (w.image >= int32_t(scene_.images.size()))
     throw std::invalid_argument("world: image index out of range");
   get_transform(d, "rotation", w.rotation);
+  // {"camera": the same keys}: the background camera rays see (World::camera_view).
+  if (d.contains("camera")) {
+    const auto c = d["camera"].cast<py::dict>();
+    World::CameraView v;
+    get_vec3(c, "color", v.color);
+    get(c, "strength", v.strength);
+    get(c, "image", v.image);
+    if (v.image >= int32_t(scene_.images.size()))
+      throw std::invalid_argument("world: camera-view image index out of range");
+    get_transform(c, "rotation", v.rotation);
+    w.camera_view = v;
+  }
 }
 
 }  // namespace gdpt::python

@@ -182,6 +182,30 @@ def case_world_hdri(scene):
     return 3
 
 
+def case_world_camera_view(scene):
+    # The classic world set-up: the HDRI of world_hdri lights the scene while camera rays see a
+    # plain colour, a Mix Shader whose factor is Light Path's Is Camera Ray; a glass-free
+    # Transparent sheet in front of part of the sky keeps the camera's view (a camera ray crossing
+    # a transparent surface stays a camera ray), and a mirror ball reflects the HDRI.
+    case_world_hdri(scene)
+    nt = scene.world.node_tree
+    out = nt.nodes["World Output"]
+    lighting = nt.nodes["Background"]
+    seen = nt.nodes.new("ShaderNodeBackground")
+    seen.inputs["Color"].default_value = (0.05, 0.1, 0.2, 1.0)
+    seen.inputs["Strength"].default_value = 1.5
+    path = nt.nodes.new("ShaderNodeLightPath")
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    nt.links.new(path.outputs["Is Camera Ray"], mix.inputs[0])
+    nt.links.new(lighting.outputs[0], mix.inputs[1])
+    nt.links.new(seen.outputs[0], mix.inputs[2])
+    nt.links.new(mix.outputs[0], out.inputs["Surface"])
+    sheet = S.shader_material("sheet", "ShaderNodeBsdfTransparent", Color=(0.6, 0.8, 1.0, 1))
+    S.plane("sheet", 1.5, (-1.6, 0.0, 2.2), rotation=(math.radians(90), 0, 0), material=sheet)
+    S.uv_sphere("mirror", 0.5, (1.5, 0.5, 0.5), S.glossy("mirror", 0.05))
+    return 3
+
+
 def case_image_texture(scene):
     lit_room(scene)
     area_ceiling(size=2.0, energy=200.0)
@@ -941,7 +965,7 @@ KIND_LIMITS = {"bounce_limits": (1, 2, 3)}
 
 # Cases whose GDPT side is also rendered in PT mode (Combined = Primal + Emission): what the
 # camera sees directly must not depend on the integrator.
-BOTH_MODES = {"normal_map", "clearcoat", "area_visible", "area_camera_visible", "ray_visibility", "holdout",
+BOTH_MODES = {"normal_map", "clearcoat", "world_camera_view", "area_visible", "area_camera_visible", "ray_visibility", "holdout",
               "bounce_limits", "no_shadow", "transparent_shadow"}
 
 

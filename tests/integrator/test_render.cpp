@@ -702,6 +702,50 @@ TEST(Render, TransparentSurfacesPassLightAndAreNotBounces) {
 
 // Disk area light seen from the floor through a transparent sheet: the BSDF-hit MIS weight must
 // use the light's density from the floor vertex (where NEE ran), not from the sheet.
+// A world whose camera rays see their own background (World::camera_view, Blender's Mix of two
+// Backgrounds by Light Path's Is Camera Ray): a Lambert floor (albedo 0.5) under the lighting
+// sky A is lit by A alone (L = 0.5 A: uniform sky over an unobstructed plane), the camera looking
+// up sees the camera view V, and through a Transparent sheet (colour T) it still sees T V, as a
+// camera ray crossing a transparent surface stays a camera ray. PT and G-PT (primal + emission:
+// G-PT takes paths through the sheet into the primal).
+TEST(Render, CameraRaysSeeTheWorldsCameraView) {
+  const Spectrum a(0.5f, 0.4f, 0.3f), view(0.1f, 0.2f, 0.45f), tint(0.5f, 0.25f, 1.0f);
+  struct Case {
+    const char* name;
+    bool floor, up, sheet;
+    Spectrum expect;
+  };
+  const Case cases[] = {
+      {"floor lit by the lighting world", true, false, false, a * 0.5f},
+      {"sky seen by the camera", false, true, false, view * 2.0f},
+      {"sky through a transparent sheet", false, true, true, view * 2.0f * tint},
+  };
+  for (const Case& c : cases)
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      Scene scene;
+      scene.world.color = a;
+      scene.world.camera_view = World::CameraView{view, 2.0f, -1, Transform()};
+      scene.meshes.push_back(quad(50.0f));
+      scene.materials.push_back(c.sheet ? transparent(tint) : diffuse(Spectrum(0.5f)));
+      // The floor at z = 0; the sheet at z = 12, above a camera at z = 10 looking up (+z).
+      scene.instances.push_back(place(0, 0, translation({0.0f, 0.0f, c.sheet ? 12.0f : 0.0f})));
+      if (!c.floor && !c.sheet) scene.instances.clear();
+      scene.camera = top_camera(8, 2.0f);
+      if (c.up) scene.camera.camera_to_world = rotation_x(kPi, {0.0f, 0.0f, 10.0f});
+      RenderSettings s = pt(16);
+      s.mode = mode;
+      s.max_bounces = 0;
+      const Image img = render(scene, s);
+      for (int ch = 0; ch < 3; ++ch) {
+        double sum = 0.0;
+        for (size_t i = size_t(ch); i < img.primal.size(); i += 3)
+          sum += img.primal[i] + img.emission[i];
+        EXPECT_NEAR(sum / double(img.primal.size() / 3), c.expect[ch], 2e-3 * (1.0 + c.expect[ch]))
+            << c.name << " channel " << ch << " G-PT " << (mode == RenderSettings::Mode::GPT);
+      }
+    }
+}
+
 TEST(Render, AreaLightThroughTransparentSheetMis) {
   const float R = 0.8f, h = 1.0f;
   Light disk;
