@@ -121,6 +121,7 @@ bool reads_vector(InputNodeKind kind) {
     case InputNodeKind::Musgrave:
     case InputNodeKind::WhiteNoise:
     case InputNodeKind::Magic:
+    case InputNodeKind::Brick:
       return true;
     default:
       return false;
@@ -255,6 +256,19 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       const Spectrum c = magic_texture(in.vector(n.vector) * in.scalar(n.value_a), n.magic_depth,
                                        in.scalar(n.value_b));
       r = n.fac_output ? Spectrum((c.x + c.y + c.z) / 3.0f) : c;
+      break;
+    }
+    case InputNodeKind::Brick: {
+      const BrickSample b = brick_texture(
+          in.vector(n.vector) * in.scalar(n.value_a), n.brick, in.scalar(n.value_b),
+          in.scalar(n.value_c), in.scalar(n.value_d), in.scalar(n.value_e), in.scalar(n.value_f));
+      if (n.fac_output) {
+        r = Spectrum(b.mortar);
+        break;
+      }
+      Spectrum brick = in.color(n.a);
+      if (b.mortar != 1.0f) brick = brick * (1.0f - b.tint) + in.color(n.b) * b.tint;
+      r = brick * (1.0f - b.mortar) + in.color(n.c) * b.mortar;
       break;
     }
     case InputNodeKind::WhiteNoise: {

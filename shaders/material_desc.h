@@ -96,6 +96,9 @@ enum class InputNodeKind : uint8_t {
                    // value_b, dimension value_c, lacunarity value_d, offset value_e, gain value_f
   VectorMath,      // Vector Math `vector_math` of vectors a, b, c and scale value_a: the Vector,
                    // or the Value (fac_output, as grey)
+  Brick,           // Brick Texture `brick` at `vector` x scale value_a: colours a, b, mortar c;
+                   // mortar size value_b, smooth value_c, bias value_d, brick width value_e, row
+                   // height value_f; Color, or the mortar factor (Fac, fac_output)
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -141,6 +144,7 @@ struct InputNode {
   uint8_t noise_dimensions = 3;  // Noise: 1, 2, 3 or 4
   uint8_t magic_depth = 2;       // Magic: 0 to 10
   MusgraveType musgrave_type = MusgraveType::Fbm;
+  BrickDesc brick;
 };
 
 enum class ShaderNodeKind : uint8_t {

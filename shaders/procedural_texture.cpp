@@ -447,6 +447,50 @@ float musgrave_texture(Vec3f p, MusgraveType type, float detail, float dimension
   return 0.0f;
 }
 
+namespace {
+// The Brick Texture's per-brick value in [0, 1): an integer hash of 31 bits (Cycles'
+// brick_noise, unsigned arithmetic wrapping).
+float brick_hash(uint32_t n) {
+  n = (n + 1013u) & 0x7fffffffu;
+  n = (n >> 13) ^ n;
+  const uint32_t h = (n * (n * n * 60493u + 19990303u) + 1376312589u) & 0x7fffffffu;
+  return 0.5f * (float(h) / 1073741824.0f);
+}
+}  // namespace
+
+BrickSample brick_texture(Vec3f p, const BrickDesc& b, float mortar_size, float mortar_smooth,
+                          float bias, float brick_width, float row_height) {
+  const int row = int(std::floor(p.y / row_height));
+  float offset = 0.0f;
+  if (b.offset_frequency != 0 && b.squash_frequency != 0) {
+    // C's remainder (negative for negative rows), as Cycles.
+    if (row % b.squash_frequency == 0) brick_width *= b.squash;
+    if (row % b.offset_frequency == 0) offset = brick_width * b.offset;
+  }
+  const int column = int(std::floor((p.x + offset) / brick_width));
+  const float x = (p.x + offset) - brick_width * float(column);
+  const float y = p.y - row_height * float(row);
+  const uint32_t key = (uint32_t(row) << 16) + (uint32_t(column) & 0xffffu);
+  BrickSample s;
+  s.tint = std::clamp(brick_hash(key) + bias, 0.0f, 1.0f);
+  // Distance to the nearest edge of the brick, then the mortar band.
+  const float edge = std::min(std::min(x, y), std::min(brick_width - x, row_height - y));
+  if (edge >= mortar_size) {
+    s.mortar = 0.0f;
+  } else if (mortar_smooth == 0.0f) {
+    s.mortar = 1.0f;
+  } else {
+    const float depth = 1.0f - edge / mortar_size;  // 0 at the band's inner edge, 1 at the brick's
+    if (depth < mortar_smooth) {
+      const float t = depth / mortar_smooth;
+      s.mortar = t * t * (3.0f - 2.0f * t);
+    } else {
+      s.mortar = 1.0f;
+    }
+  }
+  return s;
+}
+
 Spectrum magic_texture(Vec3f p, int depth, float distortion) {
   const float d = distortion;
   float x = std::sin((p.x + p.y + p.z) * 5.0f);

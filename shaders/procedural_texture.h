@@ -95,6 +95,26 @@ Spectrum white_noise_color(Vec3f p);
 // (0 to 10) more times into each other, scaled by distortion (Cycles' svm_magic).
 Spectrum magic_texture(Vec3f p, int depth, float distortion);
 
+// The Brick Texture at p (already scaled), as Cycles 3.4's svm_brick: rows of height row_height
+// holding bricks of width brick_width; every offset_frequency-th row (rows counted from 0, so
+// row 0 too) shifts by offset * width and every squash_frequency-th row's bricks are `squash`
+// times as wide (neither when either frequency is 0). Returns the brick's tint (an integer hash
+// of its row and column, plus bias, clamped to [0, 1]) and the mortar factor (1 within
+// mortar_size of the brick's edges, 0 beyond; with mortar_smooth > 0 the edge of that band is a
+// smoothstep over the last mortar_smooth of it).
+struct BrickDesc {
+  float offset = 0.5f;
+  int offset_frequency = 2;
+  float squash = 1.0f;
+  int squash_frequency = 2;
+};
+struct BrickSample {
+  float tint;
+  float mortar;
+};
+BrickSample brick_texture(Vec3f p, const BrickDesc& brick, float mortar_size, float mortar_smooth,
+                          float bias, float brick_width, float row_height);
+
 // Bob Jenkins' lookup3 hashes of 1 to 4 words (Cycles' hash_uint, hash_uint2 / 3 / 4).
 uint32_t hash_words(uint32_t a);
 uint32_t hash_words(uint32_t a, uint32_t b);

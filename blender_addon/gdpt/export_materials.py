@@ -27,7 +27,8 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
                 'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
-                'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH', 'COMBXYZ'}
+                'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH', 'COMBXYZ',
+                'TEX_BRICK'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
@@ -308,7 +309,7 @@ class _Translator:
                                    'TEX_NOISE', 'TEX_COORD', 'SEPXYZ', 'TEX_VORONOI',
                                    'TEX_GRADIENT', 'TEX_WAVE', 'TEX_MUSGRAVE',
                                    'TEX_WHITE_NOISE', 'NEW_GEOMETRY', 'TEX_MAGIC',
-                                   'VECT_MATH'}
+                                   'VECT_MATH', 'TEX_BRICK'}
         key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
@@ -331,6 +332,19 @@ class _Translator:
             d = {"kind": "MATH", "op": node.operation, "clamp_result": bool(node.use_clamp),
                  "value_a": self.value(node.inputs[0]), "value_b": self.value(node.inputs[1]),
                  "value_c": self.value(node.inputs[2])}
+        elif node.type == 'TEX_BRICK':
+            i = node.inputs
+            d = {"kind": "BRICK", "a": self.color(i["Color1"]), "b": self.color(i["Color2"]),
+                 "c": self.color(i["Mortar"]), "value_a": self.value(i["Scale"]),
+                 "value_b": self.value(i["Mortar Size"]),
+                 "value_c": self.value(i["Mortar Smooth"]), "value_d": self.value(i["Bias"]),
+                 "value_e": self.value(i["Brick Width"]), "value_f": self.value(i["Row Height"]),
+                 "brick": {"offset": float(node.offset),
+                           "offset_frequency": int(node.offset_frequency),
+                           "squash": float(node.squash),
+                           "squash_frequency": int(node.squash_frequency)},
+                 "vector": self._vector(i["Vector"], 'GENERATED'),
+                 "fac_output": out.name == "Fac"}
         elif node.type == 'VECT_MATH':
             # Inputs: three vectors and the float Scale (IOR for Refract).
             d = {"kind": "VECTOR_MATH", "op": node.operation,

@@ -153,7 +153,8 @@ InputNode read_input_node(const py::dict& d) {
       {"MUSGRAVE", InputNodeKind::Musgrave},
       {"WHITE_NOISE", InputNodeKind::WhiteNoise},
       {"MAGIC", InputNodeKind::Magic},
-      {"VECTOR_MATH", InputNodeKind::VectorMath}};
+      {"VECTOR_MATH", InputNodeKind::VectorMath},
+      {"BRICK", InputNodeKind::Brick}};
   n.kind = get_enum(d, "kind", "MIX", kKinds, "input node kind");
   static const std::pair<const char*, MixBlend> kBlends[] = {{"MIX", MixBlend::Mix},
                                                              {"ADD", MixBlend::Add},
@@ -266,6 +267,14 @@ InputNode read_input_node(const py::dict& d) {
   get(d, "clamp_range", n.clamp_range);
   if (d.contains("vector")) read_vector(d["vector"].cast<py::dict>(), n.vector);
   get(d, "fac_output", n.fac_output);
+  // Brick: {"offset", "offset_frequency", "squash", "squash_frequency"} (the node's properties).
+  if (d.contains("brick")) {
+    const auto b = d["brick"].cast<py::dict>();
+    get(b, "offset", n.brick.offset);
+    get(b, "offset_frequency", n.brick.offset_frequency);
+    get(b, "squash", n.brick.squash);
+    get(b, "squash_frequency", n.brick.squash_frequency);
+  }
   get(d, "position_output", n.position_output);
   int dimensions = 3;
   get(d, "dimensions", dimensions);
@@ -806,7 +815,8 @@ int SceneBuilder::add_material(const py::dict& material) {
   for (const InputNode& node : desc.inputs)
     for (const TextureLookup* t :
          {&node.fac.texture, &node.a.texture, &node.b.texture, &node.c.texture,
-          &node.value_a.texture, &node.value_b.texture, &node.value_c.texture})
+          &node.value_a.texture, &node.value_b.texture, &node.value_c.texture,
+          &node.value_d.texture, &node.value_e.texture, &node.value_f.texture})
       if (t->image >= int32_t(scene_.images.size()))
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
   scene_.materials.push_back(std::move(desc));

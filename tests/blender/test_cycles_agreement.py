@@ -799,14 +799,44 @@ VECTOR_OPS = ['ADD', 'SUBTRACT', 'MULTIPLY', 'DIVIDE', 'MULTIPLY_ADD', 'CROSS_PR
 VECTOR_EXTRAS = ['checker at noise-distorted coordinates', 'image at a Vector Math vector',
                  'strength from a vector', 'gradient through a Mapping of a node vector',
                  'Combine XYZ as a vector and a strength']
-VECTOR_RESOLUTION = (256, 256)  # 21 x 21 m seen
+STRIP_RESOLUTION = (256, 256)  # 21 x 21 m seen
 VECTOR_ROWS = 16
 
 
-def _vector_strip(k):
-    """Centre (x, y) of strip k of the vector_math case: two columns of VECTOR_ROWS."""
-    column, row = divmod(k, VECTOR_ROWS)
-    return (-5.25 if column == 0 else 5.25), (row - (VECTOR_ROWS - 1) / 2) * 1.05
+def _strip_centre(k, rows, height):
+    """Centre (x, y) of strip k of an emissive_strips scene: two columns of `rows`."""
+    column, row = divmod(k, rows)
+    return (-5.25 if column == 0 else 5.25), (row - (rows - 1) / 2) * 1.05 * height
+
+
+def emissive_strips(scene, builds, rows, height=1.0):
+    """Emissive strips (9.5 x `height` m) seen head-on by an orthographic camera on a black world,
+    two columns of `rows`: build(node_tree, emission node, Generated output) colours strip k."""
+    for k, build in enumerate(builds):
+        m = S.shader_material(f"strip{k}", "ShaderNodeEmission", Strength=1.0)
+        nt = m.node_tree
+        emit = next(node for node in nt.nodes if node.type == 'EMISSION')
+        coords = nt.nodes.new("ShaderNodeTexCoord")
+        build(nt, emit, coords.outputs["Generated"])
+        x, y = _strip_centre(k, rows, height)
+        obj = S.plane(f"strip{k}", 1.0, (x, y, 0.0), material=m)
+        obj.scale = (9.5, height, 1.0)
+    S.camera((0, 0, 10), (0, 0, 0), ortho_scale=21.0)
+    scene.world.color = (0, 0, 0)
+    scene.render.resolution_x, scene.render.resolution_y = STRIP_RESOLUTION
+
+
+def strip_regions(image, labels, rows, height=1.0):
+    """(label, pixels) of each strip of an emissive_strips scene, 2 pixels inside its edges."""
+    ppm = STRIP_RESOLUTION[0] / 21.0
+    regions = []
+    for k, label in enumerate(labels):
+        x, y = _strip_centre(k, rows, height)
+        x, y = x + 10.5, y + 10.5
+        span_y = slice(int((y - height / 2) * ppm) + 2, int((y + height / 2) * ppm) - 2)
+        span_x = slice(int((x - 4.75) * ppm) + 2, int((x + 4.75) * ppm) - 2)
+        regions.append((label, image[span_y, span_x, :]))
+    return regions
 
 
 def case_vector_math(scene):
@@ -816,16 +846,6 @@ def case_vector_math(scene):
     # B = (1.3, -0.7, 0.9), C = (1.0, 0.5, -0.4); then VECTOR_EXTRAS.
     img = bpy.data.images.new("grid", 64, 64)
     img.generated_type = 'COLOR_GRID'
-
-    def strip(k, build):
-        m = S.shader_material(f"vector{k}", "ShaderNodeEmission", Strength=1.0)
-        nt = m.node_tree
-        emit = next(node for node in nt.nodes if node.type == 'EMISSION')
-        coords = nt.nodes.new("ShaderNodeTexCoord")
-        build(nt, emit, coords.outputs["Generated"])
-        x, y = _vector_strip(k)
-        obj = S.plane(f"strip{k}", 1.0, (x, y, 0.0), material=m)
-        obj.scale = (9.5, 1.0, 1.0)
 
     def vmath(nt, op, a, b=None, c=None, scale=1.3):
         node = nt.nodes.new("ShaderNodeVectorMath")
@@ -854,8 +874,6 @@ def case_vector_math(scene):
             nt.links.new(shown.outputs["Vector"], emit.inputs["Color"])
         return build
 
-    for k, op in enumerate(VECTOR_OPS):
-        strip(k, op_strip(op))
 
     def distorted_checker(nt, emit, generated):
         noise = nt.nodes.new("ShaderNodeTexNoise")
@@ -906,26 +924,62 @@ def case_vector_math(scene):
         nt.links.new(wave.outputs["Color"], emit.inputs["Color"])
         nt.links.new(combine.outputs["Vector"], emit.inputs["Strength"])
 
-    for k, build in enumerate((distorted_checker, image_at_vector, strength_from_vector,
-                               mapped_gradient, combined_xyz)):
-        strip(len(VECTOR_OPS) + k, build)
-    S.camera((0, 0, 10), (0, 0, 0), ortho_scale=21.0)
-    scene.world.color = (0, 0, 0)
-    scene.render.resolution_x, scene.render.resolution_y = VECTOR_RESOLUTION
+    emissive_strips(scene, [op_strip(op) for op in VECTOR_OPS] +
+                    [distorted_checker, image_at_vector, strength_from_vector, mapped_gradient,
+                     combined_xyz], VECTOR_ROWS)
     return 1
 
 
 def vector_regions(image):
-    """(label, pixels) of each strip of the vector_math case, 2 pixels inside its edges."""
-    ppm = VECTOR_RESOLUTION[0] / 21.0
-    regions = []
-    for k, label in enumerate(VECTOR_OPS + VECTOR_EXTRAS):
-        x, y = _vector_strip(k)
-        x, y = x + 10.5, y + 10.5
-        rows = slice(int((y - 0.5) * ppm) + 2, int((y + 0.5) * ppm) - 2)
-        cols = slice(int((x - 4.75) * ppm) + 2, int((x + 4.75) * ppm) - 2)
-        regions.append((label, image[rows, cols, :]))
-    return regions
+    return strip_regions(image, VECTOR_OPS + VECTOR_EXTRAS, VECTOR_ROWS)
+
+
+# Brick Texture settings, one strip each: (label, node properties, input values, output).
+BRICKS = [
+    ("default", {}, {}, "Color"),
+    # At mortar smooth 0 the Fac is binary: a wide, smooth band keeps anti-aliasing noise out.
+    ("Fac, mortar size 0.1, smooth 0.5", {}, {"Mortar Size": 0.1, "Mortar Smooth": 0.5}, "Fac"),
+    ("offset 0.3 every 3rd row, squash 0.6 every 2nd", {"offset": 0.3, "offset_frequency": 3,
+                                                       "squash": 0.6, "squash_frequency": 2}, {},
+     "Color"),
+    ("smooth mortar, bias -0.4, narrow rows", {}, {"Mortar Smooth": 0.6, "Bias": -0.4,
+                                                   "Row Height": 0.13, "Mortar Size": 0.05},
+     "Color"),
+    ("wide bricks, scale 9", {"offset": 0.7}, {"Brick Width": 0.9, "Scale": 9.0}, "Color"),
+    ("no offset rows (frequency 0)", {"offset_frequency": 0}, {"Bias": 0.3}, "Color"),
+]
+BRICK_ROWS, BRICK_HEIGHT = 3, 6.0
+
+
+def case_brick_texture(scene):
+    # Brick Textures (BRICKS) at Generated coordinates spanning negative and positive values
+    # (x 1.2 - 0.6, y 0.6 - 0.1), on emissive strips 9.5 x 6 m: bricks of 10 x 6 pixels.
+    def brick_strip(properties, inputs, output):
+        def build(nt, emit, generated):
+            span = nt.nodes.new("ShaderNodeVectorMath")
+            span.operation = 'MULTIPLY_ADD'
+            nt.links.new(generated, span.inputs[0])
+            span.inputs[1].default_value = (1.2, 0.6, 1.0)
+            span.inputs[2].default_value = (-0.6, -0.1, 0.0)
+            brick = nt.nodes.new("ShaderNodeTexBrick")
+            for key, value in properties.items():
+                setattr(brick, key, value)
+            brick.inputs["Color1"].default_value = (0.8, 0.3, 0.1, 1.0)
+            brick.inputs["Color2"].default_value = (0.2, 0.5, 0.9, 1.0)
+            brick.inputs["Mortar"].default_value = (0.9, 0.9, 0.8, 1.0)
+            for key, value in inputs.items():
+                brick.inputs[key].default_value = value
+            nt.links.new(span.outputs["Vector"], brick.inputs["Vector"])
+            nt.links.new(brick.outputs[output], emit.inputs["Color"])
+        return build
+
+    emissive_strips(scene, [brick_strip(p, i, o) for _, p, i, o in BRICKS], BRICK_ROWS,
+                    BRICK_HEIGHT)
+    return 1
+
+
+def brick_regions(image):
+    return strip_regions(image, [label for label, *_ in BRICKS], BRICK_ROWS, BRICK_HEIGHT)
 
 
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
@@ -955,7 +1009,8 @@ SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map
 # operation (Inverse Sqrt, near its pole); vector_math's strips with discontinuities (Refract's
 # total internal reflection, the distorted checker's edges) carry anti-aliasing noise, 1e-4 - 2e-4
 # at half the default counts.
-REGIONS = {"math_nodes": (math_regions, 1e-4), "vector_math": (vector_regions, 5e-4)}
+REGIONS = {"math_nodes": (math_regions, 1e-4), "vector_math": (vector_regions, 5e-4),
+           "brick_texture": (brick_regions, 5e-4)}
 
 
 # Per-kind bounce limits (diffuse, glossy, transmission) set on both engines after the common

@@ -74,7 +74,7 @@ def test_unsupported_node(out):
 def test_texture_limits(out):
     """Textures Gradient PT does not model are reported once each and the render finishes: a 2D
     Musgrave Texture (3D only), a Checker read at the Texture Coordinate node's Normal output, a
-    Voronoi Texture's F2 feature (F1 only), a Brick Texture."""
+    Voronoi Texture's F2 feature (F1 only), a Sky Texture."""
     scene = S.clear()
     basic_scene(scene)
     m, nt, outn = S._material("textures")
@@ -92,9 +92,9 @@ def test_texture_limits(out):
     voronoi.name = "My Voronoi"
     voronoi.feature = 'F2'
     nt.links.new(voronoi.outputs["Distance"], bsdf.inputs["Metallic"])
-    brick = nt.nodes.new("ShaderNodeTexBrick")
-    brick.name = "My Brick"
-    nt.links.new(brick.outputs["Fac"], bsdf.inputs["Specular"])
+    sky = nt.nodes.new("ShaderNodeTexSky")
+    sky.name = "My Sky"
+    nt.links.new(sky.outputs["Color"], bsdf.inputs["Emission"])
     nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
     S.uv_sphere("ball", 0.6, (0, 0.3, 0.6), m)
     path, warnings = render_finished(scene, os.path.join(out, "texture_limits.exr"))
@@ -102,7 +102,7 @@ def test_texture_limits(out):
                          ("output Normal of the texture coordinate node 'My Coordinates'",
                           "the Normal coordinates"),
                          ("mode 3D F2 of the input node 'My Voronoi'", "the Voronoi F2"),
-                         ("input node 'My Brick'", "the Brick texture")):
+                         ("input node 'My Sky'", "the Sky texture")):
         check(sum(needle in w for w in warnings) == 1, f"one warning names {what}")
     check(S.read_rgb(path).mean() > 0.01, "the image was written")
 

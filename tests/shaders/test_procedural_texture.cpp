@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <random>
 
@@ -253,6 +255,50 @@ TEST(ProceduralTexture, MagicFolds) {
   EXPECT_NEAR(c1.y, 0.5f + std::cos(x - y + z) * d / (2.0f * d), 1e-6f);
   EXPECT_NEAR(c1.z, 0.5f - z / (2.0f * d), 1e-6f);
   EXPECT_EQ(magic_texture(p, 3, 0.0f), Spectrum(0.5f));
+}
+
+// Brick Texture closed forms at Blender's defaults (width 0.5, row height 0.25, mortar 0.02,
+// offset 0.5 every 2nd row counted from row 0, squash 1): where a point falls in its brick
+// decides the mortar; the tint is one value per brick.
+TEST(ProceduralTexture, BrickRowsOffsetsAndMortar) {
+  auto at = [&](float x, float y, float smooth = 0.0f, const BrickDesc& d = BrickDesc()) {
+    return brick_texture(Vec3f(x, y, 0.0f), d, 0.02f, smooth, 0.0f, 0.5f, 0.25f);
+  };
+  // Row 1 (not offset): x 0.25 is a brick's centre, x 0.51 within 0.02 of its left edge.
+  EXPECT_EQ(at(0.25f, 0.375f).mortar, 0.0f);
+  EXPECT_EQ(at(0.51f, 0.375f).mortar, 1.0f);
+  EXPECT_EQ(at(0.25f, 0.26f).mortar, 1.0f);  // 0.01 above the row's bottom
+  // Row 0 is offset by half a brick: x 0.26 lies 0.01 past an edge there, mid-brick in row 1.
+  EXPECT_EQ(at(0.26f, 0.125f).mortar, 1.0f);
+  EXPECT_EQ(at(0.26f, 0.375f).mortar, 0.0f);
+  // Row -1 (-1 % 2 = -1, as C's remainder): not offset.
+  EXPECT_EQ(at(0.26f, -0.125f).mortar, 0.0f);
+  EXPECT_EQ(at(0.51f, -0.125f).mortar, 1.0f);
+  // Smooth mortar: at 0.015 from an edge the band depth is 1 - 0.015 / 0.02 = 0.25, half of the
+  // smooth width 0.5: smoothstep(0.5) = 0.5.
+  EXPECT_NEAR(at(0.265f, 0.375f, 0.5f).mortar, 0.0f, 1e-6f);
+  EXPECT_NEAR(at(0.515f, 0.375f, 0.5f).mortar, 0.5f, 1e-5f);
+  // Squash 0.5 on every 2nd row: row 0's bricks are 0.25 wide (offset 0.125).
+  BrickDesc squashed;
+  squashed.squash = 0.5f;
+  EXPECT_EQ(at(0.125f + 0.01f, 0.125f, 0.0f, squashed).mortar, 1.0f);  // 0.01 past an edge
+  EXPECT_EQ(at(0.25f, 0.125f, 0.0f, squashed).mortar, 0.0f);           // mid-brick
+  // Frequency 0: no offset or squash anywhere.
+  BrickDesc plain;
+  plain.offset_frequency = 0;
+  EXPECT_EQ(at(0.26f, 0.125f, 0.0f, plain).mortar, 0.0f);
+  // One tint per brick, in [0, 1], varying between bricks.
+  std::vector<float> tints;
+  for (int k = 0; k < 20; ++k) {
+    const float x = 0.5f * float(k) + 0.25f;
+    const float t = at(x, 0.375f).tint;
+    EXPECT_EQ(at(x + 0.1f, 0.4f).tint, t);
+    EXPECT_GE(t, 0.0f);
+    EXPECT_LE(t, 1.0f);
+    tints.push_back(t);
+  }
+  std::sort(tints.begin(), tints.end());
+  EXPECT_GT(std::unique(tints.begin(), tints.end()) - tints.begin(), 15);
 }
 
 }  // namespace
