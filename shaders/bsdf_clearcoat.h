@@ -18,12 +18,14 @@
 // alpha < kDeltaAlpha: a perfect mirror, value = weight F(cos_i), as Cycles.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "shaders/closure.h"
 #include "shaders/fresnel.h"
 #include "shaders/lobe_util.h"
 #include "shaders/microfacet.h"
+#include "shaders/reflection_lobe.h"
 
 namespace gdpt::clearcoat {
 
@@ -40,11 +42,8 @@ inline float gtr1(float a2, float cos_h) {
 // wi, wo already mirrored to wi.z > 0. Returns eval, writes the pdf.
 inline Spectrum eval_pdf_upper(const Closure& c, Vec3f wi, Vec3f wo, float& pdf) {
   pdf = 0.0f;
-  if (!(wi.z > 0.0f && wo.z > 0.0f)) return Spectrum(0.0f);
-  const Vec3f sum = wi + wo;
-  const float len2 = length_squared(sum);
-  if (!(len2 > 0.0f)) return Spectrum(0.0f);
-  const Vec3f h = sum / std::sqrt(len2);
+  Vec3f h;
+  if (!reflection_lobe::upper_half_vector(wi, wo, h)) return Spectrum(0.0f);
   const float cos_oh = dot(wo, h);
   if (!(cos_oh > 0.0f)) return Spectrum(0.0f);
   const float d = gtr1(c.alpha * c.alpha, h.z);
@@ -56,55 +55,32 @@ inline Spectrum eval_pdf_upper(const Closure& c, Vec3f wi, Vec3f wo, float& pdf)
 }
 
 inline Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo) {
-  if (is_delta_alpha(c.alpha) || !(wi.z * wo.z > 0.0f)) return Spectrum(0.0f);
-  const MirroredPair p(wi, wo);
-  float pdf;
-  return eval_pdf_upper(c, p.wi, p.wo, pdf);
+  return reflection_lobe::eval(c, wi, wo, eval_pdf_upper);
 }
 
 inline float pdf(const Closure& c, Vec3f wi, Vec3f wo) {
-  if (is_delta_alpha(c.alpha) || !(wi.z * wo.z > 0.0f)) return 0.0f;
-  const MirroredPair p(wi, wo);
-  const Vec3f sum = p.wi + p.wo;
-  const float len2 = length_squared(sum);
-  if (!(len2 > 0.0f)) return 0.0f;
-  const Vec3f h = sum / std::sqrt(len2);
-  const float cos_oh = dot(p.wo, h);
-  if (!(cos_oh > 0.0f) || !(h.z > 0.0f)) return 0.0f;
-  return gtr1(c.alpha * c.alpha, h.z) * h.z / (4.0f * cos_oh);
+  return reflection_lobe::pdf(c, wi, wo, [](const Closure& k, Vec3f, Vec3f o, Vec3f h) {
+    const float cos_oh = dot(o, h);
+    if (!(cos_oh > 0.0f) || !(h.z > 0.0f)) return 0.0f;
+    return gtr1(k.alpha * k.alpha, h.z) * h.z / (4.0f * cos_oh);
+  });
 }
 
-inline BsdfSample sample(const Closure& c, Vec3f wi_, float, Vec2f u) {
-  BsdfSample s;
-  if (wi_.z == 0.0f) return s;
-  const float sign = wi_.z < 0.0f ? -1.0f : 1.0f;
-  const Vec3f wi = flip_z(wi_, sign);
-  s.eta = 1.0f;
-  if (is_delta_alpha(c.alpha)) {
-    s.wo = flip_z(Vec3f(-wi.x, -wi.y, wi.z), sign);
-    s.value = c.weight * fresnel_dielectric(wi.z, kIor);
-    s.pdf = 1.0f;
-    s.roughness = 0.0f;
-    s.lobe = kLobeReflection | kLobeDelta;
-    s.valid = true;
-    return s;
-  }
-  // --- Half vector from D(h) cos theta_h (the alpha -> 1 limit is cos^2 = 1 - u).
+// Half vectors from D(h) cos theta_h (the alpha -> 1 limit is cos^2 = 1 - u).
+inline Vec3f sample_normal(const Closure& c, Vec3f, Vec2f u) {
   const float a2 = c.alpha * c.alpha;
   const float cos2 = a2 < 1.0f ? (1.0f - std::pow(a2, 1.0f - u.x)) / (1.0f - a2) : 1.0f - u.x;
   const float cos_h = std::sqrt(std::clamp(cos2, 0.0f, 1.0f));
   const float sin_h = std::sqrt(std::max(0.0f, 1.0f - cos_h * cos_h));
   const float phi = 2.0f * kPi * u.y;
-  const Vec3f h(sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h);
-  const Vec3f wo = reflect(wi, h);
-  if (wo.z <= 0.0f) return s;
-  s.value = eval_pdf_upper(c, wi, wo, s.pdf);
-  if (!(s.pdf > 0.0f)) return s;
-  s.wo = flip_z(wo, sign);
-  s.roughness = c.alpha;
-  s.lobe = kLobeReflection | kLobeGlossy;
-  s.valid = true;
-  return s;
+  return Vec3f(sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h);
+}
+
+inline BsdfSample sample(const Closure& c, Vec3f wi, float, Vec2f u) {
+  return reflection_lobe::sample(
+      c, wi, u,
+      [](const Closure& k, float cos_i) { return k.weight * fresnel_dielectric(cos_i, kIor); },
+      sample_normal, eval_pdf_upper);
 }
 
 // Cycles weights the clearcoat's selection by its Fresnel at the shading normal.

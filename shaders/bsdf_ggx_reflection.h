@@ -11,6 +11,7 @@
 #include "shaders/fresnel.h"
 #include "shaders/lobe_util.h"
 #include "shaders/microfacet.h"
+#include "shaders/reflection_lobe.h"
 
 namespace gdpt::ggx_reflection {
 
@@ -22,11 +23,8 @@ inline Spectrum fresnel(const Closure& c, float cos_h) {
 // wi, wo already mirrored to wi.z > 0. Returns eval, writes the pdf.
 inline Spectrum eval_pdf_upper(const Closure& c, Vec3f wi, Vec3f wo, float& pdf) {
   pdf = 0.0f;
-  if (!(wi.z > 0.0f && wo.z > 0.0f)) return Spectrum(0.0f);
-  const Vec3f sum = wi + wo;
-  const float len2 = length_squared(sum);
-  if (!(len2 > 0.0f)) return Spectrum(0.0f);
-  const Vec3f h = sum / std::sqrt(len2);
+  Vec3f h;
+  if (!reflection_lobe::upper_half_vector(wi, wo, h)) return Spectrum(0.0f);
   const GGX ggx(c.alpha);
   const float d = ggx.D(h);
   const float g1i = ggx.G1(wi);
@@ -36,49 +34,22 @@ inline Spectrum eval_pdf_upper(const Closure& c, Vec3f wi, Vec3f wo, float& pdf)
 }
 
 inline Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo) {
-  if (is_delta_alpha(c.alpha) || !(wi.z * wo.z > 0.0f)) return Spectrum(0.0f);
-  const MirroredPair p(wi, wo);
-  float pdf;
-  return eval_pdf_upper(c, p.wi, p.wo, pdf);
+  return reflection_lobe::eval(c, wi, wo, eval_pdf_upper);
 }
 
+// Density only: D(h) G1(wi) / (4 cos_i), without the Fresnel and G1(wo) of the value.
 inline float pdf(const Closure& c, Vec3f wi, Vec3f wo) {
-  if (is_delta_alpha(c.alpha) || !(wi.z * wo.z > 0.0f)) return 0.0f;
-  // Density only: D(h) G1(wi) / (4 cos_i), without the Fresnel and G1(wo) of the value.
-  const MirroredPair p(wi, wo);
-  const Vec3f sum = p.wi + p.wo;
-  const float len2 = length_squared(sum);
-  if (!(len2 > 0.0f)) return 0.0f;
-  const GGX ggx(c.alpha);
-  return ggx.D(sum / std::sqrt(len2)) * ggx.G1(p.wi) / (4.0f * p.wi.z);
+  return reflection_lobe::pdf(c, wi, wo, [](const Closure& k, Vec3f i, Vec3f, Vec3f h) {
+    const GGX ggx(k.alpha);
+    return ggx.D(h) * ggx.G1(i) / (4.0f * i.z);
+  });
 }
 
-inline BsdfSample sample(const Closure& c, Vec3f wi_, float, Vec2f u) {
-  BsdfSample s;
-  if (wi_.z == 0.0f) return s;
-  const float sign = wi_.z < 0.0f ? -1.0f : 1.0f;
-  const Vec3f wi = flip_z(wi_, sign);
-  s.eta = 1.0f;
-  if (is_delta_alpha(c.alpha)) {
-    s.wo = flip_z(Vec3f(-wi.x, -wi.y, wi.z), sign);
-    s.value = c.weight * fresnel(c, wi.z);
-    s.pdf = 1.0f;
-    s.roughness = 0.0f;
-    s.lobe = kLobeReflection | kLobeDelta;
-    s.valid = true;
-    return s;
-  }
-  const GGX ggx(c.alpha);
-  const Vec3f m = ggx.sample_visible(wi, u);
-  const Vec3f wo = reflect(wi, m);
-  if (wo.z <= 0.0f) return s;
-  s.value = eval_pdf_upper(c, wi, wo, s.pdf);
-  if (!(s.pdf > 0.0f)) return s;
-  s.wo = flip_z(wo, sign);
-  s.roughness = c.alpha;
-  s.lobe = kLobeReflection | kLobeGlossy;
-  s.valid = true;
-  return s;
+inline BsdfSample sample(const Closure& c, Vec3f wi, float, Vec2f u) {
+  return reflection_lobe::sample(
+      c, wi, u, [](const Closure& k, float cos_i) { return k.weight * fresnel(k, cos_i); },
+      [](const Closure& k, Vec3f i, Vec2f v) { return GGX(k.alpha).sample_visible(i, v); },
+      eval_pdf_upper);
 }
 
 // Cycles weights Principled specular selection by the Fresnel colour at the shading normal.

@@ -194,6 +194,14 @@ double lambert_radiance(double cosine) {
   return 0.5 * 3.0 * cosine / kPi;
 }
 
+// Mean of channel ch over the image: the primal, plus the emission when asked.
+double channel_mean(const Image& img, int ch, bool with_emission = false) {
+  double sum = 0.0;
+  for (size_t i = size_t(ch); i < img.primal.size(); i += 3)
+    sum += img.primal[i] + (with_emission ? img.emission[i] : 0.0f);
+  return sum / double(img.primal.size() / 3);
+}
+
 // Mean primal of a render of direct light only.
 double mean_direct(const Scene& scene, RenderSettings s) {
   s.max_bounces = 0;
@@ -278,10 +286,8 @@ TEST(Render, ColorAttributeIsTheInterpolatedCornerColour) {
       s.max_bounces = 0;
       const Image img = render(scene, s);
       for (int ch = 0; ch < 3; ++ch) {
-        double sum = 0.0;
-        for (size_t i = size_t(ch); i < img.primal.size(); i += 3) sum += img.primal[i];
         const double expect = with_colors ? c[ch] * 3.0 / kPi : 0.0;
-        EXPECT_NEAR(sum / (img.primal.size() / 3), expect, 1e-3 * (1.0 + expect))
+        EXPECT_NEAR(channel_mean(img, ch), expect, 1e-3 * (1.0 + expect))
             << "channel " << ch << " colours " << with_colors << " G-PT "
             << (mode == RenderSettings::Mode::GPT);
       }
@@ -737,10 +743,7 @@ TEST(Render, CameraRaysSeeTheWorldsCameraView) {
       s.max_bounces = 0;
       const Image img = render(scene, s);
       for (int ch = 0; ch < 3; ++ch) {
-        double sum = 0.0;
-        for (size_t i = size_t(ch); i < img.primal.size(); i += 3)
-          sum += img.primal[i] + img.emission[i];
-        EXPECT_NEAR(sum / double(img.primal.size() / 3), c.expect[ch], 2e-3 * (1.0 + c.expect[ch]))
+        EXPECT_NEAR(channel_mean(img, ch, true), c.expect[ch], 2e-3 * (1.0 + c.expect[ch]))
             << c.name << " channel " << ch << " G-PT " << (mode == RenderSettings::Mode::GPT);
       }
     }
