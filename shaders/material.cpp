@@ -238,9 +238,19 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       break;
     case InputNodeKind::Voronoi: {
       const float scale = in.scalar(n.value_a);
+      const Vec3f p = in.vector(n.vector) * scale;
+      const float randomness = saturate(in.scalar(n.value_b)), exponent = in.scalar(n.value_c);
+      using Feature = InputNode::VoronoiFeature;
+      if (n.voronoi_feature == Feature::DistanceToEdge) {
+        r = Spectrum(voronoi_distance_to_edge(p, randomness));
+        break;
+      }
       const VoronoiResult v =
-          voronoi_f1(in.vector(n.vector) * scale, saturate(in.scalar(n.value_b)), n.voronoi_metric,
-                     in.scalar(n.value_c));
+          n.voronoi_feature == Feature::F2 ? voronoi_f2(p, randomness, n.voronoi_metric, exponent)
+          : n.voronoi_feature == Feature::SmoothF1
+              ? voronoi_smooth_f1(p, std::clamp(in.scalar(n.value_d) / 2.0f, 0.0f, 0.5f),
+                                  randomness, n.voronoi_metric, exponent)
+              : voronoi_f1(p, randomness, n.voronoi_metric, exponent);
       // Position back in the input's units (safe_divide_float3_float: 0 for scale 0).
       r = n.fac_output        ? Spectrum(v.distance)
           : n.position_output ? (scale != 0.0f ? v.position / scale : Vec3f(0.0f))

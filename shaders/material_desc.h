@@ -82,9 +82,9 @@ enum class InputNodeKind : uint8_t {
                    // of Perlin noise, noise_texture_Nd)
   Coordinates,     // `vector` itself as a colour (a Texture Coordinate / Mapping output plugged
                    // into a colour or float input)
-  Voronoi,         // 3D Voronoi Texture, F1, at `vector` x scale value_a: randomness value_b,
-                   // Minkowski exponent value_c, metric `voronoi_metric`; Distance (fac_output),
-                   // Color or Position (position_output) (voronoi_f1_3d)
+  Voronoi,         // 3D Voronoi Texture `voronoi_feature` at `vector` x scale value_a: randomness
+                   // value_b, Minkowski exponent value_c, metric `voronoi_metric`, smoothness
+                   // value_d; Distance (fac_output), Color or Position (position_output)
   Gradient,        // Gradient Texture of type `gradient_type` at `vector`, clamped to [0, 1]
   Wave,            // Wave Texture `wave` at `vector` x scale value_a: distortion value_b, detail
                    // value_c, detail scale value_d, detail roughness value_e, phase value_f
@@ -139,6 +139,9 @@ struct InputNode {
   bool fac_output = false;   // a texture's grey output (Fac; Voronoi: Distance) instead of Color
   bool position_output = false;  // Voronoi: the Position output
   VoronoiMetric voronoi_metric = VoronoiMetric::Euclidean;
+  // Voronoi: F1, F2, Smooth F1 (smoothness value_d) or Distance to Edge (a Distance only).
+  enum class VoronoiFeature : uint8_t { F1, F2, SmoothF1, DistanceToEdge };
+  VoronoiFeature voronoi_feature = VoronoiFeature::F1;
   GradientType gradient_type = GradientType::Linear;
   WaveDesc wave;
   uint8_t noise_dimensions = 3;  // Noise: 1, 2, 3 or 4

@@ -307,6 +307,97 @@ VoronoiResult voronoi_f1(Vec3f p, float randomness, VoronoiMetric metric, float 
   return r;
 }
 
+VoronoiResult voronoi_f2(Vec3f p, float randomness, VoronoiMetric metric, float exponent) {
+  const Vec3f cell(std::floor(p.x), std::floor(p.y), std::floor(p.z));
+  const Vec3f local = p - cell;
+  float d1 = 8.0f, d2 = 8.0f;
+  Vec3f offset1(0.0f), point1(0.0f), offset2(0.0f), point2(0.0f);
+  for (int k = -1; k <= 1; ++k)
+    for (int j = -1; j <= 1; ++j)
+      for (int i = -1; i <= 1; ++i) {
+        const Vec3f offset{float(i), float(j), float(k)};
+        const Vec3f point = offset + cell_random(cell + offset) * randomness;
+        const float d = voronoi_distance(point, local, metric, exponent);
+        if (d < d1) {  // the former nearest becomes the second
+          d2 = d1;
+          offset2 = offset1;
+          point2 = point1;
+          d1 = d;
+          offset1 = offset;
+          point1 = point;
+        } else if (d < d2) {
+          d2 = d;
+          offset2 = offset;
+          point2 = point;
+        }
+      }
+  VoronoiResult r;
+  r.distance = d2;
+  r.color = cell_random(cell + offset2);
+  r.position = point2 + cell;
+  return r;
+}
+
+VoronoiResult voronoi_smooth_f1(Vec3f p, float smoothness, float randomness, VoronoiMetric metric,
+                                float exponent) {
+  const Vec3f cell(std::floor(p.x), std::floor(p.y), std::floor(p.z));
+  const Vec3f local = p - cell;
+  float distance = 8.0f;
+  Spectrum color(0.0f);
+  Vec3f position(0.0f);
+  for (int k = -2; k <= 2; ++k)
+    for (int j = -2; j <= 2; ++j)
+      for (int i = -2; i <= 2; ++i) {
+        const Vec3f offset{float(i), float(j), float(k)};
+        const Vec3f random = cell_random(cell + offset);
+        const Vec3f point = offset + random * randomness;
+        const float d = voronoi_distance(point, local, metric, exponent);
+        // Polynomial smooth minimum: weight h of this point, and the dip that keeps it C1.
+        const float x = std::clamp(0.5f + 0.5f * (distance - d) / smoothness, 0.0f, 1.0f);
+        const float h = x * x * (3.0f - 2.0f * x);
+        float correction = smoothness * h * (1.0f - h);
+        distance = distance + (d - distance) * h - correction;
+        correction /= 1.0f + 3.0f * smoothness;
+        color = color + (random - color) * h - Spectrum(correction);
+        position = position + (point - position) * h - Vec3f(correction);
+      }
+  VoronoiResult r;
+  r.distance = distance;
+  r.color = color;
+  r.position = cell + position;
+  return r;
+}
+
+float voronoi_distance_to_edge(Vec3f p, float randomness) {
+  const Vec3f cell(std::floor(p.x), std::floor(p.y), std::floor(p.z));
+  const Vec3f local = p - cell;
+  // The nearest point (squared Euclidean distance), then the nearest bisector plane to it.
+  Vec3f to_closest(0.0f);
+  float nearest = 8.0f;
+  for (int k = -1; k <= 1; ++k)
+    for (int j = -1; j <= 1; ++j)
+      for (int i = -1; i <= 1; ++i) {
+        const Vec3f offset{float(i), float(j), float(k)};
+        const Vec3f to_point = offset + cell_random(cell + offset) * randomness - local;
+        const float d = dot(to_point, to_point);
+        if (d < nearest) {
+          nearest = d;
+          to_closest = to_point;
+        }
+      }
+  float edge = 8.0f;
+  for (int k = -1; k <= 1; ++k)
+    for (int j = -1; j <= 1; ++j)
+      for (int i = -1; i <= 1; ++i) {
+        const Vec3f offset{float(i), float(j), float(k)};
+        const Vec3f to_point = offset + cell_random(cell + offset) * randomness - local;
+        const Vec3f across = to_point - to_closest;
+        if (dot(across, across) > 0.0001f)
+          edge = std::min(edge, dot((to_closest + to_point) / 2.0f, normalize(across)));
+      }
+  return edge;
+}
+
 float gradient_texture(Vec3f p, GradientType type) {
   switch (type) {
     case GradientType::Linear:

@@ -48,6 +48,15 @@ struct VoronoiResult {
   Vec3f position{0.0f};
 };
 VoronoiResult voronoi_f1(Vec3f p, float randomness, VoronoiMetric metric, float exponent);
+// The second nearest point instead (Cycles' voronoi_f2_3d).
+VoronoiResult voronoi_f2(Vec3f p, float randomness, VoronoiMetric metric, float exponent);
+// F1 blended smoothly over the 5x5x5 neighbouring cells' points, smoothness in [0, 0.5] (the
+// node's Smoothness / 2, clamped): distance, colour and position (Cycles' voronoi_smooth_f1_3d).
+VoronoiResult voronoi_smooth_f1(Vec3f p, float smoothness, float randomness, VoronoiMetric metric,
+                                float exponent);
+// Euclidean distance to the nearest edge of the (Euclidean) F1 cell containing p (Cycles'
+// voronoi_distance_to_edge_3d).
+float voronoi_distance_to_edge(Vec3f p, float randomness);
 
 // The Gradient Texture's value at p, before the node's clamp to [0, 1] (Cycles' svm_gradient).
 enum class GradientType : uint8_t {

@@ -30,6 +30,7 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH', 'COMBXYZ',
                 'TEX_BRICK'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
+_VORONOI_FEATURES = {'F1', 'F2', 'SMOOTH_F1', 'DISTANCE_TO_EDGE'}  # 3D
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
 # Every operation of Blender 3.4's Math node (shaders/math_node.h).
@@ -420,10 +421,14 @@ class _Translator:
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
                  "fac_output": out.name == "Fac"}
         elif node.type == 'TEX_VORONOI' and node.voronoi_dimensions == '3D' and \
-                node.feature == 'F1' and out.name in {"Distance", "Color", "Position"}:
-            d = {"kind": "VORONOI", "value_a": self.value(node.inputs["Scale"]),
+                node.feature in _VORONOI_FEATURES and \
+                out.name in {"Distance", "Color", "Position"}:
+            # Distance to Edge has a Distance only (Euclidean, whatever the metric).
+            d = {"kind": "VORONOI", "feature": node.feature,
+                 "value_a": self.value(node.inputs["Scale"]),
                  "value_b": self.value(node.inputs["Randomness"]),
-                 "value_c": self.value(node.inputs["Exponent"]), "metric": node.distance,
+                 "value_c": self.value(node.inputs["Exponent"]),
+                 "value_d": self.value(node.inputs["Smoothness"]), "metric": node.distance,
                  "vector": self._vector(node.inputs["Vector"], 'GENERATED'),
                  "fac_output": out.name == "Distance", "position_output": out.name == "Position"}
         elif node.type == 'TEX_WAVE':

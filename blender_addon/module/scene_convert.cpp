@@ -289,6 +289,12 @@ InputNode read_input_node(const py::dict& d) {
       {"CHEBYCHEV", VoronoiMetric::Chebyshev},  // Blender's spelling
       {"MINKOWSKI", VoronoiMetric::Minkowski}};
   n.voronoi_metric = get_enum(d, "metric", "EUCLIDEAN", kMetrics, "voronoi metric");
+  static const std::pair<const char*, InputNode::VoronoiFeature> kFeatures[] = {
+      {"F1", InputNode::VoronoiFeature::F1},
+      {"F2", InputNode::VoronoiFeature::F2},
+      {"SMOOTH_F1", InputNode::VoronoiFeature::SmoothF1},
+      {"DISTANCE_TO_EDGE", InputNode::VoronoiFeature::DistanceToEdge}};
+  n.voronoi_feature = get_enum(d, "feature", "F1", kFeatures, "voronoi feature");
   static const std::pair<const char*, GradientType> kGradients[] = {
       {"LINEAR", GradientType::Linear},       {"QUADRATIC", GradientType::Quadratic},
       {"EASING", GradientType::Easing},       {"DIAGONAL", GradientType::Diagonal},

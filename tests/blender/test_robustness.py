@@ -74,7 +74,7 @@ def test_unsupported_node(out):
 def test_texture_limits(out):
     """Textures Gradient PT does not model are reported once each and the render finishes: a 2D
     Musgrave Texture (3D only), a Checker read at the Texture Coordinate node's Normal output, a
-    Voronoi Texture's F2 feature (F1 only), a Sky Texture."""
+    Voronoi Texture's N-Sphere Radius feature, a Sky Texture."""
     scene = S.clear()
     basic_scene(scene)
     m, nt, outn = S._material("textures")
@@ -90,8 +90,8 @@ def test_texture_limits(out):
     nt.links.new(checker.outputs["Color"], bsdf.inputs["Base Color"])
     voronoi = nt.nodes.new("ShaderNodeTexVoronoi")
     voronoi.name = "My Voronoi"
-    voronoi.feature = 'F2'
-    nt.links.new(voronoi.outputs["Distance"], bsdf.inputs["Metallic"])
+    voronoi.feature = 'N_SPHERE_RADIUS'
+    nt.links.new(voronoi.outputs["Radius"], bsdf.inputs["Metallic"])
     sky = nt.nodes.new("ShaderNodeTexSky")
     sky.name = "My Sky"
     nt.links.new(sky.outputs["Color"], bsdf.inputs["Emission"])
@@ -101,7 +101,8 @@ def test_texture_limits(out):
     for needle, what in (("mode 2D of the input node 'My 2D Musgrave'", "the 2D Musgrave"),
                          ("output Normal of the texture coordinate node 'My Coordinates'",
                           "the Normal coordinates"),
-                         ("mode 3D F2 of the input node 'My Voronoi'", "the Voronoi F2"),
+                         ("mode 3D N_SPHERE_RADIUS of the input node 'My Voronoi'",
+                          "the Voronoi N-Sphere Radius"),
                          ("input node 'My Sky'", "the Sky texture")):
         check(sum(needle in w for w in warnings) == 1, f"one warning names {what}")
     check(S.read_rgb(path).mean() > 0.01, "the image was written")

@@ -301,5 +301,35 @@ TEST(ProceduralTexture, BrickRowsOffsetsAndMortar) {
   EXPECT_GT(std::unique(tints.begin(), tints.end()) - tints.begin(), 15);
 }
 
+// Without jitter the Voronoi points are the integer lattice: at p = (3.1, 4.2, 5.3) the second
+// nearest is (3, 4, 6) at sqrt(0.01 + 0.04 + 0.49), the nearest cell wall (a bisector plane) is
+// z = 5.5, 0.2 away, and a tiny smoothness leaves F1; with jitter, F2 >= F1 everywhere and the
+// distance to the edge is at most half the gap between the two nearest points.
+TEST(ProceduralTexture, VoronoiF2SmoothF1AndDistanceToEdge) {
+  const Vec3f p(3.1f, 4.2f, 5.3f);
+  const VoronoiResult f2 = voronoi_f2(p, 0.0f, VoronoiMetric::Euclidean, 1.0f);
+  EXPECT_NEAR(f2.distance, std::sqrt(0.01f + 0.04f + 0.49f), 1e-5f);
+  EXPECT_NEAR(f2.position.z, 6.0f, 1e-5f);
+  EXPECT_NEAR(voronoi_distance_to_edge(p, 0.0f), 0.2f, 1e-5f);
+  const VoronoiResult f1 = voronoi_f1(p, 0.0f, VoronoiMetric::Euclidean, 1.0f);
+  const VoronoiResult smooth = voronoi_smooth_f1(p, 1e-4f, 0.0f, VoronoiMetric::Euclidean, 1.0f);
+  EXPECT_NEAR(smooth.distance, f1.distance, 1e-4f);
+  EXPECT_NEAR(smooth.position.x, f1.position.x, 1e-3f);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-10.0f, 10.0f);
+  for (int i = 0; i < 500; ++i) {
+    const Vec3f q(u(rng), u(rng), u(rng));
+    const VoronoiResult a = voronoi_f1(q, 1.0f, VoronoiMetric::Euclidean, 1.0f);
+    const VoronoiResult b = voronoi_f2(q, 1.0f, VoronoiMetric::Euclidean, 1.0f);
+    EXPECT_GE(b.distance, a.distance);
+    const float edge = voronoi_distance_to_edge(q, 1.0f);
+    EXPECT_GE(edge, -1e-5f);
+    // The bisector of the two nearest points is at most (F2 - F1) / 2 away... along their line.
+    EXPECT_LE(edge, 0.5f * (b.distance - a.distance) * (b.distance + a.distance) /
+                            length(b.position - a.position) +
+                        1e-4f);
+  }
+}
+
 }  // namespace
 }  // namespace gdpt
