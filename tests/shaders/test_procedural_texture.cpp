@@ -324,7 +324,7 @@ TEST(ProceduralTexture, VoronoiF2SmoothF1AndDistanceToEdge) {
     EXPECT_GE(b.distance, a.distance);
     const float edge = voronoi_distance_to_edge(q, 1.0f);
     EXPECT_GE(edge, -1e-5f);
-    // The bisector of the two nearest points is at most (F2 - F1) / 2 away... along their line.
+    // The bisector plane of the two nearest points a, b lies (F2^2 - F1^2) / (2 |a - b|) away.
     EXPECT_LE(edge, 0.5f * (b.distance - a.distance) * (b.distance + a.distance) /
                             length(b.position - a.position) +
                         1e-4f);
