@@ -113,7 +113,7 @@ class EmbreeScene {
 
   // Closest hit in (t_min, t_max). Fills `hit` when true. Inline (as occluded()): the wrappers
   // around Embree's calls are on every ray.
-  bool intersect(const Ray& ray, SurfaceHit& hit) const {
+  [[gnu::always_inline]] bool intersect(const Ray& ray, SurfaceHit& hit) const {
     RTCRayHit rh;
     closest(ray, rh);
     return read_hit(rh, ray.direction, hit);

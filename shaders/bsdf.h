@@ -62,16 +62,17 @@ class ClosureSet {
       }
     own_frames_ = true;
     ng_ = ng;
+    // Off the single-Lambert fast path (which tests shadowing_ alone); the shadowing factor of
+    // the default unperturbed normal (+z) is 1.
+    shadowing_ = true;
   }
   bool has_own_frames() const { return own_frames_; }
   // Whether wo (local; cos_ng: its cosine with the geometric normal facing wi) may carry light:
   // reflection and transmission must agree between the shading frame and the geometric
   // surface, or light leaks through it. Integrators test this before eval() and after sample().
   bool side_ok(Vec3f wo, float cos_ng) const {
-    if (cos_ng == 0.0f) return false;
-    if (own_frames_) [[unlikely]]
-      return true;  // per lobe, inside eval / pdf / sample
-    return (cos_ng > 0.0f) == (wo.z > 0.0f);
+    // With own frames the lobes decide, inside eval / pdf / sample.
+    return ((cos_ng > 0.0f) == (wo.z > 0.0f) || own_frames_) && cos_ng != 0.0f;
   }
   // Adds a lobe; weights that are zero are dropped; a full set drops the lobe of least weight.
   void add(const Closure& c);
@@ -122,10 +123,19 @@ class ClosureSet {
  private:
   // The inline fast path (bump shadowing goes through the mixture code).
   bool single_lambert() const {
-    return count_ == 1 && closures_[0].type == ClosureType::Lambert && !shadowing_ && !own_frames_;
+    return count_ == 1 && closures_[0].type == ClosureType::Lambert && !shadowing_;
   }
   // With own frames: whether lobe c may carry light towards wo (see set_interpolated_normal).
   bool lobe_side_ok(const Closure& c, Vec3f wi, Vec3f wo) const;
+  // The mixture code with (kFramed) or without own frames (closure_set.cpp).
+  template <bool kFramed>
+  Spectrum eval_mixture_t(Vec3f wi, Vec3f wo) const;
+  template <bool kFramed>
+  float pdf_mixture_t(Vec3f wi, Vec3f wo) const;
+  template <bool kFramed>
+  Spectrum eval_pdf_mixture_t(Vec3f wi, Vec3f wo, float& pdf_out) const;
+  template <bool kFramed>
+  BsdfSample sample_mixture_t(Vec3f wi, float u_lobe, Vec2f u) const;
   // Any set (the same values as the fast path for a single Lambert lobe).
   Spectrum eval_mixture(Vec3f wi, Vec3f wo) const;
   float pdf_mixture(Vec3f wi, Vec3f wo) const;

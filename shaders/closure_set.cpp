@@ -54,21 +54,21 @@ float lobe_pdf_local(const Closure& c, Vec3f wi,
 }
 float lobe_albedo_hint_local(const Closure& c, Vec3f wi){GDPT_DISPATCH(c, albedo_hint(c, wi))}
 
-Spectrum lobe_eval(const Closure& c, Vec3f wi, Vec3f wo) {
+Spectrum lobe_eval_framed(const Closure& c, Vec3f wi, Vec3f wo) {
   if (c.own_frame) [[unlikely]] {
     const Frame f(c.normal);
     return lobe_eval_local(c, f.to_local(wi), f.to_local(wo));
   }
   return lobe_eval_local(c, wi, wo);
 }
-float lobe_pdf(const Closure& c, Vec3f wi, Vec3f wo) {
+float lobe_pdf_framed(const Closure& c, Vec3f wi, Vec3f wo) {
   if (c.own_frame) [[unlikely]] {
     const Frame f(c.normal);
     return lobe_pdf_local(c, f.to_local(wi), f.to_local(wo));
   }
   return lobe_pdf_local(c, wi, wo);
 }
-BsdfSample lobe_sample(const Closure& c, Vec3f wi, float u_choice, Vec2f u) {
+BsdfSample lobe_sample_framed(const Closure& c, Vec3f wi, float u_choice, Vec2f u) {
   if (c.own_frame) [[unlikely]] {
     const Frame f(c.normal);
     const Vec3f wi_local = f.to_local(wi);
@@ -87,9 +87,31 @@ BsdfSample lobe_sample(const Closure& c, Vec3f wi, float u_choice, Vec2f u) {
   }
   return lobe_sample_local(c, wi, u_choice, u);
 }
-float lobe_albedo_hint(const Closure& c, Vec3f wi) {
+float lobe_albedo_hint_framed(const Closure& c, Vec3f wi) {
   if (c.own_frame) [[unlikely]]
     return lobe_albedo_hint_local(c, Frame(c.normal).to_local(wi));
+  return lobe_albedo_hint_local(c, wi);
+}
+// The lobe calls of a set with own frames (kFramed) or without: sets without them, all but a few,
+// run exactly the code they ran before own frames existed.
+template <bool kFramed>
+Spectrum lobe_eval(const Closure& c, Vec3f wi, Vec3f wo) {
+  if constexpr (kFramed) return lobe_eval_framed(c, wi, wo);
+  return lobe_eval_local(c, wi, wo);
+}
+template <bool kFramed>
+float lobe_pdf(const Closure& c, Vec3f wi, Vec3f wo) {
+  if constexpr (kFramed) return lobe_pdf_framed(c, wi, wo);
+  return lobe_pdf_local(c, wi, wo);
+}
+template <bool kFramed>
+BsdfSample lobe_sample(const Closure& c, Vec3f wi, float u_choice, Vec2f u) {
+  if constexpr (kFramed) return lobe_sample_framed(c, wi, u_choice, u);
+  return lobe_sample_local(c, wi, u_choice, u);
+}
+template <bool kFramed>
+float lobe_albedo_hint(const Closure& c, Vec3f wi) {
+  if constexpr (kFramed) return lobe_albedo_hint_framed(c, wi);
   return lobe_albedo_hint_local(c, wi);
 }
 #undef GDPT_DISPATCH
@@ -116,10 +138,11 @@ bool lobe_is_diffuse(const Closure& c) {
 }
 
 // Unnormalised selection weights; returns their sum.
+template <bool kFramed>
 float selection_weights(const Closure* closures, int count, Vec3f wi, float* w) {
   float total = 0.0f;
   for (int i = 0; i < count; ++i) {
-    w[i] = selection_luminance(closures[i].weight) * lobe_albedo_hint(closures[i], wi);
+    w[i] = selection_luminance(closures[i].weight) * lobe_albedo_hint<kFramed>(closures[i], wi);
     total += w[i];
   }
   return total;
@@ -157,8 +180,11 @@ float ClosureSet::diffuse_shadowing(Vec3f wo) const {
 // A lobe's value with the bump shadowing of diffuse lobes applied (`shadowing` = its factor).
 // Lobes about their own (interpolated) normal are not shadowed: Cycles shadows the closures whose
 // normal is not the interpolated one.
-inline Spectrum shadowed(const Closure& c, Spectrum value, float shadowing) {
-  return shadowing != 1.0f && lobe_is_diffuse(c) && !c.own_frame ? value * shadowing : value;
+template <bool kFramed>
+Spectrum shadowed(const Closure& c, Spectrum value, float shadowing) {
+  if constexpr (kFramed)
+    if (c.own_frame) return value;
+  return shadowing != 1.0f && lobe_is_diffuse(c) ? value * shadowing : value;
 }
 
 bool ClosureSet::lobe_side_ok(const Closure& c, Vec3f wi, Vec3f wo) const {
@@ -168,67 +194,96 @@ bool ClosureSet::lobe_side_ok(const Closure& c, Vec3f wi, Vec3f wo) const {
   return (cos_ng > 0.0f) == reflection;
 }
 
+// With own frames (kFramed) each lobe also decides reflection against transmission itself
+// (lobe_side_ok); see set_interpolated_normal.
 Spectrum ClosureSet::eval_mixture(Vec3f wi, Vec3f wo) const {
+  return own_frames_ ? eval_mixture_t<true>(wi, wo) : eval_mixture_t<false>(wi, wo);
+}
+float ClosureSet::pdf_mixture(Vec3f wi, Vec3f wo) const {
+  return own_frames_ ? pdf_mixture_t<true>(wi, wo) : pdf_mixture_t<false>(wi, wo);
+}
+Spectrum ClosureSet::eval_pdf_mixture(Vec3f wi, Vec3f wo, float& pdf_out) const {
+  return own_frames_ ? eval_pdf_mixture_t<true>(wi, wo, pdf_out)
+                     : eval_pdf_mixture_t<false>(wi, wo, pdf_out);
+}
+BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
+  return own_frames_ ? sample_mixture_t<true>(wi, u_lobe, u)
+                     : sample_mixture_t<false>(wi, u_lobe, u);
+}
+
+template <bool kFramed>
+Spectrum ClosureSet::eval_mixture_t(Vec3f wi, Vec3f wo) const {
   const float sh = diffuse_shadowing(wo);
   Spectrum f(0.0f);
   for (int i = 0; i < count_; ++i) {
-    if (own_frames_ && !lobe_side_ok(closures_[i], wi, wo)) continue;
-    f += shadowed(closures_[i], lobe_eval(closures_[i], wi, wo), sh);
+    if constexpr (kFramed)
+      if (!lobe_side_ok(closures_[i], wi, wo)) continue;
+    f += shadowed<kFramed>(closures_[i], lobe_eval<kFramed>(closures_[i], wi, wo), sh);
   }
   return f;
 }
 
-float ClosureSet::pdf_mixture(Vec3f wi, Vec3f wo) const {
-  if (count_ == 1)
-    return own_frames_ && !lobe_side_ok(closures_[0], wi, wo) ? 0.0f
-                                                              : lobe_pdf(closures_[0], wi, wo);
+template <bool kFramed>
+float ClosureSet::pdf_mixture_t(Vec3f wi, Vec3f wo) const {
+  if (count_ == 1) {
+    if constexpr (kFramed)
+      if (!lobe_side_ok(closures_[0], wi, wo)) return 0.0f;
+    return lobe_pdf<kFramed>(closures_[0], wi, wo);
+  }
   float w[kMaxClosures];
-  const float total = selection_weights(closures_, count_, wi, w);
+  const float total = selection_weights<kFramed>(closures_, count_, wi, w);
   if (!(total > 0.0f)) return 0.0f;
   float p = 0.0f;
   for (int i = 0; i < count_; ++i) {
-    if (own_frames_ && !lobe_side_ok(closures_[i], wi, wo)) continue;
-    if (w[i] > 0.0f) p += w[i] * lobe_pdf(closures_[i], wi, wo);
+    if constexpr (kFramed)
+      if (!lobe_side_ok(closures_[i], wi, wo)) continue;
+    if (w[i] > 0.0f) p += w[i] * lobe_pdf<kFramed>(closures_[i], wi, wo);
   }
   return p / total;
 }
 
-Spectrum ClosureSet::eval_pdf_mixture(Vec3f wi, Vec3f wo, float& pdf_out) const {
+template <bool kFramed>
+Spectrum ClosureSet::eval_pdf_mixture_t(Vec3f wi, Vec3f wo, float& pdf_out) const {
   const float sh = diffuse_shadowing(wo);
   if (count_ == 1) {
-    if (own_frames_ && !lobe_side_ok(closures_[0], wi, wo)) {
-      pdf_out = 0.0f;
-      return Spectrum(0.0f);
-    }
-    pdf_out = lobe_pdf(closures_[0], wi, wo);
-    return shadowed(closures_[0], lobe_eval(closures_[0], wi, wo), sh);
+    if constexpr (kFramed)
+      if (!lobe_side_ok(closures_[0], wi, wo)) {
+        pdf_out = 0.0f;
+        return Spectrum(0.0f);
+      }
+    pdf_out = lobe_pdf<kFramed>(closures_[0], wi, wo);
+    return shadowed<kFramed>(closures_[0], lobe_eval<kFramed>(closures_[0], wi, wo), sh);
   }
   // The loops of eval() and pdf() merged, each sum in the same order: identical values.
   float w[kMaxClosures];
-  const float total = selection_weights(closures_, count_, wi, w);
+  const float total = selection_weights<kFramed>(closures_, count_, wi, w);
   Spectrum f(0.0f);
   float p = 0.0f;
   for (int i = 0; i < count_; ++i) {
-    if (own_frames_ && !lobe_side_ok(closures_[i], wi, wo)) continue;
-    f += shadowed(closures_[i], lobe_eval(closures_[i], wi, wo), sh);
-    if (w[i] > 0.0f) p += w[i] * lobe_pdf(closures_[i], wi, wo);
+    if constexpr (kFramed)
+      if (!lobe_side_ok(closures_[i], wi, wo)) continue;
+    f += shadowed<kFramed>(closures_[i], lobe_eval<kFramed>(closures_[i], wi, wo), sh);
+    if (w[i] > 0.0f) p += w[i] * lobe_pdf<kFramed>(closures_[i], wi, wo);
   }
   pdf_out = total > 0.0f ? p / total : 0.0f;
   return f;
 }
 
-BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
+template <bool kFramed>
+BsdfSample ClosureSet::sample_mixture_t(Vec3f wi, float u_lobe, Vec2f u) const {
   if (count_ == 0) return {};
   if (count_ == 1) {
-    BsdfSample s = lobe_sample(closures_[0], wi, u_lobe, u);
-    if (s.valid && own_frames_ && !lobe_side_ok(closures_[0], wi, s.wo)) return {};
-    if (s.valid && shadowing_) s.value = shadowed(closures_[0], s.value, diffuse_shadowing(s.wo));
+    BsdfSample s = lobe_sample<kFramed>(closures_[0], wi, u_lobe, u);
+    if constexpr (kFramed)
+      if (s.valid && !lobe_side_ok(closures_[0], wi, s.wo)) return {};
+    if (s.valid && shadowing_)
+      s.value = shadowed<kFramed>(closures_[0], s.value, diffuse_shadowing(s.wo));
     return s;
   }
 
   // --- Pick a lobe; the leftover of u_lobe within its interval drives the lobe's own choice.
   float w[kMaxClosures];
-  const float total = selection_weights(closures_, count_, wi, w);
+  const float total = selection_weights<kFramed>(closures_, count_, wi, w);
   if (!(total > 0.0f)) return {};
   const float target = u_lobe * total;
   int k = 0;
@@ -239,9 +294,10 @@ BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
   }
   while (w[k] <= 0.0f && k > 0) --k;  // rounding at the top end: fall back to a live lobe
   const float u_choice = std::clamp((target - cdf) / w[k], 0.0f, 0.99999994f);
-  BsdfSample s = lobe_sample(closures_[k], wi, u_choice, u);
+  BsdfSample s = lobe_sample<kFramed>(closures_[k], wi, u_choice, u);
   if (!s.valid) return s;
-  if (own_frames_ && !lobe_side_ok(closures_[k], wi, s.wo)) return {};
+  if constexpr (kFramed)
+    if (!lobe_side_ok(closures_[k], wi, s.wo)) return {};
 
   const float sel_k = w[k] / total;
   if (s.is_delta()) {
@@ -251,12 +307,14 @@ BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
 
   // --- One-sample MIS: the mixture's value and density at the sampled direction.
   const float sh = diffuse_shadowing(s.wo);
-  Spectrum value = shadowed(closures_[k], s.value, sh);
+  Spectrum value = shadowed<kFramed>(closures_[k], s.value, sh);
   float pdf = w[k] * s.pdf;
   for (int i = 0; i < count_; ++i) {
-    if (i == k || (own_frames_ && !lobe_side_ok(closures_[i], wi, s.wo))) continue;
-    value += shadowed(closures_[i], lobe_eval(closures_[i], wi, s.wo), sh);
-    if (w[i] > 0.0f) pdf += w[i] * lobe_pdf(closures_[i], wi, s.wo);
+    if (i == k) continue;
+    if constexpr (kFramed)
+      if (!lobe_side_ok(closures_[i], wi, s.wo)) continue;
+    value += shadowed<kFramed>(closures_[i], lobe_eval<kFramed>(closures_[i], wi, s.wo), sh);
+    if (w[i] > 0.0f) pdf += w[i] * lobe_pdf<kFramed>(closures_[i], wi, s.wo);
   }
   s.value = value;
   s.pdf = pdf / total;

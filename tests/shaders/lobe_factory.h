@@ -73,18 +73,23 @@ inline Closure transparent(Spectrum c = Spectrum(1.0f)) {
   return k;
 }
 
-// `c` about its own unit normal `n` (shading-frame coordinates), as shading_closures sets a lobe
-// that keeps the interpolated normal under a bump.
+// `c` as a lobe that keeps the interpolated normal `n` (shading-frame coordinates) under a bump:
+// set_of() gives it its own frame about n, as shading_closures does.
 inline Closure about(Closure c, Vec3f n) {
   c.interpolated_normal = true;
-  c.own_frame = true;
   c.normal = normalize(n);
   return c;
 }
 
+// The set of `cs`; with `about` lobes, their frames set up (geometric normal +z).
 inline ClosureSet set_of(std::initializer_list<Closure> cs) {
   ClosureSet s;
-  for (const Closure& c : cs) s.add(c);
+  const Closure* framed = nullptr;
+  for (const Closure& c : cs) {
+    s.add(c);
+    if (c.interpolated_normal) framed = &c;
+  }
+  if (framed) s.set_interpolated_normal(framed->normal, Vec3f(0.0f, 0.0f, 1.0f));
   return s;
 }
 

@@ -351,7 +351,10 @@ TEST(ClosureSet, LobeAboutItsOwnNormalIsTheRotatedLobe) {
   EXPECT_NEAR(rotate(n).z, 1.0f, 1e-6f);
   for (const Closure& lobe : {ggx(0.3f), ggx_principled(0.1f, 1.5f, Spectrum(0.04f)),
                               principled_diffuse(0.4f), lambert()}) {
-    ClosureSet own = set_of({about(lobe, n)});
+    // Geometric normal n too: every direction is then on the lobe's side of the surface.
+    ClosureSet own;
+    own.add(about(lobe, n));
+    own.set_interpolated_normal(n, n);
     own.set_bump_shadowing(normalize(Vec3f(0.2f, 0.1f, 1.0f)));  // must not touch it
     const ClosureSet plain = set_of({lobe});
     Pcg32 rng(11);
@@ -359,6 +362,8 @@ TEST(ClosureSet, LobeAboutItsOwnNormalIsTheRotatedLobe) {
     for (int i = 0; i < 300; ++i) {
       const Vec3f wi = direction(0.1 + 0.9 * rng.uniform(), 2 * M_PI * rng.uniform());
       const Vec3f wo = direction(-0.3 + 1.3 * rng.uniform(), 2 * M_PI * rng.uniform());
+      if (!(dot(wi, n) > 0.0f))
+        continue;  // wi must face the lobe, as the reflection check makes it
       float p_own, p_plain;
       const Spectrum f_own = own.eval_pdf(wi, wo, p_own);
       const Spectrum f_plain = plain.eval_pdf(rotate(wi), rotate(wo), p_plain);
