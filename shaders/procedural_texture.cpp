@@ -283,24 +283,30 @@ uint32_t hash_words(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
   return final_mix(x, y, z);
 }
 
+// Calls f(offset) for the cells within r of a point's cell, z outermost and x innermost (the
+// order of Cycles' loops, which decides ties).
+template <class F>
+void for_each_cell(int r, F f) {
+  for (int k = -r; k <= r; ++k)
+    for (int j = -r; j <= r; ++j)
+      for (int i = -r; i <= r; ++i) f(Vec3f(float(i), float(j), float(k)));
+}
+
 VoronoiResult voronoi_f1(Vec3f p, float randomness, VoronoiMetric metric, float exponent) {
   const Vec3f cell(std::floor(p.x), std::floor(p.y), std::floor(p.z));
   const Vec3f local = p - cell;
   VoronoiResult r;
   float nearest = 8.0f;
   Vec3f nearest_offset(0.0f), nearest_point(0.0f);
-  for (int k = -1; k <= 1; ++k)
-    for (int j = -1; j <= 1; ++j)
-      for (int i = -1; i <= 1; ++i) {
-        const Vec3f offset{float(i), float(j), float(k)};
-        const Vec3f point = offset + cell_random(cell + offset) * randomness;
-        const float d = voronoi_distance(point, local, metric, exponent);
-        if (d < nearest) {
-          nearest = d;
-          nearest_offset = offset;
-          nearest_point = point;
-        }
-      }
+  for_each_cell(1, [&](Vec3f offset) {
+    const Vec3f point = offset + cell_random(cell + offset) * randomness;
+    const float d = voronoi_distance(point, local, metric, exponent);
+    if (d < nearest) {
+      nearest = d;
+      nearest_offset = offset;
+      nearest_point = point;
+    }
+  });
   r.distance = nearest;
   r.color = cell_random(cell + nearest_offset);
   r.position = nearest_point + cell;
@@ -312,25 +318,22 @@ VoronoiResult voronoi_f2(Vec3f p, float randomness, VoronoiMetric metric, float 
   const Vec3f local = p - cell;
   float d1 = 8.0f, d2 = 8.0f;
   Vec3f offset1(0.0f), point1(0.0f), offset2(0.0f), point2(0.0f);
-  for (int k = -1; k <= 1; ++k)
-    for (int j = -1; j <= 1; ++j)
-      for (int i = -1; i <= 1; ++i) {
-        const Vec3f offset{float(i), float(j), float(k)};
-        const Vec3f point = offset + cell_random(cell + offset) * randomness;
-        const float d = voronoi_distance(point, local, metric, exponent);
-        if (d < d1) {  // the former nearest becomes the second
-          d2 = d1;
-          offset2 = offset1;
-          point2 = point1;
-          d1 = d;
-          offset1 = offset;
-          point1 = point;
-        } else if (d < d2) {
-          d2 = d;
-          offset2 = offset;
-          point2 = point;
-        }
-      }
+  for_each_cell(1, [&](Vec3f offset) {
+    const Vec3f point = offset + cell_random(cell + offset) * randomness;
+    const float d = voronoi_distance(point, local, metric, exponent);
+    if (d < d1) {  // the former nearest becomes the second
+      d2 = d1;
+      offset2 = offset1;
+      point2 = point1;
+      d1 = d;
+      offset1 = offset;
+      point1 = point;
+    } else if (d < d2) {
+      d2 = d;
+      offset2 = offset;
+      point2 = point;
+    }
+  });
   VoronoiResult r;
   r.distance = d2;
   r.color = cell_random(cell + offset2);
@@ -345,22 +348,19 @@ VoronoiResult voronoi_smooth_f1(Vec3f p, float smoothness, float randomness, Vor
   float distance = 8.0f;
   Spectrum color(0.0f);
   Vec3f position(0.0f);
-  for (int k = -2; k <= 2; ++k)
-    for (int j = -2; j <= 2; ++j)
-      for (int i = -2; i <= 2; ++i) {
-        const Vec3f offset{float(i), float(j), float(k)};
-        const Vec3f random = cell_random(cell + offset);
-        const Vec3f point = offset + random * randomness;
-        const float d = voronoi_distance(point, local, metric, exponent);
-        // Polynomial smooth minimum: weight h of this point, and the dip that keeps it C1.
-        const float x = std::clamp(0.5f + 0.5f * (distance - d) / smoothness, 0.0f, 1.0f);
-        const float h = x * x * (3.0f - 2.0f * x);
-        float correction = smoothness * h * (1.0f - h);
-        distance = distance + (d - distance) * h - correction;
-        correction /= 1.0f + 3.0f * smoothness;
-        color = color + (random - color) * h - Spectrum(correction);
-        position = position + (point - position) * h - Vec3f(correction);
-      }
+  for_each_cell(2, [&](Vec3f offset) {
+    const Vec3f random = cell_random(cell + offset);
+    const Vec3f point = offset + random * randomness;
+    const float d = voronoi_distance(point, local, metric, exponent);
+    // Polynomial smooth minimum: weight h of this point, and the dip that keeps it C1.
+    const float x = std::clamp(0.5f + 0.5f * (distance - d) / smoothness, 0.0f, 1.0f);
+    const float h = x * x * (3.0f - 2.0f * x);
+    float correction = smoothness * h * (1.0f - h);
+    distance = distance + (d - distance) * h - correction;
+    correction /= 1.0f + 3.0f * smoothness;
+    color = color + (random - color) * h - Spectrum(correction);
+    position = position + (point - position) * h - Vec3f(correction);
+  });
   VoronoiResult r;
   r.distance = distance;
   r.color = color;
@@ -374,27 +374,21 @@ float voronoi_distance_to_edge(Vec3f p, float randomness) {
   // The nearest point (squared Euclidean distance), then the nearest bisector plane to it.
   Vec3f to_closest(0.0f);
   float nearest = 8.0f;
-  for (int k = -1; k <= 1; ++k)
-    for (int j = -1; j <= 1; ++j)
-      for (int i = -1; i <= 1; ++i) {
-        const Vec3f offset{float(i), float(j), float(k)};
-        const Vec3f to_point = offset + cell_random(cell + offset) * randomness - local;
-        const float d = dot(to_point, to_point);
-        if (d < nearest) {
-          nearest = d;
-          to_closest = to_point;
-        }
-      }
+  for_each_cell(1, [&](Vec3f offset) {
+    const Vec3f to_point = offset + cell_random(cell + offset) * randomness - local;
+    const float d = dot(to_point, to_point);
+    if (d < nearest) {
+      nearest = d;
+      to_closest = to_point;
+    }
+  });
   float edge = 8.0f;
-  for (int k = -1; k <= 1; ++k)
-    for (int j = -1; j <= 1; ++j)
-      for (int i = -1; i <= 1; ++i) {
-        const Vec3f offset{float(i), float(j), float(k)};
-        const Vec3f to_point = offset + cell_random(cell + offset) * randomness - local;
-        const Vec3f across = to_point - to_closest;
-        if (dot(across, across) > 0.0001f)
-          edge = std::min(edge, dot((to_closest + to_point) / 2.0f, normalize(across)));
-      }
+  for_each_cell(1, [&](Vec3f offset) {
+    const Vec3f to_point = offset + cell_random(cell + offset) * randomness - local;
+    const Vec3f across = to_point - to_closest;
+    if (dot(across, across) > 0.0001f)
+      edge = std::min(edge, dot((to_closest + to_point) / 2.0f, normalize(across)));
+  });
   return edge;
 }
 

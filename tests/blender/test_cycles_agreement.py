@@ -938,30 +938,34 @@ BRICKS = [
 BRICK_ROWS, BRICK_HEIGHT = 3, 6.0
 
 
-def case_brick_texture(scene):
-    # Brick Textures (BRICKS) at Generated coordinates spanning negative and positive values
-    # (x 1.2 - 0.6, y 0.6 - 0.1), on emissive strips 9.5 x 6 m: bricks of 10 x 6 pixels.
-    def brick_strip(properties, inputs, output):
-        def build(nt, emit, generated):
-            span = nt.nodes.new("ShaderNodeVectorMath")
-            span.operation = 'MULTIPLY_ADD'
-            nt.links.new(generated, span.inputs[0])
-            span.inputs[1].default_value = (1.2, 0.6, 1.0)
-            span.inputs[2].default_value = (-0.6, -0.1, 0.0)
-            brick = nt.nodes.new("ShaderNodeTexBrick")
-            for key, value in properties.items():
-                setattr(brick, key, value)
-            brick.inputs["Color1"].default_value = (0.8, 0.3, 0.1, 1.0)
-            brick.inputs["Color2"].default_value = (0.2, 0.5, 0.9, 1.0)
-            brick.inputs["Mortar"].default_value = (0.9, 0.9, 0.8, 1.0)
-            for key, value in inputs.items():
-                brick.inputs[key].default_value = value
-            nt.links.new(span.outputs["Vector"], brick.inputs["Vector"])
-            nt.links.new(brick.outputs[output], emit.inputs["Color"])
-        return build
+BRICK_COLOURS = {"Color1": (0.8, 0.3, 0.1, 1.0), "Color2": (0.2, 0.5, 0.9, 1.0),
+                 "Mortar": (0.9, 0.9, 0.8, 1.0)}
 
-    emissive_strips(scene, [brick_strip(p, i, o) for _, p, i, o in BRICKS], BRICK_ROWS,
-                    BRICK_HEIGHT)
+
+def texture_strip(node_type, properties, inputs, output, offset=(-0.6, -0.1, 0.0)):
+    """An emissive_strips builder: a `node_type` texture (node properties, input values) read at
+    Generated * (1.2, 0.6, 1) + offset (negative and positive coordinates), its `output` as the
+    emission colour."""
+    def build(nt, emit, generated):
+        span = nt.nodes.new("ShaderNodeVectorMath")
+        span.operation = 'MULTIPLY_ADD'
+        nt.links.new(generated, span.inputs[0])
+        span.inputs[1].default_value = (1.2, 0.6, 1.0)
+        span.inputs[2].default_value = offset
+        texture = nt.nodes.new(node_type)
+        for key, value in properties.items():
+            setattr(texture, key, value)
+        for key, value in inputs.items():
+            texture.inputs[key].default_value = value
+        nt.links.new(span.outputs["Vector"], texture.inputs["Vector"])
+        nt.links.new(texture.outputs[output], emit.inputs["Color"])
+    return build
+
+
+def case_brick_texture(scene):
+    # Brick Textures (BRICKS) on emissive strips 9.5 x 6 m: bricks of 10 x 6 pixels.
+    emissive_strips(scene, [texture_strip("ShaderNodeTexBrick", p, dict(BRICK_COLOURS, **i), o)
+                            for _, p, i, o in BRICKS], BRICK_ROWS, BRICK_HEIGHT)
     return 1
 
 
@@ -984,26 +988,9 @@ VORONOIS = [
 
 
 def case_voronoi_features(scene):
-    # Voronoi F2, Smooth F1 and Distance to Edge (VORONOIS) on emissive strips, at Generated
-    # coordinates spanning negative and positive values, as brick_texture.
-    def voronoi_strip(properties, inputs, output):
-        def build(nt, emit, generated):
-            span = nt.nodes.new("ShaderNodeVectorMath")
-            span.operation = 'MULTIPLY_ADD'
-            nt.links.new(generated, span.inputs[0])
-            span.inputs[1].default_value = (1.2, 0.6, 1.0)
-            span.inputs[2].default_value = (-0.6, -0.1, 0.3)
-            voronoi = nt.nodes.new("ShaderNodeTexVoronoi")
-            for key, value in properties.items():
-                setattr(voronoi, key, value)
-            for key, value in inputs.items():
-                voronoi.inputs[key].default_value = value
-            nt.links.new(span.outputs["Vector"], voronoi.inputs["Vector"])
-            nt.links.new(voronoi.outputs[output], emit.inputs["Color"])
-        return build
-
-    emissive_strips(scene, [voronoi_strip(p, i, o) for _, p, i, o in VORONOIS], BRICK_ROWS,
-                    BRICK_HEIGHT)
+    # Voronoi F2, Smooth F1 and Distance to Edge (VORONOIS) on emissive strips, as brick_texture.
+    emissive_strips(scene, [texture_strip("ShaderNodeTexVoronoi", p, i, o, (-0.6, -0.1, 0.3))
+                            for _, p, i, o in VORONOIS], BRICK_ROWS, BRICK_HEIGHT)
     return 1
 
 
