@@ -31,6 +31,7 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'TEX_BRICK'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _VORONOI_FEATURES = {'F1', 'F2', 'SMOOTH_F1', 'DISTANCE_TO_EDGE'}  # 3D
+_MAPPING_TYPES = {'POINT', 'TEXTURE', 'VECTOR'}  # Normal normalises: not a fixed transform
 _BLENDS = {'MIX', 'ADD', 'MULTIPLY', 'SUBTRACT', 'SCREEN', 'DIVIDE', 'DIFFERENCE', 'DARKEN',
            'LIGHTEN'}
 # Every operation of Blender 3.4's Math node (shaders/math_node.h).
@@ -473,7 +474,7 @@ class _Translator:
         elif (node.type == 'TEX_COORD' and out.name in {"UV", "Generated", "Object"}) or \
                 (node.type == 'NEW_GEOMETRY' and out.name == "Position") or \
                 node.type == 'UVMAP' or \
-                (node.type == 'MAPPING' and node.vector_type in {'POINT', 'TEXTURE'}):
+                (node.type == 'MAPPING' and node.vector_type in _MAPPING_TYPES):
             # A coordinate used as a colour or value (e.g. through Separate XYZ).
             d = {"kind": "COORDINATES", "vector": self._vector_of(out)}
         elif node.type == 'RGBTOBW':
@@ -546,9 +547,11 @@ class _Translator:
             return {"coordinates": out.name.upper(), "mapping": IDENTITY12}
         if node.type == 'NEW_GEOMETRY' and out.name == "Position":
             return {"coordinates": 'POSITION', "mapping": IDENTITY12}
-        if node.type == 'MAPPING' and node.vector_type in {'POINT', 'TEXTURE'}:
+        if node.type == 'MAPPING' and node.vector_type in _MAPPING_TYPES:
             inner = self._vector(node.inputs["Vector"], default)
-            loc = node.inputs["Location"].default_value
+            # Vector type: a direction, no translation (the Location socket is hidden).
+            loc = node.inputs["Location"].default_value if node.vector_type != 'VECTOR' \
+                else (0.0, 0.0, 0.0)
             rot = node.inputs["Rotation"].default_value
             scale = node.inputs["Scale"].default_value
             for name in ("Location", "Rotation", "Scale"):

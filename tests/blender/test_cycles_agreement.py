@@ -785,9 +785,10 @@ VECTOR_OPS = ['ADD', 'SUBTRACT', 'MULTIPLY', 'DIVIDE', 'MULTIPLY_ADD', 'CROSS_PR
               'MINIMUM', 'MAXIMUM', 'SINE', 'COSINE', 'TANGENT']
 VECTOR_EXTRAS = ['checker at noise-distorted coordinates', 'image at a Vector Math vector',
                  'strength from a vector', 'gradient through a Mapping of a node vector',
-                 'Combine XYZ as a vector and a strength']
+                 'Combine XYZ as a vector and a strength',
+                 'Mapping of Vector type (no translation)']
 STRIP_RESOLUTION = (256, 256)  # 21 x 21 m seen
-VECTOR_ROWS = 16
+VECTOR_ROWS = 17
 
 
 def _strip_centre(k, rows, height):
@@ -911,9 +912,22 @@ def case_vector_math(scene):
         nt.links.new(wave.outputs["Color"], emit.inputs["Color"])
         nt.links.new(combine.outputs["Vector"], emit.inputs["Strength"])
 
+    def vector_mapping(nt, emit, generated):
+        v = vmath(nt, 'MULTIPLY_ADD', generated, (3.0, 2.0, 1.0), (-1.5, -1.0, 0.0))
+        mapping = nt.nodes.new("ShaderNodeMapping")
+        mapping.vector_type = 'VECTOR'
+        mapping.inputs["Location"].default_value = (5.0, 5.0, 5.0)  # hidden: no effect
+        mapping.inputs["Rotation"].default_value = (0.3, 0.0, 0.8)
+        mapping.inputs["Scale"].default_value = (1.5, 0.7, 1.0)
+        nt.links.new(v.outputs["Vector"], mapping.inputs["Vector"])
+        wave = nt.nodes.new("ShaderNodeTexWave")
+        wave.inputs["Scale"].default_value = 2.0
+        nt.links.new(mapping.outputs["Vector"], wave.inputs["Vector"])
+        nt.links.new(wave.outputs["Color"], emit.inputs["Color"])
+
     emissive_strips(scene, [op_strip(op) for op in VECTOR_OPS] +
                     [distorted_checker, image_at_vector, strength_from_vector, mapped_gradient,
-                     combined_xyz], VECTOR_ROWS)
+                     combined_xyz, vector_mapping], VECTOR_ROWS)
     return 1
 
 
