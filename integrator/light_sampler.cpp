@@ -77,21 +77,36 @@ struct LightSampler::Impl {
   std::vector<Entry> entries;
   Distribution1D selection;
 
+  // A Background's radiance: its environment map, or its constant colour x strength.
+  struct BackgroundRadiance {
+    std::optional<EnvironmentMap> environment;  // none for a constant or a black image
+    Spectrum constant{0.0f, 0.0f, 0.0f};
+
+    // Sets it up from `b` (the Scene's images outlive it); returns the mean radiance over the
+    // sphere (0 when black).
+    Spectrum set(const Background& b, const Scene& scene) {
+      if (b.image >= 0 && size_t(b.image) < scene.images.size()) {
+        environment.emplace(scene.images[size_t(b.image)], b.rotation, b.strength);
+        if (!environment->black()) return environment->average();
+        environment.reset();
+        return Spectrum(0.0f);
+      }
+      constant = max(b.color * b.strength, Spectrum(0.0f));
+      return constant;
+    }
+    Spectrum eval(Vec3f d) const { return environment ? environment->eval(d) : constant; }
+  };
+
   bool world_enabled = false;  // non-black world in the CDF
   float world_pmf = 0.0f;
-  Spectrum world_constant{0.0f, 0.0f, 0.0f};
-  std::optional<EnvironmentMap> environment;
+  BackgroundRadiance world;
 
-  Spectrum world_radiance(Vec3f d) const {
-    return environment ? environment->eval(d) : world_constant;
-  }
-
-  // World::camera_view, when set: a constant or an environment map (never sampled as a light).
+  // World::camera_view, when set (never sampled as a light).
   bool camera_view = false;
   bool camera_enabled = false;  // non-black
-  Spectrum camera_constant{0.0f, 0.0f, 0.0f};
-  std::optional<EnvironmentMap> camera_environment;
-  float world_pdf(Vec3f d) const { return environment ? environment->pdf(d) : kInv4Pi; }
+  BackgroundRadiance camera;
+
+  float world_pdf(Vec3f d) const { return world.environment ? world.environment->pdf(d) : kInv4Pi; }
 };
 
 LightSampler::LightSampler(const Scene& scene, std::span<const Material> materials,
@@ -202,18 +217,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
 
   // --- World ---------------------------------------------------------------------------------
   const World& w = scene.world;
-  Spectrum world_average(0.0f);
-  if (w.image >= 0 && size_t(w.image) < scene.images.size()) {
-    I.environment.emplace(scene.images[size_t(w.image)], w.rotation, w.strength);
-    if (I.environment->black()) {
-      I.environment.reset();
-    } else {
-      world_average = I.environment->average();
-    }
-  } else {
-    I.world_constant = max(w.color * w.strength, Spectrum(0.0f));
-    world_average = I.world_constant;
-  }
+  const Spectrum world_average = I.world.set(w, scene);
   {
     const float p = 4.0f * kPi * kPi * radius * radius * luminance(world_average);
     if (p > 0.0f && std::isfinite(p)) {
@@ -221,21 +225,14 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
       I.entries.push_back({Kind::World, 0});
       weights.push_back(p);
     } else {
-      I.world_constant = Spectrum(0.0f);
+      I.world.constant = Spectrum(0.0f);
     }
   }
 
   if (w.camera_view) {
-    const World::CameraView& v = *w.camera_view;
     I.camera_view = true;
-    if (v.image >= 0 && size_t(v.image) < scene.images.size()) {
-      I.camera_environment.emplace(scene.images[size_t(v.image)], v.rotation, v.strength);
-      I.camera_enabled = !I.camera_environment->black();
-    } else {
-      I.camera_constant = max(v.color * v.strength, Spectrum(0.0f));
-      I.camera_enabled =
-          !is_black(I.camera_constant) && std::isfinite(luminance(I.camera_constant));
-    }
+    const Spectrum average = I.camera.set(*w.camera_view, scene);
+    I.camera_enabled = !is_black(average) && std::isfinite(luminance(average));
   }
 
   single_area_ = areas_.size() == 1 && points_.empty() && I.suns.empty();
@@ -313,15 +310,15 @@ LightSample LightSampler::sample_any(Vec3f ref, float u_select, Vec2f u) const {
     case Kind::World: {
       float pdf = 0.0f;
       Vec3f d;
-      if (I.environment) {
-        d = I.environment->sample(u, &pdf);
+      if (I.world.environment) {
+        d = I.world.environment->sample(u, &pdf);
       } else {
         d = lights::square_to_sphere(u);
         pdf = kInv4Pi;
       }
       if (pdf > 0.0f) {
         s.direction = d;
-        s.radiance = I.world_radiance(d);
+        s.radiance = I.world.eval(d);
         s.position = ref + d;
         s.normal = -d;
         s.distance = std::numeric_limits<float>::infinity();
@@ -412,14 +409,13 @@ bool LightSampler::intersect_any(Vec3f origin, Vec3f direction, float t_max, Lig
 
 Spectrum LightSampler::environment(Vec3f direction) const {
   const Impl& I = *impl_;
-  return I.world_enabled ? I.world_radiance(direction) : Spectrum(0.0f);
+  return I.world_enabled ? I.world.eval(direction) : Spectrum(0.0f);
 }
 
 Spectrum LightSampler::camera_environment(Vec3f direction) const {
   const Impl& I = *impl_;
   if (!I.camera_view) return environment(direction);
-  if (!I.camera_enabled) return Spectrum(0.0f);
-  return I.camera_environment ? I.camera_environment->eval(direction) : I.camera_constant;
+  return I.camera_enabled ? I.camera.eval(direction) : Spectrum(0.0f);
 }
 
 bool LightSampler::has_camera_environment() const {

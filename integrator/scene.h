@@ -114,21 +114,18 @@ struct Light {
   bool cast_shadow = true;
 };
 
-struct World {
+// A world background: a constant colour, or an equirectangular image, times strength.
+struct Background {
   Spectrum color{0.05f, 0.05f, 0.05f};  // Blender's default world grey
   float strength = 1.0f;
   int32_t image = -1;  // equirectangular environment in Scene::images; -1 = constant colour
   Transform rotation;  // world direction -> environment lookup direction (Mapping node rotation)
-  // What camera rays see of the world instead, when its node tree gives them their own
-  // background (a Mix Shader by Light Path's Is Camera Ray): the same fields. The background
-  // above lights the scene (every other ray).
-  struct CameraView {
-    Spectrum color{0.0f, 0.0f, 0.0f};
-    float strength = 1.0f;
-    int32_t image = -1;
-    Transform rotation;
-  };
-  std::optional<CameraView> camera_view;
+};
+
+// The background that lights the scene, and what camera rays see of the world instead when its
+// node tree gives them their own (a Mix Shader by Light Path's Is Camera Ray).
+struct World : Background {
+  std::optional<Background> camera_view;
 };
 
 struct Scene {

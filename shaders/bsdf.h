@@ -31,6 +31,7 @@ class ClosureSet {
     shadowing_ = other.shadowing_;
     unperturbed_ = other.unperturbed_;
     own_frames_ = other.own_frames_;
+    interpolated_ = other.interpolated_;
     ng_ = other.ng_;
   }
   // Cycles' bump shadowing (Conty Estevez et al. 2019, Cycles 3.4's bump_shadowing_term): at a
@@ -49,18 +50,14 @@ class ClosureSet {
       if (closures_[i].interpolated_normal) return true;
     return false;
   }
-  // Gives those lobes their own frame about `n` (unit, local: the shading frame's +z is the
-  // perturbed normal); `ng`: the geometric normal facing wi, local. From then on each lobe
-  // decides reflection against transmission about its own normal and contributes only where
-  // that agrees with the side of the geometric surface wo is on (Cycles decides per closure),
-  // and side_ok() leaves the decision to the lobes.
+  // From now on those lobes are evaluated in their own frame about `n` (unit, local: the shading
+  // frame's +z is the perturbed normal); `ng`: the geometric normal facing wi, local. Each lobe
+  // then decides reflection against transmission about its own normal and contributes only
+  // where that agrees with the side of the geometric surface wo is on (Cycles decides per
+  // closure), and side_ok() leaves the decision to the lobes.
   void set_interpolated_normal(Vec3f n, Vec3f ng) {
-    for (int i = 0; i < count_; ++i)
-      if (closures_[i].interpolated_normal) {
-        closures_[i].own_frame = true;
-        closures_[i].normal = n;
-      }
     own_frames_ = true;
+    interpolated_ = n;
     ng_ = ng;
     // Off the single-Lambert fast path (which tests shadowing_ alone); the shadowing factor of
     // the default unperturbed normal (+z) is 1.
@@ -147,7 +144,9 @@ class ClosureSet {
   Spectrum emission_{0.0f, 0.0f, 0.0f};
   bool shadowing_ = false;
   Vec3f unperturbed_{0.0f, 0.0f, 1.0f};
+  // set_interpolated_normal: the frame normal of the interpolated_normal lobes, and ng.
   bool own_frames_ = false;
+  Vec3f interpolated_{0.0f, 0.0f, 1.0f};
   Vec3f ng_{0.0f, 0.0f, 1.0f};
 };
 

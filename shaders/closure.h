@@ -52,12 +52,9 @@ struct Closure {
   Spectrum transmission_tint{1.0f, 1.0f, 1.0f};
   // The lobe keeps the interpolated normal where the material's normal map or bump tilts the
   // others (a BSDF whose Normal input is unlinked, Principled clearcoat with its Clearcoat Normal
-  // unlinked: Cycles gives those sd->N). Material data; the integrators act on it per hit.
+  // unlinked: Cycles gives those sd->N). Material data; per hit, the set evaluates such lobes
+  // about that normal (ClosureSet::set_interpolated_normal).
   bool interpolated_normal = false;
-  // Per hit (shading_closures): the lobe is evaluated about its own unit `normal`, given in the
-  // shading frame, instead of about +z.
-  bool own_frame = false;
-  Vec3f normal{0.0f, 0.0f, 1.0f};
 };
 
 enum LobeFlags : uint8_t {

@@ -43,7 +43,6 @@ namespace {
   }                                      \
   return {};
 
-// A lobe with its own normal (Closure::own_frame) sees wi and wo in the frame of that normal.
 Spectrum lobe_eval_local(const Closure& c, Vec3f wi, Vec3f wo) {
   GDPT_DISPATCH(c, eval(c, wi, wo))
 }
@@ -54,23 +53,25 @@ float lobe_pdf_local(const Closure& c, Vec3f wi,
 }
 float lobe_albedo_hint_local(const Closure& c, Vec3f wi){GDPT_DISPATCH(c, albedo_hint(c, wi))}
 
-Spectrum lobe_eval_framed(const Closure& c, Vec3f wi, Vec3f wo) {
-  if (c.own_frame) [[unlikely]] {
-    const Frame f(c.normal);
+// A lobe of a set with own frames: one that keeps the interpolated normal `n` sees wi and wo in
+// the frame of n.
+Spectrum lobe_eval_framed(const Closure& c, Vec3f n, Vec3f wi, Vec3f wo) {
+  if (c.interpolated_normal) {
+    const Frame f(n);
     return lobe_eval_local(c, f.to_local(wi), f.to_local(wo));
   }
   return lobe_eval_local(c, wi, wo);
 }
-float lobe_pdf_framed(const Closure& c, Vec3f wi, Vec3f wo) {
-  if (c.own_frame) [[unlikely]] {
-    const Frame f(c.normal);
+float lobe_pdf_framed(const Closure& c, Vec3f n, Vec3f wi, Vec3f wo) {
+  if (c.interpolated_normal) {
+    const Frame f(n);
     return lobe_pdf_local(c, f.to_local(wi), f.to_local(wo));
   }
   return lobe_pdf_local(c, wi, wo);
 }
-BsdfSample lobe_sample_framed(const Closure& c, Vec3f wi, float u_choice, Vec2f u) {
-  if (c.own_frame) [[unlikely]] {
-    const Frame f(c.normal);
+BsdfSample lobe_sample_framed(const Closure& c, Vec3f n, Vec3f wi, float u_choice, Vec2f u) {
+  if (c.interpolated_normal) {
+    const Frame f(n);
     const Vec3f wi_local = f.to_local(wi);
     BsdfSample s = lobe_sample_local(c, wi_local, u_choice, u);
     if (!s.valid) return s;
@@ -87,31 +88,30 @@ BsdfSample lobe_sample_framed(const Closure& c, Vec3f wi, float u_choice, Vec2f 
   }
   return lobe_sample_local(c, wi, u_choice, u);
 }
-float lobe_albedo_hint_framed(const Closure& c, Vec3f wi) {
-  if (c.own_frame) [[unlikely]]
-    return lobe_albedo_hint_local(c, Frame(c.normal).to_local(wi));
+float lobe_albedo_hint_framed(const Closure& c, Vec3f n, Vec3f wi) {
+  if (c.interpolated_normal) return lobe_albedo_hint_local(c, Frame(n).to_local(wi));
   return lobe_albedo_hint_local(c, wi);
 }
-// The lobe calls of a set with own frames (kFramed) or without: sets without them, all but a few,
-// run exactly the code they ran before own frames existed.
+// The lobe calls of a set with own frames (kFramed; `n` ClosureSet::interpolated_) or without:
+// sets without them, all but a few, run exactly the code they ran before own frames existed.
 template <bool kFramed>
-Spectrum lobe_eval(const Closure& c, Vec3f wi, Vec3f wo) {
-  if constexpr (kFramed) return lobe_eval_framed(c, wi, wo);
+Spectrum lobe_eval(const Closure& c, Vec3f n, Vec3f wi, Vec3f wo) {
+  if constexpr (kFramed) return lobe_eval_framed(c, n, wi, wo);
   return lobe_eval_local(c, wi, wo);
 }
 template <bool kFramed>
-float lobe_pdf(const Closure& c, Vec3f wi, Vec3f wo) {
-  if constexpr (kFramed) return lobe_pdf_framed(c, wi, wo);
+float lobe_pdf(const Closure& c, Vec3f n, Vec3f wi, Vec3f wo) {
+  if constexpr (kFramed) return lobe_pdf_framed(c, n, wi, wo);
   return lobe_pdf_local(c, wi, wo);
 }
 template <bool kFramed>
-BsdfSample lobe_sample(const Closure& c, Vec3f wi, float u_choice, Vec2f u) {
-  if constexpr (kFramed) return lobe_sample_framed(c, wi, u_choice, u);
+BsdfSample lobe_sample(const Closure& c, Vec3f n, Vec3f wi, float u_choice, Vec2f u) {
+  if constexpr (kFramed) return lobe_sample_framed(c, n, wi, u_choice, u);
   return lobe_sample_local(c, wi, u_choice, u);
 }
 template <bool kFramed>
-float lobe_albedo_hint(const Closure& c, Vec3f wi) {
-  if constexpr (kFramed) return lobe_albedo_hint_framed(c, wi);
+float lobe_albedo_hint(const Closure& c, Vec3f n, Vec3f wi) {
+  if constexpr (kFramed) return lobe_albedo_hint_framed(c, n, wi);
   return lobe_albedo_hint_local(c, wi);
 }
 #undef GDPT_DISPATCH
@@ -139,10 +139,10 @@ bool lobe_is_diffuse(const Closure& c) {
 
 // Unnormalised selection weights; returns their sum.
 template <bool kFramed>
-float selection_weights(const Closure* closures, int count, Vec3f wi, float* w) {
+float selection_weights(const Closure* closures, int count, Vec3f n, Vec3f wi, float* w) {
   float total = 0.0f;
   for (int i = 0; i < count; ++i) {
-    w[i] = selection_luminance(closures[i].weight) * lobe_albedo_hint<kFramed>(closures[i], wi);
+    w[i] = selection_luminance(closures[i].weight) * lobe_albedo_hint<kFramed>(closures[i], n, wi);
     total += w[i];
   }
   return total;
@@ -183,14 +183,15 @@ float ClosureSet::diffuse_shadowing(Vec3f wo) const {
 template <bool kFramed>
 Spectrum shadowed(const Closure& c, Spectrum value, float shadowing) {
   if constexpr (kFramed)
-    if (c.own_frame) return value;
+    if (c.interpolated_normal) return value;
   return shadowing != 1.0f && lobe_is_diffuse(c) ? value * shadowing : value;
 }
 
 bool ClosureSet::lobe_side_ok(const Closure& c, Vec3f wi, Vec3f wo) const {
   const float cos_ng = dot(ng_, wo);
   if (cos_ng == 0.0f) return false;
-  const bool reflection = c.own_frame ? dot(c.normal, wi) * dot(c.normal, wo) > 0.0f : wo.z > 0.0f;
+  const bool reflection =
+      c.interpolated_normal ? dot(interpolated_, wi) * dot(interpolated_, wo) > 0.0f : wo.z > 0.0f;
   return (cos_ng > 0.0f) == reflection;
 }
 
@@ -218,7 +219,8 @@ Spectrum ClosureSet::eval_mixture_t(Vec3f wi, Vec3f wo) const {
   for (int i = 0; i < count_; ++i) {
     if constexpr (kFramed)
       if (!lobe_side_ok(closures_[i], wi, wo)) continue;
-    f += shadowed<kFramed>(closures_[i], lobe_eval<kFramed>(closures_[i], wi, wo), sh);
+    f += shadowed<kFramed>(closures_[i], lobe_eval<kFramed>(closures_[i], interpolated_, wi, wo),
+                           sh);
   }
   return f;
 }
@@ -228,16 +230,16 @@ float ClosureSet::pdf_mixture_t(Vec3f wi, Vec3f wo) const {
   if (count_ == 1) {
     if constexpr (kFramed)
       if (!lobe_side_ok(closures_[0], wi, wo)) return 0.0f;
-    return lobe_pdf<kFramed>(closures_[0], wi, wo);
+    return lobe_pdf<kFramed>(closures_[0], interpolated_, wi, wo);
   }
   float w[kMaxClosures];
-  const float total = selection_weights<kFramed>(closures_, count_, wi, w);
+  const float total = selection_weights<kFramed>(closures_, count_, interpolated_, wi, w);
   if (!(total > 0.0f)) return 0.0f;
   float p = 0.0f;
   for (int i = 0; i < count_; ++i) {
     if constexpr (kFramed)
       if (!lobe_side_ok(closures_[i], wi, wo)) continue;
-    if (w[i] > 0.0f) p += w[i] * lobe_pdf<kFramed>(closures_[i], wi, wo);
+    if (w[i] > 0.0f) p += w[i] * lobe_pdf<kFramed>(closures_[i], interpolated_, wi, wo);
   }
   return p / total;
 }
@@ -251,19 +253,21 @@ Spectrum ClosureSet::eval_pdf_mixture_t(Vec3f wi, Vec3f wo, float& pdf_out) cons
         pdf_out = 0.0f;
         return Spectrum(0.0f);
       }
-    pdf_out = lobe_pdf<kFramed>(closures_[0], wi, wo);
-    return shadowed<kFramed>(closures_[0], lobe_eval<kFramed>(closures_[0], wi, wo), sh);
+    pdf_out = lobe_pdf<kFramed>(closures_[0], interpolated_, wi, wo);
+    return shadowed<kFramed>(closures_[0], lobe_eval<kFramed>(closures_[0], interpolated_, wi, wo),
+                             sh);
   }
   // The loops of eval() and pdf() merged, each sum in the same order: identical values.
   float w[kMaxClosures];
-  const float total = selection_weights<kFramed>(closures_, count_, wi, w);
+  const float total = selection_weights<kFramed>(closures_, count_, interpolated_, wi, w);
   Spectrum f(0.0f);
   float p = 0.0f;
   for (int i = 0; i < count_; ++i) {
     if constexpr (kFramed)
       if (!lobe_side_ok(closures_[i], wi, wo)) continue;
-    f += shadowed<kFramed>(closures_[i], lobe_eval<kFramed>(closures_[i], wi, wo), sh);
-    if (w[i] > 0.0f) p += w[i] * lobe_pdf<kFramed>(closures_[i], wi, wo);
+    f += shadowed<kFramed>(closures_[i], lobe_eval<kFramed>(closures_[i], interpolated_, wi, wo),
+                           sh);
+    if (w[i] > 0.0f) p += w[i] * lobe_pdf<kFramed>(closures_[i], interpolated_, wi, wo);
   }
   pdf_out = total > 0.0f ? p / total : 0.0f;
   return f;
@@ -273,7 +277,7 @@ template <bool kFramed>
 BsdfSample ClosureSet::sample_mixture_t(Vec3f wi, float u_lobe, Vec2f u) const {
   if (count_ == 0) return {};
   if (count_ == 1) {
-    BsdfSample s = lobe_sample<kFramed>(closures_[0], wi, u_lobe, u);
+    BsdfSample s = lobe_sample<kFramed>(closures_[0], interpolated_, wi, u_lobe, u);
     if constexpr (kFramed)
       if (s.valid && !lobe_side_ok(closures_[0], wi, s.wo)) return {};
     if (s.valid && shadowing_)
@@ -283,7 +287,7 @@ BsdfSample ClosureSet::sample_mixture_t(Vec3f wi, float u_lobe, Vec2f u) const {
 
   // --- Pick a lobe; the leftover of u_lobe within its interval drives the lobe's own choice.
   float w[kMaxClosures];
-  const float total = selection_weights<kFramed>(closures_, count_, wi, w);
+  const float total = selection_weights<kFramed>(closures_, count_, interpolated_, wi, w);
   if (!(total > 0.0f)) return {};
   const float target = u_lobe * total;
   int k = 0;
@@ -294,7 +298,7 @@ BsdfSample ClosureSet::sample_mixture_t(Vec3f wi, float u_lobe, Vec2f u) const {
   }
   while (w[k] <= 0.0f && k > 0) --k;  // rounding at the top end: fall back to a live lobe
   const float u_choice = std::clamp((target - cdf) / w[k], 0.0f, 0.99999994f);
-  BsdfSample s = lobe_sample<kFramed>(closures_[k], wi, u_choice, u);
+  BsdfSample s = lobe_sample<kFramed>(closures_[k], interpolated_, wi, u_choice, u);
   if (!s.valid) return s;
   if constexpr (kFramed)
     if (!lobe_side_ok(closures_[k], wi, s.wo)) return {};
@@ -313,8 +317,9 @@ BsdfSample ClosureSet::sample_mixture_t(Vec3f wi, float u_lobe, Vec2f u) const {
     if (i == k) continue;
     if constexpr (kFramed)
       if (!lobe_side_ok(closures_[i], wi, s.wo)) continue;
-    value += shadowed<kFramed>(closures_[i], lobe_eval<kFramed>(closures_[i], wi, s.wo), sh);
-    if (w[i] > 0.0f) pdf += w[i] * lobe_pdf<kFramed>(closures_[i], wi, s.wo);
+    value += shadowed<kFramed>(closures_[i],
+                               lobe_eval<kFramed>(closures_[i], interpolated_, wi, s.wo), sh);
+    if (w[i] > 0.0f) pdf += w[i] * lobe_pdf<kFramed>(closures_[i], interpolated_, wi, s.wo);
   }
   s.value = value;
   s.pdf = pdf / total;

@@ -926,24 +926,25 @@ void SceneBuilder::set_camera(const py::dict& d) {
   get(d, "region_height", c.region_height);
 }
 
+namespace {
+// {"color", "strength", "image", "rotation"}: a Background (`what` names it in errors).
+void read_background(const py::dict& d, size_t images, const char* what, Background& b) {
+  get_vec3(d, "color", b.color);
+  get(d, "strength", b.strength);
+  get(d, "image", b.image);
+  if (b.image >= int32_t(images))
+    throw std::invalid_argument(std::string(what) + ": image index out of range");
+  get_transform(d, "rotation", b.rotation);
+}
+}  // namespace
+
 void SceneBuilder::set_world(const py::dict& d) {
   World& w = scene_.world;
-  get_vec3(d, "color", w.color);
-  get(d, "strength", w.strength);
-  get(d, "image", w.image);
-  if (w.image >= int32_t(scene_.images.size()))
-    throw std::invalid_argument("world: image index out of range");
-  get_transform(d, "rotation", w.rotation);
+  read_background(d, scene_.images.size(), "world", w);
   // {"camera": the same keys}: the background camera rays see (World::camera_view).
   if (d.contains("camera")) {
-    const auto c = d["camera"].cast<py::dict>();
-    World::CameraView v;
-    get_vec3(c, "color", v.color);
-    get(c, "strength", v.strength);
-    get(c, "image", v.image);
-    if (v.image >= int32_t(scene_.images.size()))
-      throw std::invalid_argument("world: camera-view image index out of range");
-    get_transform(c, "rotation", v.rotation);
+    Background v;
+    read_background(d["camera"].cast<py::dict>(), scene_.images.size(), "world camera view", v);
     w.camera_view = v;
   }
 }

@@ -730,7 +730,7 @@ TEST(Render, CameraRaysSeeTheWorldsCameraView) {
     for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
       Scene scene;
       scene.world.color = a;
-      scene.world.camera_view = World::CameraView{view, 2.0f, -1, Transform()};
+      scene.world.camera_view = Background{view, 2.0f, -1, Transform()};
       scene.meshes.push_back(quad(50.0f));
       scene.materials.push_back(c.sheet ? transparent(tint) : diffuse(Spectrum(0.5f)));
       // The floor at z = 0; the sheet at z = 12, above a camera at z = 10 looking up (+z).

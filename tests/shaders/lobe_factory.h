@@ -73,23 +73,23 @@ inline Closure transparent(Spectrum c = Spectrum(1.0f)) {
   return k;
 }
 
-// `c` as a lobe that keeps the interpolated normal `n` (shading-frame coordinates) under a bump:
-// set_of() gives it its own frame about n, as shading_closures does.
-inline Closure about(Closure c, Vec3f n) {
+// `c` as a lobe that keeps the interpolated normal under a bump (Closure::interpolated_normal).
+inline Closure kept(Closure c) {
   c.interpolated_normal = true;
-  c.normal = normalize(n);
   return c;
 }
 
-// The set of `cs`; with `about` lobes, their frames set up (geometric normal +z).
-inline ClosureSet set_of(std::initializer_list<Closure> cs) {
+// The set of `cs`; with `kept` lobes, evaluated about `interpolated` (shading-frame coordinates,
+// normalised here) as shading_closures sets them up, the geometric normal +z.
+inline ClosureSet set_of(std::initializer_list<Closure> cs,
+                         Vec3f interpolated = Vec3f(0.0f, 0.0f, 1.0f)) {
   ClosureSet s;
-  const Closure* framed = nullptr;
+  bool kept_lobes = false;
   for (const Closure& c : cs) {
     s.add(c);
-    if (c.interpolated_normal) framed = &c;
+    kept_lobes |= c.interpolated_normal;
   }
-  if (framed) s.set_interpolated_normal(framed->normal, Vec3f(0.0f, 0.0f, 1.0f));
+  if (kept_lobes) s.set_interpolated_normal(normalize(interpolated), Vec3f(0.0f, 0.0f, 1.0f));
   return s;
 }
 

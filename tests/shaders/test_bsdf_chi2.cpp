@@ -53,10 +53,11 @@ std::vector<Case> lobe_cases() {
                                         glass(0.0f, 1.5f, Spectrum(0.5f))})});
   // Lobes about their own normal (a clearcoat on the interpolated normal under a bump), alone
   // and mixed with a lobe about the shading normal.
-  cases.push_back({"GGXOwnNormal20", set_of({about(ggx(0.2f), Vec3f(0.4f, -0.2f, 0.9f))})});
+  cases.push_back({"GGXOwnNormal20", set_of({kept(ggx(0.2f))}, Vec3f(0.4f, -0.2f, 0.9f))});
   cases.push_back(
-      {"MixDiffuseCoatOwnNormal", set_of({principled_diffuse(0.5f, Spectrum(0.4f, 0.3f, 0.2f)),
-                                          about(clearcoat(0.05f), Vec3f(-0.3f, 0.1f, 0.95f))})});
+      {"MixDiffuseCoatOwnNormal",
+       set_of({principled_diffuse(0.5f, Spectrum(0.4f, 0.3f, 0.2f)), kept(clearcoat(0.05f))},
+              Vec3f(-0.3f, 0.1f, 0.95f))});
   return cases;
 }
 

@@ -333,10 +333,11 @@ TEST(ClosureSet, BumpShadowingScalesDiffuseValuesOnly) {
   }
 }
 
-// A lobe about its own normal n (Closure::own_frame) is the same lobe seen in a rotated frame:
-// for isotropic lobes any rotation taking n to +z gives the same value and density. The rotation
-// here is built independently of Frame (Rodrigues' formula, then a turn about z), and a diffuse
-// lobe about its own normal is not bump-shadowed (its normal is the interpolated one).
+// A lobe about its own normal n (ClosureSet::set_interpolated_normal) is the same lobe seen in a
+// rotated frame: for isotropic lobes any rotation taking n to +z gives the same value and
+// density. The rotation here is built independently of Frame (Rodrigues' formula, then a turn
+// about z), and a diffuse lobe about its own normal is not bump-shadowed (its normal is the
+// interpolated one).
 TEST(ClosureSet, LobeAboutItsOwnNormalIsTheRotatedLobe) {
   const Vec3f n = normalize(Vec3f(0.5f, -0.3f, 0.8f));
   // Rodrigues: rotate n onto z about axis n x z, then by 0.7 rad about z.
@@ -353,7 +354,7 @@ TEST(ClosureSet, LobeAboutItsOwnNormalIsTheRotatedLobe) {
                               principled_diffuse(0.4f), lambert()}) {
     // Geometric normal n too: every direction is then on the lobe's side of the surface.
     ClosureSet own;
-    own.add(about(lobe, n));
+    own.add(kept(lobe));
     own.set_interpolated_normal(n, n);
     own.set_bump_shadowing(normalize(Vec3f(0.2f, 0.1f, 1.0f)));  // must not touch it
     const ClosureSet plain = set_of({lobe});
@@ -389,12 +390,13 @@ TEST(BsdfRobustness, NoNaNOrInfInDegenerateConfigurations) {
     lobes.push_back(glass(a, 1.5f));
     lobes.push_back(glass(a, 1.00001f));
     lobes.push_back(clearcoat(a));
-    lobes.push_back(about(clearcoat(a), Vec3f(0.3f, 0.2f, 0.9f)));
+    lobes.push_back(kept(clearcoat(a)));
   }
   const Vec3f wis[] = {Vec3f(1, 0, 0),  Vec3f(0, 0, 1),   Vec3f(0, 0, -1),
                        incident(1e-7f), incident(-1e-7f), normalize(Vec3f(1, 1, 0))};
   for (const Closure& c : lobes) {
-    const ClosureSet set = set_of({c, lambert(Spectrum(0.1f))});
+    // A kept lobe is evaluated about a tilted normal.
+    const ClosureSet set = set_of({c, lambert(Spectrum(0.1f))}, Vec3f(0.3f, 0.2f, 0.9f));
     for (const Vec3f& wi : wis) {
       const Vec3f wos[] = {
           -wi, wi, Vec3f(0, 0, 1), Vec3f(0, 0, -1), Vec3f(1, 0, 0), Vec3f(-wi.x, -wi.y, wi.z)};
