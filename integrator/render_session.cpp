@@ -44,6 +44,8 @@ RenderSession::RenderSession(Scene scene, RenderSettings settings)
   if (settings.max_bounces < 0 || settings.max_diffuse_bounces < 0 ||
       settings.max_glossy_bounces < 0 || settings.max_transmission_bounces < 0)
     throw std::invalid_argument("render settings: bounce limits must be >= 0");
+  if (settings.rr_depth < 0)
+    throw std::invalid_argument("render settings: the Russian roulette depth must be >= 0");
   if (settings.threads < 0) throw std::invalid_argument("render settings: threads must be >= 0");
   if (settings.samples_per_pass < 1) settings.samples_per_pass = 1;
   Impl& d = *impl_;

@@ -18,21 +18,12 @@ BOUNCES = int(os.environ.get("GDPT_BENCH_BOUNCES", "4"))
 # with the engines alternating; the median time counts. A single ~2 s render moved Cycles' rate
 # by +-12% between runs on this shared machine.
 REPEATS = int(os.environ.get("GDPT_BENCH_REPEATS", "3"))
-# Russian roulette depth of the core for this benchmark only (the add-on has no setting for it;
-# unset = the core's default). For comparing termination policies with Cycles, which applies
-# roulette from the second bounce on (path_state_continuation_probability).
-RR_DEPTH = os.environ.get("GDPT_BENCH_RR_DEPTH")
-
-
-def _with_rr_depth():
-    import gdpt.properties as properties
-    settings_dict = properties.settings_dict
-
-    def patched(scene):
-        d = settings_dict(scene)
-        d["rr_depth"] = int(RR_DEPTH)
-        return d
-    properties.settings_dict = patched
+# Min Light Bounces (Russian roulette may end a path only after that many bounces past the first
+# indirect hit) of the comparisons, one comparison per entry: a number sets both engines to it
+# (the same termination rule, q = min(sqrt(max throughput), 1), from the same vertex); "defaults"
+# leaves each engine at its own default (Cycles 0, GDPT 2). Paths that end later cost more per sample and have less
+# noise per sample, so samples/s ratios only compare like with like at equal settings.
+MIN_LIGHT_BOUNCES = os.environ.get("GDPT_BENCH_MIN_LIGHT_BOUNCES", "0,2,defaults").split(",")
 
 
 def cornell(scene):
@@ -55,18 +46,22 @@ def textured(scene):
     floor.data.materials.append(S.image_material("tex2", img))
 
 
-def render(scene, engine, samples, path):
+def render(scene, engine, samples, path, min_bounces):
     if engine == 'GDPT':
         S.setup_gdpt(scene, samples, mode='PT', reconstruction='NONE', bounces=BOUNCES)
+        if min_bounces != "defaults":
+            scene.gdpt.min_light_bounces = int(min_bounces)
     else:
         S.setup_cycles(scene, samples, bounces=BOUNCES)
+        if min_bounces != "defaults":
+            scene.cycles.min_light_bounces = int(min_bounces)
     scene.render.resolution_x, scene.render.resolution_y = RES
     t0 = time.perf_counter()
     S.render(scene, path)
     return time.perf_counter() - t0, S.read_rgb(path)
 
 
-def compare(name, build, out):
+def compare(name, build, out, min_bounces):
     import gdpt.engine as engine
     scene = S.clear()
     build(scene)
@@ -74,12 +69,14 @@ def compare(name, build, out):
     # A 1-spp render per engine first: one-time costs of the first render of a scene in the
     # process (OpenColorIO config and processors, Cycles' device and kernels) are not per-render
     # costs, and would otherwise land in the fixed cost of the 32-spp render below.
-    first = {eng: render(scene, eng, 1, os.path.join(out, f"{name}_{eng}_warm.exr"))[0]
+    first = {eng: render(scene, eng, 1, os.path.join(out, f"{name}_{eng}_warm.exr"),
+                         min_bounces)[0]
              for eng in ('GDPT', 'CYCLES')}
     rays = 0.0
     low = {}
     for eng in ('GDPT', 'CYCLES'):
-        t, img = render(scene, eng, SAMPLES, os.path.join(out, f"{name}_{eng}_{SAMPLES}.exr"))
+        t, img = render(scene, eng, SAMPLES, os.path.join(out, f"{name}_{eng}_{SAMPLES}.exr"),
+                        min_bounces)
         render_only = engine.LAST_RENDER["render"] if eng == 'GDPT' else t
         if eng == 'GDPT':
             rays = engine.LAST_RENDER["rays"] / (RES[0] * RES[1] * SAMPLES)
@@ -89,7 +86,7 @@ def compare(name, build, out):
     for _ in range(max(1, REPEATS)):
         for eng in ('GDPT', 'CYCLES'):
             t_ref, refs[eng] = render(scene, eng, REF_SAMPLES,
-                                      os.path.join(out, f"{name}_{eng}_ref.exr"))
+                                      os.path.join(out, f"{name}_{eng}_ref.exr"), min_bounces)
             ref_times[eng].append(t_ref)
     for eng in ('GDPT', 'CYCLES'):
         t, render_only, img = low[eng]
@@ -98,7 +95,10 @@ def compare(name, build, out):
     pixels = RES[0] * RES[1] * SAMPLES
     g, c = row['GDPT'], row['CYCLES']
     cross = S.rel_mse(g[3], c[3])
-    print(f"BENCH {name}: {RES[0]}x{RES[1]}, {SAMPLES} spp, {BOUNCES} bounces")
+    setting = ("each engine's default (GDPT 2, Cycles 0)" if min_bounces == "defaults"
+               else f"{min_bounces} in both engines")
+    print(f"BENCH {name}: {RES[0]}x{RES[1]}, {SAMPLES} spp, {BOUNCES} bounces, min light bounces "
+          f"{setting}")
     print(f"  GDPT PT : {g[0]:.2f} s wall ({g[1]:.2f} s render) = {pixels / g[0] / 1e6:.3f} "
           f"Msamples/s wall; relMSE vs own {REF_SAMPLES} spp: {g[2]:.5f}; {rays:.2f} rays per "
           f"sample (camera, extension and shadow rays)")
@@ -164,13 +164,11 @@ def export_and_overhead(out):
 
 
 def main():
-    if RR_DEPTH is not None:
-        _with_rr_depth()
-        print(f"BENCH note: GDPT rr_depth = {RR_DEPTH} (GDPT_BENCH_RR_DEPTH)")
     out = S.args()["out"]
     os.makedirs(out, exist_ok=True)
-    compare("cornell", cornell, out)
-    compare("textured", textured, out)
+    for min_bounces in MIN_LIGHT_BOUNCES:
+        compare("cornell", cornell, out, min_bounces)
+        compare("textured", textured, out, min_bounces)
     export_and_overhead(out)
 
 

@@ -1277,6 +1277,9 @@ TEST(Render, RussianRouletteIsUnbiasedAndShortensPaths) {
   // survival falls geometrically.
   EXPECT_LT(double(rays[0]), 0.2 * double(rays[2]));
   EXPECT_LT(rays[1], rays[2]);
+  RenderSettings bad = pt(1);
+  bad.rr_depth = -1;
+  EXPECT_THROW(RenderSession(scene, bad), std::invalid_argument);
 }
 
 // Thin lens: emissive stripes on the focus plane render as with a pinhole; moving the focus away
