@@ -8,8 +8,21 @@ CMAKE_FLAGS ?=
 deps:
 	bash scripts/setup-deps.sh
 
+# Profile-guided optimisation: an instrumented training build renders the benchmark scenes once
+# per build directory (scripts/pgo-train.sh); the real build is optimised with its profile.
+# PGO=0 builds without it.
+PGO ?= 1
+ifeq ($(PGO),1)
+PGO_PROFILE := $(abspath $(BUILD))/pgo-profile
+PGO_FLAGS := -DGDPT_PGO_USE=$(PGO_PROFILE)
+$(BUILD)/CMakeCache.txt: $(PGO_PROFILE)/.trained
+$(PGO_PROFILE)/.trained: | deps
+	bash scripts/pgo-train.sh $(BUILD)
+	touch $@
+endif
+
 $(BUILD)/CMakeCache.txt:
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(PGO_FLAGS) $(CMAKE_FLAGS)
 
 build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
