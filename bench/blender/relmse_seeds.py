@@ -21,10 +21,10 @@ for name, build in (("cornell", cornell), ("textured", textured)):
     for seed in range(1, 9):
         for e in ("GDPT", "CYCLES"):
             if e == "GDPT":
-                S.setup_gdpt(scene, 32, mode='PT', reconstruction='NONE', bounces=4, seed=seed)
+                S.setup_gdpt(scene, 32, mode='PT', reconstruction='NONE', bounces=BOUNCES, seed=seed)
                 scene.gdpt.min_light_bounces = int(M)
             else:
-                S.setup_cycles(scene, 32, bounces=4, seed=seed)
+                S.setup_cycles(scene, 32, bounces=BOUNCES, seed=seed)
                 scene.cycles.min_light_bounces = int(M)
             scene.render.resolution_x, scene.render.resolution_y = RES
             p = S.render(scene, f"{out}/{name}_{e}_{seed}.exr")
