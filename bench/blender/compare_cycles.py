@@ -21,8 +21,9 @@ REPEATS = int(os.environ.get("GDPT_BENCH_REPEATS", "3"))
 # Min Light Bounces (Russian roulette may end a path only after that many bounces past the first
 # indirect hit) of the comparisons, one comparison per entry: a number sets both engines to it
 # (the same termination rule, q = min(sqrt(max throughput), 1), from the same vertex); "defaults"
-# leaves each engine at its own default (Cycles 0, GDPT 2). Paths that end later cost more per sample and have less
-# noise per sample, so samples/s ratios only compare like with like at equal settings.
+# leaves each engine at its own default (Cycles 0, GDPT 2). Paths that end later cost more per
+# sample and have less noise per sample, so samples/s ratios only compare like with like at
+# equal settings.
 MIN_LIGHT_BOUNCES = os.environ.get("GDPT_BENCH_MIN_LIGHT_BOUNCES", "0,2,defaults").split(",")
 
 
@@ -46,13 +47,13 @@ def textured(scene):
     floor.data.materials.append(S.image_material("tex2", img))
 
 
-def render(scene, engine, samples, path, min_bounces):
+def render(scene, engine, samples, path, min_bounces, seed=1):
     if engine == 'GDPT':
-        S.setup_gdpt(scene, samples, mode='PT', reconstruction='NONE', bounces=BOUNCES)
+        S.setup_gdpt(scene, samples, mode='PT', reconstruction='NONE', bounces=BOUNCES, seed=seed)
         if min_bounces != "defaults":
             scene.gdpt.min_light_bounces = int(min_bounces)
     else:
-        S.setup_cycles(scene, samples, bounces=BOUNCES)
+        S.setup_cycles(scene, samples, bounces=BOUNCES, seed=seed)
         if min_bounces != "defaults":
             scene.cycles.min_light_bounces = int(min_bounces)
     scene.render.resolution_x, scene.render.resolution_y = RES
@@ -172,4 +173,5 @@ def main():
     export_and_overhead(out)
 
 
-main()
+if __name__ == "__main__":  # run by Blender; relmse_seeds.py imports the scenes and render()
+    main()
