@@ -25,6 +25,8 @@ REPEATS = int(os.environ.get("GDPT_BENCH_REPEATS", "3"))
 # sample and have less noise per sample, so samples/s ratios only compare like with like at
 # equal settings.
 MIN_LIGHT_BOUNCES = os.environ.get("GDPT_BENCH_MIN_LIGHT_BOUNCES", "0,2,defaults").split(",")
+# Cycles' sampling pattern: its default Progressive Multi-Jitter, or SOBOL.
+CYCLES_PATTERN = os.environ.get("GDPT_BENCH_CYCLES_PATTERN", "PROGRESSIVE_MULTI_JITTER")
 
 
 def cornell(scene):
@@ -54,6 +56,7 @@ def render(scene, engine, samples, path, min_bounces, seed=1):
             scene.gdpt.min_light_bounces = int(min_bounces)
     else:
         S.setup_cycles(scene, samples, bounces=BOUNCES, seed=seed)
+        scene.cycles.sampling_pattern = CYCLES_PATTERN
         if min_bounces != "defaults":
             scene.cycles.min_light_bounces = int(min_bounces)
     scene.render.resolution_x, scene.render.resolution_y = RES
@@ -99,7 +102,7 @@ def compare(name, build, out, min_bounces):
     setting = ("each engine's default (GDPT 2, Cycles 0)" if min_bounces == "defaults"
                else f"{min_bounces} in both engines")
     print(f"BENCH {name}: {RES[0]}x{RES[1]}, {SAMPLES} spp, {BOUNCES} bounces, min light bounces "
-          f"{setting}")
+          f"{setting}; Cycles pattern {CYCLES_PATTERN}")
     print(f"  GDPT PT : {g[0]:.2f} s wall ({g[1]:.2f} s render) = {pixels / g[0] / 1e6:.3f} "
           f"Msamples/s wall; relMSE vs own {REF_SAMPLES} spp: {g[2]:.5f}; {rays:.2f} rays per "
           f"sample (camera, extension and shadow rays)")

@@ -6,7 +6,8 @@
 # Knobs (environment): GDPT_BENCH_RES (default 96x72), GDPT_BENCH_SAMPLES (32),
 # GDPT_BENCH_REF_SAMPLES (512), GDPT_BENCH_REPEATS (3, reference renders per engine, median
 # time), GDPT_BENCH_BOUNCES (4), GDPT_BENCH_MIN_LIGHT_BOUNCES (0,2,defaults: one comparison per
-# entry, a number being set in both engines, "defaults" each engine's own).
+# entry, a number being set in both engines, "defaults" each engine's own),
+# GDPT_BENCH_CYCLES_PATTERN (PROGRESSIVE_MULTI_JITTER, Cycles' default, or SOBOL).
 set -euo pipefail
 build=${1:-build}
 root=$(cd "$(dirname "$0")/../.." && pwd)
