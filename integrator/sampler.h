@@ -8,12 +8,14 @@
 // samples. A value is a pure function of (seed, pixel, sample index, dimension): the image does not
 // depend on thread count or tile order.
 //
-// The BSDF directions of vertices 2k and 2k + 1 are one 4D point instead of two padded pairs: the
-// odd vertex's pair shares the even vertex's index shuffle and takes Sobol dimensions 2 and 3
-// (the four dimensions form a (2,m,4)-net; dimensions 2 and 3 alone a (1,m,2)-net). A diffuse
-// bounce's direction and the next one's are then stratified jointly, which lowered relMSE at 32
-// spp by 3.5% (diffuse Cornell box) to 6.5% (glossy ball: the floor -> ball -> lamp caustic) in
-// Blender, 16 seeds (docs/integrator.md, thirteenth session).
+// Vertices 2k and 2k + 1 share one 6D point instead of three padded pairs: the even vertex's BSDF
+// direction is Sobol dimensions 0-1, the odd vertex's direction 2-3 and its light point 4-5, all
+// with the even vertex's index shuffle and each coordinate Owen-scrambled. The first four
+// dimensions form a (2,m,4)-net, all six a (3,m,6)-net. So a bounce's direction is stratified
+// jointly with the next direction (diffuse interreflection; the floor -> glossy ball -> lamp
+// caustic) and with the lamp sample taken where it lands. In Blender at 32 spp (16 seeds) this
+// lowered relMSE by 4.6% (Cornell box) to 9.4% (textured box) against padded pairs
+// (docs/integrator.md, thirteenth session).
 //
 // Dimension layout (Sampler::Dim): camera jitter 2D, lens 2D, then per bounce kDimsPerBounce
 // dimensions: light select 1D, light position 2D, BSDF lobe 1D, BSDF direction 2D, Russian
@@ -98,15 +100,23 @@ inline uint32_t sobol_dim1(uint32_t i) {
   return reverse_bits(reversed_sobol_dim1(i));
 }
 
-// Sobol dimensions 2 and 3 (Joe and Kuo's primitive polynomials x^2 + x + 1 with m = 1, 3 and
-// x^3 + x + 1 with m = 1, 3, 1): direction numbers by the standard recurrence.
-inline uint32_t sobol_dim23_slow(int which, uint32_t i) {
-  const int s = which == 0 ? 2 : 3;
-  uint32_t m[32] = {1, 3, 1};
-  for (int k = s; k < 32; ++k) {
-    uint32_t v = m[k - s] ^ (m[k - s] << s);
-    if (s == 2) v ^= m[k - 1] << 1;  // a = 1: the x term
-    if (s == 3) v ^= m[k - 2] << 2;  // a = 1 (binary 01): the x term of x^3 + x + 1
+// Sobol dimensions 2 to 5, from Joe and Kuo's primitive polynomials and initial direction numbers
+// (degree s, coefficient bits a, m_1..m_s): x^2+x+1 (2, 1, 1 3), x^3+x+1 (3, 1, 1 3 1),
+// x^3+x^2+1 (3, 2, 1 1 1), x^4+x+1 (4, 1, 1 1 3 3); the rest by the standard recurrence.
+inline uint32_t sobol_dim_slow(int dim, uint32_t i) {
+  struct Poly {
+    int s;
+    uint32_t a, m[4];
+  };
+  static constexpr Poly kPolys[4] = {
+      {2, 1, {1, 3, 0, 0}}, {3, 1, {1, 3, 1, 0}}, {3, 2, {1, 1, 1, 0}}, {4, 1, {1, 1, 3, 3}}};
+  const Poly& p = kPolys[dim - 2];
+  uint32_t m[32] = {};
+  for (int k = 0; k < p.s; ++k) m[k] = p.m[k];
+  for (int k = p.s; k < 32; ++k) {
+    uint32_t v = m[k - p.s] ^ (m[k - p.s] << p.s);
+    for (int j = 1; j < p.s; ++j)
+      if ((p.a >> (p.s - 1 - j)) & 1u) v ^= m[k - j] << j;
     m[k] = v;
   }
   uint32_t r = 0;
@@ -114,18 +124,18 @@ inline uint32_t sobol_dim23_slow(int which, uint32_t i) {
     if (i & 1u) r ^= m[k] << (31 - k);
   return r;
 }
-struct SobolDim23Tables {
-  uint32_t t[2][4][256];  // reverse_bits(sobol_dim{2,3}(.)), per byte of the index
-  SobolDim23Tables() {
-    for (int w = 0; w < 2; ++w)
+struct SobolDim2To5Tables {
+  uint32_t t[4][4][256];  // reverse_bits(sobol_dim{2..5}(.)), per byte of the index
+  SobolDim2To5Tables() {
+    for (int d = 0; d < 4; ++d)
       for (uint32_t b = 0; b < 4; ++b)
         for (uint32_t v = 0; v < 256; ++v)
-          t[w][b][v] = reverse_bits(sobol_dim23_slow(w, v << (8 * b)));
+          t[d][b][v] = reverse_bits(sobol_dim_slow(d + 2, v << (8 * b)));
   }
 };
-inline const SobolDim23Tables kSobolDim23;
-inline uint32_t reversed_sobol_dim23(int which, uint32_t i) {
-  const auto& t = kSobolDim23.t[which];
+inline const SobolDim2To5Tables kSobolDim2To5;
+inline uint32_t reversed_sobol_dim(int dim, uint32_t i) {  // dim in 2..5
+  const auto& t = kSobolDim2To5.t[dim - 2];
   return t[0][i & 0xffu] ^ t[1][(i >> 8) & 0xffu] ^ t[2][(i >> 16) & 0xffu] ^ t[3][i >> 24];
 }
 
@@ -174,10 +184,14 @@ class Sampler {
   };
   VertexNumbers vertex_numbers(int vertex, bool lights) const {
     VertexNumbers u;
+    if (vertex & 1) {  // dimensions 2-5 of the 6D point of the previous vertex's direction
+      const uint32_t first = bounce_dim(vertex - 1, kBsdfDir);
+      if (lights) u.light = get2d_joint(bounce_dim(vertex, kLightPoint), first, 4);
+      u.dir = get2d_joint(bounce_dim(vertex, kBsdfDir), first, 2);
+      return u;
+    }
     if (lights) u.light = get2d(bounce_dim(vertex, kLightPoint));
-    u.dir = vertex & 1
-                ? get2d_second(bounce_dim(vertex, kBsdfDir), bounce_dim(vertex - 1, kBsdfDir))
-                : get2d(bounce_dim(vertex, kBsdfDir));
+    u.dir = get2d(bounce_dim(vertex, kBsdfDir));
     return u;
   }
 
@@ -205,16 +219,17 @@ class Sampler {
     return {to_unit_float(x), to_unit_float(y)};
   }
 
-  // Dimensions 2 and 3 of the 4D point whose dimensions 0 and 1 are get2d(first): the same
-  // shuffled index, its own coordinate scrambles.
-  [[gnu::noinline]] Vec2f get2d_second(uint32_t dim, uint32_t first) const {
+  // Sobol dimensions sobol_dim and sobol_dim + 1 (2 or 4) of the point whose dimensions 0 and 1
+  // are get2d(first): the same shuffled index, its own coordinate scrambles.
+  [[gnu::noinline]] Vec2f get2d_joint(uint32_t dim, uint32_t first, int sobol_dim) const {
     using namespace sampler_detail;
     const uint64_t h = mix64(pixel_key_ ^ dim);
     const uint32_t shuffle = uint32_t(mix64(pixel_key_ ^ first));
     const uint32_t i = reverse_bits(lk_permutation(reversed_index_, shuffle));
-    const uint32_t x = reverse_bits(lk_permutation(reversed_sobol_dim23(0, i), uint32_t(h >> 32)));
-    const uint32_t y = reverse_bits(
-        lk_permutation(reversed_sobol_dim23(1, i), uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32)));
+    const uint32_t x =
+        reverse_bits(lk_permutation(reversed_sobol_dim(sobol_dim, i), uint32_t(h >> 32)));
+    const uint32_t y = reverse_bits(lk_permutation(reversed_sobol_dim(sobol_dim + 1, i),
+                                                   uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32)));
     return {to_unit_float(x), to_unit_float(y)};
   }
 
