@@ -74,43 +74,31 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
   return reverse_bits(lk_permutation(reverse_bits(x), seed));
 }
 
-// Sobol dimension 1 (the second): generator matrix with v_k = v_{k-1} ^ (v_{k-1} >> 1), i.e. the
-// Pascal matrix mod 2. The map is linear over GF(2), so it is the XOR of four per-byte tables.
+// Sobol dimension 1 (the second) by its definition: generator matrix with
+// v_k = v_{k-1} ^ (v_{k-1} >> 1), i.e. the Pascal matrix mod 2 (the tests check the tables below
+// against it).
 inline uint32_t sobol_dim1_slow(uint32_t i) {
   uint32_t r = 0;
   for (uint32_t v = 1u << 31; i != 0; i >>= 1, v ^= v >> 1)
     if (i & 1u) r ^= v;
   return r;
 }
-// The tables store reverse_bits(sobol_dim1(.)) (still linear over GF(2)): the Owen scramble that
-// follows works on reversed bits, so this saves two reversals per 2D sample.
-struct SobolDim1Tables {
-  uint32_t t[4][256];
-  SobolDim1Tables() {
-    for (uint32_t b = 0; b < 4; ++b)
-      for (uint32_t v = 0; v < 256; ++v) t[b][v] = reverse_bits(sobol_dim1_slow(v << (8 * b)));
-  }
-};
-inline const SobolDim1Tables kSobolDim1;
-inline uint32_t reversed_sobol_dim1(uint32_t i) {
-  const auto& t = kSobolDim1.t;
-  return t[0][i & 0xffu] ^ t[1][(i >> 8) & 0xffu] ^ t[2][(i >> 16) & 0xffu] ^ t[3][i >> 24];
-}
-inline uint32_t sobol_dim1(uint32_t i) {
-  return reverse_bits(reversed_sobol_dim1(i));
-}
 
-// Sobol dimensions 2 to 5, from Joe and Kuo's primitive polynomials and initial direction numbers
-// (degree s, coefficient bits a, m_1..m_s): x^2+x+1 (2, 1, 1 3), x^3+x+1 (3, 1, 1 3 1),
-// x^3+x^2+1 (3, 2, 1 1 1), x^4+x+1 (4, 1, 1 1 3 3); the rest by the standard recurrence.
+// Sobol dimensions 1 to 5, from Joe and Kuo's primitive polynomials and initial direction numbers
+// (degree s, coefficient bits a, m_1..m_s): x+1 (1, 0, 1), x^2+x+1 (2, 1, 1 3), x^3+x+1
+// (3, 1, 1 3 1), x^3+x^2+1 (3, 2, 1 1 1), x^4+x+1 (4, 1, 1 1 3 3); the rest by the standard
+// recurrence.
 inline uint32_t sobol_dim_slow(int dim, uint32_t i) {
   struct Poly {
     int s;
     uint32_t a, m[4];
   };
-  static constexpr Poly kPolys[4] = {
-      {2, 1, {1, 3, 0, 0}}, {3, 1, {1, 3, 1, 0}}, {3, 2, {1, 1, 1, 0}}, {4, 1, {1, 1, 3, 3}}};
-  const Poly& p = kPolys[dim - 2];
+  static constexpr Poly kPolys[5] = {{1, 0, {1, 0, 0, 0}},
+                                     {2, 1, {1, 3, 0, 0}},
+                                     {3, 1, {1, 3, 1, 0}},
+                                     {3, 2, {1, 1, 1, 0}},
+                                     {4, 1, {1, 1, 3, 3}}};
+  const Poly& p = kPolys[dim - 1];
   uint32_t m[32] = {};
   for (int k = 0; k < p.s; ++k) m[k] = p.m[k];
   for (int k = p.s; k < 32; ++k) {
@@ -124,19 +112,25 @@ inline uint32_t sobol_dim_slow(int dim, uint32_t i) {
     if (i & 1u) r ^= m[k] << (31 - k);
   return r;
 }
-struct SobolDim2To5Tables {
-  uint32_t t[4][4][256];  // reverse_bits(sobol_dim{2..5}(.)), per byte of the index
-  SobolDim2To5Tables() {
-    for (int d = 0; d < 4; ++d)
+// Each dimension is linear over GF(2), so it is the XOR of four per-byte tables. The tables store
+// reverse_bits(sobol_dim(.)) (still linear): the Owen scramble that follows works on reversed
+// bits, so this saves two reversals per 2D sample.
+struct SobolTables {
+  uint32_t t[5][4][256];  // dimensions 1..5
+  SobolTables() {
+    for (int d = 0; d < 5; ++d)
       for (uint32_t b = 0; b < 4; ++b)
         for (uint32_t v = 0; v < 256; ++v)
-          t[d][b][v] = reverse_bits(sobol_dim_slow(d + 2, v << (8 * b)));
+          t[d][b][v] = reverse_bits(sobol_dim_slow(d + 1, v << (8 * b)));
   }
 };
-inline const SobolDim2To5Tables kSobolDim2To5;
-inline uint32_t reversed_sobol_dim(int dim, uint32_t i) {  // dim in 2..5
-  const auto& t = kSobolDim2To5.t[dim - 2];
+inline const SobolTables kSobolTables;
+inline uint32_t reversed_sobol_dim(int dim, uint32_t i) {  // dim in 1..5
+  const auto& t = kSobolTables.t[dim - 1];
   return t[0][i & 0xffu] ^ t[1][(i >> 8) & 0xffu] ^ t[2][(i >> 16) & 0xffu] ^ t[3][i >> 24];
+}
+inline uint32_t sobol_dim1(uint32_t i) {
+  return reverse_bits(reversed_sobol_dim(1, i));
 }
 
 inline float to_unit_float(uint32_t x) {
@@ -183,13 +177,8 @@ class Sampler {
     Vec2f light, dir;
   };
   VertexNumbers vertex_numbers(int vertex, bool lights) const {
+    if (vertex & 1) return odd_vertex_numbers(vertex, lights);
     VertexNumbers u;
-    if (vertex & 1) {  // dimensions 2-5 of the 6D point of the previous vertex's direction
-      const uint32_t first = bounce_dim(vertex - 1, kBsdfDir);
-      if (lights) u.light = get2d_joint(bounce_dim(vertex, kLightPoint), first, 4);
-      u.dir = get2d_joint(bounce_dim(vertex, kBsdfDir), first, 2);
-      return u;
-    }
     if (lights) u.light = get2d(bounce_dim(vertex, kLightPoint));
     u.dir = get2d(bounce_dim(vertex, kBsdfDir));
     return u;
@@ -197,43 +186,56 @@ class Sampler {
 
   // Written with the reversals folded: nested_uniform_scramble(v, s) =
   // reverse_bits(lk_permutation(reverse_bits(v), s)), Sobol dimension 0 is reverse_bits(i) and
-  // the dimension-1 table already returns reversed bits.
+  // the tables of the other dimensions already return reversed bits.
   // The seeds of the index shuffle and of the coordinate scrambles all come from one 64-bit hash
   // of (pixel key, dim): its low and high halves, and for y the high half of a multiple of it.
   float get1d(uint32_t dim) const {
     using namespace sampler_detail;
     const uint64_t h = mix64(pixel_key_ ^ dim);
-    const uint32_t i = reverse_bits(lk_permutation(reversed_index_, uint32_t(h)));  // shuffled
+    const uint32_t i = shuffle(uint32_t(h));
     return to_unit_float(reverse_bits(lk_permutation(i, uint32_t(h >> 32))));
   }
 
   // Out of line: inlined into the PT kernel it cost more instructions than the call (+41 per
   // Cornell-box sample, register pressure in the path loop).
   [[gnu::noinline]] Vec2f get2d(uint32_t dim) const {
-    using namespace sampler_detail;
-    const uint64_t h = mix64(pixel_key_ ^ dim);
-    const uint32_t i = reverse_bits(lk_permutation(reversed_index_, uint32_t(h)));  // shuffled
-    const uint32_t x = reverse_bits(lk_permutation(i, uint32_t(h >> 32)));
-    const uint32_t y = reverse_bits(
-        lk_permutation(reversed_sobol_dim1(i), uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32)));
-    return {to_unit_float(x), to_unit_float(y)};
+    const uint64_t h = sampler_detail::mix64(pixel_key_ ^ dim);
+    const uint32_t i = shuffle(uint32_t(h));
+    return scrambled_pair(i, sampler_detail::reversed_sobol_dim(1, i), h);
   }
 
-  // Sobol dimensions sobol_dim and sobol_dim + 1 (2 or 4) of the point whose dimensions 0 and 1
-  // are get2d(first): the same shuffled index, its own coordinate scrambles.
-  [[gnu::noinline]] Vec2f get2d_joint(uint32_t dim, uint32_t first, int sobol_dim) const {
+  // An odd vertex's numbers: Sobol dimensions 2-3 (direction) and 4-5 (light point) of the 6D
+  // point whose dimensions 0-1 are the previous vertex's direction, get2d(first): the same
+  // shuffled index, computed once, and their own coordinate scrambles. Out of line as get2d.
+  [[gnu::noinline]] VertexNumbers odd_vertex_numbers(int vertex, bool lights) const {
     using namespace sampler_detail;
-    const uint64_t h = mix64(pixel_key_ ^ dim);
-    const uint32_t shuffle = uint32_t(mix64(pixel_key_ ^ first));
-    const uint32_t i = reverse_bits(lk_permutation(reversed_index_, shuffle));
-    const uint32_t x =
-        reverse_bits(lk_permutation(reversed_sobol_dim(sobol_dim, i), uint32_t(h >> 32)));
-    const uint32_t y = reverse_bits(lk_permutation(reversed_sobol_dim(sobol_dim + 1, i),
-                                                   uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32)));
-    return {to_unit_float(x), to_unit_float(y)};
+    const uint32_t i = shuffle(uint32_t(mix64(pixel_key_ ^ bounce_dim(vertex - 1, kBsdfDir))));
+    VertexNumbers u;
+    if (lights)
+      u.light = scrambled_pair(reversed_sobol_dim(4, i), reversed_sobol_dim(5, i),
+                               mix64(pixel_key_ ^ bounce_dim(vertex, kLightPoint)));
+    u.dir = scrambled_pair(reversed_sobol_dim(2, i), reversed_sobol_dim(3, i),
+                           mix64(pixel_key_ ^ bounce_dim(vertex, kBsdfDir)));
+    return u;
   }
 
  private:
+  // The sample index shuffled by a nested uniform scramble: aligned blocks of 2^m indices map to
+  // aligned blocks, so every such block stays a net.
+  uint32_t shuffle(uint32_t seed) const {
+    using namespace sampler_detail;
+    return reverse_bits(lk_permutation(reversed_index_, seed));
+  }
+  // Owen-scrambled point from the reversed-bit Sobol coordinates rx, ry, seeded by the high half of
+  // h (x) and of a multiple of h (y).
+  static Vec2f scrambled_pair(uint32_t rx, uint32_t ry, uint64_t h) {
+    using namespace sampler_detail;
+    const uint32_t x = reverse_bits(lk_permutation(rx, uint32_t(h >> 32)));
+    const uint32_t y =
+        reverse_bits(lk_permutation(ry, uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32)));
+    return {to_unit_float(x), to_unit_float(y)};
+  }
+
   uint64_t pixel_key_ = 0;
   uint32_t reversed_index_ = 0;
 };
