@@ -4,9 +4,11 @@
 #   BLENDER_USER_SCRIPTS=<staged add-on> MLB=0 blender -b --factory-startup --addons gdpt \
 #     --python bench/blender/relmse_seeds.py -- --out out/bench/seeds
 # Knobs (environment): MLB (Min Light Bounces in both engines, default 2), GDPT_BENCH_SEEDS
-# (number of seeds, 8), GDPT_BENCH_SCENES (cornell,textured), GDPT_BENCH_DIFFUSE_BALL (1: the
-# glossy ball made diffuse, which removes the caustic fireflies), and compare_cycles.py's
-# GDPT_BENCH_BOUNCES and GDPT_BENCH_CYCLES_PATTERN. The references use seed 1000, outside the
+# (number of seeds, 8), GDPT_BENCH_SEED_REF_SAMPLES (samples of the references, 1024; one
+# reference serves every seed, so its own error is in every seed's), GDPT_BENCH_SCENES
+# (cornell,textured), GDPT_BENCH_DIFFUSE_BALL (1: the glossy ball made diffuse, which removes
+# the caustic fireflies), and compare_cycles.py's GDPT_BENCH_BOUNCES and
+# GDPT_BENCH_CYCLES_PATTERN. The references use seed 1000, outside the
 # seeds measured: a 32-spp render of the reference's own seed is the first 32 samples of the
 # reference in both engines, which would lower its error.
 import os
@@ -25,6 +27,7 @@ SEEDS = range(1, int(os.environ.get("GDPT_BENCH_SEEDS", "8")) + 1)
 SCENES = os.environ.get("GDPT_BENCH_SCENES", "cornell,textured").split(",")
 DIFFUSE_BALL = os.environ.get("GDPT_BENCH_DIFFUSE_BALL", "0") == "1"
 REFERENCE_SEED = 1000
+REFERENCE_SAMPLES = int(os.environ.get("GDPT_BENCH_SEED_REF_SAMPLES", "1024"))
 
 
 def main():
@@ -40,7 +43,8 @@ def main():
             ball = bpy.data.objects["b"]
             ball.data.materials.clear()
             ball.data.materials.append(S.diffuse("ball", (0.8, 0.8, 0.8)))
-        refs = {e: C.render(scene, e, 1024, f"{out}/{name}_{e}_ref.exr", m, REFERENCE_SEED)[1]
+        refs = {e: C.render(scene, e, REFERENCE_SAMPLES, f"{out}/{name}_{e}_ref.exr", m,
+                          REFERENCE_SEED)[1]
                 for e in engines}
         errs = {e: [S.rel_mse(C.render(scene, e, C.SAMPLES, f"{out}/{name}_{e}_{seed}.exr", m,
                                        seed)[1], refs[e]) for seed in SEEDS]
@@ -48,7 +52,8 @@ def main():
         g, c = np.array(errs["GDPT"]), np.array(errs["CYCLES"])
         n = len(SEEDS)
         print(f"SEEDS {name}{' (diffuse ball)' if DIFFUSE_BALL else ''}, {C.BOUNCES} bounces, "
-              f"min light bounces {m}, Cycles pattern {C.CYCLES_PATTERN}, {n} seeds: GDPT relMSE "
+              f"min light bounces {m}, references {REFERENCE_SAMPLES} spp, Cycles pattern "
+              f"{C.CYCLES_PATTERN}, {n} seeds: GDPT relMSE "
               f"{g.mean():.5f} +- {g.std(ddof=1) / n ** 0.5:.5f}, Cycles {c.mean():.5f} +- "
               f"{c.std(ddof=1) / n ** 0.5:.5f}; ratio of means {g.mean() / c.mean():.3f}, "
               f"per-seed ratios {np.round(g / c, 3).tolist()}", flush=True)
