@@ -192,8 +192,7 @@ class Sampler {
   float get1d(uint32_t dim) const {
     using namespace sampler_detail;
     const uint64_t h = mix64(pixel_key_ ^ dim);
-    const uint32_t i = shuffle(uint32_t(h));
-    return to_unit_float(reverse_bits(lk_permutation(i, uint32_t(h >> 32))));
+    return scrambled(shuffle(uint32_t(h)), uint32_t(h >> 32));
   }
 
   // Out of line: inlined into the PT kernel it cost more instructions than the call (+41 per
@@ -226,14 +225,16 @@ class Sampler {
     using namespace sampler_detail;
     return reverse_bits(lk_permutation(reversed_index_, seed));
   }
+  // Owen-scrambled coordinate in [0, 1) from its reversed-bit Sobol value r.
+  static float scrambled(uint32_t r, uint32_t seed) {
+    using namespace sampler_detail;
+    return to_unit_float(reverse_bits(lk_permutation(r, seed)));
+  }
   // Owen-scrambled point from the reversed-bit Sobol coordinates rx, ry, seeded by the high half of
   // h (x) and of a multiple of h (y).
   static Vec2f scrambled_pair(uint32_t rx, uint32_t ry, uint64_t h) {
-    using namespace sampler_detail;
-    const uint32_t x = reverse_bits(lk_permutation(rx, uint32_t(h >> 32)));
-    const uint32_t y =
-        reverse_bits(lk_permutation(ry, uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32)));
-    return {to_unit_float(x), to_unit_float(y)};
+    return {scrambled(rx, uint32_t(h >> 32)),
+            scrambled(ry, uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32))};
   }
 
   uint64_t pixel_key_ = 0;
