@@ -24,8 +24,17 @@ endif
 $(BUILD)/CMakeCache.txt:
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(PGO_FLAGS) $(CMAKE_FLAGS)
 
+# A second build of the add-on's module for x86-64-v3 CPUs (AVX2, FMA, BMI2; a few percent
+# faster), which the add-on loads when the CPU runs it (scripts/build-variant.sh, built only on
+# such a machine). ISA_VARIANTS= skips it.
+ISA_VARIANTS ?= x86-64-v3
+
 build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
+	@for arch in $(ISA_VARIANTS); do \
+	  PGO=$(PGO) JOBS=$(JOBS) CMAKE_FLAGS="$(CMAKE_FLAGS)" \
+	    bash scripts/build-variant.sh $(BUILD) $$arch || exit 1; \
+	done
 
 install-addon: build
 	@if [ -f scripts/install-addon.sh ]; then bash scripts/install-addon.sh $(BUILD); fi

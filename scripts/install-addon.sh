@@ -2,22 +2,15 @@
 # Installs the Gradient PT add-on into the current user's Blender and enables it persistently, so
 # that a plain `blender -b scene.blend -E GDPT -f 1` renders with it afterwards.
 #   bash scripts/install-addon.sh <build-dir>
-# Copies blender_addon/gdpt plus the built _gdpt*.so into Blender's user add-on folder (as Blender
-# itself reports it: ~/.config/blender/3.4/scripts/addons, or $BLENDER_USER_SCRIPTS/addons), then
-# enables the add-on and saves the user preferences, and finally checks that a fresh Blender
-# really lists the GDPT engine and imports the module.
+# Copies the add-on (scripts/assemble-addon.sh: blender_addon/gdpt and the built modules) into
+# Blender's user add-on folder (as Blender itself reports it: ~/.config/blender/3.4/scripts/addons,
+# or $BLENDER_USER_SCRIPTS/addons), then enables the add-on and saves the user preferences, and
+# finally checks that a fresh Blender really lists the GDPT engine and imports the module.
 set -euo pipefail
 build=${1:-build}
 root=$(cd "$(dirname "$0")/.." && pwd)
 case "$build" in /*) ;; *) build="$root/$build" ;; esac
 blender=${BLENDER:-blender}
-
-shopt -s nullglob
-modules=("$build"/blender_addon/_gdpt*.so)
-if [ ${#modules[@]} -eq 0 ]; then
-  echo "install-addon: no _gdpt module in $build/blender_addon (build it first: cmake --build $build)" >&2
-  exit 1
-fi
 
 addons=$("$blender" -b --factory-startup --python-expr \
   "import bpy; print('GDPT_ADDONS=' + bpy.utils.user_resource('SCRIPTS', path='addons', create=True))" \
@@ -27,13 +20,7 @@ if [ -z "$addons" ]; then
   exit 1
 fi
 
-dest="$addons/gdpt"
-rm -rf "$dest"
-mkdir -p "$dest"
-cp -r "$root"/blender_addon/gdpt/. "$dest"/
-find "$dest" -name '__pycache__' -prune -exec rm -rf {} +
-cp "${modules[0]}" "$dest"/
-echo "install-addon: copied add-on and $(basename "${modules[0]}") to $dest"
+bash "$root/scripts/assemble-addon.sh" "$build" "$addons/gdpt"
 
 # Enable and save the preferences (not --factory-startup: keep the user's other preferences).
 "$blender" -b --python-expr "
@@ -49,8 +36,8 @@ check=$("$blender" -b --python-expr "
 import bpy, addon_utils
 enabled = addon_utils.check('gdpt')[1]
 engines = {e.bl_idname for e in bpy.types.RenderEngine.__subclasses__()}
-from gdpt import _gdpt
-print('GDPT_CHECK', enabled, 'GDPT' in engines, _gdpt.__file__)
+from gdpt import _gdpt, native
+print('GDPT_CHECK', enabled, 'GDPT' in engines, _gdpt.__file__, '(' + native.load()[1] + ' build)')
 " 2>&1 | sed -n 's/^GDPT_CHECK //p')
 case "$check" in
   "True True "*) echo "install-addon: enabled; Blender loads ${check#True True }" ;;

@@ -12,11 +12,9 @@ set -euo pipefail
 build=${1:-build}
 root=$(cd "$(dirname "$0")/../.." && pwd)
 case "$build" in /*) ;; *) build="$root/$build" ;; esac
-module=$(ls "$build"/blender_addon/_gdpt*.so 2>/dev/null | head -1)
-[ -n "$module" ] || { echo "compare_cycles: build the _gdpt module first" >&2; exit 1; }
 scripts=$(mktemp -d)
 trap 'rm -rf "$scripts"' EXIT
-bash "$root/tests/blender/stage_addon.sh" "$root" "$module" "$scripts" >/dev/null
+bash "$root/tests/blender/stage_addon.sh" "$root" "$build" "$scripts" >/dev/null
 out="$root/out/bench/blender"
 mkdir -p "$out"
 BLENDER_USER_SCRIPTS="$scripts" blender -b --factory-startup --addons gdpt --python-exit-code 1 \

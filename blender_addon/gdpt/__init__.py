@@ -2,7 +2,7 @@
 #
 # The add-on only translates Blender data into flat arrays (export_*.py) and hands them to the
 # C++ core through the `_gdpt` pybind11 module, which scripts/install-addon.sh puts next to this
-# file.
+# file (and its x86-64-v3 build in x86-64-v3/, see native.py).
 
 bl_info = {
     "name": "Gradient PT",
@@ -14,6 +14,12 @@ bl_info = {
                    "reconstruction",
     "category": "Render",
 }
+
+# The C++ module first: native.py picks the build this CPU runs (baseline or x86-64-v3) before
+# any other file imports `_gdpt`.
+from . import native  # noqa: E402
+
+native.load()
 
 if "bpy" in locals():
     import importlib

@@ -32,7 +32,7 @@ from bpy.app.handlers import persistent
 from bpy.props import EnumProperty, FloatProperty
 from nodeitems_utils import NodeItem
 
-from . import export_camera
+from . import export_camera, native
 
 NODE_IDNAME = "CompositorNodeGDPTReconstruct"
 MARKER = "GDPT:"
@@ -57,10 +57,9 @@ class InputError(Exception):
 
 
 def _module():
-    from . import engine
-    module, error = engine._load_module()
+    module, _, error = native.load()
     if module is None:
-        raise InputError(f"the _gdpt module could not be loaded ({error})")
+        raise InputError(error)
     return module
 
 

@@ -10,7 +10,7 @@ import time
 
 import bpy
 
-from . import compositor_node, export_camera, export_scene, passes, properties
+from . import compositor_node, export_camera, export_scene, native, passes, properties
 
 MARKER = "GDPT:"  # every console line of the engine starts with it (tests look for it)
 
@@ -18,14 +18,6 @@ MARKER = "GDPT:"  # every console line of the engine starts with it (tests look 
 # and the benchmark to tell that Gradient PT really rendered and what the add-on cost.
 LAST_RENDER = {}
 LAST_ERROR = {}  # the last error reported (message), for the same readers
-
-
-def _load_module():
-    try:
-        from . import _gdpt  # built by blender_addon/CMakeLists.txt, copied by install-addon.sh
-    except ImportError as e:
-        return None, str(e)
-    return _gdpt, None
 
 
 # Pixel-samples per progressive pass. Every pass ends in a barrier (all tiles done, film
@@ -93,10 +85,9 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         settings = scene.gdpt
         t_start = time.perf_counter()
 
-        module, import_error = _load_module()
+        module, build, import_error = native.load()
         if module is None:
-            self._error(f"the _gdpt module could not be loaded ({import_error}); reinstall the "
-                        f"add-on with scripts/install-addon.sh")
+            self._error(import_error)
             return
         if scene.camera is None:
             self._error("the scene has no active camera: add a camera and set it as the scene "
@@ -217,10 +208,10 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
             setup=session_seconds, render=t_done - t_render,
             reconstruct=t_reconstruct - t_done, write=t_end - t_reconstruct,
             total=t_end - t_start, triangles=stats.triangles, rays=job.rays_traced(),
-            warnings=sorted(self._warned))
+            warnings=sorted(self._warned), build=build)
         print(f"{MARKER} view layer '{view_layer.name}' {status}: {film['samples']}/"
               f"{settings.samples} samples, {width}x{height}, mode {settings.mode}, "
-              f"reconstruction {norm}; export {stats.seconds:.3f} s, scene setup "
+              f"reconstruction {norm}, {build} build; export {stats.seconds:.3f} s, scene setup "
               f"{session_seconds:.3f} s, render "
               f"{t_done - t_render:.3f} s, reconstruction {t_reconstruct - t_done:.3f} s, "
               f"write {t_end - t_reconstruct:.3f} s, total {t_end - t_start:.3f} s", flush=True)

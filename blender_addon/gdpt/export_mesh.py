@@ -12,10 +12,7 @@ import ctypes
 
 import numpy as np
 
-try:
-    from ._gdpt import empty as _module_empty
-except ImportError:  # engine.py reports the missing module; numpy's own buffers still work here
-    _module_empty = None
+from . import native
 
 _GEOMETRY_TYPES = {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META', 'CURVES'}
 
@@ -26,9 +23,10 @@ def _empty(count, dtype):
     fresh memory in 4 KB pages cost more than the copies themselves (about 0.2 s for the 40 MB of
     a 1M-triangle mesh on the 2-core benchmark VM)."""
     dtype = np.dtype(dtype)
-    if _module_empty is None or count * dtype.itemsize < (2 << 20):
+    module = native.load()[0]  # None: engine.py reports it; numpy's own buffers still work here
+    if module is None or count * dtype.itemsize < (2 << 20):
         return np.empty(count, dtype=dtype)
-    return _module_empty(count, dtype)
+    return module.empty(count, dtype)
 
 
 def _raw_int_column(collection, column, attr):
