@@ -16,9 +16,12 @@ namespace {}  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     : scene_(&scene), default_material_(default_material) {
-  // $GDPT_EMBREE_CONFIG is passed to Embree as its device configuration (e.g. "isa=avx2",
-  // "verbose=2"), for benchmarking Embree's kernels on a given machine.
-  device_ = rtcNewDevice(std::getenv("GDPT_EMBREE_CONFIG"));
+  // Embree's device configuration: $GDPT_EMBREE_CONFIG when set (e.g. "isa=sse4.2", "verbose=2",
+  // for benchmarking Embree's kernels on a given machine), else its AVX2 kernels at most. On an
+  // AVX-512 CPU Embree would pick its AVX-512 kernels, which render 1.5-2% slower on Zen 5
+  // (docs/integrator.md, "Fifteenth session").
+  const char* config = std::getenv("GDPT_EMBREE_CONFIG");
+  device_ = rtcNewDevice(config ? config : "max_isa=avx2");
   if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
 
   // How often each mesh is placed: a mesh placed once is flattened into the top level in world
