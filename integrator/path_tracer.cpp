@@ -44,7 +44,13 @@ class PathTracer final : public Integrator {
 
  public:
   PathTracer(const SceneContext& ctx, const RenderSettings& settings)
-      : ctx_(ctx), settings_(settings), data_(settings, ctx.camera()) {}
+      : ctx_(ctx),
+        settings_(settings),
+        data_(settings, ctx.camera()),
+        rays_find_emission_((kAnalytic || kWorld || kEmissive) &&
+                            (ctx.scene_features() &
+                             (kSceneAnalyticLights | kSceneWorld | kSceneEmissiveTriangles)) != 0) {
+  }
 
   // Camera rays go to Embree a row segment at a time (kStream pixels of one sample index) as one
   // coherent stream, which traverses neighbouring rays together; each path then continues from
@@ -131,13 +137,26 @@ class PathTracer final : public Integrator {
     BounceCounts kinds;       // scattering events by kind, for the per-kind limits
     bool camera_path = true;  // nothing but transparent crossings since the camera
     bool crossed_since_vertex = false;  // transparent crossings since prev_position
+    // Russian roulette is decided after scattering. After a glossy or specular bounce it takes
+    // effect past the next hit (Cycles' order, which Cycles uses for every bounce): the ray that
+    // bounce sampled is traced either way, what it finds first (a lamp, an emitter, the world)
+    // counts at the throughput before the roulette, and only what follows is stopped (rr_stop:
+    // that hit is the path's last, traced like the one past the bounce limit) or divided by the
+    // continuation probability (rr_divide). After a diffuse bounce it takes effect at once (a
+    // stopped path ends, a surviving one is divided before its next hit): next-event estimation
+    // carries nearly all of the lamp light such a ray could find, while a glossy bounce's lamp
+    // reflections come mostly from its sampled rays. Blender Cornell box: relMSE -3.2% for +0.4%
+    // rays; Cycles' order after every bounce: the same relMSE for +6.2% rays (docs/integrator.md,
+    // "Fifteenth session").
+    bool rr_stop = false;
+    float rr_divide = 1.0f;
 
     // `vertex` numbers every surface interaction (sampler dimensions); `bounce` follows Cycles.
     for (int vertex = 0;; ++vertex) {
       // Past the bounce limits a vertex only ends the path: without emissive triangles its hit
       // needs no record, only the distance (analytic lights in front of it, the world behind).
-      const bool last =
-          bounce > max_bounces || transparent > kMaxTransparentBounces || kinds.over(settings_);
+      const bool last = rr_stop || bounce > max_bounces || transparent > kMaxTransparentBounces ||
+                        kinds.over(settings_);
       // Drawn before the ray is traced, to run alongside it (Sampler::vertex_numbers).
       Sampler::VertexNumbers u;
       if (!last) u = sampler.vertex_numbers(vertex, has_lights);
@@ -217,6 +236,10 @@ class PathTracer final : public Integrator {
         }
       }
       if (last) break;
+      if (rr_divide != 1.0f) [[unlikely]] {  // survived the roulette: what follows is divided
+        beta /= rr_divide;
+        rr_divide = 1.0f;
+      }
       const ClosureSet& material_closures = material.closures(sc, closure_scratch);
       if (camera_path && data_.active()) data_.at_surface(hit, material_closures, beta, out.data);
       if (!material_closures.has_bsdf()) break;
@@ -309,8 +332,17 @@ class PathTracer final : public Integrator {
       if (!crossing && bounce - 1 >= settings_.rr_depth) {
         const float q = roulette_continuation(beta);
         if (q < 1.0f) {
-          if (!(sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kRoulette)) < q)) break;
-          beta /= q;
+          // Either order is unbiased, as long as the survivors match the stopped paths.
+          const bool last_ray = rays_find_emission_ && !(bs.lobe & kLobeDiffuse);
+          const bool survive = sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kRoulette)) < q;
+          if (survive && last_ray)
+            rr_divide = q;  // from after the next hit's emission on
+          else if (survive)
+            beta /= q;
+          else if (last_ray)
+            rr_stop = true;  // the last ray, for the lamp, emitter or world it may find
+          else
+            break;
         }
       }
 
@@ -329,6 +361,9 @@ class PathTracer final : public Integrator {
   const SceneContext& ctx_;
   RenderSettings settings_;
   DataPasses data_;
+  // A ray can find emission: a lamp it can hit, an emissive triangle or a non-black world.
+  // Without, a path the roulette stops does not trace its last ray.
+  bool rays_find_emission_;
 };
 
 // --- Dispatch: one instantiation per subset of kSpecialised, picked once per session ---

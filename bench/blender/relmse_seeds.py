@@ -7,7 +7,8 @@
 # (number of seeds, 8), GDPT_BENCH_SEED_REF_SAMPLES (samples of the references, 1024; one
 # reference serves every seed, so its own error is in every seed's), GDPT_BENCH_SCENES
 # (cornell,textured), GDPT_BENCH_DIFFUSE_BALL (1: the glossy ball made diffuse, which removes
-# the caustic fireflies), and compare_cycles.py's GDPT_BENCH_BOUNCES and
+# the caustic fireflies), GDPT_BENCH_ENGINES (GDPT,CYCLES; one of them alone to compare
+# builds of one engine), and compare_cycles.py's GDPT_BENCH_BOUNCES and
 # GDPT_BENCH_CYCLES_PATTERN. The references use seed 1000, outside the
 # seeds measured: a 32-spp render of the reference's own seed is the first 32 samples of the
 # reference in both engines, which would lower its error.
@@ -28,13 +29,14 @@ SCENES = os.environ.get("GDPT_BENCH_SCENES", "cornell,textured").split(",")
 DIFFUSE_BALL = os.environ.get("GDPT_BENCH_DIFFUSE_BALL", "0") == "1"
 REFERENCE_SEED = 1000
 REFERENCE_SAMPLES = int(os.environ.get("GDPT_BENCH_SEED_REF_SAMPLES", "1024"))
+ENGINES = tuple(os.environ.get("GDPT_BENCH_ENGINES", "GDPT,CYCLES").split(","))
 
 
 def main():
     out = S.args()["out"]
     os.makedirs(out, exist_ok=True)
     m = os.environ.get("MLB", "2")
-    engines = ("GDPT", "CYCLES")
+    engines = ENGINES
     builds = {"cornell": C.cornell, "textured": C.textured}
     for name in SCENES:
         scene = S.clear()
@@ -49,14 +51,17 @@ def main():
         errs = {e: [S.rel_mse(C.render(scene, e, C.SAMPLES, f"{out}/{name}_{e}_{seed}.exr", m,
                                        seed)[1], refs[e]) for seed in SEEDS]
                 for e in engines}
-        g, c = np.array(errs["GDPT"]), np.array(errs["CYCLES"])
         n = len(SEEDS)
+        stats = {e: (np.array(errs[e]).mean(), np.array(errs[e]).std(ddof=1) / n ** 0.5)
+                 for e in engines}
+        line = ", ".join(f"{e} relMSE {m:.5f} +- {se:.5f}" for e, (m, se) in stats.items())
+        if len(engines) == 2:
+            g, c = np.array(errs["GDPT"]), np.array(errs["CYCLES"])
+            line += (f"; ratio of means {g.mean() / c.mean():.3f}, per-seed ratios "
+                     f"{np.round(g / c, 3).tolist()}")
         print(f"SEEDS {name}{' (diffuse ball)' if DIFFUSE_BALL else ''}, {C.BOUNCES} bounces, "
               f"min light bounces {m}, references {REFERENCE_SAMPLES} spp, Cycles pattern "
-              f"{C.CYCLES_PATTERN}, {n} seeds: GDPT relMSE "
-              f"{g.mean():.5f} +- {g.std(ddof=1) / n ** 0.5:.5f}, Cycles {c.mean():.5f} +- "
-              f"{c.std(ddof=1) / n ** 0.5:.5f}; ratio of means {g.mean() / c.mean():.3f}, "
-              f"per-seed ratios {np.round(g / c, 3).tolist()}", flush=True)
+              f"{C.CYCLES_PATTERN}, {n} seeds: {line}", flush=True)
 
 
 main()
