@@ -14,6 +14,12 @@ case "$arch" in
   *) echo "build-variant: unknown arch '$arch' (x86-64-v2, x86-64-v3 or x86-64-v4)" >&2; exit 1 ;;
 esac
 tree="$build/$arch"
+shopt -s nullglob
+cpu=("$build"/blender_addon/_gdpt_cpu.*so)
+if [ ${#cpu[@]} -eq 0 ]; then
+  echo "build-variant: no _gdpt_cpu module in $build/blender_addon (GDPT_BUILD_PYTHON=OFF?): no $arch build"
+  exit 0
+fi
 # The CPU's level, from the module the add-on itself asks (built by the main build).
 level=$(PYTHONPATH="$build/blender_addon" /usr/bin/python3 -c \
   'import _gdpt_cpu; print(_gdpt_cpu.x86_64_level())')
