@@ -3,7 +3,8 @@
 //
 // Parameters (RenderSettings): max_bounces and the per-kind limits (bounce_limits.h), rr_depth
 // (Russian roulette decided by the base path, its probability multiplied into base and offset
-// densities alike), shift_roughness_threshold (vertex classification), seed, clamp (applied to the
+// densities alike; after a glossy bounce only past the sampled segment's emission, as in PT),
+// shift_roughness_threshold (vertex classification), seed, clamp (applied to the
 // primal only, as in PT).
 //
 // Bookkeeping: each path keeps its throughput f (product of BSDF values, not divided by pdfs) and
@@ -344,7 +345,10 @@ class GradientPathTracer final : public Integrator {
         has_emissive_((ctx.features() & kSceneEmissiveTriangles) != 0),
         sides_(material_sides(ctx)),
         data_(settings, ctx.camera()),
-        transparent_shadows_((ctx.features() & kFeatureTransparent) != 0) {}
+        transparent_shadows_((ctx.features() & kFeatureTransparent) != 0),
+        rays_find_emission_((ctx.scene_features() &
+                             (kSceneAnalyticLights | kSceneWorld | kSceneEmissiveTriangles)) != 0) {
+  }
 
   bool estimates_gradients() const override { return true; }
 
@@ -725,6 +729,8 @@ class GradientPathTracer final : public Integrator {
     int scatterings = 0, crossings = 0;
     Vec3d fb(1.0, 1.0, 1.0);
     double pb = 1.0;
+    bool rr_stop = false;  // the roulette stopped the base: the current segment is its last
+    float rr_q = 1.0f;     // a survived roulette whose division waits for the segment's emission
 
     // Bounce 0's numbers; later bounces' are drawn before the segment to them is traced, to run
     // alongside it (Sampler::vertex_numbers).
@@ -919,13 +925,22 @@ class GradientPathTracer final : public Integrator {
       // no limit and no roulette, and keeps the ray's kind.
       const bool crossing = bs.is_straight_crossing();
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
+      // After a glossy or specular bounce it takes effect past the segment's emission events,
+      // as in PT (path_tracer.cpp): the segment is traced either way (a stopped path's last).
       if (!crossing && scatterings >= settings_.rr_depth) {
         const float q = roulette_continuation(beta);
         if (q < 1.0f) {
-          if (!(sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kRoulette)) < q)) break;
-          beta /= q;
-          pb *= q;
-          for (Offset& o : std::span(off, kOffsets)) o.p *= q;
+          const bool last_ray = rays_find_emission_ && !(bs.lobe & kLobeDiffuse);
+          const bool survive = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kRoulette)) < q;
+          if (survive && last_ray) {
+            rr_q = q;
+          } else if (survive) {
+            divide_by_continuation(q, beta, pb, off);
+          } else if (last_ray) {
+            rr_stop = true;
+          } else {
+            break;
+          }
         }
       }
 
@@ -948,8 +963,8 @@ class GradientPathTracer final : public Integrator {
       // The hit goes straight into the next vertex. Its end point only ends the path at the last
       // bounce: no vertex set-up there (the offsets' shifts need its classification alone), and
       // no hit record either when no offset shifts and no triangle emits (as PT).
-      const bool last =
-          scatterings > max_bounces || crossings > kMaxTransparentBounces || kinds.over(settings_);
+      const bool last = rr_stop || scatterings > max_bounces ||
+                        crossings > kMaxTransparentBounces || kinds.over(settings_);
       if (!last) u = sampler.vertex_numbers(bounce + 1, has_lights);
       const SurfaceHit& next = next_base.hit;
       // A holdout met by the camera path (only transparent crossings so far) ends it as an escape
@@ -1109,6 +1124,10 @@ class GradientPathTracer final : public Integrator {
       }
 
       if (!is_zero(emit_merged)) add_merged(off, fb, pb, emit_merged);
+      if (rr_q != 1.0f) {  // survived a deferred roulette: what follows is divided
+        divide_by_continuation(rr_q, beta, pb, off);
+        rr_q = 1.0f;
+      }
 
       // ==================== Advance ====================
       fb = mul(fb, seg_b);
@@ -1139,6 +1158,14 @@ class GradientPathTracer final : public Integrator {
   // the event part E = connected_event(Y, ...) common to all offsets. A dead offset is the same
   // with f' = 0 and p' = 0 (it adds -w C, the base keeping both of its techniques). Equal up to
   // rounding to the per-pair evaluation, which the open offsets still use.
+  // A survived roulette of continuation probability q: the base's throughput is divided by it,
+  // and it enters every density of the pair.
+  static void divide_by_continuation(float q, Spectrum& beta, double& pb, Offset* off) {
+    beta /= q;
+    pb *= q;
+    for (Offset& o : std::span(off, kOffsets)) o.p *= q;
+  }
+
   static void add_merged(Offset* off, Vec3d fb, double pb, Vec3d event) {
     for (Offset& o : std::span(off, kOffsets)) {
       if (!o.active || (o.alive && o.link != Link::Connected)) continue;
@@ -1464,6 +1491,9 @@ class GradientPathTracer final : public Integrator {
   std::vector<MaterialSide> sides_;
   DataPasses data_;
   bool transparent_shadows_ = false;  // some material has a Transparent closure
+  // A ray can find emission (a lamp it can hit, an emissive triangle, a non-black world): else a
+  // path the roulette stops does not trace its last segment.
+  bool rays_find_emission_ = false;
 };
 
 }  // namespace
