@@ -345,10 +345,7 @@ class GradientPathTracer final : public Integrator {
         has_emissive_((ctx.features() & kSceneEmissiveTriangles) != 0),
         sides_(material_sides(ctx)),
         data_(settings, ctx.camera()),
-        transparent_shadows_((ctx.features() & kFeatureTransparent) != 0),
-        rays_find_emission_((ctx.scene_features() &
-                             (kSceneAnalyticLights | kSceneWorld | kSceneEmissiveTriangles)) != 0) {
-  }
+        transparent_shadows_((ctx.features() & kFeatureTransparent) != 0) {}
 
   bool estimates_gradients() const override { return true; }
 
@@ -925,12 +922,12 @@ class GradientPathTracer final : public Integrator {
       // no limit and no roulette, and keeps the ray's kind.
       const bool crossing = bs.is_straight_crossing();
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
-      // After a glossy or specular bounce it takes effect past the segment's emission events,
-      // as in PT (path_tracer.cpp): the segment is traced either way (a stopped path's last).
+      // After a glossy or specular bounce it takes effect past the segment's emission events
+      // (roulette_past_next_hit): the segment is traced either way (a stopped path's last).
       if (!crossing && scatterings >= settings_.rr_depth) {
         const float q = roulette_continuation(beta);
         if (q < 1.0f) {
-          const bool last_ray = rays_find_emission_ && !(bs.lobe & kLobeDiffuse);
+          const bool last_ray = roulette_past_next_hit(bs.lobe, ctx_.scene_features());
           const bool survive = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kRoulette)) < q;
           if (survive && last_ray) {
             rr_q = q;
@@ -1491,9 +1488,6 @@ class GradientPathTracer final : public Integrator {
   std::vector<MaterialSide> sides_;
   DataPasses data_;
   bool transparent_shadows_ = false;  // some material has a Transparent closure
-  // A ray can find emission (a lamp it can hit, an emissive triangle, a non-black world): else a
-  // path the roulette stops does not trace its last segment.
-  bool rays_find_emission_ = false;
 };
 
 }  // namespace

@@ -44,13 +44,7 @@ class PathTracer final : public Integrator {
 
  public:
   PathTracer(const SceneContext& ctx, const RenderSettings& settings)
-      : ctx_(ctx),
-        settings_(settings),
-        data_(settings, ctx.camera()),
-        rays_find_emission_((kAnalytic || kWorld || kEmissive) &&
-                            (ctx.scene_features() &
-                             (kSceneAnalyticLights | kSceneWorld | kSceneEmissiveTriangles)) != 0) {
-  }
+      : ctx_(ctx), settings_(settings), data_(settings, ctx.camera()) {}
 
   // Camera rays go to Embree a row segment at a time (kStream pixels of one sample index) as one
   // coherent stream, which traverses neighbouring rays together; each path then continues from
@@ -137,17 +131,9 @@ class PathTracer final : public Integrator {
     BounceCounts kinds;       // scattering events by kind, for the per-kind limits
     bool camera_path = true;  // nothing but transparent crossings since the camera
     bool crossed_since_vertex = false;  // transparent crossings since prev_position
-    // Russian roulette is decided after scattering. After a glossy or specular bounce it takes
-    // effect past the next hit (Cycles' order, which Cycles uses for every bounce): the ray that
-    // bounce sampled is traced either way, what it finds first (a lamp, an emitter, the world)
-    // counts at the throughput before the roulette, and only what follows is stopped (rr_stop:
-    // that hit is the path's last, traced like the one past the bounce limit) or divided by the
-    // continuation probability (rr_divide). After a diffuse bounce it takes effect at once (a
-    // stopped path ends, a surviving one is divided before its next hit): next-event estimation
-    // carries nearly all of the lamp light such a ray could find, while a glossy bounce's lamp
-    // reflections come mostly from its sampled rays. Blender Cornell box: relMSE -3.2% for +0.4%
-    // rays; Cycles' order after every bounce: the same relMSE for +6.2% rays (docs/integrator.md,
-    // "Fifteenth session").
+    // A roulette that takes effect past the next hit (roulette_past_next_hit): stopped, that hit
+    // is the path's last, traced like the one past the bounce limit; survived, what follows the
+    // hit's emission is divided by the continuation probability.
     bool rr_stop = false;
     float rr_divide = 1.0f;
 
@@ -333,7 +319,7 @@ class PathTracer final : public Integrator {
         const float q = roulette_continuation(beta);
         if (q < 1.0f) {
           // Either order is unbiased, as long as the survivors match the stopped paths.
-          const bool last_ray = rays_find_emission_ && !(bs.lobe & kLobeDiffuse);
+          const bool last_ray = roulette_past_next_hit(bs.lobe, ctx_.scene_features());
           const bool survive = sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kRoulette)) < q;
           if (survive && last_ray)
             rr_divide = q;  // from after the next hit's emission on
@@ -361,9 +347,6 @@ class PathTracer final : public Integrator {
   const SceneContext& ctx_;
   RenderSettings settings_;
   DataPasses data_;
-  // A ray can find emission: a lamp it can hit, an emissive triangle or a non-black world.
-  // Without, a path the roulette stops does not trace its last ray.
-  bool rays_find_emission_;
 };
 
 // --- Dispatch: one instantiation per subset of kSpecialised, picked once per session ---

@@ -36,7 +36,6 @@ def main():
     out = S.args()["out"]
     os.makedirs(out, exist_ok=True)
     m = os.environ.get("MLB", "2")
-    engines = ENGINES
     builds = {"cornell": C.cornell, "textured": C.textured}
     for name in SCENES:
         scene = S.clear()
@@ -47,15 +46,15 @@ def main():
             ball.data.materials.append(S.diffuse("ball", (0.8, 0.8, 0.8)))
         refs = {e: C.render(scene, e, REFERENCE_SAMPLES, f"{out}/{name}_{e}_ref.exr", m,
                           REFERENCE_SEED)[1]
-                for e in engines}
+                for e in ENGINES}
         errs = {e: [S.rel_mse(C.render(scene, e, C.SAMPLES, f"{out}/{name}_{e}_{seed}.exr", m,
                                        seed)[1], refs[e]) for seed in SEEDS]
-                for e in engines}
+                for e in ENGINES}
         n = len(SEEDS)
         stats = {e: (np.array(errs[e]).mean(), np.array(errs[e]).std(ddof=1) / n ** 0.5)
-                 for e in engines}
+                 for e in ENGINES}
         line = ", ".join(f"{e} relMSE {m:.5f} +- {se:.5f}" for e, (m, se) in stats.items())
-        if len(engines) == 2:
+        if len(ENGINES) == 2:
             g, c = np.array(errs["GDPT"]), np.array(errs["CYCLES"])
             line += (f"; ratio of means {g.mean() / c.mean():.3f}, per-seed ratios "
                      f"{np.round(g / c, 3).tolist()}")
