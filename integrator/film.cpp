@@ -25,8 +25,17 @@ Film::Film(int width, int height)
     : width_(std::max(width, 0)),
       height_(std::max(height, 0)),
       acc_(size_t(width_) * size_t(height_)),
+      grad_(size_t(width_) * size_t(height_)),
       samples_(size_t(width_) * size_t(height_), 0u),
       first_hit_(size_t(width_) * size_t(height_)) {}
+
+void Film::set_gradients_from_primal(bool on) {
+  gradients_from_primal_ = on;
+  if (on)
+    std::vector<GradientAccumulator>().swap(grad_);
+  else
+    grad_.assign(pixel_count(), GradientAccumulator{});
+}
 
 void Film::enable_data_passes(bool normal, bool mist) {
   normal_.assign(normal ? 3 * pixel_count() : 0, 0.0);
@@ -37,6 +46,7 @@ void Film::clear() {
   std::fill(normal_.begin(), normal_.end(), 0.0);
   std::fill(mist_.begin(), mist_.end(), 0.0);
   std::fill(acc_.begin(), acc_.end(), Accumulator{});
+  std::fill(grad_.begin(), grad_.end(), GradientAccumulator{});
   std::fill(samples_.begin(), samples_.end(), 0u);
   std::fill(first_hit_.begin(), first_hit_.end(), FirstHit{});
 }
@@ -47,20 +57,28 @@ void Film::take_rows(Film& pass, int y0, int y1) {
     Accumulator& b = pass.acc_[i];
     for (int c = 0; c < 3; ++c) {
       a.primal[c] += b.primal[c];
-      a.dx[c] += b.dx[c];
-      a.dy[c] += b.dy[c];
       a.emission[c] += b.emission[c];
-      a.dx_left[c] += b.dx_left[c];
-      a.dy_down[c] += b.dy_down[c];
     }
-    a.dx_left2 += b.dx_left2;
-    a.dy_down2 += b.dy_down2;
     a.primal2 += b.primal2;
-    a.dx2 += b.dx2;
-    a.dy2 += b.dy2;
-    a.shift_attempts += b.shift_attempts;
     a.alpha += b.alpha;
-    a.shift_failures += b.shift_failures;
+    b = Accumulator{};
+    if (!grad_.empty()) {
+      GradientAccumulator& ga = grad_[i];
+      GradientAccumulator& gb = pass.grad_[i];
+      for (int c = 0; c < 3; ++c) {
+        ga.dx[c] += gb.dx[c];
+        ga.dy[c] += gb.dy[c];
+        ga.dx_left[c] += gb.dx_left[c];
+        ga.dy_down[c] += gb.dy_down[c];
+      }
+      ga.dx2 += gb.dx2;
+      ga.dy2 += gb.dy2;
+      ga.dx_left2 += gb.dx_left2;
+      ga.dy_down2 += gb.dy_down2;
+      ga.shift_attempts += gb.shift_attempts;
+      ga.shift_failures += gb.shift_failures;
+      gb = GradientAccumulator{};
+    }
     samples_[i] += pass.samples_[i];
     if (!normal_.empty())
       for (size_t c = 3 * i; c < 3 * i + 3; ++c) {
@@ -74,7 +92,6 @@ void Film::take_rows(Film& pass, int y0, int y1) {
     // Sample 0 was in this pass and hit a surface.
     if (pass.first_hit_[i].depth != 0.0f) first_hit_[i] = pass.first_hit_[i];
     pass.first_hit_[i] = FirstHit{};
-    b = Accumulator{};
     pass.samples_[i] = 0;
   }
 }
@@ -136,8 +153,8 @@ void Film::emission_rgb(float* out) const {
 // One routine for both axes: the neighbour of pixel i along the axis is i + step when `inside`;
 // G-PT gradients combine this pixel's forward half with the neighbour's backward half, PT ones are
 // forward differences of the primal means. The last column / row is 0 (Neumann).
-void Film::gradient_rgb(float* out, bool along_x, double (Accumulator::*forward)[3],
-                        double (Accumulator::*backward)[3]) const {
+void Film::gradient_rgb(float* out, bool along_x, double (GradientAccumulator::*forward)[3],
+                        double (GradientAccumulator::*backward)[3]) const {
   const size_t step = along_x ? 1 : size_t(width_);
   const auto inv_samples = [&](size_t i) { return samples_[i] ? 1.0 / samples_[i] : 0.0; };
   for (int y = 0; y < height_; ++y)
@@ -151,8 +168,8 @@ void Film::gradient_rgb(float* out, bool along_x, double (Accumulator::*forward)
         if (gradients_from_primal_) {
           v = inside ? acc_[i + step].primal[c] * inv_next - acc_[i].primal[c] * inv : 0.0;
         } else {
-          v = (acc_[i].*forward)[c] * inv;
-          if (inside) v -= (acc_[i + step].*backward)[c] * inv_next;
+          v = (grad_[i].*forward)[c] * inv;
+          if (inside) v -= (grad_[i + step].*backward)[c] * inv_next;
         }
         out[3 * i + c] = float(v);
       }
@@ -160,11 +177,11 @@ void Film::gradient_rgb(float* out, bool along_x, double (Accumulator::*forward)
 }
 
 void Film::gradient_x_rgb(float* out) const {
-  gradient_rgb(out, true, &Accumulator::dx, &Accumulator::dx_left);
+  gradient_rgb(out, true, &GradientAccumulator::dx, &GradientAccumulator::dx_left);
 }
 
 void Film::gradient_y_rgb(float* out) const {
-  gradient_rgb(out, false, &Accumulator::dy, &Accumulator::dy_down);
+  gradient_rgb(out, false, &GradientAccumulator::dy, &GradientAccumulator::dy_down);
 }
 
 void Film::variance3(float* out) const {
@@ -174,7 +191,6 @@ void Film::variance3(float* out) const {
   for (int y = 0; y < height_; ++y)
     for (int x = 0; x < width_; ++x) {
       const size_t i = size_t(y) * width_ + x;
-      const Accumulator& a = acc_[i];
       const double vp = primal_var(i);
       double vdx, vdy;
       if (gradients_from_primal_) {
@@ -183,14 +199,15 @@ void Film::variance3(float* out) const {
         vdy = y + 1 < height_ ? vp + primal_var(i + width_) : 0.0;
       } else {
         // G-PT: the two halves come from different pixels' base paths (independent).
+        const GradientAccumulator& a = grad_[i];
         vdx = variance_of_mean(lum(a.dx), a.dx2, samples_[i]);
         vdy = variance_of_mean(lum(a.dy), a.dy2, samples_[i]);
         if (x + 1 < width_) {
-          const Accumulator& b = acc_[i + 1];
+          const GradientAccumulator& b = grad_[i + 1];
           vdx += variance_of_mean(lum(b.dx_left), b.dx_left2, samples_[i + 1]);
         }
         if (y + 1 < height_) {
-          const Accumulator& b = acc_[i + width_];
+          const GradientAccumulator& b = grad_[i + width_];
           vdy += variance_of_mean(lum(b.dy_down), b.dy_down2, samples_[i + width_]);
         }
       }
@@ -201,10 +218,11 @@ void Film::variance3(float* out) const {
 }
 
 void Film::shift_failures(float* out) const {
-  for (size_t i = 0; i < acc_.size(); ++i) {
-    const Accumulator& a = acc_[i];
+  for (size_t i = 0; i < grad_.size(); ++i) {
+    const GradientAccumulator& a = grad_[i];
     out[i] = a.shift_attempts > 0.0 ? float(a.shift_failures / a.shift_attempts) : 0.0f;
   }
+  if (grad_.empty()) std::fill(out, out + pixel_count(), 0.0f);
 }
 
 }  // namespace gdpt

@@ -58,19 +58,11 @@ class Film {
   uint32_t min_samples() const;
 
   // --- Accumulation (called by the integrators; each pixel is written by one thread at a time) ---
-  struct Accumulator {
+  // What every sample adds: one cache line per pixel (alignas), the whole film in PT mode.
+  struct alignas(64) Accumulator {
     double primal[3] = {0, 0, 0}, primal2 = 0;  // sum, sum of squared luminance
-    double dx[3] = {0, 0, 0}, dx2 = 0;
-    double dy[3] = {0, 0, 0}, dy2 = 0;
     double emission[3] = {0, 0, 0};
-    double shift_attempts = 0, shift_failures = 0;
     double alpha = 0;  // sum of the samples' alphas
-    // G-PT: this pixel's one-sided halves G_left and G_down (sum, sum of squared luminance),
-    // written only by the pixel's own tile and subtracted from the neighbours' dx(x - 1) and
-    // dy(y - 1) at read-out, so that no tile has to trace its neighbours' base paths. dx and dy
-    // then hold the G_right / G_up halves; both are zero in PT mode.
-    double dx_left[3] = {0, 0, 0}, dx_left2 = 0;
-    double dy_down[3] = {0, 0, 0}, dy_down2 = 0;
 
     // One camera sample's primal and camera-visible emission, as every integrator adds them: a
     // non-finite value would poison the pixel forever and is dropped (counted as black); with
@@ -93,8 +85,23 @@ class Film {
       alpha += std::isfinite(alpha_sample) ? alpha_sample : 1.0f;
     }
   };
+  // What G-PT adds besides: gradient halves and shift statistics. Kept apart, and allocated only
+  // when the integrator estimates gradients, so that PT's films (the pass film is cleared and
+  // merged after every pass) take 64 bytes per pixel instead of 208.
+  struct GradientAccumulator {
+    double dx[3] = {0, 0, 0}, dx2 = 0;  // sums and sums of squared luminance
+    double dy[3] = {0, 0, 0}, dy2 = 0;
+    double shift_attempts = 0, shift_failures = 0;
+    // This pixel's one-sided halves G_left and G_down, written only by the pixel's own tile and
+    // subtracted from the neighbours' dx(x - 1) and dy(y - 1) at read-out, so that no tile has to
+    // trace its neighbours' base paths. dx and dy then hold the G_right / G_up halves.
+    double dx_left[3] = {0, 0, 0}, dx_left2 = 0;
+    double dy_down[3] = {0, 0, 0}, dy_down2 = 0;
+  };
   Accumulator& pixel(int x, int y) { return acc_[size_t(y) * width_ + x]; }
   const Accumulator& pixel(int x, int y) const { return acc_[size_t(y) * width_ + x]; }
+  // Only while the film holds gradients (!gradients_from_primal()).
+  GradientAccumulator& gradients(int x, int y) { return grad_[size_t(y) * width_ + x]; }
   void add_sample_count(int x, int y, uint32_t n = 1) { samples_[size_t(y) * width_ + x] += n; }
   // Sample 0's camera hit (view-axis distance > 0, pass indices); integrators call it for that
   // sample only.
@@ -114,7 +121,9 @@ class Film {
   // differences of the primal pixel means (0 at the last column / row, the Neumann rows of the
   // reconstruction) and variance3() the matching sum of the two pixels' variances, so that
   // reconstructing PT passes returns the PT image.
-  void set_gradients_from_primal(bool on) { gradients_from_primal_ = on; }
+  // On, the film drops its gradient accumulators (GradientAccumulator); off (the default), it
+  // has them, zeroed.
+  void set_gradients_from_primal(bool on);
   bool gradients_from_primal() const { return gradients_from_primal_; }
   void clear();  // zero every accumulator and sample count
   // Allocates the Normal / Mist sums (none by default: films without them cost nothing).
@@ -124,11 +133,12 @@ class Film {
   void take_rows(Film& pass, int y0, int y1);
 
  private:
-  void gradient_rgb(float* out, bool along_x, double (Accumulator::*forward)[3],
-                    double (Accumulator::*backward)[3]) const;
+  void gradient_rgb(float* out, bool along_x, double (GradientAccumulator::*forward)[3],
+                    double (GradientAccumulator::*backward)[3]) const;
 
   int width_ = 0, height_ = 0;
   std::vector<Accumulator> acc_;
+  std::vector<GradientAccumulator> grad_;  // empty when gradients_from_primal_
   std::vector<uint32_t> samples_;
   struct FirstHit {
     float depth = 0.0f;  // 0: no surface (yet)

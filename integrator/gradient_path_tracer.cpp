@@ -370,24 +370,25 @@ class GradientPathTracer final : public Integrator {
     SampleResult r;
     // Runs pixel (x, y)'s base path and adds it to the film.
     auto run_path = [&](const Sampler& sampler, const CameraSample& cs, int x, int y) {
-      // The pixel's accumulator (4 cache lines) is read after the path: fetch it now.
-      const char* acc_bytes = reinterpret_cast<const char*>(&film.pixel(x, y));
-      for (size_t b = 0; b < sizeof(Film::Accumulator); b += 64)
-        __builtin_prefetch(acc_bytes + b, 1);
+      // The pixel's accumulators (4 cache lines) are read after the path: fetch them now.
+      Film::Accumulator& acc = film.pixel(x, y);
+      Film::GradientAccumulator& grad = film.gradients(x, y);
+      __builtin_prefetch(&acc, 1);
+      const char* grad_bytes = reinterpret_cast<const char*>(&grad);
+      for (size_t b = 0; b < sizeof(grad); b += 64) __builtin_prefetch(grad_bytes + b, 1);
       trace(sampler, cs, scratch, r);
       rays += r.rays;
       // --- Primal, emission and statistics of the pixel's base path ---
-      Film::Accumulator& acc = film.pixel(x, y);
       acc.add_path(r.primal, r.emission, clamp, r.alpha);
       if (data_.active()) film.add_data(x, y, r.data.normal, r.data.mist);
-      acc.shift_attempts += r.attempts;
-      acc.shift_failures += r.failures;
+      grad.shift_attempts += r.attempts;
+      grad.shift_failures += r.failures;
       // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
       const bool* mask = cs.mask;
-      if (mask[kRight]) add_half(r.grad[kRight], acc.dx, acc.dx2);
-      if (mask[kUp]) add_half(r.grad[kUp], acc.dy, acc.dy2);
-      if (mask[kLeft]) add_half(r.grad[kLeft], acc.dx_left, acc.dx_left2);
-      if (mask[kDown]) add_half(r.grad[kDown], acc.dy_down, acc.dy_down2);
+      if (mask[kRight]) add_half(r.grad[kRight], grad.dx, grad.dx2);
+      if (mask[kUp]) add_half(r.grad[kUp], grad.dy, grad.dy2);
+      if (mask[kLeft]) add_half(r.grad[kLeft], grad.dx_left, grad.dx_left2);
+      if (mask[kDown]) add_half(r.grad[kDown], grad.dy_down, grad.dy_down2);
     };
     // Every offset whose target pixel is inside the image: the pixel's own halves of dx(x),
     // dy(x), dx(x - 1) and dy(y - 1) (the latter two combined at read-out).

@@ -19,10 +19,10 @@
 // column has dx = 0 and the last row dy = 0 (the Neumann rows of the reconstruction).
 //
 // Threads: render_tile() writes only the pixels of its tile. Each pixel stores its own four
-// halves (G_right and G_up in Film::Accumulator::dx/dy, G_left and G_down in dx_left/dy_down);
-// the film combines them with the neighbours' at read-out, so no tile traces another tile's base
-// paths. Sample values depend only on (seed, pixel, sample index), so the result is
-// bit-identical for any tile order or thread count.
+// halves (G_right and G_up in Film::GradientAccumulator::dx/dy, G_left and G_down in
+// dx_left/dy_down); the film combines them with the neighbours' at read-out, so no tile traces
+// another tile's base paths. Sample values depend only on (seed, pixel, sample index), so the
+// result is bit-identical for any tile order or thread count.
 #pragma once
 
 #include <memory>

@@ -31,8 +31,8 @@ class Integrator {
   // (accumulators and sample counts). Called concurrently for disjoint tiles.
   virtual void render_tile(const Tile& tile, uint32_t first_sample, uint32_t sample_count,
                            Film& film) const = 0;
-  // True when render_tile() fills Film::Accumulator::dx/dy (G-PT). Otherwise the film derives the
-  // gradient passes from the primal means (Film::set_gradients_from_primal).
+  // True when render_tile() fills Film::GradientAccumulator::dx/dy (G-PT). Otherwise the film
+  // derives the gradient passes from the primal means (Film::set_gradients_from_primal).
   virtual bool estimates_gradients() const { return false; }
   // Rays traced so far (camera, extension and shadow rays), for the benchmarks.
   uint64_t rays_traced() const { return rays_.load(std::memory_order_relaxed); }

@@ -80,6 +80,7 @@ RenderSession::RenderSession(Scene scene, RenderSettings settings)
   d.film = Film(w, h);
   d.pass_film = Film(w, h);
   d.film.set_gradients_from_primal(!d.integrator->estimates_gradients());
+  d.pass_film.set_gradients_from_primal(!d.integrator->estimates_gradients());
   d.film.enable_data_passes(d.settings.normal_pass, d.settings.mist_pass);
   d.pass_film.enable_data_passes(d.settings.normal_pass, d.settings.mist_pass);
   const int th = tile_height(w, h, d.arena->max_concurrency());

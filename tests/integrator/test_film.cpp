@@ -59,7 +59,7 @@ TEST(Film, PrimalGradientsInPtMode) {
 
 TEST(Film, EstimatedGradientsAndShiftFailures) {
   Film f(1, 1);
-  Film::Accumulator& a = f.pixel(0, 0);
+  Film::GradientAccumulator& a = f.gradients(0, 0);
   a.dx[1] = 3.0;
   a.dy[2] = -6.0;
   a.shift_attempts = 8.0;
