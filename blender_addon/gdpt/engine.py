@@ -20,11 +20,14 @@ LAST_RENDER = {}
 LAST_ERROR = {}  # the last error reported (message), for the same readers
 
 
-# Pixel-samples per progressive pass. Every pass ends in a barrier (all tiles done, film
-# committed), so passes of 1 spp on a small frame (7k pixel-samples at 96x72, a few ms) cost
-# several percent of the render in idle tails; passes of about this many pixel-samples (a tenth
-# of a second or so) do not. Large frames keep 1 spp per pass.
-PASS_PIXEL_SAMPLES = 1 << 17
+# Pixel-samples per progressive pass. Every pass ends in a barrier and a film commit, and with
+# 1 spp per pass each sample also finds its pixel's accumulator out of cache: 1-spp passes cost
+# 3% at 320x240 against passes of 13 spp, and several percent more in idle tails on small frames
+# (docs/blender.md, "Passes"). Passes of about this many pixel-samples (0.3-0.5 s on 2 cores)
+# do not; a cancel discards at most one. Frames of 1024x1024 and up keep 1 spp per pass. The
+# count depends only on the frame size, never on time: pass sizes group the sums, so the image
+# stays the same for a seed.
+PASS_PIXEL_SAMPLES = 1 << 20
 
 
 def samples_per_pass(pixels, settings):
