@@ -25,6 +25,10 @@
 #pragma once
 
 #include <cstdint>
+#if defined(__SSSE3__) && defined(__SSE4_1__)
+#include <immintrin.h>
+#define GDPT_SAMPLER_SIMD 1  // x86-64-v2 and up (the x86-64-v3 module build)
+#endif
 
 #include "integrator/math/vec.h"
 
@@ -137,6 +141,39 @@ inline float to_unit_float(uint32_t x) {
   return float(x >> 8) * 0x1p-24f;  // in [0, 1), exactly representable
 }
 
+#if GDPT_SAMPLER_SIMD
+// reverse_bits() in four 32-bit lanes: a byte swap, then each byte reversed through two nibble
+// tables.
+inline __m128i reverse_bits4(__m128i x) {
+  x = _mm_shuffle_epi8(x, _mm_setr_epi8(3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12));
+  const __m128i nibble = _mm_set1_epi8(0x0f);
+  // rev4(n) << 4 and rev4(n) for each nibble value n.
+  const __m128i rev_hi =
+      _mm_setr_epi8(0x00, char(0x80), 0x40, char(0xc0), 0x20, char(0xa0), 0x60, char(0xe0), 0x10,
+                    char(0x90), 0x50, char(0xd0), 0x30, char(0xb0), 0x70, char(0xf0));
+  const __m128i rev_lo =
+      _mm_setr_epi8(0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf);
+  const __m128i lo = _mm_and_si128(x, nibble);
+  const __m128i hi = _mm_and_si128(_mm_srli_epi16(x, 4), nibble);
+  return _mm_or_si128(_mm_shuffle_epi8(rev_hi, lo), _mm_shuffle_epi8(rev_lo, hi));
+}
+// reverse_bits(lk_permutation(x, seed)) in four lanes.
+inline __m128i nested_scramble_reversed4(__m128i x, __m128i seed) {
+  x = _mm_add_epi32(x, seed);
+  x = _mm_xor_si128(x, _mm_mullo_epi32(x, _mm_set1_epi32(int(0x6c50b47cu))));
+  x = _mm_xor_si128(x, _mm_mullo_epi32(x, _mm_set1_epi32(int(0xb82f1e52u))));
+  x = _mm_xor_si128(x, _mm_mullo_epi32(x, _mm_set1_epi32(int(0xc7afe638u))));
+  x = _mm_xor_si128(x, _mm_mullo_epi32(x, _mm_set1_epi32(int(0x8d22f6e6u))));
+  return reverse_bits4(x);
+}
+// to_unit_float(reverse_bits(lk_permutation(r, seed))) in four lanes, the same integer steps, so
+// the same floats (conversions of values below 2^24 are exact).
+inline __m128 scrambled4(__m128i r, __m128i seed) {
+  const __m128i x = _mm_srli_epi32(nested_scramble_reversed4(r, seed), 8);
+  return _mm_mul_ps(_mm_cvtepi32_ps(x), _mm_set1_ps(0x1p-24f));
+}
+#endif
+
 }  // namespace sampler_detail
 
 class Sampler {
@@ -178,6 +215,9 @@ class Sampler {
   };
   VertexNumbers vertex_numbers(int vertex, bool lights) const {
     if (vertex & 1) return odd_vertex_numbers(vertex, lights);
+#if GDPT_SAMPLER_SIMD
+    if (lights) return even_vertex_numbers(vertex);
+#endif
     VertexNumbers u;
     if (lights) u.light = get2d(bounce_dim(vertex, kLightPoint));
     u.dir = get2d(bounce_dim(vertex, kBsdfDir));
@@ -203,6 +243,27 @@ class Sampler {
     return scrambled_pair(i, sampler_detail::reversed_sobol_dim(1, i), h);
   }
 
+#if GDPT_SAMPLER_SIMD
+  // An even vertex's two pairs, get2d(light point) and get2d(direction), with their four
+  // coordinate scrambles in one register. Out of line as get2d.
+  [[gnu::noinline]] VertexNumbers even_vertex_numbers(int vertex) const {
+    using namespace sampler_detail;
+    const uint64_t hd = mix64(pixel_key_ ^ bounce_dim(vertex, kBsdfDir));
+    const uint64_t hl = mix64(pixel_key_ ^ bounce_dim(vertex, kLightPoint));
+    // shuffle() of both seeds in two lanes.
+    const __m128i ids =
+        nested_scramble_reversed4(_mm_set1_epi32(int(reversed_index_)),
+                                  _mm_setr_epi32(int(uint32_t(hd)), int(uint32_t(hl)), 0, 0));
+    const uint32_t id = uint32_t(_mm_cvtsi128_si32(ids)), il = uint32_t(_mm_extract_epi32(ids, 1));
+    alignas(16) float v[4];
+    _mm_store_ps(v, scrambled4(_mm_setr_epi32(int(id), int(reversed_sobol_dim(1, id)), int(il),
+                                              int(reversed_sobol_dim(1, il))),
+                               _mm_setr_epi32(int(pair_seed_x(hd)), int(pair_seed_y(hd)),
+                                              int(pair_seed_x(hl)), int(pair_seed_y(hl)))));
+    return {{v[2], v[3]}, {v[0], v[1]}};
+  }
+#endif
+
   // An odd vertex's numbers: Sobol dimensions 2-3 (direction) and 4-5 (light point) of the 6D
   // point whose dimensions 0-1 are the previous vertex's direction, get2d(first): the same
   // shuffled index, computed once, and their own coordinate scrambles. Out of line as get2d.
@@ -210,11 +271,26 @@ class Sampler {
     using namespace sampler_detail;
     const uint32_t i = shuffle(uint32_t(mix64(pixel_key_ ^ bounce_dim(vertex - 1, kBsdfDir))));
     VertexNumbers u;
+#if GDPT_SAMPLER_SIMD
+    // Both pairs in one register (the light pair's lanes are unused without lights).
+    const uint64_t hd = mix64(pixel_key_ ^ bounce_dim(vertex, kBsdfDir));
+    const uint64_t hl = lights ? mix64(pixel_key_ ^ bounce_dim(vertex, kLightPoint)) : 0;
+    alignas(16) float v[4];
+    _mm_store_ps(
+        v, scrambled4(_mm_setr_epi32(int(reversed_sobol_dim(2, i)), int(reversed_sobol_dim(3, i)),
+                                     int(lights ? reversed_sobol_dim(4, i) : 0),
+                                     int(lights ? reversed_sobol_dim(5, i) : 0)),
+                      _mm_setr_epi32(int(pair_seed_x(hd)), int(pair_seed_y(hd)),
+                                     int(pair_seed_x(hl)), int(pair_seed_y(hl)))));
+    u.dir = {v[0], v[1]};
+    if (lights) u.light = {v[2], v[3]};
+#else
     if (lights)
       u.light = scrambled_pair(reversed_sobol_dim(4, i), reversed_sobol_dim(5, i),
                                mix64(pixel_key_ ^ bounce_dim(vertex, kLightPoint)));
     u.dir = scrambled_pair(reversed_sobol_dim(2, i), reversed_sobol_dim(3, i),
                            mix64(pixel_key_ ^ bounce_dim(vertex, kBsdfDir)));
+#endif
     return u;
   }
 
@@ -232,9 +308,22 @@ class Sampler {
   }
   // Owen-scrambled point from the reversed-bit Sobol coordinates rx, ry, seeded by the high half of
   // h (x) and of a multiple of h (y).
+  static uint32_t pair_seed_x(uint64_t h) {
+    return uint32_t(h >> 32);
+  }
+  static uint32_t pair_seed_y(uint64_t h) {
+    return uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32);
+  }
   static Vec2f scrambled_pair(uint32_t rx, uint32_t ry, uint64_t h) {
-    return {scrambled(rx, uint32_t(h >> 32)),
-            scrambled(ry, uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32))};
+#if GDPT_SAMPLER_SIMD
+    alignas(16) float v[4];
+    _mm_store_ps(v, sampler_detail::scrambled4(
+                        _mm_setr_epi32(int(rx), int(ry), 0, 0),
+                        _mm_setr_epi32(int(pair_seed_x(h)), int(pair_seed_y(h)), 0, 0)));
+    return {v[0], v[1]};
+#else
+    return {scrambled(rx, pair_seed_x(h)), scrambled(ry, pair_seed_y(h))};
+#endif
   }
 
   uint64_t pixel_key_ = 0;

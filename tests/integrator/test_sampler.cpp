@@ -1,12 +1,19 @@
 // The per-pixel Owen-scrambled Sobol sampler: range, purity (same inputs -> same value),
 // stratification of every 2D pair over a power-of-two sample count, decorrelation across pixels
-// and dimensions.
+// and dimensions, and every value against its definition in scalar steps. This file is built twice:
+// test_sampler (the x86-64 baseline: scalar code) and, on a CPU with SSSE3 and SSE4.1,
+// test_sampler_simd (the sampler's SSE lanes, as in the x86-64-v3 module build).
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "integrator/sampler.h"
+
+#if defined(GDPT_TEST_EXPECTS_SAMPLER_SIMD) && !defined(GDPT_SAMPLER_SIMD)
+#error "test_sampler_simd must build the sampler's SIMD path"
+#endif
 
 namespace gdpt {
 namespace {
@@ -177,6 +184,95 @@ TEST(Sampler, ConsecutiveVerticesShareOneSixDimensionalNet) {
         EXPECT_FALSE(is_net(dirs, m, 1)) << "t = 2 is the best the first four dimensions reach";
       }
 }
+
+// Sampler's values by their definition (sampler.h), one scalar step at a time: the pixel key and
+// the reversed index of start(), then per 2D pair one 64-bit hash of (key, dimension) whose low
+// half seeds the index shuffle and whose high halves seed the two coordinate scrambles.
+struct ScalarSampler {
+  uint64_t key;
+  uint32_t reversed_index;
+  ScalarSampler(uint32_t seed, int x, int y, uint32_t index) {
+    using namespace sampler_detail;
+    key = mix64((uint64_t(uint32_t(y)) << 32 | uint32_t(x)) ^
+                uint64_t(hash_u32(seed)) * 0x9e3779b97f4a7c15ull);
+    reversed_index = reverse_bits(index);
+  }
+  static float scramble(uint32_t reversed_value, uint32_t seed) {
+    using namespace sampler_detail;
+    return to_unit_float(reverse_bits(lk_permutation(reversed_value, seed)));
+  }
+  static uint32_t seed_y(uint64_t h) { return uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32); }
+  uint32_t shuffled(uint64_t h) const {
+    using namespace sampler_detail;
+    return reverse_bits(lk_permutation(reversed_index, uint32_t(h)));
+  }
+  // Sobol dimensions (d, d + 1) of shuffled index i (d = 0: dimension 0 is i reversed, i.e. the
+  // reversed value is i itself).
+  static Vec2f pair(uint32_t i, int d, uint64_t h) {
+    using namespace sampler_detail;
+    const uint32_t rx = d == 0 ? i : reversed_sobol_dim(d, i);
+    return {scramble(rx, uint32_t(h >> 32)), scramble(reversed_sobol_dim(d + 1, i), seed_y(h))};
+  }
+  Vec2f get2d(uint32_t dim) const {
+    const uint64_t h = sampler_detail::mix64(key ^ dim);
+    return pair(shuffled(h), 0, h);
+  }
+  Sampler::VertexNumbers vertex(int v) const {
+    if (!(v & 1))
+      return {get2d(Sampler::bounce_dim(v, Sampler::kLightPoint)),
+              get2d(Sampler::bounce_dim(v, Sampler::kBsdfDir))};
+    using sampler_detail::mix64;
+    const uint32_t i = shuffled(mix64(key ^ Sampler::bounce_dim(v - 1, Sampler::kBsdfDir)));
+    return {pair(i, 4, mix64(key ^ Sampler::bounce_dim(v, Sampler::kLightPoint))),
+            pair(i, 2, mix64(key ^ Sampler::bounce_dim(v, Sampler::kBsdfDir)))};
+  }
+};
+
+TEST(Sampler, ValuesMatchTheirScalarDefinition) {
+  std::mt19937 rng(7);
+  for (int k = 0; k < 20000; ++k) {
+    const uint32_t seed = rng(), index = rng() >> (rng() % 32);
+    const int x = int(rng() % 4096) - 8, y = int(rng() % 4096) - 8;
+    Sampler s;
+    s.start(seed, x, y, index);
+    const ScalarSampler ref(seed, x, y, index);
+    const Vec2f cam = s.get2d(Sampler::kDimCamera), want_cam = ref.get2d(Sampler::kDimCamera);
+    ASSERT_EQ(cam.x, want_cam.x);
+    ASSERT_EQ(cam.y, want_cam.y);
+    const int v = int(rng() % 16);
+    for (bool lights : {true, false}) {
+      const Sampler::VertexNumbers u = s.vertex_numbers(v, lights), want = ref.vertex(v);
+      ASSERT_EQ(u.dir.x, want.dir.x) << v;
+      ASSERT_EQ(u.dir.y, want.dir.y) << v;
+      if (lights) {
+        ASSERT_EQ(u.light.x, want.light.x) << v;
+        ASSERT_EQ(u.light.y, want.light.y) << v;
+      }
+    }
+  }
+}
+
+#if GDPT_SAMPLER_SIMD
+TEST(Sampler, SimdLanesMatchTheScalarSteps) {
+  using namespace sampler_detail;
+  std::mt19937 rng(11);
+  for (int k = 0; k < 100000; ++k) {
+    alignas(16) uint32_t x[4], seed[4], rev[4], nested[4];
+    alignas(16) float unit[4];
+    for (int l = 0; l < 4; ++l) x[l] = rng(), seed[l] = rng();
+    const __m128i X = _mm_load_si128(reinterpret_cast<const __m128i*>(x));
+    const __m128i S = _mm_load_si128(reinterpret_cast<const __m128i*>(seed));
+    _mm_store_si128(reinterpret_cast<__m128i*>(rev), reverse_bits4(X));
+    _mm_store_si128(reinterpret_cast<__m128i*>(nested), nested_scramble_reversed4(X, S));
+    _mm_store_ps(unit, scrambled4(X, S));
+    for (int l = 0; l < 4; ++l) {
+      ASSERT_EQ(rev[l], reverse_bits(x[l]));
+      ASSERT_EQ(nested[l], reverse_bits(lk_permutation(x[l], seed[l])));
+      ASSERT_EQ(unit[l], to_unit_float(reverse_bits(lk_permutation(x[l], seed[l]))));
+    }
+  }
+}
+#endif
 
 TEST(Sampler, OneDimensionalValuesAreStratified) {
   const int n = 128;
