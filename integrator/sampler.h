@@ -17,6 +17,10 @@
 // lowered relMSE by 4.6% (Cornell box) to 9.4% (textured box) against padded pairs
 // (docs/integrator.md, thirteenth session).
 //
+// Where SSSE3 and SSE4.1 are available (the x86-64-v3 module build) the coordinate scrambles of
+// a pair, or of a vertex's two pairs, run in SSE lanes (GDPT_SAMPLER_SIMD): the same integer
+// steps, hence the same values (tests/integrator/test_sampler.cpp builds both).
+//
 // Dimension layout (Sampler::Dim): camera jitter 2D, lens 2D, then per bounce kDimsPerBounce
 // dimensions: light select 1D, light position 2D, BSDF lobe 1D, BSDF direction 2D, Russian
 // roulette 1D. G-PT uses the same layout for its base path; without depth of field it takes the
@@ -66,12 +70,10 @@ inline uint64_t mix64(uint64_t z) {
 
 // Laine-Karras style permutation in reversed-bit order: each bit is flipped depending only on the
 // bits below it, which after the reversal below is exactly an Owen scramble (Burley 2020).
+constexpr uint32_t kLkMultipliers[4] = {0x6c50b47cu, 0xb82f1e52u, 0xc7afe638u, 0x8d22f6e6u};
 inline uint32_t lk_permutation(uint32_t x, uint32_t seed) {
   x += seed;
-  x ^= x * 0x6c50b47cu;
-  x ^= x * 0xb82f1e52u;
-  x ^= x * 0xc7afe638u;
-  x ^= x * 0x8d22f6e6u;
+  for (uint32_t m : kLkMultipliers) x ^= x * m;
   return x;
 }
 inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
@@ -160,10 +162,8 @@ inline __m128i reverse_bits4(__m128i x) {
 // reverse_bits(lk_permutation(x, seed)) in four lanes.
 inline __m128i nested_scramble_reversed4(__m128i x, __m128i seed) {
   x = _mm_add_epi32(x, seed);
-  x = _mm_xor_si128(x, _mm_mullo_epi32(x, _mm_set1_epi32(int(0x6c50b47cu))));
-  x = _mm_xor_si128(x, _mm_mullo_epi32(x, _mm_set1_epi32(int(0xb82f1e52u))));
-  x = _mm_xor_si128(x, _mm_mullo_epi32(x, _mm_set1_epi32(int(0xc7afe638u))));
-  x = _mm_xor_si128(x, _mm_mullo_epi32(x, _mm_set1_epi32(int(0x8d22f6e6u))));
+  for (uint32_t m : kLkMultipliers)
+    x = _mm_xor_si128(x, _mm_mullo_epi32(x, _mm_set1_epi32(int(m))));
   return reverse_bits4(x);
 }
 // to_unit_float(reverse_bits(lk_permutation(r, seed))) in four lanes, the same integer steps, so
@@ -306,14 +306,15 @@ class Sampler {
     using namespace sampler_detail;
     return to_unit_float(reverse_bits(lk_permutation(r, seed)));
   }
-  // Owen-scrambled point from the reversed-bit Sobol coordinates rx, ry, seeded by the high half of
-  // h (x) and of a multiple of h (y).
+  // A 2D sample's coordinate scramble seeds from its hash h: the high half of h (x) and of a
+  // multiple of h (y).
   static uint32_t pair_seed_x(uint64_t h) {
     return uint32_t(h >> 32);
   }
   static uint32_t pair_seed_y(uint64_t h) {
     return uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32);
   }
+  // Owen-scrambled point from the reversed-bit Sobol coordinates rx, ry and their hash h.
   static Vec2f scrambled_pair(uint32_t rx, uint32_t ry, uint64_t h) {
 #if GDPT_SAMPLER_SIMD
     alignas(16) float v[4];
