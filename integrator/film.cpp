@@ -1,6 +1,7 @@
 #include "integrator/film.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace gdpt {
 
@@ -52,6 +53,8 @@ void Film::clear() {
 }
 
 void Film::take_rows(Film& pass, int y0, int y1) {
+  if (pass.acc_.size() != acc_.size() || pass.grad_.size() != grad_.size())
+    throw std::logic_error("Film::take_rows: the pass film has another size or gradient layout");
   for (size_t i = size_t(y0) * width_, end = size_t(y1) * width_; i < end; ++i) {
     Accumulator& a = acc_[i];
     Accumulator& b = pass.acc_[i];

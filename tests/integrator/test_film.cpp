@@ -2,6 +2,7 @@
 // means with zero last column / row), shift-failure fractions and pass commits.
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <vector>
 
 #include "integrator/film.h"
@@ -87,6 +88,25 @@ TEST(Film, TakeRowsCommitsAndClearsThePass) {
   film.primal_rgb(p.data());
   EXPECT_FLOAT_EQ(p[0], 2.0f);
   EXPECT_FLOAT_EQ(p[9], 0.0f);  // pixel (1, 1) not committed yet
+}
+
+// PT films hold no gradient accumulators: commits and read-outs work without them, and a pass
+// film of the other layout is refused rather than read out of bounds.
+TEST(Film, PtFilmsCommitWithoutGradientAccumulators) {
+  Film film(2, 1), pass(2, 1), gpt_pass(2, 1);
+  film.set_gradients_from_primal(true);
+  pass.set_gradients_from_primal(true);
+  add(pass, 1, 0, Spectrum(4.0f));
+  film.take_rows(pass, 0, 1);
+  std::vector<float> p(6), sf(2, -1.0f), dx(6);
+  film.primal_rgb(p.data());
+  film.shift_failures(sf.data());
+  film.gradient_x_rgb(dx.data());
+  EXPECT_FLOAT_EQ(p[3], 4.0f);
+  EXPECT_FLOAT_EQ(sf[0], 0.0f);
+  EXPECT_FLOAT_EQ(sf[1], 0.0f);
+  EXPECT_FLOAT_EQ(dx[0], 4.0f);  // forward difference of the primal means (pixel 0 has none)
+  EXPECT_THROW(film.take_rows(gpt_pass, 0, 1), std::logic_error);
 }
 
 }  // namespace
