@@ -79,10 +79,10 @@ RenderSession::RenderSession(Scene scene, RenderSettings settings)
   const int w = d.scene.camera.image_width(), h = d.scene.camera.image_height();
   d.film = Film(w, h);
   d.pass_film = Film(w, h);
-  d.film.set_gradients_from_primal(!d.integrator->estimates_gradients());
-  d.pass_film.set_gradients_from_primal(!d.integrator->estimates_gradients());
-  d.film.enable_data_passes(d.settings.normal_pass, d.settings.mist_pass);
-  d.pass_film.enable_data_passes(d.settings.normal_pass, d.settings.mist_pass);
+  for (Film* f : {&d.film, &d.pass_film}) {  // the pass film has the output film's layout
+    f->set_gradients_from_primal(!d.integrator->estimates_gradients());
+    f->enable_data_passes(d.settings.normal_pass, d.settings.mist_pass);
+  }
   const int th = tile_height(w, h, d.arena->max_concurrency());
   for (int y = 0; y < h; y += th)
     for (int x = 0; x < w; x += kTileSize)

@@ -255,12 +255,9 @@ class Sampler {
         nested_scramble_reversed4(_mm_set1_epi32(int(reversed_index_)),
                                   _mm_setr_epi32(int(uint32_t(hd)), int(uint32_t(hl)), 0, 0));
     const uint32_t id = uint32_t(_mm_cvtsi128_si32(ids)), il = uint32_t(_mm_extract_epi32(ids, 1));
-    alignas(16) float v[4];
-    _mm_store_ps(v, scrambled4(_mm_setr_epi32(int(id), int(reversed_sobol_dim(1, id)), int(il),
-                                              int(reversed_sobol_dim(1, il))),
-                               _mm_setr_epi32(int(pair_seed_x(hd)), int(pair_seed_y(hd)),
-                                              int(pair_seed_x(hl)), int(pair_seed_y(hl)))));
-    return {{v[2], v[3]}, {v[0], v[1]}};
+    const PointPair p =
+        scrambled_pairs(id, reversed_sobol_dim(1, id), hd, il, reversed_sobol_dim(1, il), hl);
+    return {p.second, p.first};
   }
 #endif
 
@@ -275,15 +272,11 @@ class Sampler {
     // Both pairs in one register (the light pair's lanes are unused without lights).
     const uint64_t hd = mix64(pixel_key_ ^ bounce_dim(vertex, kBsdfDir));
     const uint64_t hl = lights ? mix64(pixel_key_ ^ bounce_dim(vertex, kLightPoint)) : 0;
-    alignas(16) float v[4];
-    _mm_store_ps(
-        v, scrambled4(_mm_setr_epi32(int(reversed_sobol_dim(2, i)), int(reversed_sobol_dim(3, i)),
-                                     int(lights ? reversed_sobol_dim(4, i) : 0),
-                                     int(lights ? reversed_sobol_dim(5, i) : 0)),
-                      _mm_setr_epi32(int(pair_seed_x(hd)), int(pair_seed_y(hd)),
-                                     int(pair_seed_x(hl)), int(pair_seed_y(hl)))));
-    u.dir = {v[0], v[1]};
-    if (lights) u.light = {v[2], v[3]};
+    const PointPair p = scrambled_pairs(reversed_sobol_dim(2, i), reversed_sobol_dim(3, i), hd,
+                                        lights ? reversed_sobol_dim(4, i) : 0,
+                                        lights ? reversed_sobol_dim(5, i) : 0, hl);
+    u.dir = p.first;
+    if (lights) u.light = p.second;
 #else
     if (lights)
       u.light = scrambled_pair(reversed_sobol_dim(4, i), reversed_sobol_dim(5, i),
@@ -314,14 +307,25 @@ class Sampler {
   static uint32_t pair_seed_y(uint64_t h) {
     return uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32);
   }
+#if GDPT_SAMPLER_SIMD
+  // Two Owen-scrambled points in one register: (rx0, ry0) with hash h0, (rx1, ry1) with h1.
+  struct PointPair {
+    Vec2f first, second;
+  };
+  static PointPair scrambled_pairs(uint32_t rx0, uint32_t ry0, uint64_t h0, uint32_t rx1,
+                                   uint32_t ry1, uint64_t h1) {
+    alignas(16) float v[4];
+    _mm_store_ps(
+        v, sampler_detail::scrambled4(_mm_setr_epi32(int(rx0), int(ry0), int(rx1), int(ry1)),
+                                      _mm_setr_epi32(int(pair_seed_x(h0)), int(pair_seed_y(h0)),
+                                                     int(pair_seed_x(h1)), int(pair_seed_y(h1)))));
+    return {{v[0], v[1]}, {v[2], v[3]}};
+  }
+#endif
   // Owen-scrambled point from the reversed-bit Sobol coordinates rx, ry and their hash h.
   static Vec2f scrambled_pair(uint32_t rx, uint32_t ry, uint64_t h) {
 #if GDPT_SAMPLER_SIMD
-    alignas(16) float v[4];
-    _mm_store_ps(v, sampler_detail::scrambled4(
-                        _mm_setr_epi32(int(rx), int(ry), 0, 0),
-                        _mm_setr_epi32(int(pair_seed_x(h)), int(pair_seed_y(h)), 0, 0)));
-    return {v[0], v[1]};
+    return scrambled_pairs(rx, ry, h, 0, 0, 0).first;
 #else
     return {scrambled(rx, pair_seed_x(h)), scrambled(ry, pair_seed_y(h))};
 #endif
