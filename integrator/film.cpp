@@ -22,13 +22,14 @@ double variance_of_mean(double sum, double sum2, uint32_t n) {
 
 }  // namespace
 
-Film::Film(int width, int height)
+Film::Film(int width, int height, bool gradients_from_primal)
     : width_(std::max(width, 0)),
       height_(std::max(height, 0)),
       acc_(size_t(width_) * size_t(height_)),
-      grad_(size_t(width_) * size_t(height_)),
+      grad_(gradients_from_primal ? 0 : size_t(width_) * size_t(height_)),
       samples_(size_t(width_) * size_t(height_), 0u),
-      first_hit_(size_t(width_) * size_t(height_)) {}
+      first_hit_(size_t(width_) * size_t(height_)),
+      gradients_from_primal_(gradients_from_primal) {}
 
 void Film::set_gradients_from_primal(bool on) {
   gradients_from_primal_ = on;

@@ -77,12 +77,11 @@ RenderSession::RenderSession(Scene scene, RenderSettings settings)
                      ? make_gradient_path_tracer(*d.context, d.settings)
                      : make_path_tracer(*d.context, d.settings);
   const int w = d.scene.camera.image_width(), h = d.scene.camera.image_height();
-  d.film = Film(w, h);
-  d.pass_film = Film(w, h);
-  for (Film* f : {&d.film, &d.pass_film}) {  // the pass film has the output film's layout
-    f->set_gradients_from_primal(!d.integrator->estimates_gradients());
+  const bool gradients_from_primal = !d.integrator->estimates_gradients();
+  d.film = Film(w, h, gradients_from_primal);
+  d.pass_film = Film(w, h, gradients_from_primal);  // the output film's layout (take_rows)
+  for (Film* f : {&d.film, &d.pass_film})
     f->enable_data_passes(d.settings.normal_pass, d.settings.mist_pass);
-  }
   const int th = tile_height(w, h, d.arena->max_concurrency());
   for (int y = 0; y < h; y += th)
     for (int x = 0; x < w; x += kTileSize)

@@ -91,11 +91,13 @@ TEST(Film, TakeRowsCommitsAndClearsThePass) {
 }
 
 // PT films hold no gradient accumulators: commits and read-outs work without them, and a pass
-// film of the other layout is refused rather than read out of bounds.
+// film of the other layout is refused rather than read out of bounds. The layout is chosen at
+// construction (as RenderSession does) or switched afterwards.
 TEST(Film, PtFilmsCommitWithoutGradientAccumulators) {
-  Film film(2, 1), pass(2, 1), gpt_pass(2, 1);
+  Film film(2, 1), pass(2, 1, true), gpt_pass(2, 1);
+  EXPECT_FALSE(film.gradients_from_primal());
+  EXPECT_TRUE(pass.gradients_from_primal());
   film.set_gradients_from_primal(true);
-  pass.set_gradients_from_primal(true);
   add(pass, 1, 0, Spectrum(4.0f));
   film.take_rows(pass, 0, 1);
   std::vector<float> p(6), sf(2, -1.0f), dx(6);
