@@ -34,7 +34,7 @@ Film::Film(int width, int height, bool gradients_from_primal)
 void Film::set_gradients_from_primal(bool on) {
   gradients_from_primal_ = on;
   if (on)
-    std::vector<GradientAccumulator>().swap(grad_);
+    HugePageVector<GradientAccumulator>().swap(grad_);
   else
     grad_.assign(pixel_count(), GradientAccumulator{});
 }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "integrator/huge_pages.h"
 #include "integrator/math/vec.h"
 
 namespace gdpt {
@@ -140,15 +141,16 @@ class Film {
                     double (GradientAccumulator::*backward)[3]) const;
 
   int width_ = 0, height_ = 0;
-  std::vector<Accumulator> acc_;
-  std::vector<GradientAccumulator> grad_;  // empty when gradients_from_primal_
-  std::vector<uint32_t> samples_;
+  // Per-pixel arrays in huge pages: a 1920x1080 film is 170-470 MB (huge_pages.h).
+  HugePageVector<Accumulator> acc_;
+  HugePageVector<GradientAccumulator> grad_;  // empty when gradients_from_primal_
+  HugePageVector<uint32_t> samples_;
   struct FirstHit {
     float depth = 0.0f;  // 0: no surface (yet)
     float object_index = 0.0f, material_index = 0.0f;
   };
-  std::vector<FirstHit> first_hit_;
-  std::vector<double> normal_, mist_;  // sums; empty when the pass is off
+  HugePageVector<FirstHit> first_hit_;
+  HugePageVector<double> normal_, mist_;  // sums; empty when the pass is off
   bool gradients_from_primal_ = false;
 };
 

@@ -16,24 +16,19 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "reconstruct/huge_pages.h"
+#include "integrator/huge_pages.h"
 #include "reconstruct/parallel.h"
 #include "reconstruct/real_fft_dct.h"
 
 namespace gdpt::detail {
 
 void DctFree::operator()(double* p) const {
-  std::free(p);
+  free_huge(p);
 }
 
 DctBuffer dct_alloc(size_t count) {
-  // Large buffers start on a huge page boundary; 64 bytes is more than any SIMD FFTW uses.
-  const size_t bytes = sizeof(double) * std::max<size_t>(count, 1);
-  const size_t align = bytes >= kHugePageMinBytes ? size_t(2) << 20 : 64;
-  auto* p = static_cast<double*>(std::aligned_alloc(align, (bytes + align - 1) / align * align));
-  if (!p) throw std::bad_alloc();
-  advise_huge_pages(p, bytes);
-  return DctBuffer(p);
+  // 64 bytes is more than any SIMD FFTW uses (large buffers start on a huge page boundary).
+  return DctBuffer(static_cast<double*>(allocate_huge(sizeof(double) * count, 64)));
 }
 
 namespace {

@@ -12,7 +12,7 @@
 #include <tbb/task_arena.h>
 
 #include "reconstruct/dct_solver.h"
-#include "reconstruct/huge_pages.h"
+#include "integrator/huge_pages.h"
 #include "reconstruct/irls_reweight.h"
 #include "reconstruct/parallel.h"
 #include "reconstruct/weighted_cg.h"
@@ -133,9 +133,9 @@ double squared3(const float* e) {
 struct Weights {
   std::vector<float> w0, wx, wy;
   explicit Weights(size_t n)
-      : w0(detail::huge_vector<float>(n)),
-        wx(detail::huge_vector<float>(n)),
-        wy(detail::huge_vector<float>(n)) {}
+      : w0(huge_vector<float>(n)),
+        wx(huge_vector<float>(n)),
+        wy(huge_vector<float>(n)) {}
 };
 
 Weights uniform_weights(const Prepared& pr, double alpha) {
@@ -271,7 +271,7 @@ std::vector<float> l2_solution(const Prepared& pr, double alpha, bool measure,
   const int W = pr.width, H = pr.height;
   const size_t plane = size_t(W) * H;
   const detail::CachedDctBuffer planes(3 * plane);
-  auto x = detail::huge_vector<float>(3 * plane);
+  auto x = huge_vector<float>(3 * plane);
   const bool ok = detail::solve_l2_dct_rows(
       W, H, alpha, pr.primal, pr.gradient_x, pr.gradient_y, planes.get(), measure,
       [&](int y, const double* const* rows) {
@@ -356,7 +356,7 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
         // L1 objective. One pass forms the weights, the Jacobi diagonal and the CG's starting
         // residual (irls_reweight.h); the buffers live across the reweightings.
         Weights w(n);
-        auto inv_diag = detail::huge_vector<float>(n);
+        auto inv_diag = huge_vector<float>(n);
         ws.resize(3 * n);
         const detail::IrlsData data{W,
                                     H,

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "reconstruct/huge_pages.h"
+#include "integrator/huge_pages.h"
 #include "reconstruct/parallel.h"
 
 namespace gdpt::detail {

@@ -9,6 +9,7 @@
 import time
 
 import bpy
+import numpy as np
 
 from . import compositor_node, export_camera, export_scene, native, passes, properties
 
@@ -68,15 +69,17 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         print(f"{MARKER} error: {message}", flush=True)
         self.report({'ERROR'}, f"Gradient PT: {message}")
 
-    def _combined(self, module, film, norm, settings):
+    def _combined(self, module, film, norm, settings, out=None):
+        """The Combined RGB image; `out` (optional) takes it when no solve is needed."""
         if norm == 'NONE' or settings.mode == 'PT':
-            return film["primal"] + film["emission"]
+            return np.add(film["primal"], film["emission"], out=out)
         return module.reconstruct(film["primal"], film["gradient_x"], film["gradient_y"],
                                   film["variance"], film["emission"], norm, settings.alpha,
                                   settings.threads)
 
-    def _write(self, result, layer, film, combined):
-        layer.passes.foreach_set("rect", passes.layer_buffer(layer, film, combined))
+    def _write(self, result, layer, film, combined, buffers):
+        layer.passes.foreach_set("rect", passes.layer_buffer(layer, film, combined,
+                                                             buffers["layer"]))
         self.update_result(result)
 
     # --- render -------------------------------------------------------------------------------
@@ -138,10 +141,19 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
                         f"PT computed a {width}x{height} image (render region / resolution)")
             return
 
+        # Reused by every update of this render: fresh pages of a full-HD frame's buffers cost
+        # more than the update itself (passes.layer_buffer).
+        buffers = {"layer": module.empty(passes.layer_buffer_size(layer, width * height),
+                                         np.dtype(np.float32)),
+                   "combined": module.empty(width * height * 3, np.dtype(np.float32))
+                   .reshape(height, width, 3)}
+
         t_render = time.perf_counter()
         interval = settings.preview_interval
         state = {"next_preview": t_render + min(1.0, interval), "cancelled": False,
                  "last_line": 0.0, "last_done": -1}
+        # (samples, mean and mean square of the Combined RGB) of each preview, for LAST_RENDER.
+        previews = []
 
         def poll(done, total, elapsed, snapshot_ready):
             flags = 0
@@ -150,8 +162,12 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
                 return 1
             now = time.perf_counter()
             if snapshot_ready:
-                film = job.snapshot()
-                self._write(result, layer, film, self._combined(module, film, 'L2', settings))
+                film = job.snapshot()  # views, valid until the next snapshot
+                combined = self._combined(module, film, 'L2', settings, buffers["combined"])
+                self._write(result, layer, film, combined, buffers)
+                flat = combined.reshape(-1)
+                previews.append((film["samples"], float(np.mean(flat)),
+                                 float(np.vdot(flat, flat)) / max(flat.size, 1)))
             if now >= state["next_preview"]:
                 state["next_preview"] = now + interval
                 flags |= 2
@@ -188,9 +204,9 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         norm = settings.reconstruction
         self.update_stats("", f"Sample {film['samples']}/{settings.samples} | Reconstructing "
                               f"({norm})")
-        combined = self._combined(module, film, norm, settings)
+        combined = self._combined(module, film, norm, settings, buffers["combined"])
         t_reconstruct = time.perf_counter()
-        self._write(result, layer, film, combined)
+        self._write(result, layer, film, combined, buffers)
         self.end_result(result)
         # Gradient Reconstruct compositor nodes solve from this layer's passes now: Blender
         # composites after render() returns (compositor_node.py).
@@ -211,7 +227,7 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
             setup=session_seconds, render=t_done - t_render,
             reconstruct=t_reconstruct - t_done, write=t_end - t_reconstruct,
             total=t_end - t_start, triangles=stats.triangles, rays=job.rays_traced(),
-            warnings=sorted(self._warned), build=build)
+            warnings=sorted(self._warned), build=build, previews=previews)
         print(f"{MARKER} view layer '{view_layer.name}' {status}: {film['samples']}/"
               f"{settings.samples} samples, {width}x{height}, mode {settings.mode}, "
               f"reconstruction {norm}, {build} build; export {stats.seconds:.3f} s, scene setup "

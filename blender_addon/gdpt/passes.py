@@ -68,14 +68,24 @@ def data_pass_settings(scene, view_layer):
     return d
 
 
-def layer_buffer(layer, film, combined_rgb):
+def layer_buffer_size(layer, count):
+    """Floats in one buffer for every pass of `layer` at `count` pixels."""
+    return sum(p.channels for p in layer.passes) * count
+
+
+def layer_buffer(layer, film, combined_rgb, out=None):
     """One float32 buffer for every pass of `layer` (its order), from a film dict and the
-    reconstructed RGB image. Passes GDPT does not produce (e.g. Depth) are written as zeros."""
+    reconstructed RGB image. Passes GDPT does not produce (e.g. Depth) are written as zeros.
+    `out`: a buffer of layer_buffer_size() floats to fill and return instead of a new one (every
+    element is written). Progressive updates reuse one: a fresh 166 MB buffer (1920x1080) cost
+    0.66-1.1 s of page faults per update on the benchmark VM, a reused one 6 ms."""
     height, width = film["height"], film["width"]
     count = width * height
     passes = list(layer.passes)
-    total = sum(p.channels for p in passes)
-    buffer = np.zeros(total * count, dtype=np.float32)
+    total = sum(p.channels for p in passes) * count
+    buffer = np.empty(total, dtype=np.float32) if out is None else out
+    if buffer.size != total:
+        raise ValueError(f"layer buffer of {buffer.size} floats for {total}")
     offset = 0
     for p in passes:
         size = p.channels * count
@@ -84,8 +94,12 @@ def layer_buffer(layer, film, combined_rgb):
             view[:, :3] = combined_rgb.reshape(count, 3)
             # Coverage: 1 unless Film > Transparent leaves the background out.
             view[:, 3] = film["alpha"].reshape(count) if "alpha" in film else 1.0
-        elif p.name in _FILM_KEYS:
+        elif p.name in _FILM_KEYS and _FILM_KEYS[p.name] in film:
             data = film[_FILM_KEYS[p.name]].reshape(count, -1)
-            view[:, :min(p.channels, data.shape[1])] = data[:, :p.channels]
+            used = min(p.channels, data.shape[1])
+            view[:, :used] = data[:, :used]
+            view[:, used:] = 0.0
+        else:
+            view[:] = 0.0
         offset += size
     return buffer

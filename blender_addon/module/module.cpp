@@ -118,7 +118,7 @@ PYBIND11_MODULE(_gdpt, m) {
            }),
            py::arg("builder"), py::arg("settings"))
       .def("render", &RenderJob::render, py::arg("poll"), py::arg("poll_interval") = 0.1)
-      .def("snapshot", &RenderJob::snapshot)
+      .def("snapshot", [](py::object self) { return self.cast<RenderJob&>().snapshot(self); })
       .def("passes", &RenderJob::passes)
       .def("features_summary", &RenderJob::features_summary)
       .def("rays_traced", &RenderJob::rays_traced)

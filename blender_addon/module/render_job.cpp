@@ -15,12 +15,20 @@ namespace gdpt::python {
 namespace {
 
 // A numpy array that owns a moved-in vector (no second copy).
-py::array_t<float> to_numpy(std::vector<float>&& v, int height, int width, int channels) {
-  auto* owner = new std::vector<float>(std::move(v));
-  py::capsule free_owner(owner, [](void* p) { delete static_cast<std::vector<float>*>(p); });
+template <typename Vector>
+py::array_t<float> to_numpy(Vector&& v, int height, int width, int channels) {
+  auto* owner = new Vector(std::move(v));
+  py::capsule free_owner(owner, [](void* p) { delete static_cast<Vector*>(p); });
   std::vector<py::ssize_t> shape{height, width};
   if (channels > 1) shape.push_back(channels);
   return py::array_t<float>(shape, owner->data(), free_owner);
+}
+
+py::array_t<float> view_numpy(const HugePageVector<float>& v, int height, int width, int channels,
+                              const py::handle& owner) {
+  std::vector<py::ssize_t> shape{height, width};
+  if (channels > 1) shape.push_back(channels);
+  return py::array_t<float>(shape, v.data(), owner);
 }
 
 }  // namespace
@@ -56,25 +64,42 @@ void FilmPasses::read(const Film& film, int samples) {
   film.shift_failures(shift_failures.data());
 }
 
-py::dict FilmPasses::to_python() const {
-  FilmPasses copy = *this;  // the Python arrays own their data; this object may be reused
+// Every pass with its channel count; normal and mist only when the render computes them.
+template <typename Passes, typename Add>
+void for_each_pass(Passes& p, Add&& add) {
+  add("primal", p.primal, 3);
+  add("gradient_x", p.gradient_x, 3);
+  add("gradient_y", p.gradient_y, 3);
+  add("emission", p.emission, 3);
+  add("variance", p.variance, 3);
+  add("shift_failures", p.shift_failures, 1);
+  add("alpha", p.alpha, 1);
+  add("depth", p.depth, 1);
+  add("object_index", p.object_index, 1);
+  add("material_index", p.material_index, 1);
+  if (!p.normal.empty()) add("normal", p.normal, 3);
+  if (!p.mist.empty()) add("mist", p.mist, 1);
+}
+
+py::dict FilmPasses::to_python_owning() {
   py::dict d;
   d["width"] = width;
   d["height"] = height;
   d["samples"] = samples_done;
-  d["primal"] = to_numpy(std::move(copy.primal), height, width, 3);
-  d["gradient_x"] = to_numpy(std::move(copy.gradient_x), height, width, 3);
-  d["gradient_y"] = to_numpy(std::move(copy.gradient_y), height, width, 3);
-  d["emission"] = to_numpy(std::move(copy.emission), height, width, 3);
-  d["variance"] = to_numpy(std::move(copy.variance), height, width, 3);
-  d["shift_failures"] = to_numpy(std::move(copy.shift_failures), height, width, 1);
-  d["alpha"] = to_numpy(std::move(copy.alpha), height, width, 1);
-  d["depth"] = to_numpy(std::move(copy.depth), height, width, 1);
-  d["object_index"] = to_numpy(std::move(copy.object_index), height, width, 1);
-  d["material_index"] = to_numpy(std::move(copy.material_index), height, width, 1);
-  // Only the data passes the render computes (RenderSettings::normal_pass / mist_pass).
-  if (!copy.normal.empty()) d["normal"] = to_numpy(std::move(copy.normal), height, width, 3);
-  if (!copy.mist.empty()) d["mist"] = to_numpy(std::move(copy.mist), height, width, 1);
+  for_each_pass(*this, [&](const char* key, HugePageVector<float>& v, int channels) {
+    d[key] = to_numpy(std::move(v), height, width, channels);
+  });
+  return d;
+}
+
+py::dict FilmPasses::to_python_views(const py::handle& owner) const {
+  py::dict d;
+  d["width"] = width;
+  d["height"] = height;
+  d["samples"] = samples_done;
+  for_each_pass(*this, [&](const char* key, const HugePageVector<float>& v, int channels) {
+    d[key] = view_numpy(v, height, width, channels, owner);
+  });
   return d;
 }
 
@@ -173,11 +198,15 @@ void RenderJob::render(const py::function& poll, double poll_interval) {
   if (poll_error) std::rethrow_exception(poll_error);
 }
 
-py::dict RenderJob::snapshot() {
-  std::lock_guard lock(state_->mutex);
-  if (!state_->snapshot_ready) throw std::runtime_error("no snapshot has been taken");
-  state_->snapshot_ready = false;
-  return state_->snapshot.to_python();
+py::dict RenderJob::snapshot(const py::handle& self) {
+  {
+    std::lock_guard lock(state_->mutex);
+    if (!state_->snapshot_ready) throw std::runtime_error("no snapshot has been taken");
+    state_->snapshot_ready = false;
+    // The worker reads the next snapshot into the buffers the previous views used.
+    std::swap(shown_, state_->snapshot);
+  }
+  return shown_.to_python_views(self);
 }
 
 py::dict RenderJob::passes() {
@@ -186,7 +215,7 @@ py::dict RenderJob::passes() {
     py::gil_scoped_release no_gil;
     p.read(session_->film(), int(session_->film().min_samples()));
   }
-  return p.to_python();
+  return p.to_python_owning();
 }
 
 uint64_t RenderJob::rays_traced() const {

@@ -18,18 +18,24 @@
 #include <memory>
 
 #include "blender_addon/module/scene_convert.h"
+#include "integrator/huge_pages.h"
 #include "integrator/render_session.h"
 
 namespace gdpt::python {
 
-// The film passes as float32 images, row 0 at the bottom, interleaved.
+// The film passes as float32 images, row 0 at the bottom, interleaved. In huge pages
+// (integrator/huge_pages.h): at 1920x1080 they are 166 MB, which in fresh 4 KB pages cost the
+// benchmark VM 0.4-0.7 s of page faults per read.
 struct FilmPasses {
   int width = 0, height = 0, samples_done = 0;
-  std::vector<float> primal, gradient_x, gradient_y, emission, variance, shift_failures, alpha,
+  HugePageVector<float> primal, gradient_x, gradient_y, emission, variance, shift_failures, alpha,
       depth, object_index, material_index;
-  std::vector<float> normal, mist;  // empty unless the render computes them
+  HugePageVector<float> normal, mist;  // empty unless the render computes them
   void read(const Film& film, int samples);
-  py::dict to_python() const;  // numpy views owning copies of the vectors
+  // numpy arrays that take the vectors over (this object is left empty).
+  py::dict to_python_owning();
+  // numpy views of the vectors, which keep `owner` alive; valid while this object keeps them.
+  py::dict to_python_views(const py::handle& owner) const;
 };
 
 class RenderJob {
@@ -41,8 +47,12 @@ class RenderJob {
   // bitmask: 1 = cancel, 2 = take a snapshot after the next pass. Exceptions from the core or from
   // poll cancel the render and propagate.
   void render(const py::function& poll, double poll_interval);
-  py::dict snapshot();  // last snapshot taken (after poll saw snapshot_ready)
-  py::dict passes();    // the film after render() returned
+  // The last snapshot taken (after poll saw snapshot_ready), as views into this job's memory that
+  // the next snapshot() overwrites: copy what must outlive it. `self` is this job's Python object,
+  // which the views keep alive. Two buffers take turns, so snapshots after the first two allocate
+  // nothing (a preview at 1920x1080 cost 0.7 s of fresh-page faults on the benchmark VM).
+  py::dict snapshot(const py::handle& self);
+  py::dict passes();  // the film after render() returned, in arrays of its own
   std::string features_summary() const;
   uint64_t rays_traced() const;  // camera, extension and shadow rays so far
   py::list warnings() const;
@@ -51,6 +61,7 @@ class RenderJob {
   struct State;
   std::unique_ptr<RenderSession> session_;
   std::unique_ptr<State> state_;
+  FilmPasses shown_;  // the snapshot Python's views see (snapshot())
 };
 
 // Screened Poisson reconstruction of numpy passes (the same code as the CLI and the engine).

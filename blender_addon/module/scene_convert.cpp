@@ -11,10 +11,7 @@
 
 #include <pybind11/stl.h>  // lists to std::vector (colour ramp tables)
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
+#include "integrator/huge_pages.h"
 #include "shaders/image_io.h"
 
 namespace gdpt::python {
@@ -342,21 +339,6 @@ ShaderNodeKind to_kind(const std::string& kind) {
   bad_enum("shader node kind", kind);
 }
 
-// Asks the kernel to back the whole 2 MB pages inside [data, data + bytes) with transparent huge
-// pages before anything touches them. Where THP is in `madvise` mode (as on the benchmark VM),
-// first touching fresh memory then takes one fault per 2 MB instead of one per 4 KB: there,
-// touching 256 MB took 1.0-1.2 s in 4 KB pages (15-19 us per fault under load) and 48-66 ms
-// advised, so a 1M-triangle mesh's 80 MB of arrays cost about 0.3 s in faults alone. Only whole
-// pages inside the buffer are advised. A no-op elsewhere and for buffers under 2 MB.
-void advise_huge_pages([[maybe_unused]] const void* data, [[maybe_unused]] size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-  const uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
-  const uintptr_t end = (reinterpret_cast<uintptr_t>(data) + bytes) & ~(kHuge - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#endif
-}
-
 // An empty vector with room for n elements, its fresh pages advised as huge pages.
 template <typename T>
 void reserve_fresh(std::vector<T>& v, size_t n) {
@@ -378,14 +360,8 @@ const T* checked_data(const py::array_t<T, py::array::c_style>& a, size_t expect
 
 py::array empty_array(py::ssize_t count, const py::dtype& dtype) {
   if (count < 0) throw std::invalid_argument("empty: negative count");
-  const size_t bytes = size_t(count) * size_t(dtype.itemsize());
-  constexpr size_t kHuge = size_t(2) << 20;
-  // Large buffers start on a 2 MB boundary so that every page of them can be a huge page.
-  void* p = bytes >= kHuge ? std::aligned_alloc(kHuge, (bytes + kHuge - 1) & ~(kHuge - 1))
-                           : std::malloc(std::max<size_t>(bytes, 1));
-  if (!p) throw std::bad_alloc();
-  advise_huge_pages(p, bytes);
-  py::capsule owner(p, [](void* q) { std::free(q); });
+  void* p = allocate_huge(size_t(count) * size_t(dtype.itemsize()));
+  py::capsule owner(p, [](void* q) { free_huge(q); });
   return py::array(dtype, {count}, {}, p, owner);
 }
 
