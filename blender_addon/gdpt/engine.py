@@ -3,9 +3,11 @@
 # render() runs once per view layer (and frame). Timeline:
 #   export (depsgraph -> arrays) -> _gdpt.RenderJob (BVH, lights) -> job.render(poll)
 # poll() runs on Blender's thread about every 0.1 s while the core renders on its own threads: it
-# checks Esc (test_break), prints progress, and every `preview_interval` seconds asks for a film
-# snapshot, reconstructs it (L2, the fast exact solve) and shows it with update_result. At the end
+# checks Esc (test_break), prints progress, and every `preview_interval` seconds (not in background
+# renders) asks for a film snapshot, reconstructs it (L2, the fast exact solve) and shows it with
+# update_result. At the end
 # the film is reconstructed with the chosen norm and every pass is written in one foreach_set.
+import os
 import time
 
 import bpy
@@ -14,6 +16,8 @@ import numpy as np
 from . import compositor_node, export_camera, export_scene, native, passes, properties
 
 MARKER = "GDPT:"  # every console line of the engine starts with it (tests look for it)
+# Set to 1, background renders take progressive previews too (tests, benchmarks of their cost).
+PREVIEWS_IN_BACKGROUND = "GDPT_PREVIEWS_IN_BACKGROUND"
 
 # Figures of the last finished render() in this process (samples, timings): read by the tests
 # and the benchmark to tell that Gradient PT really rendered and what the add-on cost.
@@ -150,6 +154,10 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
 
         t_render = time.perf_counter()
         interval = settings.preview_interval
+        # Background renders (blender -b) show no image until it is written, so they take no
+        # previews: at 1920x1080 on 2 cores each cost 0.5 s of G-PT render time (docs/blender.md,
+        # "Rendering"). PREVIEWS_IN_BACKGROUND (the environment variable) takes them anyway.
+        previews_on = not bpy.app.background or os.environ.get(PREVIEWS_IN_BACKGROUND) == "1"
         state = {"next_preview": t_render + min(1.0, interval), "cancelled": False,
                  "last_line": 0.0, "last_done": -1}
         # (samples, mean and mean square of the Combined RGB) of each preview, for LAST_RENDER.
@@ -168,7 +176,7 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
                 flat = combined.reshape(-1)
                 previews.append((film["samples"], float(np.mean(flat)),
                                  float(np.vdot(flat, flat)) / max(flat.size, 1)))
-            if now >= state["next_preview"]:
+            if previews_on and now >= state["next_preview"]:
                 state["next_preview"] = now + interval
                 flags |= 2
             # ETA from the sample rate of the finished passes, counted down on the wall clock so

@@ -70,7 +70,9 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
     clamp: FloatProperty(name="Clamp", description="Maximum sample value (0 = off)", default=0.0,
                          min=0.0)
     preview_interval: FloatProperty(
-        name="Preview Interval", description="Seconds between reconstructed preview updates",
+        name="Preview Interval",
+        description="Seconds between reconstructed preview updates of the image (none in "
+                    "background renders, blender -b, where no image is shown until it is saved)",
         default=3.0, min=0.5, max=600.0)
 
 

@@ -10,7 +10,10 @@
 #    while the first has more noise than the final image (a larger mean square: the mean square
 #    is the squared mean plus the noise variance), which a preview repeating a stale image fails;
 #  - the same for G-PT, whose previews are L2 reconstructions of the snapshot's passes (except
-#    the noise comparison: the reconstruction smooths the noise).
+#    the noise comparison: the reconstruction smooths the noise);
+#  - these renders run in background mode, which by default takes no previews (nothing shows
+#    them): the test asks for them with GDPT_PREVIEWS_IN_BACKGROUND=1, and checks that without it
+#    a render takes none and still finishes.
 import math
 import os
 import sys
@@ -65,7 +68,11 @@ def render_with_previews(scene, out, mode, samples, reconstruction):
     import gdpt.engine as engine
     S.setup_gdpt(scene, samples, mode=mode, reconstruction=reconstruction, bounces=4)
     scene.gdpt.preview_interval = 0.5
-    path = S.render(scene, os.path.join(out, f"{mode}.exr"))
+    os.environ[engine.PREVIEWS_IN_BACKGROUND] = "1"
+    try:
+        path = S.render(scene, os.path.join(out, f"{mode}.exr"))
+    finally:
+        del os.environ[engine.PREVIEWS_IN_BACKGROUND]
     final = S.read_rgb(path)
     r = engine.LAST_RENDER
     check(r["status"] == "finished" and r["samples"] == samples,
@@ -102,6 +109,14 @@ def main():
     # About 3 s of PT (13 spp per pass at this size) and 2.5 s of G-PT on 2 cores.
     render_with_previews(scene, out, 'PT', 128, 'NONE')
     render_with_previews(scene, out, 'GPT', 48, 'L2')
+
+    import gdpt.engine as engine
+    S.setup_gdpt(scene, 128, mode='PT', reconstruction='NONE', bounces=4)
+    scene.gdpt.preview_interval = 0.5
+    S.render(scene, os.path.join(out, "background.exr"))
+    r = engine.LAST_RENDER
+    check(r["status"] == "finished" and r["samples"] == 128 and r["previews"] == [],
+          f"a background render takes no previews ({r['render']:.2f} s, finished)")
 
 
 main()
