@@ -3,8 +3,9 @@
 // diffuse-only scene against the same scene with every feature path forced on.
 //
 // Usage: bench_integrator [seconds_per_case [cases]]   (default 3 s; cases: any of
-// "cornell", "textured", "field", "features", "blender", default all five; "blender" is
-// compare_cycles.py's Cornell box with its 4 bounces, at 256x192)
+// "cornell", "textured", "field", "features", "blender", "film", default all six; "blender" is
+// compare_cycles.py's Cornell box with its 4 bounces, at 256x192; "film" times the construction
+// of a render's two films at 1920x1080, PT and G-PT layout: zeroing fresh memory)
 // Each case renders passes of 1 spp at 256x256 until the time budget is used, then reports
 // samples/s = pixels * spp / wall time and rays/s (camera + extension + shadow rays).
 //
@@ -385,7 +386,7 @@ void report(const char* name, int threads, const Result& r) {
 
 int main(int argc, char** argv) {
   const double budget = argc > 1 ? std::atof(argv[1]) : 3.0;
-  const std::string cases = argc > 2 ? argv[2] : "cornell,textured,field,features,blender";
+  const std::string cases = argc > 2 ? argv[2] : "cornell,textured,field,features,blender,film";
   auto want = [&](const char* c) { return cases.find(c) != std::string::npos; };
   const int res = 256;
   std::printf("bench_integrator: PT, 8 bounces, %dx%d, %.1f s per case\n", res, res, budget);
@@ -468,6 +469,19 @@ int main(int argc, char** argv) {
   if (want("blender")) {
     const Scene b = blender_cornell(res, res * 3 / 4);
     for (int t : {1, 2}) report("blender_cornell (4 bounces)", t, run(b, t, budget, false, 4));
+  }
+
+  if (want("film")) {
+    // What RenderSession allocates for a 1920x1080 frame: the output film and the pass film.
+    for (int round = 0; round < 3; ++round)
+      for (bool pt : {true, false}) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const Film output(1920, 1080, pt), pass(1920, 1080, pt);
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count();
+        std::printf("film 1920x1080 (%s layout, two films): %.1f ms\n", pt ? "PT" : "G-PT", ms);
+      }
   }
 
   if (want("field")) {
