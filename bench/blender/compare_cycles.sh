@@ -9,13 +9,8 @@
 # entry, a number being set in both engines, "defaults" each engine's own),
 # GDPT_BENCH_CYCLES_PATTERN (PROGRESSIVE_MULTI_JITTER, Cycles' default, or SOBOL).
 set -euo pipefail
-build=${1:-build}
 root=$(cd "$(dirname "$0")/../.." && pwd)
-case "$build" in /*) ;; *) build="$root/$build" ;; esac
-scripts=$(mktemp -d)
-trap 'rm -rf "$scripts"' EXIT
-bash "$root/tests/blender/stage_addon.sh" "$root" "$build" "$scripts" >/dev/null
 out="$root/out/bench/blender"
 mkdir -p "$out"
-BLENDER_USER_SCRIPTS="$scripts" blender -b --factory-startup --addons gdpt --python-exit-code 1 \
-  --python "$root/bench/blender/compare_cycles.py" -- --out "$out" 2>&1 | grep -E "^(BENCH|  )" 
+bash "$root/scripts/blender-bench.sh" "${1:-build}" "$root/bench/blender/compare_cycles.py" \
+  --out "$out"
