@@ -71,8 +71,10 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
                          min=0.0)
     preview_interval: FloatProperty(
         name="Preview Interval",
-        description="Seconds between reconstructed preview updates of the image (none in "
-                    "background renders, blender -b, where no image is shown until it is saved)",
+        description="Seconds between reconstructed preview updates of the image, at least "
+                    "(previews that take long are spaced to cost at most 5% of the render; none "
+                    "in background renders, blender -b, where no image is shown until it is "
+                    "saved)",
         default=3.0, min=0.5, max=600.0)
 
 

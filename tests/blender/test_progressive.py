@@ -11,6 +11,8 @@
 #    is the squared mean plus the noise variance), which a preview repeating a stale image fails;
 #  - the same for G-PT, whose previews are L2 reconstructions of the snapshot's passes (except
 #    the noise comparison: the reconstruction smooths the noise);
+#  - engine.preview_gap: the Preview Interval for cheap previews, and for costly ones (a full-HD
+#    G-PT L2 solve) a gap that keeps previews at 5% of the time;
 #  - these renders run in background mode, which by default takes no previews (nothing shows
 #    them): the test asks for them with GDPT_PREVIEWS_IN_BACKGROUND=1, and checks that without it
 #    a render takes none and still finishes.
@@ -95,10 +97,18 @@ def render_with_previews(scene, out, mode, samples, reconstruction):
         check(squares[0] > mean_sq, f"{mode}: the first preview is noisier than the final image")
 
 
+def check_preview_gap():
+    from gdpt import engine
+    check(engine.preview_gap(3.0, 0.01) == 3.0, "cheap previews keep the Preview Interval")
+    check(abs(engine.preview_gap(3.0, 0.4) - 8.0) < 1e-9,
+          "a 0.4 s preview is followed by 8 s without one (at most 5% of the time)")
+
+
 def main():
     out = S.args()["out"]
     os.makedirs(out, exist_ok=True)
     check_layer_buffer_reuse()
+    check_preview_gap()
     scene = S.clear()
     S.room()
     S.camera((0, -5.5, 2.0), (0, 0, 1.7), lens=30)
