@@ -5,8 +5,8 @@
 # poll() runs on Blender's thread about every 0.1 s while the core renders on its own threads: it
 # checks Esc (test_break), prints progress, and every `preview_interval` seconds (not in background
 # renders) asks for a film snapshot, reconstructs it (L2, the fast exact solve) and shows it with
-# update_result. At the end
-# the film is reconstructed with the chosen norm and every pass is written in one foreach_set.
+# update_result. At the end the film is reconstructed with the chosen norm and every pass is
+# written in one foreach_set.
 import os
 import time
 
