@@ -22,7 +22,8 @@
 namespace gdpt::detail {
 
 // Double buffer for the DCT planes: 2 MiB aligned and advised for transparent huge pages
-// (integrator/huge_pages.h), which also satisfies FFTW's SIMD alignment (that of the planning buffer).
+// (integrator/huge_pages.h), which also satisfies FFTW's SIMD alignment (that of the planning
+// buffer).
 struct DctFree {
   void operator()(double* p) const;
 };

@@ -11,8 +11,8 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
-#include "reconstruct/dct_solver.h"
 #include "integrator/huge_pages.h"
+#include "reconstruct/dct_solver.h"
 #include "reconstruct/irls_reweight.h"
 #include "reconstruct/parallel.h"
 #include "reconstruct/weighted_cg.h"
@@ -133,9 +133,7 @@ double squared3(const float* e) {
 struct Weights {
   std::vector<float> w0, wx, wy;
   explicit Weights(size_t n)
-      : w0(huge_vector<float>(n)),
-        wx(huge_vector<float>(n)),
-        wy(huge_vector<float>(n)) {}
+      : w0(huge_vector<float>(n)), wx(huge_vector<float>(n)), wy(huge_vector<float>(n)) {}
 };
 
 Weights uniform_weights(const Prepared& pr, double alpha) {
