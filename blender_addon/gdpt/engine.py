@@ -95,10 +95,14 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
                                   film["variance"], film["emission"], norm, settings.alpha,
                                   settings.threads)
 
-    def _write(self, result, layer, film, combined, buffers):
+    def _write(self, result, layer, film, combined, buffers, show=True):
+        """Writes every pass into `result`; `show`: display it now (previews; end_result shows
+        the final image itself: an update_result just before it made the final write 0.1 s
+        slower at 1920x1080, 1.04 against 0.94 s over 6 renders each)."""
         layer.passes.foreach_set("rect", passes.layer_buffer(layer, film, combined,
                                                              buffers["layer"]))
-        self.update_result(result)
+        if show:
+            self.update_result(result)
 
     # --- render -------------------------------------------------------------------------------
 
@@ -234,7 +238,7 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
                               f"({norm})")
         combined = self._combined(module, film, norm, settings, buffers["combined"])
         t_reconstruct = time.perf_counter()
-        self._write(result, layer, film, combined, buffers)
+        self._write(result, layer, film, combined, buffers, show=False)
         self.end_result(result)
         # Gradient Reconstruct compositor nodes solve from this layer's passes now: Blender
         # composites after render() returns (compositor_node.py).
