@@ -72,14 +72,20 @@ struct HugePageAllocator {
 template <typename T>
 using HugePageVector = std::vector<T, HugePageAllocator<T>>;
 
-// For plain std::vectors (APIs that hand them on): v.resize(n), a new allocation advised before
-// it is zeroed; and a vector of n value-initialised elements made so.
+// For plain std::vectors (APIs that hand them on): an empty vector with room for n elements, its
+// fresh pages advised (filled later without a zero fill); v.resize(n), a new allocation advised
+// before it is zeroed; and a vector of n value-initialised elements made so.
+template <class T>
+void reserve_fresh(std::vector<T>& v, size_t n) {
+  v.clear();
+  v.reserve(n);
+  advise_huge_pages(v.data(), n * sizeof(T));
+}
 template <class T>
 void resize_huge(std::vector<T>& v, size_t n) {
   if (v.capacity() < n) {
     std::vector<T> fresh;
-    fresh.reserve(n);
-    advise_huge_pages(fresh.data(), n * sizeof(T));
+    reserve_fresh(fresh, n);
     fresh.assign(v.begin(), v.end());
     v.swap(fresh);
   }

@@ -81,11 +81,17 @@ void for_each_pass(Passes& p, Add&& add) {
   if (!p.mist.empty()) add("mist", p.mist, 1);
 }
 
-py::dict FilmPasses::to_python_owning() {
+// The dict's size and sample count, before the passes.
+static py::dict film_dict(const FilmPasses& p) {
   py::dict d;
-  d["width"] = width;
-  d["height"] = height;
-  d["samples"] = samples_done;
+  d["width"] = p.width;
+  d["height"] = p.height;
+  d["samples"] = p.samples_done;
+  return d;
+}
+
+py::dict FilmPasses::to_python_owning() {
+  py::dict d = film_dict(*this);
   for_each_pass(*this, [&](const char* key, HugePageVector<float>& v, int channels) {
     d[key] = to_numpy(std::move(v), height, width, channels);
   });
@@ -93,10 +99,7 @@ py::dict FilmPasses::to_python_owning() {
 }
 
 py::dict FilmPasses::to_python_views(const py::handle& owner) const {
-  py::dict d;
-  d["width"] = width;
-  d["height"] = height;
-  d["samples"] = samples_done;
+  py::dict d = film_dict(*this);
   for_each_pass(*this, [&](const char* key, const HugePageVector<float>& v, int channels) {
     d[key] = view_numpy(v, height, width, channels, owner);
   });

@@ -339,14 +339,6 @@ ShaderNodeKind to_kind(const std::string& kind) {
   bad_enum("shader node kind", kind);
 }
 
-// An empty vector with room for n elements, its fresh pages advised as huge pages.
-template <typename T>
-void reserve_fresh(std::vector<T>& v, size_t n) {
-  v.clear();
-  v.reserve(n);
-  advise_huge_pages(v.data(), n * sizeof(T));
-}
-
 template <typename T>
 const T* checked_data(const py::array_t<T, py::array::c_style>& a, size_t expected,
                       const char* what) {
