@@ -1,12 +1,14 @@
 // Cost of the shading hot path: Material::evaluate into a ClosureSet, then the BSDF queries a
 // path vertex makes (one sample, one eval + pdf for next-event estimation), for a diffuse, a
-// Principled (diffuse + specular) and a glass material. Prints ns per operation.
+// Principled (diffuse + specular) and a glass material; and an image texture's bilinear lookup at
+// random coordinates (what a textured surface costs per hit). Prints ns per operation.
 #include <benchmark/benchmark.h>
 
 #include <cstdint>
 #include <vector>
 
 #include "shaders/material.h"
+#include "shaders/texture.h"
 
 namespace gdpt {
 namespace {
@@ -78,7 +80,33 @@ void BM_Vertex(benchmark::State& state) {
   state.SetLabel(kNames[state.range(0)]);
 }
 
+// A 256x256 sRGB image of random 8-bit values (kept as 8-bit codes, texture.h) or, with range 1,
+// of random floats (kept as float RGBA): bilinear Repeat lookups at random coordinates, so that
+// the texels come from the caches as they do along incoherent paths.
+void BM_TextureLookup(benchmark::State& state) {
+  const bool coded = state.range(0) == 0;
+  ImageDesc img;
+  img.name = "bench";
+  img.width = img.height = 256;
+  img.srgb_encoded = coded;
+  img.rgba.resize(size_t(img.width) * size_t(img.height) * 4);
+  Lcg rng;
+  for (size_t i = 0; i < img.rgba.size(); ++i)
+    img.rgba[i] = coded ? float(uint32_t(rng.next() * 256.0f)) / 255.0f : rng.next();
+  const Texture tex(img);
+  std::vector<Vec2f> uv(4096);
+  for (Vec2f& p : uv) p = {rng.next() * 3.0f - 1.0f, rng.next() * 3.0f - 1.0f};
+  size_t i = 0;
+  for (auto _ : state) {
+    const Rgba c = tex.lookup(uv[i++ & 4095], TextureLookup::Interpolation::Linear,
+                              TextureLookup::Extension::Repeat);
+    benchmark::DoNotOptimize(c);
+  }
+  state.SetLabel(tex.coded() ? "8-bit sRGB" : "float");
+}
+
 BENCHMARK(BM_Evaluate)->DenseRange(0, 2);
+BENCHMARK(BM_TextureLookup)->DenseRange(0, 1);
 BENCHMARK(BM_Vertex)->DenseRange(0, 2);
 
 }  // namespace

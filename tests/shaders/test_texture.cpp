@@ -69,6 +69,10 @@ TEST(Texture, ExtensionModesAtTheBorder) {
   expect_rgba(t.lookup({-0.75f, 0.25f}, I::Linear, E::Repeat), A, 0.1f);
   expect_rgba(t.lookup({-3.0f, 5.0f}, I::Linear, E::Extend), C, 0.3f);  // left, top
   expect_rgba(t.lookup({1e9f, 0.25f}, I::Linear, E::Repeat), (A + B) * 0.5f, 0.15f);
+  // u - floor(u) rounds to 1 exactly: the last pixel blends with the first, wrapped by compare.
+  expect_rgba(t.lookup({-1e-9f, 0.25f}, I::Linear, E::Repeat), (A + B) * 0.5f, 0.15f);
+  const Rgba at_zero = t.lookup({0.25f, 0.0f}, I::Linear, E::Repeat);
+  expect_rgba(t.lookup({0.25f, -1e-9f}, I::Linear, E::Repeat), at_zero.rgb, at_zero.a);
 }
 
 TEST(Texture, MissingImageIsMagentaAndBadSizesThrow) {
