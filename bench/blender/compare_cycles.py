@@ -128,6 +128,11 @@ def compare(name, build, out, min_bounces):
           f"{g[0] - RES[0] * RES[1] * SAMPLES / mg:.2f} s, Cycles "
           f"{c[0] - RES[0] * RES[1] * SAMPLES / mc:.2f} s (first 1-spp render of the scene: "
           f"GDPT {first['GDPT']:.2f} s, Cycles {first['CYCLES']:.2f} s)")
+    # The ratio of each alternating pair of reference renders (GDPT then Cycles, seconds apart):
+    # how far the machine's drift moves the ratio within this run.
+    pairs = [(tc - c[0]) / max(tg - g[0], 1e-9)
+             for tg, tc in zip(ref_times['GDPT'], ref_times['CYCLES'])]
+    print(f"  marginal ratio of each alternating pair: {min(pairs):.2f}x-{max(pairs):.2f}x")
     print(f"  efficiency 1 / (relMSE x marginal time per sample), GDPT/Cycles: {efficiency:.2f}x")
 
 
