@@ -16,13 +16,12 @@ namespace gdpt {
 inline Vec2f square_to_disk_concentric(Vec2f u) {
   const float a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
   if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f};
+  // Which of a and b is larger in magnitude is a coin flip per sample: selects, not branches.
+  const bool wide = std::fabs(a) > std::fabs(b);
+  const float num = wide ? b : a, den = wide ? a : b;
   float s, c;
-  if (std::fabs(a) > std::fabs(b)) {
-    sincos_quarter((kPi / 4.0f) * (b / a), &s, &c);
-    return {a * c, a * s};
-  }
-  sincos_quarter((kPi / 4.0f) * (a / b), &s, &c);
-  return {b * s, b * c};
+  sincos_quarter((kPi / 4.0f) * (num / den), &s, &c);
+  return {den * (wide ? c : s), den * (wide ? s : c)};
 }
 
 }  // namespace gdpt
