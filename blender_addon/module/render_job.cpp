@@ -14,21 +14,51 @@ namespace gdpt::python {
 
 namespace {
 
+// An image's numpy shape: (height, width) for one channel, else (height, width, channels).
+std::vector<py::ssize_t> image_shape(int height, int width, int channels) {
+  std::vector<py::ssize_t> shape{height, width};
+  if (channels > 1) shape.push_back(channels);
+  return shape;
+}
+
 // A numpy array that owns a moved-in vector (no second copy).
 template <typename Vector>
 py::array_t<float> to_numpy(Vector&& v, int height, int width, int channels) {
   auto* owner = new Vector(std::move(v));
   py::capsule free_owner(owner, [](void* p) { delete static_cast<Vector*>(p); });
-  std::vector<py::ssize_t> shape{height, width};
-  if (channels > 1) shape.push_back(channels);
-  return py::array_t<float>(shape, owner->data(), free_owner);
+  return py::array_t<float>(image_shape(height, width, channels), owner->data(), free_owner);
 }
 
+// A numpy view of a vector that `owner` keeps alive.
 py::array_t<float> view_numpy(const HugePageVector<float>& v, int height, int width, int channels,
                               const py::handle& owner) {
-  std::vector<py::ssize_t> shape{height, width};
-  if (channels > 1) shape.push_back(channels);
-  return py::array_t<float>(shape, v.data(), owner);
+  return py::array_t<float>(image_shape(height, width, channels), v.data(), owner);
+}
+
+// Every pass with its channel count; normal and mist only when the render computes them.
+template <typename Passes, typename Add>
+void for_each_pass(Passes& p, Add&& add) {
+  add("primal", p.primal, 3);
+  add("gradient_x", p.gradient_x, 3);
+  add("gradient_y", p.gradient_y, 3);
+  add("emission", p.emission, 3);
+  add("variance", p.variance, 3);
+  add("shift_failures", p.shift_failures, 1);
+  add("alpha", p.alpha, 1);
+  add("depth", p.depth, 1);
+  add("object_index", p.object_index, 1);
+  add("material_index", p.material_index, 1);
+  if (!p.normal.empty()) add("normal", p.normal, 3);
+  if (!p.mist.empty()) add("mist", p.mist, 1);
+}
+
+// The dict's size and sample count, before the passes.
+py::dict film_dict(const FilmPasses& p) {
+  py::dict d;
+  d["width"] = p.width;
+  d["height"] = p.height;
+  d["samples"] = p.samples_done;
+  return d;
 }
 
 }  // namespace
@@ -62,32 +92,6 @@ void FilmPasses::read(const Film& film, int samples) {
   film.emission_rgb(emission.data());
   film.variance3(variance.data());
   film.shift_failures(shift_failures.data());
-}
-
-// Every pass with its channel count; normal and mist only when the render computes them.
-template <typename Passes, typename Add>
-void for_each_pass(Passes& p, Add&& add) {
-  add("primal", p.primal, 3);
-  add("gradient_x", p.gradient_x, 3);
-  add("gradient_y", p.gradient_y, 3);
-  add("emission", p.emission, 3);
-  add("variance", p.variance, 3);
-  add("shift_failures", p.shift_failures, 1);
-  add("alpha", p.alpha, 1);
-  add("depth", p.depth, 1);
-  add("object_index", p.object_index, 1);
-  add("material_index", p.material_index, 1);
-  if (!p.normal.empty()) add("normal", p.normal, 3);
-  if (!p.mist.empty()) add("mist", p.mist, 1);
-}
-
-// The dict's size and sample count, before the passes.
-static py::dict film_dict(const FilmPasses& p) {
-  py::dict d;
-  d["width"] = p.width;
-  d["height"] = p.height;
-  d["samples"] = p.samples_done;
-  return d;
 }
 
 py::dict FilmPasses::to_python_owning() {
