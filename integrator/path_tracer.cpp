@@ -15,6 +15,7 @@
 #include "integrator/russian_roulette.h"
 #include "integrator/sampler.h"
 #include "integrator/scene_context.h"
+#include "integrator/vertex_number_batch.h"
 #include "shaders/shading_context.h"
 
 namespace gdpt {
@@ -55,6 +56,8 @@ class PathTracer final : public Integrator {
     constexpr int kStream = 16;
     uint64_t rays = 0;
     Sampler samplers[kStream];
+    VertexNumberBatch numbers;  // the segment's camera jitters and first vertices' numbers
+    static_assert(VertexNumberBatch::kMaxPixels >= kStream);
     Ray camera_rays[kStream];
     bool valid[kStream], found[kStream];
     SurfaceHit hits[kStream];      // each path's working hit record, starting as its camera hit
@@ -66,11 +69,15 @@ class PathTracer final : public Integrator {
     for (int y = tile.y0; y < tile.y1; ++y) {
       for (int x0 = tile.x0; x0 < tile.x1; x0 += kStream) {
         const int n = std::min(kStream, tile.x1 - x0);
+        numbers.prepare(settings_.seed, x0 + rx, y + ry, n, settings_.max_bounces + 1,
+                        !ctx_.lights().empty());
+        for (int j = 0; j < n; ++j) samplers[j].start(settings_.seed, x0 + j + rx, y + ry, 0);
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
           // --- Camera rays of the segment, traced together ---
+          numbers.fill(s);
           for (int j = 0; j < n; ++j) {
-            samplers[j].start(settings_.seed, x0 + j + rx, y + ry, s);
-            camera_rays[j] = camera_ray(samplers[j], x0 + j + rx, y + ry);
+            samplers[j].set_index(s);
+            camera_rays[j] = camera_ray(samplers[j], numbers.camera(j), x0 + j + rx, y + ry);
           }
           ctx_.bvh().intersect_stream(camera_rays, valid, n, found, hits);
           if (s == 0)  // Depth and index passes: sample 0's camera hit, as Cycles
@@ -78,8 +85,8 @@ class PathTracer final : public Integrator {
               if (found[j]) ctx_.record_first_hit(film, x0 + j, y, hits[j]);
           // --- The paths ---
           for (int j = 0; j < n; ++j) {
-            const PathResult r =
-                trace(samplers[j], camera_rays[j], found[j], closures, scratch, hits[j]);
+            const PathResult r = trace(samplers[j], numbers, j, camera_rays[j], found[j], closures,
+                                       scratch, hits[j]);
             rays += r.rays;
             film.pixel(x0 + j, y).add_path(r.primal, r.emission, clamp, r.alpha);
             if (data_.active()) film.add_data(x0 + j, y, r.data.normal, r.data.mist);
@@ -103,16 +110,16 @@ class PathTracer final : public Integrator {
   }
 
   // The camera ray of pixel (px, py) of the frame.
-  Ray camera_ray(const Sampler& sampler, int px, int py) const {
-    const Vec2f jitter = sampler.get2d(Sampler::kDimCamera);
+  Ray camera_ray(const Sampler& sampler, Vec2f jitter, int px, int py) const {
     const Vec2f lens = kDoF ? sampler.get2d(Sampler::kDimLens) : Vec2f(0.5f, 0.5f);
     return ctx_.camera().generate_ray({float(px) + jitter.x, float(py) + jitter.y}, lens);
   }
 
   // The path of one camera sample, from its camera ray already traced (`camera_found`, and `hit`
   // holding the hit when found); `hit` is the path's working hit record from there on.
-  PathResult trace(const Sampler& sampler, Ray ray, bool camera_found, ClosureSet& closure_scratch,
-                   ClosureSet& scratch, SurfaceHit& hit) const {
+  PathResult trace(const Sampler& sampler, const VertexNumberBatch& numbers, int lane, Ray ray,
+                   bool camera_found, ClosureSet& closure_scratch, ClosureSet& scratch,
+                   SurfaceHit& hit) const {
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
     const auto& materials = ctx_.materials();
@@ -145,7 +152,9 @@ class PathTracer final : public Integrator {
                         kinds.over(settings_);
       // Drawn before the ray is traced, to run alongside it (Sampler::vertex_numbers).
       Sampler::VertexNumbers u;
-      if (!last) u = sampler.vertex_numbers(vertex, has_lights);
+      if (!last)
+        u = vertex < numbers.vertices() ? numbers.vertex(lane, vertex)
+                                        : sampler.vertex_numbers(vertex, has_lights);
       const bool found = vertex == 0          ? camera_found
                          : !kEmissive && last ? bvh.intersect_distance(ray, hit.t)
                                               : bvh.intersect(ray, hit);

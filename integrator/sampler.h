@@ -139,6 +139,15 @@ inline uint32_t sobol_dim1(uint32_t i) {
   return reverse_bits(reversed_sobol_dim(1, i));
 }
 
+// A 2D sample's coordinate scramble seeds from its hash h: the high half of h (x) and of a
+// multiple of h (y).
+inline uint32_t pair_seed_x(uint64_t h) {
+  return uint32_t(h >> 32);
+}
+inline uint32_t pair_seed_y(uint64_t h) {
+  return uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32);
+}
+
 inline float to_unit_float(uint32_t x) {
   return float(x >> 8) * 0x1p-24f;  // in [0, 1), exactly representable
 }
@@ -195,10 +204,16 @@ class Sampler {
 
   // Starts sample `index` of pixel (x, y) for a render with `seed`.
   void start(uint32_t seed, int x, int y, uint32_t index) {
+    pixel_key_ = pixel_key(seed, x, y);
+    set_index(index);
+  }
+  // Another sample index of the same pixel.
+  void set_index(uint32_t index) { reversed_index_ = sampler_detail::reverse_bits(index); }
+  // The hash of (seed, pixel) that every dimension's hash starts from.
+  static uint64_t pixel_key(uint32_t seed, int x, int y) {
     using namespace sampler_detail;
-    pixel_key_ = mix64((uint64_t(uint32_t(y)) << 32 | uint32_t(x)) ^
-                       uint64_t(hash_u32(seed)) * 0x9e3779b97f4a7c15ull);
-    reversed_index_ = reverse_bits(index);
+    return mix64((uint64_t(uint32_t(y)) << 32 | uint32_t(x)) ^
+                 uint64_t(hash_u32(seed)) * 0x9e3779b97f4a7c15ull);
   }
 
   static uint32_t bounce_dim(int bounce, BounceDim d) {
@@ -299,14 +314,6 @@ class Sampler {
     using namespace sampler_detail;
     return to_unit_float(reverse_bits(lk_permutation(r, seed)));
   }
-  // A 2D sample's coordinate scramble seeds from its hash h: the high half of h (x) and of a
-  // multiple of h (y).
-  static uint32_t pair_seed_x(uint64_t h) {
-    return uint32_t(h >> 32);
-  }
-  static uint32_t pair_seed_y(uint64_t h) {
-    return uint32_t((h * 0x9e3779b97f4a7c15ull) >> 32);
-  }
 #if GDPT_SAMPLER_SIMD
   // Two Owen-scrambled points in one register: (rx0, ry0) with hash h0, (rx1, ry1) with h1.
   struct PointPair {
@@ -315,10 +322,12 @@ class Sampler {
   static PointPair scrambled_pairs(uint32_t rx0, uint32_t ry0, uint64_t h0, uint32_t rx1,
                                    uint32_t ry1, uint64_t h1) {
     alignas(16) float v[4];
-    _mm_store_ps(
-        v, sampler_detail::scrambled4(_mm_setr_epi32(int(rx0), int(ry0), int(rx1), int(ry1)),
-                                      _mm_setr_epi32(int(pair_seed_x(h0)), int(pair_seed_y(h0)),
-                                                     int(pair_seed_x(h1)), int(pair_seed_y(h1)))));
+    _mm_store_ps(v,
+                 sampler_detail::scrambled4(_mm_setr_epi32(int(rx0), int(ry0), int(rx1), int(ry1)),
+                                            _mm_setr_epi32(int(sampler_detail::pair_seed_x(h0)),
+                                                           int(sampler_detail::pair_seed_y(h0)),
+                                                           int(sampler_detail::pair_seed_x(h1)),
+                                                           int(sampler_detail::pair_seed_y(h1)))));
     return {{v[0], v[1]}, {v[2], v[3]}};
   }
 #endif
@@ -327,7 +336,8 @@ class Sampler {
 #if GDPT_SAMPLER_SIMD
     return scrambled_pairs(rx, ry, h, 0, 0, 0).first;
 #else
-    return {scrambled(rx, pair_seed_x(h)), scrambled(ry, pair_seed_y(h))};
+    return {scrambled(rx, sampler_detail::pair_seed_x(h)),
+            scrambled(ry, sampler_detail::pair_seed_y(h))};
 #endif
   }
 
