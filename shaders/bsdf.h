@@ -133,6 +133,10 @@ class ClosureSet {
   Spectrum eval_pdf_mixture_t(Vec3f wi, Vec3f wo, float& pdf_out) const;
   template <bool kFramed>
   BsdfSample sample_mixture_t(Vec3f wi, float u_lobe, Vec2f u) const;
+  template <bool kFramed>
+  BsdfSample sample_single_t(Vec3f wi, float u_lobe, Vec2f u) const;  // count_ == 1
+  template <bool kFramed>
+  BsdfSample sample_several_t(Vec3f wi, float u_lobe, Vec2f u) const;  // count_ > 1
   // Any set (the same values as the fast path for a single Lambert lobe).
   Spectrum eval_mixture(Vec3f wi, Vec3f wo) const;
   float pdf_mixture(Vec3f wi, Vec3f wo) const;

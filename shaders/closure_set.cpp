@@ -273,35 +273,51 @@ Spectrum ClosureSet::eval_pdf_mixture_t(Vec3f wi, Vec3f wo, float& pdf_out) cons
   return f;
 }
 
+// Each of these returns prvalues or one named result only, so that the sample is built in the
+// caller's slot: copying out a sample that lobe_sample_local had just stored field by field
+// loaded it back in 16-byte pieces, a store-forwarding stall on every BSDF sample.
 template <bool kFramed>
 BsdfSample ClosureSet::sample_mixture_t(Vec3f wi, float u_lobe, Vec2f u) const {
   if (count_ == 0) return {};
-  if (count_ == 1) {
-    BsdfSample s = lobe_sample<kFramed>(closures_[0], interpolated_, wi, u_lobe, u);
-    if constexpr (kFramed)
-      if (s.valid && !lobe_side_ok(closures_[0], wi, s.wo)) return {};
-    if (s.valid && shadowing_)
-      s.value = shadowed<kFramed>(closures_[0], s.value, diffuse_shadowing(s.wo));
-    return s;
-  }
+  return count_ == 1 ? sample_single_t<kFramed>(wi, u_lobe, u)
+                     : sample_several_t<kFramed>(wi, u_lobe, u);
+}
 
+template <bool kFramed>
+BsdfSample ClosureSet::sample_single_t(Vec3f wi, float u_lobe, Vec2f u) const {
+  BsdfSample s = lobe_sample<kFramed>(closures_[0], interpolated_, wi, u_lobe, u);
+  if constexpr (kFramed)
+    if (s.valid && !lobe_side_ok(closures_[0], wi, s.wo)) s = BsdfSample{};
+  if (s.valid && shadowing_)
+    s.value = shadowed<kFramed>(closures_[0], s.value, diffuse_shadowing(s.wo));
+  return s;
+}
+
+template <bool kFramed>
+BsdfSample ClosureSet::sample_several_t(Vec3f wi, float u_lobe, Vec2f u) const {
   // --- Pick a lobe; the leftover of u_lobe within its interval drives the lobe's own choice.
   float w[kMaxClosures];
   const float total = selection_weights<kFramed>(closures_, count_, interpolated_, wi, w);
-  if (!(total > 0.0f)) return {};
-  const float target = u_lobe * total;
   int k = 0;
-  float cdf = 0.0f;
-  for (; k < count_ - 1; ++k) {
-    if (target < cdf + w[k]) break;
-    cdf += w[k];
+  float u_choice = 0.0f;
+  if (total > 0.0f) {
+    const float target = u_lobe * total;
+    float cdf = 0.0f;
+    for (; k < count_ - 1; ++k) {
+      if (target < cdf + w[k]) break;
+      cdf += w[k];
+    }
+    while (w[k] <= 0.0f && k > 0) --k;  // rounding at the top end: fall back to a live lobe
+    u_choice = std::clamp((target - cdf) / w[k], 0.0f, 0.99999994f);
   }
-  while (w[k] <= 0.0f && k > 0) --k;  // rounding at the top end: fall back to a live lobe
-  const float u_choice = std::clamp((target - cdf) / w[k], 0.0f, 0.99999994f);
-  BsdfSample s = lobe_sample<kFramed>(closures_[k], interpolated_, wi, u_choice, u);
+  BsdfSample s = total > 0.0f ? lobe_sample<kFramed>(closures_[k], interpolated_, wi, u_choice, u)
+                              : BsdfSample{};
   if (!s.valid) return s;
   if constexpr (kFramed)
-    if (!lobe_side_ok(closures_[k], wi, s.wo)) return {};
+    if (!lobe_side_ok(closures_[k], wi, s.wo)) {
+      s = BsdfSample{};
+      return s;
+    }
 
   const float sel_k = w[k] / total;
   if (s.is_delta()) {
