@@ -159,8 +159,10 @@ Scene cornell_box(int res) {
   return s;
 }
 
-// The Cornell box with a 256x256 8-bit colour grid (sRGB-decoded, bilinear, repeat) as the base
-// colour of the floor and the back wall: what an image texture costs per sample.
+// The Cornell box with a 256x256 8-bit sRGB colour grid (bilinear, repeat) as the base colour of
+// the floor and the back wall: what an image texture costs per sample, through the same code as
+// an 8-bit sRGB image from Blender (coded texels, the sRGB decode per lookup), which is also what
+// the PGO training (scripts/pgo-train.sh) then sees.
 Scene textured_cornell_box(int res) {
   Scene s = cornell_box(res);
   ImageDesc img;
@@ -171,8 +173,9 @@ Scene textured_cornell_box(int res) {
       const bool line = x % 32 == 0 || y % 32 == 0;
       // 8-bit values, as from a PNG: the texture keeps 8-bit codes (texture.h).
       const float r = float(line ? 230 : x) / 255.0f, g = float(line ? 230 : y) / 255.0f;
-      img.rgba.insert(img.rgba.end(), {r * r, g * g, 0.2f, 1.0f});
+      img.rgba.insert(img.rgba.end(), {r, g, 0.49f, 1.0f});
     }
+  img.srgb_encoded = true;
   s.images.push_back(std::move(img));
   MaterialDesc tex = diffuse(Spectrum(0.8f));
   tex.nodes[0].color.texture.image = 0;
