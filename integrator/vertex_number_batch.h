@@ -10,7 +10,9 @@
 // values, at a fraction of the cost. Numbers of vertices a path never reaches are wasted, hence
 // only the first kMaxVertices; later vertices draw from the Sampler as before.
 //
-// Without AVX2 (the x86-64 baseline build) fill() asks each pixel's Sampler (fill_each).
+// Without AVX2 (the x86-64 baseline build) no vertex is batched (vertices() is 0: integrators
+// draw from the Sampler, as fast as before there) and fill() takes each pixel's camera jitter from
+// its Sampler.
 #pragma once
 
 #include <cstdint>
@@ -24,27 +26,19 @@ namespace gdpt {
 
 class VertexNumberBatch {
  public:
-  static constexpr int kMaxPixels = 16;   // a camera-ray stream (PathTracer::render_tile)
+  static constexpr int kMaxPixels = 16;  // a camera-ray stream (PathTracer::render_tile)
+#if defined(__AVX2__)
   static constexpr int kMaxVertices = 4;  // vertices 0-3: two 6D points (Sampler)
+#else
+  static constexpr int kMaxVertices = 0;
+#endif
 
   // Pixels (x0 + j, y), j < count, of a render with `seed`; numbers for vertices below
   // `vertices` (clamped to kMaxVertices), light points only when `lights`.
   void prepare(uint32_t seed, int x0, int y, int count, int vertices, bool lights);
 
   // Every prepared pixel's numbers for sample `index`.
-  void fill(uint32_t index) {
-#if defined(__AVX2__)
-    fill_lanes(index);
-#else
-    fill_each(index);
-#endif
-  }
-  // The same, one pixel at a time through its Sampler.
-  void fill_each(uint32_t index);
-#if defined(__AVX2__)
-  // The same, eight pixels per AVX2 register.
-  void fill_lanes(uint32_t index);
-#endif
+  void fill(uint32_t index);
 
   int vertices() const {
     return vertices_;
@@ -52,14 +46,23 @@ class VertexNumberBatch {
   Vec2f camera(int j) const {
     return {cam_[0][j], cam_[1][j]};
   }
+  // Vertex v < vertices() of pixel j.
   Sampler::VertexNumbers vertex(int j, int v) const {
     Sampler::VertexNumbers u;
+#if defined(__AVX2__)
     u.light = {light_[v][0][j], light_[v][1][j]};
     u.dir = {dir_[v][0][j], dir_[v][1][j]};
+#else
+    (void)j, (void)v;
+#endif
     return u;
   }
 
  private:
+  int count_ = 0, vertices_ = 0;
+  bool lights_ = false;
+  alignas(32) float cam_[2][kMaxPixels] = {};  // [component][pixel]
+#if defined(__AVX2__)
   // Per pixel (lane j), the seeds of each 2D dimension: index shuffle (idx) and the x and y
   // coordinate scrambles, from that dimension's hash as Sampler::get2d derives them.
   struct PairSeeds {
@@ -67,42 +70,41 @@ class VertexNumberBatch {
     alignas(32) uint32_t x[kMaxPixels];
     alignas(32) uint32_t y[kMaxPixels];
   };
-  void set_seeds(PairSeeds& s, int j, uint64_t pixel_key, uint32_t dim);
-
-  int count_ = 0, vertices_ = 0;
-  bool lights_ = false;
-  Sampler samplers_[kMaxPixels];  // for fill_each
+  static void set_seeds(PairSeeds& s, int j, uint64_t pixel_key, uint32_t dim) {
+    const uint64_t h = sampler_detail::mix64(pixel_key ^ dim);
+    s.idx[j] = uint32_t(h);
+    s.x[j] = sampler_detail::pair_seed_x(h);
+    s.y[j] = sampler_detail::pair_seed_y(h);
+  }
   PairSeeds cam_seeds_;
   PairSeeds dir_seeds_[kMaxVertices], light_seeds_[kMaxVertices];
-  // Results: [component][pixel], per vertex.
-  alignas(32) float cam_[2][kMaxPixels] = {};
-  alignas(32) float dir_[kMaxVertices][2][kMaxPixels] = {};
+  alignas(32) float dir_[kMaxVertices][2][kMaxPixels] = {};    // [vertex][component][pixel]
   alignas(32) float light_[kMaxVertices][2][kMaxPixels] = {};  // zero without lights
+#else
+  Sampler samplers_[kMaxPixels];
+#endif
 };
-
-inline void VertexNumberBatch::set_seeds(PairSeeds& s, int j, uint64_t pixel_key, uint32_t dim) {
-  const uint64_t h = sampler_detail::mix64(pixel_key ^ dim);
-  s.idx[j] = uint32_t(h);
-  s.x[j] = sampler_detail::pair_seed_x(h);
-  s.y[j] = sampler_detail::pair_seed_y(h);
-}
 
 inline void VertexNumberBatch::prepare(uint32_t seed, int x0, int y, int count, int vertices,
                                        bool lights) {
   count_ = count < kMaxPixels ? count : kMaxPixels;
   vertices_ = vertices < 0 ? 0 : vertices < kMaxVertices ? vertices : kMaxVertices;
   lights_ = lights;
+  (void)seed, (void)y;
   for (int j = 0; j < kMaxPixels; ++j) {
     // Lanes past count repeat the last pixel: full registers, results unused.
     const int px = x0 + (j < count_ ? j : count_ - 1);
+#if defined(__AVX2__)
     const uint64_t key = Sampler::pixel_key(seed, px, y);
-    samplers_[j].start(seed, px, y, 0);
     set_seeds(cam_seeds_, j, key, Sampler::kDimCamera);
     for (int v = 0; v < vertices_; ++v) {
       // An odd vertex's index is its even predecessor's direction index (Sampler).
       set_seeds(dir_seeds_[v], j, key, Sampler::bounce_dim(v, Sampler::kBsdfDir));
       set_seeds(light_seeds_[v], j, key, Sampler::bounce_dim(v, Sampler::kLightPoint));
     }
+#else
+    samplers_[j].start(seed, px, y, 0);
+#endif
   }
 }
 
@@ -155,7 +157,7 @@ inline __m256i reversed_sobol_dim8(int dim, __m256i i) {
 
 }  // namespace sampler_detail
 
-inline void VertexNumberBatch::fill_lanes(uint32_t index) {
+inline void VertexNumberBatch::fill(uint32_t index) {
   using namespace sampler_detail;
   const __m256i ri = _mm256_set1_epi32(int(reverse_bits(index)));
   auto load = [](const uint32_t* p) {
@@ -190,24 +192,16 @@ inline void VertexNumberBatch::fill_lanes(uint32_t index) {
     }
   }
 }
-#endif
-
-inline void VertexNumberBatch::fill_each(uint32_t index) {
+#else
+inline void VertexNumberBatch::fill(uint32_t index) {
   for (int j = 0; j < count_; ++j) {
     Sampler& s = samplers_[j];
     s.set_index(index);
     const Vec2f c = s.get2d(Sampler::kDimCamera);
     cam_[0][j] = c.x;
     cam_[1][j] = c.y;
-    for (int v = 0; v < vertices_; ++v) {
-      const Sampler::VertexNumbers u = s.vertex_numbers(v, lights_);
-      dir_[v][0][j] = u.dir.x;
-      dir_[v][1][j] = u.dir.y;
-      if (!lights_) continue;
-      light_[v][0][j] = u.light.x;
-      light_[v][1][j] = u.light.y;
-    }
   }
 }
+#endif
 
 }  // namespace gdpt

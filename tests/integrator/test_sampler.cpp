@@ -338,50 +338,50 @@ TEST(Sampler, MeanConvergesFasterThanRandom) {
 
 // VertexNumberBatch returns each pixel's Sampler values bit for bit: camera jitter and every
 // batched vertex's light point and direction, for full and partial segments (count < 8 and
-// between 8 and 16), with and without lights, sample indices from 0 to past 2^24. Both of its
-// paths where this build has them (fill_each always; fill_lanes with AVX2, test_sampler_avx2).
+// between 8 and 16), with and without lights, sample indices from 0 to past 2^24. Vertices are
+// batched only with AVX2 (test_sampler_avx2, built as the x86-64-v3 module is).
 TEST(VertexNumberBatch, EqualsEachPixelsSampler) {
   struct Segment {
     uint32_t seed;
     int x0, y, count;
   };
-  using Fill = void (VertexNumberBatch::*)(uint32_t);
-  std::vector<Fill> fills = {&VertexNumberBatch::fill, &VertexNumberBatch::fill_each};
-#if defined(__AVX2__)
-  fills.push_back(&VertexNumberBatch::fill_lanes);
-#endif
-  int checked = 0;
+  int cameras = 0, vertices_checked = 0;
   for (const Segment seg :
        {Segment{1, 0, 0, 16}, Segment{77, 33, 9, 5}, Segment{0xdeadbeefu, 4080, 2159, 11}})
     for (int vertices : {0, 1, 3, 4, 9})
-      for (bool lights : {true, false})
-        for (Fill fill : fills) {
-          VertexNumberBatch batch;
-          batch.prepare(seg.seed, seg.x0, seg.y, seg.count, vertices, lights);
-          ASSERT_EQ(batch.vertices(), std::min(vertices, VertexNumberBatch::kMaxVertices));
-          for (uint32_t index : {0u, 1u, 2u, 3u, 17u, 255u, 1000u, 65535u, (1u << 24) + 5u}) {
-            (batch.*fill)(index);
-            for (int j = 0; j < seg.count; ++j) {
-              Sampler s;
-              s.start(seg.seed, seg.x0 + j, seg.y, index);
-              const Vec2f c = s.get2d(Sampler::kDimCamera);
-              ASSERT_EQ(batch.camera(j).x, c.x) << "pixel " << j << " index " << index;
-              ASSERT_EQ(batch.camera(j).y, c.y);
-              for (int v = 0; v < batch.vertices(); ++v) {
-                const Sampler::VertexNumbers u = s.vertex_numbers(v, lights);
-                const Sampler::VertexNumbers b = batch.vertex(j, v);
-                ASSERT_EQ(b.dir.x, u.dir.x)
-                    << "pixel " << j << " vertex " << v << " index " << index;
-                ASSERT_EQ(b.dir.y, u.dir.y);
-                if (!lights) continue;
-                ASSERT_EQ(b.light.x, u.light.x) << "pixel " << j << " vertex " << v;
-                ASSERT_EQ(b.light.y, u.light.y);
-                ++checked;
-              }
+      for (bool lights : {true, false}) {
+        VertexNumberBatch batch;
+        batch.prepare(seg.seed, seg.x0, seg.y, seg.count, vertices, lights);
+        ASSERT_EQ(batch.vertices(), std::min(vertices, VertexNumberBatch::kMaxVertices));
+        for (uint32_t index : {0u, 1u, 2u, 3u, 17u, 255u, 1000u, 65535u, (1u << 24) + 5u}) {
+          batch.fill(index);
+          for (int j = 0; j < seg.count; ++j) {
+            Sampler s;
+            s.start(seg.seed, seg.x0 + j, seg.y, index);
+            const Vec2f c = s.get2d(Sampler::kDimCamera);
+            ASSERT_EQ(batch.camera(j).x, c.x) << "pixel " << j << " index " << index;
+            ASSERT_EQ(batch.camera(j).y, c.y);
+            ++cameras;
+            for (int v = 0; v < batch.vertices(); ++v) {
+              const Sampler::VertexNumbers u = s.vertex_numbers(v, lights);
+              const Sampler::VertexNumbers b = batch.vertex(j, v);
+              ASSERT_EQ(b.dir.x, u.dir.x) << "pixel " << j << " vertex " << v << " index " << index;
+              ASSERT_EQ(b.dir.y, u.dir.y);
+              ++vertices_checked;
+              if (!lights) continue;
+              ASSERT_EQ(b.light.x, u.light.x) << "pixel " << j << " vertex " << v;
+              ASSERT_EQ(b.light.y, u.light.y);
             }
           }
         }
-  EXPECT_GT(checked, 1000);
+      }
+  EXPECT_EQ(cameras, 32 * 10 * 9);
+#if defined(__AVX2__)
+  EXPECT_EQ(VertexNumberBatch::kMaxVertices, 4);
+  EXPECT_GT(vertices_checked, 1000);
+#else
+  EXPECT_EQ(vertices_checked, 0);
+#endif
 }
 
 }  // namespace
