@@ -72,16 +72,7 @@ class ClosureSet {
     return ((cos_ng > 0.0f) == (wo.z > 0.0f) || own_frames_) && cos_ng != 0.0f;
   }
   // Adds a lobe; weights that are zero are dropped; a full set drops the lobe of least weight.
-  // Inline, so that a closure built field by field in the caller is stored straight into the set:
-  // copied by an out-of-line add(), the just-stored fields were loaded back in 16-byte pieces (a
-  // store-forwarding stall per closure of every textured hit).
-  void add(const Closure& c) {
-    if (is_black(c.weight)) return;
-    if (count_ < kMaxClosures)
-      closures_[count_++] = c;
-    else
-      replace_weakest(c);
-  }
+  void add(const Closure& c);
   void add_emission(Spectrum e) { emission_ += e; }
 
   int count() const { return count_; }
@@ -127,8 +118,6 @@ class ClosureSet {
   bool has_delta() const;
 
  private:
-  // Full set: c replaces the weakest lobe when it is stronger (keeps the kMaxClosures strongest).
-  void replace_weakest(const Closure& c);
   // The inline fast path (bump shadowing goes through the mixture code).
   bool single_lambert() const {
     return count_ == 1 && closures_[0].type == ClosureType::Lambert && !shadowing_;

@@ -150,7 +150,13 @@ float selection_weights(const Closure* closures, int count, Vec3f n, Vec3f wi, f
 
 }  // namespace
 
-void ClosureSet::replace_weakest(const Closure& c) {
+void ClosureSet::add(const Closure& c) {
+  if (is_black(c.weight)) return;
+  if (count_ < kMaxClosures) {
+    closures_[count_++] = c;
+    return;
+  }
+  // Full: keep the kMaxClosures strongest lobes.
   int weakest = 0;
   for (int i = 1; i < count_; ++i)
     if (selection_luminance(closures_[i].weight) < selection_luminance(closures_[weakest].weight))
