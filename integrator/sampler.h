@@ -153,20 +153,29 @@ inline float to_unit_float(uint32_t x) {
 }
 
 #if GDPT_SAMPLER_SIMD
+// Byte-shuffle tables of reverse_bits() in SIMD lanes (here and in vertex_number_batch.h): the
+// byte swap of each 32-bit lane, and rev4(n) << 4 and rev4(n) for each nibble value n.
+struct alignas(16) ShuffleTable {
+  uint8_t b[16];
+  __m128i load() const { return _mm_load_si128(reinterpret_cast<const __m128i*>(b)); }
+};
+inline constexpr ShuffleTable kByteSwap32 = {
+    {3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12}};
+inline constexpr ShuffleTable kReversedNibbleHigh = {{0x00, 0x80, 0x40, 0xc0, 0x20, 0xa0, 0x60,
+                                                      0xe0, 0x10, 0x90, 0x50, 0xd0, 0x30, 0xb0,
+                                                      0x70, 0xf0}};
+inline constexpr ShuffleTable kReversedNibbleLow = {
+    {0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf}};
+
 // reverse_bits() in four 32-bit lanes: a byte swap, then each byte reversed through two nibble
 // tables.
 inline __m128i reverse_bits4(__m128i x) {
-  x = _mm_shuffle_epi8(x, _mm_setr_epi8(3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12));
+  x = _mm_shuffle_epi8(x, kByteSwap32.load());
   const __m128i nibble = _mm_set1_epi8(0x0f);
-  // rev4(n) << 4 and rev4(n) for each nibble value n.
-  const __m128i rev_hi =
-      _mm_setr_epi8(0x00, char(0x80), 0x40, char(0xc0), 0x20, char(0xa0), 0x60, char(0xe0), 0x10,
-                    char(0x90), 0x50, char(0xd0), 0x30, char(0xb0), 0x70, char(0xf0));
-  const __m128i rev_lo =
-      _mm_setr_epi8(0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf);
   const __m128i lo = _mm_and_si128(x, nibble);
   const __m128i hi = _mm_and_si128(_mm_srli_epi16(x, 4), nibble);
-  return _mm_or_si128(_mm_shuffle_epi8(rev_hi, lo), _mm_shuffle_epi8(rev_lo, hi));
+  return _mm_or_si128(_mm_shuffle_epi8(kReversedNibbleHigh.load(), lo),
+                      _mm_shuffle_epi8(kReversedNibbleLow.load(), hi));
 }
 // reverse_bits(lk_permutation(x, seed)) in four lanes.
 inline __m128i nested_scramble_reversed4(__m128i x, __m128i seed) {

@@ -111,23 +111,15 @@ inline void VertexNumberBatch::prepare(uint32_t seed, int x0, int y, int count, 
 #if defined(__AVX2__)
 namespace sampler_detail {
 
-// reverse_bits() in eight lanes (reverse_bits4 on both halves).
+// reverse_bits() in eight lanes: reverse_bits4's tables in both halves.
 inline __m256i reverse_bits8(__m256i x) {
-  const __m256i swap = _mm256_setr_epi8(3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 3, 2,
-                                        1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12);
-  x = _mm256_shuffle_epi8(x, swap);
+  const auto both = [](const ShuffleTable& t) { return _mm256_broadcastsi128_si256(t.load()); };
+  x = _mm256_shuffle_epi8(x, both(kByteSwap32));
   const __m256i nibble = _mm256_set1_epi8(0x0f);
-  const __m256i rev_hi =
-      _mm256_setr_epi8(0x00, char(0x80), 0x40, char(0xc0), 0x20, char(0xa0), 0x60, char(0xe0), 0x10,
-                       char(0x90), 0x50, char(0xd0), 0x30, char(0xb0), 0x70, char(0xf0), 0x00,
-                       char(0x80), 0x40, char(0xc0), 0x20, char(0xa0), 0x60, char(0xe0), 0x10,
-                       char(0x90), 0x50, char(0xd0), 0x30, char(0xb0), 0x70, char(0xf0));
-  const __m256i rev_lo = _mm256_setr_epi8(0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5,
-                                          0xd, 0x3, 0xb, 0x7, 0xf, 0x0, 0x8, 0x4, 0xc, 0x2, 0xa,
-                                          0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf);
   const __m256i lo = _mm256_and_si256(x, nibble);
   const __m256i hi = _mm256_and_si256(_mm256_srli_epi16(x, 4), nibble);
-  return _mm256_or_si256(_mm256_shuffle_epi8(rev_hi, lo), _mm256_shuffle_epi8(rev_lo, hi));
+  return _mm256_or_si256(_mm256_shuffle_epi8(both(kReversedNibbleHigh), lo),
+                         _mm256_shuffle_epi8(both(kReversedNibbleLow), hi));
 }
 // reverse_bits(lk_permutation(x, seed)) in eight lanes.
 inline __m256i nested_scramble_reversed8(__m256i x, __m256i seed) {
