@@ -55,8 +55,7 @@ class PathTracer final : public Integrator {
                    Film& film) const override {
     constexpr int kStream = 16;
     uint64_t rays = 0;
-    Sampler samplers[kStream];
-    VertexNumberBatch numbers;  // the segment's camera jitters and first vertices' numbers
+    VertexNumberBatch numbers;  // the segment's Samplers, camera jitters, first vertices' numbers
     static_assert(VertexNumberBatch::kMaxPixels >= kStream);
     Ray camera_rays[kStream];
     bool valid[kStream], found[kStream];
@@ -71,22 +70,19 @@ class PathTracer final : public Integrator {
         const int n = std::min(kStream, tile.x1 - x0);
         numbers.prepare(settings_.seed, x0 + rx, y + ry, n, settings_.max_bounces + 1,
                         !ctx_.lights().empty());
-        for (int j = 0; j < n; ++j) samplers[j].start(settings_.seed, x0 + j + rx, y + ry, 0);
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
           // --- Camera rays of the segment, traced together ---
           numbers.fill(s);
-          for (int j = 0; j < n; ++j) {
-            samplers[j].set_index(s);
-            camera_rays[j] = camera_ray(samplers[j], numbers.camera(j), x0 + j + rx, y + ry);
-          }
+          for (int j = 0; j < n; ++j)
+            camera_rays[j] = camera_ray(numbers.sampler(j), numbers.camera(j), x0 + j + rx, y + ry);
           ctx_.bvh().intersect_stream(camera_rays, valid, n, found, hits);
           if (s == 0)  // Depth and index passes: sample 0's camera hit, as Cycles
             for (int j = 0; j < n; ++j)
               if (found[j]) ctx_.record_first_hit(film, x0 + j, y, hits[j]);
           // --- The paths ---
           for (int j = 0; j < n; ++j) {
-            const PathResult r = trace(samplers[j], numbers, j, camera_rays[j], found[j], closures,
-                                       scratch, hits[j]);
+            const PathResult r =
+                trace(numbers, j, camera_rays[j], found[j], closures, scratch, hits[j]);
             rays += r.rays;
             film.pixel(x0 + j, y).add_path(r.primal, r.emission, clamp, r.alpha);
             if (data_.active()) film.add_data(x0 + j, y, r.data.normal, r.data.mist);
@@ -117,9 +113,10 @@ class PathTracer final : public Integrator {
 
   // The path of one camera sample, from its camera ray already traced (`camera_found`, and `hit`
   // holding the hit when found); `hit` is the path's working hit record from there on.
-  PathResult trace(const Sampler& sampler, const VertexNumberBatch& numbers, int lane, Ray ray,
-                   bool camera_found, ClosureSet& closure_scratch, ClosureSet& scratch,
-                   SurfaceHit& hit) const {
+  // `numbers` holds the pixel's Sampler and first vertices' numbers in lane `lane`.
+  PathResult trace(const VertexNumberBatch& numbers, int lane, Ray ray, bool camera_found,
+                   ClosureSet& closure_scratch, ClosureSet& scratch, SurfaceHit& hit) const {
+    const Sampler& sampler = numbers.sampler(lane);
     const EmbreeScene& bvh = ctx_.bvh();
     const LightSampler& lights = ctx_.lights();
     const auto& materials = ctx_.materials();
@@ -152,9 +149,7 @@ class PathTracer final : public Integrator {
                         kinds.over(settings_);
       // Drawn before the ray is traced, to run alongside it (Sampler::vertex_numbers).
       Sampler::VertexNumbers u;
-      if (!last)
-        u = vertex < numbers.vertices() ? numbers.vertex(lane, vertex)
-                                        : sampler.vertex_numbers(vertex, has_lights);
+      if (!last) u = numbers.vertex_numbers(lane, vertex);
       const bool found = vertex == 0          ? camera_found
                          : !kEmissive && last ? bvh.intersect_distance(ray, hit.t)
                                               : bvh.intersect(ray, hit);

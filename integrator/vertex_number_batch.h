@@ -1,6 +1,6 @@
-// The random numbers of a row segment's paths for one sample index, computed together: each
-// pixel's camera jitter and, for its first vertices, the light point and BSDF direction
-// (Sampler::vertex_numbers), exactly the values the pixel's Sampler returns.
+// The Samplers of a row segment's pixels, and their paths' random numbers for one sample index
+// computed together: each pixel's camera jitter and, for its first vertices, the light point and
+// BSDF direction (Sampler::vertex_numbers), exactly the values the pixel's Sampler returns.
 //
 // Drawn one path at a time, each vertex's numbers are a ~70-cycle chain of dependent multiplies
 // (hash, index shuffle, Sobol matrix, Owen scramble); a timing-only variant with an LCG in their
@@ -10,8 +10,8 @@
 // values, at a fraction of the cost. Numbers of vertices a path never reaches are wasted, hence
 // only the first kMaxVertices; later vertices draw from the Sampler as before.
 //
-// Without AVX2 (the x86-64 baseline build) no vertex is batched (vertices() is 0: integrators
-// draw from the Sampler, as fast as before there) and fill() takes each pixel's camera jitter from
+// Without AVX2 (the x86-64 baseline build) no vertex is batched (vertices() is 0: every vertex
+// draws from the Sampler, as fast as before there) and fill() takes each pixel's camera jitter from
 // its Sampler.
 #pragma once
 
@@ -33,12 +33,16 @@ class VertexNumberBatch {
   static constexpr int kMaxVertices = 0;
 #endif
 
-  // Pixels (x0 + j, y), j < count, of a render with `seed`; numbers for vertices below
-  // `vertices` (clamped to kMaxVertices), light points only when `lights`.
+  // Pixels (x0 + j, y), j < count, of a render with `seed` (starts their Samplers); numbers for
+  // vertices below `vertices` (clamped to kMaxVertices), light points only when `lights`.
   void prepare(uint32_t seed, int x0, int y, int count, int vertices, bool lights);
 
-  // Every prepared pixel's numbers for sample `index`.
+  // Every prepared pixel's Sampler at sample `index`, and its numbers.
   void fill(uint32_t index);
+
+  const Sampler& sampler(int j) const {
+    return samplers_[j];
+  }
 
   int vertices() const {
     return vertices_;
@@ -46,21 +50,23 @@ class VertexNumberBatch {
   Vec2f camera(int j) const {
     return {cam_[0][j], cam_[1][j]};
   }
-  // Vertex v < vertices() of pixel j.
-  Sampler::VertexNumbers vertex(int j, int v) const {
-    Sampler::VertexNumbers u;
+  // Pixel j's numbers of vertex v: batched below vertices(), else from its Sampler.
+  Sampler::VertexNumbers vertex_numbers(int j, int v) const {
 #if defined(__AVX2__)
-    u.light = {light_[v][0][j], light_[v][1][j]};
-    u.dir = {dir_[v][0][j], dir_[v][1][j]};
-#else
-    (void)j, (void)v;
+    if (v < vertices_) {
+      Sampler::VertexNumbers u;
+      u.light = {light_[v][0][j], light_[v][1][j]};
+      u.dir = {dir_[v][0][j], dir_[v][1][j]};
+      return u;
+    }
 #endif
-    return u;
+    return samplers_[j].vertex_numbers(v, lights_);
   }
 
  private:
   int count_ = 0, vertices_ = 0;
   bool lights_ = false;
+  Sampler samplers_[kMaxPixels];
   alignas(32) float cam_[2][kMaxPixels] = {};  // [component][pixel]
 #if defined(__AVX2__)
   // Per pixel (lane j), the seeds of each 2D dimension: index shuffle (idx) and the x and y
@@ -80,8 +86,6 @@ class VertexNumberBatch {
   PairSeeds dir_seeds_[kMaxVertices], light_seeds_[kMaxVertices];
   alignas(32) float dir_[kMaxVertices][2][kMaxPixels] = {};    // [vertex][component][pixel]
   alignas(32) float light_[kMaxVertices][2][kMaxPixels] = {};  // zero without lights
-#else
-  Sampler samplers_[kMaxPixels];
 #endif
 };
 
@@ -90,11 +94,11 @@ inline void VertexNumberBatch::prepare(uint32_t seed, int x0, int y, int count, 
   count_ = count < kMaxPixels ? count : kMaxPixels;
   vertices_ = vertices < 0 ? 0 : vertices < kMaxVertices ? vertices : kMaxVertices;
   lights_ = lights;
-  (void)seed, (void)y;
+  for (int j = 0; j < count_; ++j) samplers_[j].start(seed, x0 + j, y, 0);
+#if defined(__AVX2__)
   for (int j = 0; j < kMaxPixels; ++j) {
     // Lanes past count repeat the last pixel: full registers, results unused.
     const int px = x0 + (j < count_ ? j : count_ - 1);
-#if defined(__AVX2__)
     const uint64_t key = Sampler::pixel_key(seed, px, y);
     set_seeds(cam_seeds_, j, key, Sampler::kDimCamera);
     for (int v = 0; v < vertices_; ++v) {
@@ -102,10 +106,8 @@ inline void VertexNumberBatch::prepare(uint32_t seed, int x0, int y, int count, 
       set_seeds(dir_seeds_[v], j, key, Sampler::bounce_dim(v, Sampler::kBsdfDir));
       set_seeds(light_seeds_[v], j, key, Sampler::bounce_dim(v, Sampler::kLightPoint));
     }
-#else
-    samplers_[j].start(seed, px, y, 0);
-#endif
   }
+#endif
 }
 
 #if defined(__AVX2__)
@@ -151,6 +153,7 @@ inline __m256i reversed_sobol_dim8(int dim, __m256i i) {
 
 inline void VertexNumberBatch::fill(uint32_t index) {
   using namespace sampler_detail;
+  for (int j = 0; j < count_; ++j) samplers_[j].set_index(index);
   const __m256i ri = _mm256_set1_epi32(int(reverse_bits(index)));
   auto load = [](const uint32_t* p) {
     return _mm256_load_si256(reinterpret_cast<const __m256i*>(p));

@@ -92,8 +92,4 @@ SrgbTable::SrgbTable() {
 const SrgbTable kSrgb;
 }  // namespace texture_detail
 
-float srgb_to_linear(float encoded) {
-  return texture_detail::srgb_decode(encoded);
-}
-
 }  // namespace gdpt

@@ -22,9 +22,29 @@ struct Rgba {
 // codes with one 256-entry decode table per channel: a quarter of the memory of float RGBA, so
 // that bilinear lookups, which land anywhere in the image at every bounce, miss the caches far
 // less. Lookups return the same values either way (the tables hold the exact floats).
+namespace texture_detail {
+// The sRGB curve sampled at 4097 points (texture.cpp): a namespace-scope table costs no
+// initialisation guard per call, as a function-local static did.
+struct SrgbTable {
+  static constexpr int kSegments = 4096;
+  float v[kSegments + 1];
+  SrgbTable();
+};
+extern const SrgbTable kSrgb;
+}  // namespace texture_detail
+
 // The sRGB curve (encoded [0, 1] -> linear), from a 4096-segment table with linear
-// interpolation: within 1e-7 of the exact curve, without a pow per channel and lookup.
-float srgb_to_linear(float encoded);
+// interpolation: within 1e-7 of the exact curve, without a pow per channel and lookup. Always
+// inline: PGO profiles without sRGB textures (or with few) left it out of line, three calls per
+// texture lookup with the colour spilled around them.
+[[gnu::always_inline]] inline float srgb_to_linear(float encoded) {
+  using texture_detail::kSrgb;
+  constexpr int kSegments = texture_detail::SrgbTable::kSegments;
+  const float x = std::clamp(encoded, 0.0f, 1.0f) * float(kSegments);
+  const int i = std::min(int(x), kSegments - 1);
+  const float t = x - float(i);
+  return kSrgb.v[i] + (kSrgb.v[i + 1] - kSrgb.v[i]) * t;
+}
 inline Spectrum srgb_to_linear(Spectrum encoded) {
   return {srgb_to_linear(encoded.x), srgb_to_linear(encoded.y), srgb_to_linear(encoded.z)};
 }
@@ -81,25 +101,6 @@ inline int wrap_index(int i, int n, TextureLookup::Extension ext) {
   return -1;
 }
 
-// The sRGB curve sampled at 4097 points (texture.cpp): a namespace-scope table costs no
-// initialisation guard per call, as a function-local static did.
-struct SrgbTable {
-  static constexpr int kSegments = 4096;
-  float v[kSegments + 1];
-  SrgbTable();
-};
-extern const SrgbTable kSrgb;
-
-// Always inline: PGO profiles without sRGB textures (or with few) left it out of line, three calls
-// per lookup with the colour spilled around them.
-[[gnu::always_inline]] inline float srgb_decode(float encoded) {
-  constexpr int kSegments = SrgbTable::kSegments;
-  const float x = std::clamp(encoded, 0.0f, 1.0f) * float(kSegments);
-  const int i = std::min(int(x), kSegments - 1);
-  const float t = x - float(i);
-  return kSrgb.v[i] + (kSrgb.v[i + 1] - kSrgb.v[i]) * t;
-}
-
 }  // namespace texture_detail
 
 // The lookups are inline (here rather than in texture.cpp) so that they inline into the material
@@ -108,9 +109,7 @@ extern const SrgbTable kSrgb;
 inline Rgba Texture::lookup(Vec2f uv, TextureLookup::Interpolation interpolation,
                             TextureLookup::Extension extension) const {
   Rgba c = lookup_stored(uv, interpolation, extension);
-  if (srgb_)
-    c.rgb = {texture_detail::srgb_decode(c.rgb.x), texture_detail::srgb_decode(c.rgb.y),
-             texture_detail::srgb_decode(c.rgb.z)};
+  if (srgb_) c.rgb = {srgb_to_linear(c.rgb.x), srgb_to_linear(c.rgb.y), srgb_to_linear(c.rgb.z)};
   return c;
 }
 

@@ -364,7 +364,7 @@ TEST(VertexNumberBatch, EqualsEachPixelsSampler) {
             ++cameras;
             for (int v = 0; v < batch.vertices(); ++v) {
               const Sampler::VertexNumbers u = s.vertex_numbers(v, lights);
-              const Sampler::VertexNumbers b = batch.vertex(j, v);
+              const Sampler::VertexNumbers b = batch.vertex_numbers(j, v);
               ASSERT_EQ(b.dir.x, u.dir.x) << "pixel " << j << " vertex " << v << " index " << index;
               ASSERT_EQ(b.dir.y, u.dir.y);
               ++vertices_checked;
