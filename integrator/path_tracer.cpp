@@ -249,7 +249,15 @@ class PathTracer final : public Integrator {
       const ClosureSet& closures =
           shading_closures(material_closures, closure_scratch, hit, frame, ng, wi_world, rotated);
 
-      // --- Next-event estimation ---
+      // --- Next-event estimation: the light sample and its BSDF value. Its shadow ray is traced
+      // after the BSDF sample below, which does not depend on it: the sampling and the next
+      // ray's set-up then run while Embree traverses the shadow ray, instead of delaying the
+      // next traversal.
+      Ray shadow;
+      bool shadow_pending = false;
+      bool shadow_cast = false;
+      Spectrum nee_beta_f, nee_radiance;  // beta f before this vertex's sample updates beta
+      float nee_scale = 0.0f;             // MIS weight / light pdf
       if (has_lights) {
         // Dimensions are indexed, not streamed: skipping an unused one changes no other value.
         const float u_select =
@@ -264,7 +272,6 @@ class PathTracer final : public Integrator {
             float bsdf_pdf;
             const Spectrum f = closures.eval_pdf(wi, wo, bsdf_pdf);
             if (!is_black(f)) {
-              Ray shadow;
               shadow.origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);
               shadow.direction = ls.direction;
               shadow.t_min = 0.0f;
@@ -280,70 +287,78 @@ class PathTracer final : public Integrator {
                 shadow.direction = ls.position - shadow.origin;
                 shadow.t_max = 1.0f - 1e-4f;
               }
-              const Spectrum tr =
-                  ls.cast_shadow ? transmittance(shadow, scratch, out.rays) : Spectrum(1.0f);
-              if (!is_black(tr)) {
-                const float w = ls.is_delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
-                out.primal += beta * f * tr * ls.radiance * (w / ls.pdf);
-              }
+              shadow_pending = true;
+              shadow_cast = ls.cast_shadow;
+              nee_beta_f = beta * f;
+              nee_radiance = ls.radiance;
+              nee_scale = (ls.is_delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf)) / ls.pdf;
             }
           }
         }
       }
 
-      // --- BSDF sampling: continue the path ---
+      // --- BSDF sampling: the direction the path continues in ---
       const float u_lobe = closures.uses_lobe_choice()
                                ? sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kBsdfLobe))
                                : 0.0f;
       const BsdfSample bs = closures.sample(wi, u_lobe, u.dir);
-      if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;
+      bool continues = bs.valid && bs.pdf > 0.0f && !is_black(bs.value);
       const Vec3f wo_world = frame.to_world(bs.wo);
-      const float cos_ng = dot(wo_world, ng);
-      if (!closures.side_ok(bs.wo, cos_ng)) break;
-      beta *= bs.value / bs.pdf;
-      // A transparent crossing (straight through, eta 1) is not a bounce, keeps the camera-path
-      // status and keeps the MIS state of the last real scattering vertex: shadow rays see
-      // through transparent surfaces too (transmittance()), so the NEE density from that vertex
-      // is still the competing technique.
-      const bool crossing = bs.is_straight_crossing();
-      if (crossing) {
-        ++transparent;
-        crossed_since_vertex = true;
-      } else {
-        crossed_since_vertex = false;
-        prev_delta = bs.is_delta();
-        prev_pdf = bs.pdf;
-        prev_position = hit.position;
-        camera_path = false;
-        ++bounce;
-      }
+      const float cos_wo_ng = dot(wo_world, ng);
+      continues = continues && closures.side_ok(bs.wo, cos_wo_ng);
+      if (continues) {
+        beta *= bs.value / bs.pdf;
+        // A transparent crossing (straight through, eta 1) is not a bounce, keeps the
+        // camera-path status and keeps the MIS state of the last real scattering vertex: shadow
+        // rays see through transparent surfaces too (transmittance()), so the NEE density from
+        // that vertex is still the competing technique.
+        const bool crossing = bs.is_straight_crossing();
+        if (crossing) {
+          ++transparent;
+          crossed_since_vertex = true;
+        } else {
+          crossed_since_vertex = false;
+          prev_delta = bs.is_delta();
+          prev_pdf = bs.pdf;
+          prev_position = hit.position;
+          camera_path = false;
+          ++bounce;
+        }
 
-      // --- Russian roulette (real bounces only) ---
-      if (!crossing && bounce - 1 >= settings_.rr_depth) {
-        const float q = roulette_continuation(beta);
-        if (q < 1.0f) {
-          // Either order is unbiased, as long as the survivors match the stopped paths.
-          const bool last_ray = roulette_past_next_hit(bs.lobe, ctx_.scene_features());
-          const bool survive = sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kRoulette)) < q;
-          if (survive && last_ray)
-            rr_divide = q;  // from after the next hit's emission on
-          else if (survive)
-            beta /= q;
-          else if (last_ray)
-            rr_stop = true;  // the last ray, for the lamp, emitter or world it may find
-          else
-            break;
+        // --- Russian roulette (real bounces only) ---
+        if (!crossing && bounce - 1 >= settings_.rr_depth) {
+          const float q = roulette_continuation(beta);
+          if (q < 1.0f) {
+            // Either order is unbiased, as long as the survivors match the stopped paths.
+            const bool last_ray = roulette_past_next_hit(bs.lobe, ctx_.scene_features());
+            const bool survive = sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kRoulette)) < q;
+            if (survive && last_ray)
+              rr_divide = q;  // from after the next hit's emission on
+            else if (survive)
+              beta /= q;
+            else if (last_ray)
+              rr_stop = true;  // the last ray, for the lamp, emitter or world it may find
+            else
+              continues = false;
+          }
+        }
+
+        ray.origin = offset_ray_origin(hit.position, cos_wo_ng > 0.0f ? ng : -ng);
+        ray.direction = normalize(wo_world);
+        ray.t_min = 0.0f;
+        ray.t_max = kInf;
+        if (!crossing) {  // a crossing keeps the kind and counts for no limit
+          ray.kind = ray_kind_of_lobe(bs.lobe);
+          kinds.add(ray.kind);
         }
       }
 
-      ray.origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);
-      ray.direction = normalize(wo_world);
-      ray.t_min = 0.0f;
-      ray.t_max = kInf;
-      if (!crossing) {  // a crossing keeps the kind and counts for no limit
-        ray.kind = ray_kind_of_lobe(bs.lobe);
-        kinds.add(ray.kind);
+      // --- The NEE's shadow ray ---
+      if (shadow_pending) {
+        const Spectrum tr = shadow_cast ? transmittance(shadow, scratch, out.rays) : Spectrum(1.0f);
+        if (!is_black(tr)) out.primal += nee_beta_f * tr * nee_radiance * nee_scale;
       }
+      if (!continues) break;
     }
     return out;
   }
