@@ -271,19 +271,6 @@ bool LightSampler::has_environment() const {
   return impl_->world_enabled;
 }
 
-LightSample LightSampler::sample_only_area(Vec3f ref, Vec2f u) const {
-  // Its pmf is 1 and its radiance finite (a non-finite one has non-finite power: not stored).
-  // One named result, so that it is built in the caller's slot: returning either it or a fresh
-  // LightSample{} made GCC build it on the stack and copy it out with 16-byte loads of fields
-  // just stored as floats, a store-forwarding stall on every light sample.
-  LightSample s;
-  if (areas_[0].sample(ref, u, s))
-    s.cast_shadow = areas_[0].cast_shadow;
-  else
-    s = LightSample{};
-  return s;
-}
-
 LightSample LightSampler::sample_any(Vec3f ref, float u_select, Vec2f u) const {
   const Impl& I = *impl_;
   LightSample s;

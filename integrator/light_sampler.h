@@ -67,7 +67,20 @@ class LightSampler {
                        LightHit& hit);
   static void fill_hit(const lights::AreaLight& l, Vec3f origin, Vec3f direction, float t,
                        LightHit& hit);
-  LightSample sample_only_area(Vec3f ref_position, Vec2f u) const;
+  // In line: one call less per vertex in the common one-lamp scene (the spherical branch stays
+  // out of line, AreaLight::sample_spherical). Its pmf is 1 and its radiance finite (a
+  // non-finite one has non-finite power: not stored). One named result, so that it is built in
+  // the caller's slot: returning either it or a fresh LightSample{} made GCC build it on the
+  // stack and copy it out with 16-byte loads of fields just stored as floats, a
+  // store-forwarding stall on every light sample.
+  [[gnu::always_inline]] LightSample sample_only_area(Vec3f ref, Vec2f u) const {
+    LightSample s;
+    if (areas_[0].sample(ref, u, s))
+      s.cast_shadow = areas_[0].cast_shadow;
+    else
+      s = LightSample{};
+    return s;
+  }
   LightSample sample_any(Vec3f ref_position, float u_select, Vec2f u) const;
   bool intersect_any(Vec3f origin, Vec3f direction, float t_max, LightHit& hit) const;
 
