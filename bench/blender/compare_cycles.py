@@ -132,7 +132,10 @@ def compare(name, build, out, min_bounces):
     # how far the machine's drift moves the ratio within this run.
     pairs = [(tc - c[0]) / max(tg - g[0], 1e-9)
              for tg, tc in zip(ref_times['GDPT'], ref_times['CYCLES'])]
-    print(f"  marginal ratio of each alternating pair: {min(pairs):.2f}x-{max(pairs):.2f}x")
+    # Their median: each pair's two renders ran seconds apart, so drift of the machine's speed
+    # over the run moves it less than the ratio of the two engines' median times above.
+    print(f"  marginal ratio of each alternating pair: {min(pairs):.2f}x-{max(pairs):.2f}x, "
+          f"median {float(np.median(pairs)):.2f}x")
     print(f"  efficiency 1 / (relMSE x marginal time per sample), GDPT/Cycles: {efficiency:.2f}x")
 
 
