@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS  ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: deps build test demo bench fuzz format clean install-addon
+.PHONY: deps build test demo bench fuzz format clean install-addon dev
 
 deps:
 	bash scripts/setup-deps.sh
@@ -44,6 +44,13 @@ test: build install-addon
 
 demo: build install-addon
 	bash scripts/demo.sh $(BUILD)
+
+# Developer loop (CMakePresets.json "dev", in build-dev/): no PGO training, no x86-64-v3 module,
+# every test. Not what CI runs: `make test` is.
+dev: deps
+	cmake --preset dev
+	cmake --build --preset dev -j $(JOBS)
+	ctest --preset dev -j $(JOBS)
 
 bench: build
 	bash scripts/bench.sh $(BUILD)

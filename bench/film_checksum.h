@@ -6,7 +6,7 @@
 #include <cstring>
 #include <vector>
 
-#include "integrator/film.h"
+#include "render/film.h"
 
 namespace gdpt::bench {
 

@@ -16,7 +16,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "integrator/huge_pages.h"
+#include "core/huge_pages.h"
 #include "reconstruct/parallel.h"
 #include "reconstruct/real_fft_dct.h"
 

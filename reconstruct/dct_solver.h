@@ -22,7 +22,7 @@
 namespace gdpt::detail {
 
 // Double buffer for the DCT planes: 2 MiB aligned and advised for transparent huge pages
-// (integrator/huge_pages.h), which also satisfies FFTW's SIMD alignment (that of the planning
+// (core/huge_pages.h), which also satisfies FFTW's SIMD alignment (that of the planning
 // buffer).
 struct DctFree {
   void operator()(double* p) const;

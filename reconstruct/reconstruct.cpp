@@ -11,7 +11,7 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
-#include "integrator/huge_pages.h"
+#include "core/huge_pages.h"
 #include "reconstruct/dct_solver.h"
 #include "reconstruct/irls_reweight.h"
 #include "reconstruct/parallel.h"

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "integrator/huge_pages.h"
+#include "core/huge_pages.h"
 #include "reconstruct/parallel.h"
 
 namespace gdpt::detail {

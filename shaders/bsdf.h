@@ -6,7 +6,7 @@
 // single Lambert lobe, the commonest, is evaluated and sampled inline, without the mixture code.
 #pragma once
 
-#include "integrator/math/vec.h"
+#include "core/vec.h"
 #include "shaders/bsdf_lambert.h"
 #include "shaders/closure.h"
 

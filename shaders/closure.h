@@ -15,8 +15,8 @@
 
 #include <cstdint>
 
-#include "integrator/math/frame.h"
-#include "integrator/math/vec.h"
+#include "core/frame.h"
+#include "core/vec.h"
 
 namespace gdpt {
 

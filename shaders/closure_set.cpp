@@ -6,7 +6,7 @@
 // eval() / pdf() (delta lobes excepted: they return their own value and s_k * probability).
 #include <algorithm>
 
-#include "integrator/math/frame.h"
+#include "core/frame.h"
 #include "shaders/bsdf.h"
 #include "shaders/bsdf_clearcoat.h"
 #include "shaders/bsdf_ggx_dielectric.h"

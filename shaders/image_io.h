@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "shaders/material_desc.h"
+#include "scene/material_desc.h"
 
 namespace gdpt {
 

@@ -10,7 +10,7 @@
 // wi is below the surface the problem is mirrored through the tangent plane.
 #pragma once
 
-#include "integrator/math/vec.h"
+#include "core/vec.h"
 #include "shaders/closure.h"
 
 namespace gdpt {

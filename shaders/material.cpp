@@ -17,6 +17,7 @@
 #include "shaders/microfacet.h"
 #include "shaders/principled.h"
 #include "shaders/procedural_texture.h"
+#include "shaders/vector_math_node.h"
 
 namespace gdpt {
 

@@ -5,8 +5,8 @@
 #include <span>
 #include <vector>
 
+#include "scene/material_desc.h"
 #include "shaders/bsdf.h"
-#include "shaders/material_desc.h"
 #include "shaders/shading_context.h"
 #include "shaders/texture.h"
 

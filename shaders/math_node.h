@@ -11,50 +11,9 @@
 #include <cmath>
 #include <cstdint>
 
-namespace gdpt {
+#include "scene/node_types.h"
 
-enum class MathOp : uint8_t {
-  Add,
-  Subtract,
-  Multiply,
-  Divide,
-  MultiplyAdd,
-  Power,
-  Logarithm,
-  Sqrt,
-  InverseSqrt,
-  Absolute,
-  Exponent,
-  Minimum,
-  Maximum,
-  LessThan,
-  GreaterThan,
-  Sign,
-  Compare,
-  SmoothMin,
-  SmoothMax,
-  Round,
-  Floor,
-  Ceil,
-  Trunc,
-  Fract,
-  Modulo,
-  Wrap,
-  Snap,
-  PingPong,
-  Sine,
-  Cosine,
-  Tangent,
-  Arcsine,
-  Arccosine,
-  Arctangent,
-  Arctan2,
-  Sinh,
-  Cosh,
-  Tanh,
-  Radians,
-  Degrees,
-};
+namespace gdpt {
 
 namespace math_node_detail {
 inline float safe_divide(float a, float b) {

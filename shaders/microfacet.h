@@ -13,7 +13,7 @@
 
 #include <cmath>
 
-#include "integrator/math/vec.h"
+#include "core/vec.h"
 
 namespace gdpt {
 

@@ -12,7 +12,8 @@
 
 #include <cstdint>
 
-#include "integrator/math/vec.h"
+#include "core/vec.h"
+#include "scene/node_types.h"
 
 namespace gdpt {
 
@@ -41,7 +42,6 @@ NoiseTextureResult noise_texture(int dimensions, Vec3f p, float w, float detail,
 // The 3D Voronoi Texture's F1 feature at p (already scaled): the nearest of one jittered point
 // per unit cell (jitter = randomness, in [0, 1]) by the metric, its distance, its cell's random
 // colour and its position (Cycles' voronoi_f1_3d).
-enum class VoronoiMetric : uint8_t { Euclidean, Manhattan, Chebyshev, Minkowski };
 struct VoronoiResult {
   float distance = 0.0f;
   Spectrum color{0.0f};
@@ -59,39 +59,17 @@ VoronoiResult voronoi_smooth_f1(Vec3f p, float smoothness, float randomness, Vor
 float voronoi_distance_to_edge(Vec3f p, float randomness);
 
 // The Gradient Texture's value at p, before the node's clamp to [0, 1] (Cycles' svm_gradient).
-enum class GradientType : uint8_t {
-  Linear,
-  Quadratic,
-  Easing,
-  Diagonal,
-  Spherical,
-  QuadraticSphere,
-  Radial
-};
 float gradient_texture(Vec3f p, GradientType type);
 
 // The Wave Texture at p (already scaled): bands along an axis or the diagonal, or rings around an
 // axis or a point, phase-shifted, distorted by fractal noise, through a sine, saw or triangle
 // profile (Cycles' svm_wave).
-struct WaveDesc {
-  enum class Type : uint8_t { Bands, Rings } type = Type::Bands;
-  // Bands: X, Y, Z, Diagonal; rings: X, Y, Z, Spherical.
-  enum class Direction : uint8_t { X, Y, Z, Other } direction = Direction::X;
-  enum class Profile : uint8_t { Sine, Saw, Triangle } profile = Profile::Sine;
-};
 float wave_texture(Vec3f p, const WaveDesc& wave, float distortion, float detail,
                    float detail_scale, float detail_roughness, float phase);
 
 // The 3D Musgrave Texture at p (already scaled): Musgrave's fractals of Perlin noise with
 // roughness exponent `dimension` (H), lacunarity, detail octaves, offset and gain (Cycles 3.4's
 // noise_musgrave_*_3d, before Blender 4.1 folded them into the Noise Texture).
-enum class MusgraveType : uint8_t {
-  Fbm,
-  Multifractal,
-  HeteroTerrain,
-  HybridMultifractal,
-  RidgedMultifractal
-};
 float musgrave_texture(Vec3f p, MusgraveType type, float detail, float dimension, float lacunarity,
                        float offset, float gain);
 
@@ -111,12 +89,6 @@ Spectrum magic_texture(Vec3f p, int depth, float distortion);
 // of its row and column, plus bias, clamped to [0, 1]) and the mortar factor (1 within
 // mortar_size of the brick's edges, 0 beyond; with mortar_smooth > 0 the edge of that band is a
 // smoothstep over the last mortar_smooth of it).
-struct BrickDesc {
-  float offset = 0.5f;
-  int offset_frequency = 2;
-  float squash = 1.0f;
-  int squash_frequency = 2;
-};
 struct BrickSample {
   float tint;
   float mortar;

@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "integrator/math/vec.h"
-#include "integrator/math/warp_disk.h"
+#include "core/vec.h"
+#include "core/warp_disk.h"
 
 namespace gdpt {
 

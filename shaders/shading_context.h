@@ -1,7 +1,7 @@
 // What a material needs to know about a hit point.
 #pragma once
 
-#include "integrator/math/vec.h"
+#include "core/vec.h"
 
 namespace gdpt {
 

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "integrator/math/vec.h"
-#include "shaders/material_desc.h"
+#include "core/vec.h"
+#include "scene/material_desc.h"
 
 namespace gdpt {
 

@@ -8,40 +8,11 @@
 #include <cmath>
 #include <cstdint>
 
-#include "integrator/math/vec.h"
+#include "core/vec.h"
+#include "scene/node_types.h"
 #include "shaders/math_node.h"
 
 namespace gdpt {
-
-enum class VectorMathOp : uint8_t {
-  Add,
-  Subtract,
-  Multiply,
-  Divide,
-  MultiplyAdd,
-  CrossProduct,
-  Project,
-  Reflect,
-  Refract,
-  Faceforward,
-  DotProduct,
-  Distance,
-  Length,
-  Scale,
-  Normalize,
-  Snap,
-  Floor,
-  Ceil,
-  Modulo,
-  Wrap,
-  Fraction,
-  Absolute,
-  Minimum,
-  Maximum,
-  Sine,
-  Cosine,
-  Tangent,
-};
 
 // Whether the operation's result is the Value output.
 inline bool vector_math_gives_value(VectorMathOp op) {

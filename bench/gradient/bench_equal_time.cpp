@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "reconstruct/reconstruct.h"
-#include "tests/gradient/gradient_scenes.h"
+#include "testing/gradient_scenes.h"
 
 using namespace gdpt;
 using namespace gdpt::gradient_test;

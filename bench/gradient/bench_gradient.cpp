@@ -25,8 +25,8 @@
 #include <ctime>
 
 #include "bench/film_checksum.h"
-#include "integrator/render_session.h"
-#include "tests/gradient/gradient_scenes.h"
+#include "integrators/render_session.h"
+#include "testing/gradient_scenes.h"
 
 using namespace gdpt;
 using namespace gdpt::gradient_test;

@@ -32,7 +32,7 @@
 #include <vector>
 
 #include "bench/film_checksum.h"
-#include "integrator/render_session.h"
+#include "integrators/render_session.h"
 
 using namespace gdpt;
 

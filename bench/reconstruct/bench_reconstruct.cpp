@@ -33,8 +33,8 @@
 #include "reconstruct/parallel.h"
 #include "reconstruct/reconstruct.h"
 #include "reconstruct/weighted_cg.h"
-#include "tests/reconstruct/l1d_reference.h"
-#include "tests/reconstruct/test_images.h"
+#include "testing/l1d_reference.h"
+#include "testing/test_images.h"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "shaders/material.h"
-#include "tests/shaders/chi2.h"  // Integrator2D, Pcg32, direction()
+#include "testing/chi2.h"  // Integrator2D, Pcg32, direction()
 
 using namespace gdpt;
 

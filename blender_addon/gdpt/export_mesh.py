@@ -201,7 +201,7 @@ def add_mesh(builder, mesh, tangents=False, warn=print, color_attribute=None):
     return index
 
 
-# Object > Visibility > Ray Visibility -> the core's RayKind bits (integrator/scene.h).
+# Object > Visibility > Ray Visibility -> the core's RayKind bits (scene/scene.h).
 _RAY_KINDS = (("visible_camera", 1 << 0), ("visible_diffuse", 1 << 1), ("visible_glossy", 1 << 2),
               ("visible_transmission", 1 << 3), ("visible_shadow", 1 << 4))
 

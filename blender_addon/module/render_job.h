@@ -18,13 +18,13 @@
 #include <memory>
 
 #include "blender_addon/module/scene_convert.h"
-#include "integrator/huge_pages.h"
-#include "integrator/render_session.h"
+#include "core/huge_pages.h"
+#include "integrators/render_session.h"
 
 namespace gdpt::python {
 
 // The film passes as float32 images, row 0 at the bottom, interleaved. In huge pages
-// (integrator/huge_pages.h): at 1920x1080 they are 166 MB, which in fresh 4 KB pages cost the
+// (core/huge_pages.h): at 1920x1080 they are 166 MB, which in fresh 4 KB pages cost the
 // benchmark VM 0.4-0.7 s of page faults per read.
 struct FilmPasses {
   int width = 0, height = 0, samples_done = 0;

@@ -11,7 +11,7 @@
 
 #include <pybind11/stl.h>  // lists to std::vector (colour ramp tables)
 
-#include "integrator/huge_pages.h"
+#include "core/huge_pages.h"
 #include "shaders/image_io.h"
 
 namespace gdpt::python {

@@ -29,7 +29,7 @@
 #include <span>
 #include <string>
 
-#include "integrator/scene.h"
+#include "scene/scene.h"
 
 namespace gdpt::python {
 

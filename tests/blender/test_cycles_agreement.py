@@ -565,7 +565,7 @@ def case_smooth_silhouettes(scene):
     # Smooth shading on coarse meshes, where interpolated normals mirror the view below the
     # surface near silhouettes: a 10x6-segment GGX sphere and an 8x4 diffuse one, smooth-shaded,
     # under a sun from the camera's side and a grey world (Cycles' ensure_valid_reflection,
-    # integrator/math/valid_reflection.h).
+    # core/valid_reflection.h).
     S.camera((0, -4, 0.5), (0, 0, 0), lens=35)
     for name, kind, segments, rings, x, inputs in (
             ("glossy", "ShaderNodeBsdfGlossy", 10, 6, -0.9, {"Roughness": 0.3,

@@ -187,7 +187,7 @@ def main():
     check(len(evaluated.polygons) == 24, "the evaluated cube has the modifier's 24 faces")
     compare("evaluated", evaluated)
 
-    # Object > Visibility > Ray Visibility -> RayKind bits (integrator/scene.h), and the panel.
+    # Object > Visibility > Ray Visibility -> RayKind bits (scene/scene.h), and the panel.
     from gdpt.export_mesh import ray_visibility
     obj = bpy.data.objects.new("vis", me)
     check(ray_visibility(obj) == 31, "all rays see an object by default")

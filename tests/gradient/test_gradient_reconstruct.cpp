@@ -7,8 +7,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "gradient_scenes.h"
 #include "reconstruct/reconstruct.h"
+#include "testing/gradient_scenes.h"
 
 namespace gdpt::gradient_test {
 namespace {

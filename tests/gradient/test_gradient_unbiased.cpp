@@ -44,8 +44,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "gradient_scenes.h"
-#include "integrator/camera.h"
+#include "render/camera.h"
+#include "testing/gradient_scenes.h"
 
 namespace gdpt::gradient_test {
 namespace {

@@ -1,4 +1,4 @@
-// Oracles for the pure shift mathematics of integrator/shift_mapping.h:
+// Oracles for the pure shift mathematics of integrators/gpt/shift_mapping.h:
 //  - every Jacobian equals a finite-difference estimate of the shift's change of measure
 //    (perturb the base direction or point, map it through the shift, measure the ratio of the
 //    solid angles spanned numerically);
@@ -10,7 +10,7 @@
 #include <cmath>
 #include <random>
 
-#include "integrator/shift_mapping.h"
+#include "integrators/gpt/shift_mapping.h"
 
 namespace gdpt::shift {
 namespace {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "integrator/math/atan2_fast.h"
+#include "core/atan2_fast.h"
 
 using gdpt::atan2_fast;
 

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "integrator/camera.h"
-#include "integrator/math/warp_disk.h"
+#include "core/warp_disk.h"
+#include "render/camera.h"
 
 namespace gdpt {
 namespace {

@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "integrator/embree_scene.h"
-#include "integrator/math/frame.h"
-#include "integrator/sampler.h"
+#include "core/frame.h"
+#include "render/embree_scene.h"
+#include "render/sampler.h"
 
 namespace gdpt {
 namespace {

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "integrator/film.h"
+#include "render/film.h"
 
 namespace gdpt {
 namespace {

@@ -13,10 +13,10 @@
 #include <utility>
 #include <vector>
 
-#include "integrator/integrator.h"
-#include "integrator/render_session.h"
-#include "integrator/scene_context.h"
-#include "tests/common/materials.h"
+#include "integrators/integrator.h"
+#include "integrators/render_session.h"
+#include "render/scene_context.h"
+#include "testing/materials.h"
 
 namespace gdpt {
 namespace {
@@ -889,9 +889,9 @@ TEST(Render, DepthPassIsSampleZerosViewAxisDistance) {
   }
 }
 
-// Normal and Mist passes (integrator/data_passes.h, Cycles' definitions), PT and G-PT: a quad
-// 7 below an orthographic camera covering the right half of the view. Normal: the shading normal
-// turned towards the camera, (0, 0, 1), also for the quad seen from its back; 0 for the sky.
+// Normal and Mist passes (integrators/common/data_passes.h, Cycles' definitions), PT and G-PT: a
+// quad 7 below an orthographic camera covering the right half of the view. Normal: the shading
+// normal turned towards the camera, (0, 0, 1), also for the quad seen from its back; 0 for the sky.
 // Mist: 1 - (1 - clamp((7 - start) / depth) ^ falloff), 1 for the sky. Off: the film has none.
 TEST(Render, NormalAndMistPassesAsCycles) {
   for (const bool back : {false, true}) {

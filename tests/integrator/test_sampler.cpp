@@ -9,8 +9,8 @@
 #include <random>
 #include <vector>
 
-#include "integrator/sampler.h"
-#include "integrator/vertex_number_batch.h"
+#include "render/sampler.h"
+#include "render/vertex_number_batch.h"
 
 #if defined(GDPT_TEST_EXPECTS_SAMPLER_SIMD) && !defined(GDPT_SAMPLER_SIMD)
 #error "test_sampler_simd must build the sampler's SIMD path"

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "integrator/math/sincos_fast.h"
-#include "integrator/math/warp_disk.h"
+#include "core/sincos_fast.h"
+#include "core/warp_disk.h"
 
 using gdpt::sincos_fast;
 

@@ -1,7 +1,7 @@
-// valid_reflection_normal (integrator/math/valid_reflection.h): Cycles' ensure_valid_reflection.
+// valid_reflection_normal (core/valid_reflection.h): Cycles' ensure_valid_reflection.
 // Oracle: a brute-force search for the smallest rotation of the shading normal towards the
 // geometric normal, in their plane, that lifts the mirrored incoming direction to the threshold.
-#include "integrator/math/valid_reflection.h"
+#include "core/valid_reflection.h"
 
 #include <gtest/gtest.h>
 

@@ -12,7 +12,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "reconstruct/exr_io.h"
-#include "tests/reconstruct/test_images.h"
+#include "testing/test_images.h"
 
 namespace gdpt {
 namespace {

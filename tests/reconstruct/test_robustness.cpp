@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "reconstruct/reconstruct.h"
-#include "tests/reconstruct/test_images.h"
+#include "testing/test_images.h"
 
 namespace gdpt {
 namespace {

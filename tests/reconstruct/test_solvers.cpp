@@ -8,8 +8,8 @@
 #include "reconstruct/dct_solver.h"
 #include "reconstruct/reconstruct.h"
 #include "reconstruct/weighted_cg.h"
-#include "tests/reconstruct/l1d_reference.h"
-#include "tests/reconstruct/test_images.h"
+#include "testing/l1d_reference.h"
+#include "testing/test_images.h"
 
 namespace gdpt {
 namespace {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "integrator/math/vec.h"
+#include "core/vec.h"
 #include "shaders/bsdf.h"
 
 namespace gdpt::test {

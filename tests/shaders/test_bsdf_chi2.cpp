@@ -6,7 +6,7 @@
 #include <optional>
 #include <vector>
 
-#include "tests/shaders/chi2.h"
+#include "testing/chi2.h"
 #include "tests/shaders/lobe_factory.h"
 
 namespace gdpt::test {

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "shaders/fresnel.h"
-#include "tests/shaders/chi2.h"
+#include "testing/chi2.h"
 #include "tests/shaders/lobe_factory.h"
 
 namespace gdpt::test {

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "integrator/math/frame.h"
+#include "core/frame.h"
 
 namespace gdpt::test {
 

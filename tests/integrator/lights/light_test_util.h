@@ -1,17 +1,17 @@
 // Shared helpers for the light tests: scene construction, Monte Carlo estimators of the solid
 // angle (mean of 1 / pdf) and irradiance (mean of L cos / pdf); chi-square statistics come from
-// tests/common/statistics.h.
+// testing/statistics.h.
 #pragma once
 
 #include <cstdint>
 #include <random>
 #include <vector>
 
-#include "integrator/light_sampler.h"
-#include "integrator/scene.h"
+#include "render/light_sampler.h"
+#include "scene/scene.h"
 #include "shaders/material.h"
-#include "tests/common/materials.h"
-#include "tests/common/statistics.h"
+#include "testing/materials.h"
+#include "testing/statistics.h"
 
 namespace gdpt::test {
 

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "integrator/light_sampler.h"
 #include "light_test_util.h"
+#include "render/light_sampler.h"
 
 namespace gdpt {
 namespace {

@@ -7,9 +7,9 @@
 #include <random>
 #include <vector>
 
-#include "integrator/environment_map.h"
-#include "integrator/light_sampler.h"
 #include "light_test_util.h"
+#include "render/environment_map.h"
+#include "render/light_sampler.h"
 
 namespace gdpt {
 namespace {

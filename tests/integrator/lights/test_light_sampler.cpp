@@ -8,8 +8,8 @@
 #include <thread>
 #include <vector>
 
-#include "integrator/light_sampler.h"
 #include "light_test_util.h"
+#include "render/light_sampler.h"
 
 namespace gdpt {
 namespace {

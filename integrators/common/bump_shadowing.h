@@ -1,0 +1,37 @@
+// Which closure set a shading point evaluates: Cycles 3.4 applies its bump shadowing term to the
+// diffuse lobes of every closure whose normal differs from the interpolated one (a normal map or
+// bump replaced it, or its reflection check rotated it: `sc->N != sd->N`). Such points get a copy
+// of their closures marked with the interpolated normal (ClosureSet::set_bump_shadowing); all
+// others keep theirs untouched, at the cost of one comparison.
+#pragma once
+
+#include "core/frame.h"
+#include "core/valid_reflection.h"
+#include "render/embree_scene.h"
+#include "shaders/bsdf.h"
+
+namespace gdpt {
+
+// `closures`: the point's set (possibly `scratch` itself); `frame`: its shading frame, facing the
+// incoming ray; `ng`: the geometric normal on the same side; `wi`: the unit direction to the
+// previous vertex (world); `rotated`: the frame's normal is not the hit's shading normal (the
+// reflection check or a fallback replaced it). Returns `closures` or `scratch`.
+inline const ClosureSet& shading_closures(const ClosureSet& closures, ClosureSet& scratch,
+                                          const SurfaceHit& hit, const Frame& frame, Vec3f ng,
+                                          Vec3f wi, bool rotated) {
+  if (!hit.perturbed && !rotated) [[likely]]
+    return closures;
+  const Vec3f interpolated = hit.perturbed ? hit.unperturbed_normal : hit.shading_normal;
+  const Vec3f n0 = hit.front_facing ? interpolated : -interpolated;
+  if (frame.n == n0) return closures;
+  if (&closures != &scratch) scratch.assign(closures);
+  scratch.set_bump_shadowing(frame.to_local(n0));
+  // Lobes that keep the interpolated normal under the perturbation get it, with Cycles'
+  // reflection check of their own.
+  if (hit.perturbed && scratch.has_interpolated_normal_lobes())
+    scratch.set_interpolated_normal(frame.to_local(valid_reflection_normal(n0, ng, wi)),
+                                    frame.to_local(ng));
+  return scratch;
+}
+
+}  // namespace gdpt

@@ -1,0 +1,181 @@
+#include "integrators/render_session.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+#include <stdexcept>
+
+#include "integrators/gpt/gradient_path_tracer.h"
+#include "integrators/integrator.h"
+#include "integrators/pt/path_tracer.h"
+#include "render/features.h"
+#include "render/scene_context.h"
+
+namespace gdpt {
+
+namespace {
+// Tiles are 16 pixels wide (a camera-ray stream, PathTracer::render_tile) and 16 tall; at one
+// sample per pixel a tile takes well under a millisecond in typical scenes, so the cancel flag
+// (polled between tiles) is seen almost immediately.
+constexpr int kTileSize = 16;
+// Every pass ends in a barrier, and its idle tail is about half a tile per worker. On small frames
+// tiles are therefore 8 or 4 pixels tall, until each worker has at least this many per pass: a
+// 96x72 frame on 2 workers has 30 16x16 tiles, and its 108 16x4 tiles render 1.5-3% faster
+// (docs/integrator.md, "Fourteenth session"). Large frames keep 16x16 tiles, whose per-task
+// overhead is smaller.
+constexpr int kTilesPerWorker = 32;
+// Pixel-samples per render_tile call (16 spp of a full tile): a few milliseconds of PT or G-PT.
+constexpr uint32_t kChunkSamples = 16 * kTileSize * kTileSize;
+
+int tile_height(int w, int h, int workers) {
+  const int columns = (w + kTileSize - 1) / kTileSize;
+  int height = kTileSize;
+  while (height > 4 && columns * ((h + height - 1) / height) < kTilesPerWorker * workers)
+    height /= 2;
+  return height;
+}
+}  // namespace
+
+struct RenderSession::Impl {
+  Scene scene;
+  RenderSettings settings;
+  std::unique_ptr<SceneContext> context;
+  std::unique_ptr<Integrator> integrator;
+  Film film, pass_film;
+  std::vector<Tile> tiles;
+  std::vector<std::string> warnings;
+  // settings.threads worker slots (0 = all cores): used for the BVH build and every pass.
+  std::unique_ptr<tbb::task_arena> arena;
+};
+
+RenderSession::RenderSession(Scene scene, RenderSettings settings)
+    : impl_(std::make_unique<Impl>()) {
+  if (settings.samples < 0) throw std::invalid_argument("render settings: samples must be >= 0");
+  if (settings.max_bounces < 0 || settings.max_diffuse_bounces < 0 ||
+      settings.max_glossy_bounces < 0 || settings.max_transmission_bounces < 0)
+    throw std::invalid_argument("render settings: bounce limits must be >= 0");
+  if (settings.rr_depth < 0)
+    throw std::invalid_argument("render settings: the Russian roulette depth must be >= 0");
+  if (settings.threads < 0) throw std::invalid_argument("render settings: threads must be >= 0");
+  if (settings.samples_per_pass < 1) settings.samples_per_pass = 1;
+  Impl& d = *impl_;
+  d.scene = std::move(scene);  // owned: the context and the BVH refer to it
+  d.settings = settings;
+  const int arena_threads =
+      d.settings.threads > 0 ? d.settings.threads : int(tbb::task_arena::automatic);
+  d.arena = std::make_unique<tbb::task_arena>(arena_threads);
+  // Embree builds with TBB: inside the arena it uses no more threads than the user allowed.
+  d.arena->execute([&] { d.context = std::make_unique<SceneContext>(d.scene, d.settings); });
+  d.warnings = d.context->warnings();
+  // Mode dispatch: G-PT estimates the gradients itself; PT derives them from the primal (Film).
+  d.integrator = d.settings.mode == RenderSettings::Mode::GPT
+                     ? make_gradient_path_tracer(*d.context, d.settings)
+                     : make_path_tracer(*d.context, d.settings);
+  const int w = d.scene.camera.image_width(), h = d.scene.camera.image_height();
+  const bool gradients_from_primal = !d.integrator->estimates_gradients();
+  d.film = Film(w, h, gradients_from_primal);
+  d.pass_film = Film(w, h, gradients_from_primal);  // the output film's layout (take_rows)
+  for (Film* f : {&d.film, &d.pass_film})
+    f->enable_data_passes(d.settings.normal_pass, d.settings.mist_pass);
+  const int th = tile_height(w, h, d.arena->max_concurrency());
+  for (int y = 0; y < h; y += th)
+    for (int x = 0; x < w; x += kTileSize)
+      d.tiles.push_back({x, y, std::min(x + kTileSize, w), std::min(y + th, h)});
+}
+
+RenderSession::~RenderSession() = default;
+
+void RenderSession::render(const std::function<void(const RenderProgress&)>& on_pass,
+                           const std::atomic<bool>& cancel) {
+  Impl& d = *impl_;
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  tbb::task_arena& arena = *d.arena;
+  const int total = d.settings.samples;
+  int done = int(d.film.min_samples());
+  const int height = d.film.height();
+  while (done < total) {
+    if (cancel.load(std::memory_order_relaxed)) break;
+    if (d.settings.time_limit > 0.0 && elapsed() >= d.settings.time_limit) break;
+    const uint32_t first = uint32_t(done);
+    const uint32_t count = uint32_t(std::min(d.settings.samples_per_pass, total - done));
+
+    // --- One pass over every tile; a pass interrupted by cancel is discarded, so every pixel
+    // always has the same sample count ---
+    std::atomic<bool> aborted{false};
+    arena.execute([&] {
+      tbb::parallel_for(
+          tbb::blocked_range<size_t>(0, d.tiles.size(), 1),
+          [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t t = r.begin(); t != r.end(); ++t) {
+              // A tile's samples go in chunks of at most kChunkSamples pixel-samples, with the
+              // cancel flag polled between chunks, so a large samples_per_pass does not delay a
+              // cancel. Each pixel still receives its samples in index order: the sums, hence the
+              // image, do not depend on the chunking.
+              const Tile& tile = d.tiles[t];
+              const uint32_t pixels = uint32_t((tile.x1 - tile.x0) * (tile.y1 - tile.y0));
+              const uint32_t chunk = std::max<uint32_t>(1, kChunkSamples / std::max(pixels, 1u));
+              for (uint32_t s = 0; s < count; s += chunk) {
+                if (cancel.load(std::memory_order_relaxed)) {
+                  aborted.store(true, std::memory_order_relaxed);
+                  return;
+                }
+                d.integrator->render_tile(tile, first + s, std::min(chunk, count - s), d.pass_film);
+              }
+            }
+          },
+          tbb::simple_partitioner());
+    });
+    if (aborted.load()) {
+      d.pass_film.clear();
+      break;
+    }
+    // --- Commit the pass ---
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<int>(0, height, 8),
+                        [&](const tbb::blocked_range<int>& r) {
+                          d.film.take_rows(d.pass_film, r.begin(), r.end());
+                        });
+    });
+    done += int(count);
+    if (on_pass) on_pass(RenderProgress{done, total, elapsed()});
+  }
+}
+
+const Film& RenderSession::film() const {
+  return impl_->film;
+}
+
+const RenderSettings& RenderSession::settings() const {
+  return impl_->settings;
+}
+
+const std::vector<std::string>& RenderSession::warnings() const {
+  return impl_->warnings;
+}
+
+uint64_t RenderSession::rays_traced() const {
+  return impl_->integrator->rays_traced();
+}
+
+std::string RenderSession::features_summary() const {
+  const Impl& d = *impl_;
+  const SceneContext& c = *d.context;
+  std::ostringstream s;
+  s << "scene features: " << features_to_string(c.scene_features());
+  s << "; kernel: " << features_to_string(path_tracer_specialised_features(c.features()));
+  if (d.settings.force_all_features) s << " (forced)";
+  s << "; " << c.bvh().triangle_count() << " unique / " << c.bvh().instanced_triangle_count()
+    << " instanced triangles, " << d.scene.instances.size() << " instances, "
+    << d.scene.lights.size() << " lights";
+  return s.str();
+}
+
+}  // namespace gdpt

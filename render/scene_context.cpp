@@ -1,0 +1,138 @@
+#include "render/scene_context.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "render/features.h"
+#include "shaders/shading_context.h"
+
+namespace gdpt {
+
+namespace {
+
+void validate(const Scene& scene, std::vector<std::string>& warnings) {
+  const Camera& cam = scene.camera;
+  if (cam.width <= 0 || cam.height <= 0)
+    throw std::invalid_argument("scene: camera resolution must be positive, got " +
+                                std::to_string(cam.width) + "x" + std::to_string(cam.height));
+  if (cam.projection == Camera::Projection::Perspective && !(cam.focal_length_mm > 0.0f))
+    throw std::invalid_argument("scene: camera focal length must be positive");
+  if (cam.projection == Camera::Projection::Orthographic && !(cam.ortho_scale > 0.0f))
+    throw std::invalid_argument("scene: orthographic scale must be positive");
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    const std::string name = "scene: mesh " + std::to_string(m);
+    if (mesh.indices.size() % 3 != 0)
+      throw std::invalid_argument(name + ": index count is not a multiple of 3");
+    const size_t tris = mesh.triangle_count();
+    if (!mesh.corner_normals.empty() && mesh.corner_normals.size() != 3 * tris)
+      throw std::invalid_argument(name + ": corner_normals must have 3 entries per triangle");
+    if (!mesh.vertex_normals.empty() && mesh.vertex_normals.size() != mesh.positions.size())
+      throw std::invalid_argument(name + ": vertex_normals must have 1 entry per vertex");
+    if (!mesh.corner_uvs.empty() && mesh.corner_uvs.size() != 3 * tris)
+      throw std::invalid_argument(name + ": corner_uvs must have 3 entries per triangle");
+    if (!mesh.material_slot.empty() && mesh.material_slot.size() != tris)
+      throw std::invalid_argument(name + ": material_slot must have 1 entry per triangle");
+  }
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    if (inst.mesh >= scene.meshes.size())
+      throw std::invalid_argument("scene: instance " + std::to_string(i) + " refers to mesh " +
+                                  std::to_string(inst.mesh) + " of " +
+                                  std::to_string(scene.meshes.size()));
+    for (int32_t mat : inst.slot_material)
+      if (mat >= int32_t(scene.materials.size()))
+        warnings.push_back("instance " + std::to_string(i) + ": material " + std::to_string(mat) +
+                           " out of range, using the default material");
+  }
+  for (const ImageDesc& img : scene.images)
+    if (img.rgba.size() != size_t(img.width) * size_t(img.height) * 4)
+      throw std::invalid_argument("scene: image '" + img.name + "' has " +
+                                  std::to_string(img.rgba.size()) + " floats, expected " +
+                                  std::to_string(size_t(img.width) * img.height * 4));
+  if (scene.world.image >= int32_t(scene.images.size()))
+    throw std::invalid_argument("scene: world image index out of range");
+  if (scene.world.camera_view && scene.world.camera_view->image >= int32_t(scene.images.size()))
+    throw std::invalid_argument("scene: camera-view world image index out of range");
+}
+
+}  // namespace
+
+SceneContext::SceneContext(const Scene& scene, const RenderSettings& settings) : scene_(scene) {
+  validate(scene, warnings_);
+
+  // Textures first: materials keep a span over them.
+  textures_.reserve(scene.images.size());
+  for (const ImageDesc& img : scene.images) textures_.emplace_back(img);
+  materials_.reserve(scene.materials.size() + 1);
+  for (const MaterialDesc& desc : scene.materials) materials_.emplace_back(desc, textures_);
+  materials_.emplace_back();  // Blender's default grey diffuse
+
+  bvh_ = std::make_unique<EmbreeScene>(scene, default_material());
+  bvh_->set_materials(materials_);
+  for (const Instance& inst : scene.instances) has_holdout_ = has_holdout_ || inst.holdout;
+  lights_ = std::make_unique<LightSampler>(scene, materials_, textures_);
+  camera_ = CameraModel(scene.camera);
+
+  // --- Feature mask: what the instanced geometry, lights, world and camera really use ---
+  uint32_t f = 0;
+  std::vector<int> mesh_uses(scene.meshes.size(), 0);
+  for (const Instance& inst : scene.instances) {
+    ++mesh_uses[inst.mesh];
+    bool uses_default = inst.slot_material.empty();
+    for (int32_t mat : inst.slot_material) {
+      if (mat >= 0 && mat < default_material())
+        f |= materials_[size_t(mat)].features();
+      else
+        uses_default = true;
+    }
+    // Meshes may use slots beyond the map: they fall back to the default material.
+    if (uses_default) f |= materials_.back().features();
+  }
+  for (int uses : mesh_uses)
+    if (uses > 1) f |= kSceneInstances;
+  if (f & kFeatureEmission) f |= kSceneEmissiveTriangles;
+  if (scene.camera.aperture_radius > 0.0f) f |= kSceneDoF;
+  if (scene.camera.projection == Camera::Projection::Orthographic) f |= kSceneOrthographic;
+  if (lights_->has_environment() || lights_->has_camera_environment()) f |= kSceneWorld;
+  if (scene.world.image >= 0) f |= kSceneWorldImage | kSceneWorld;
+  for (const Light& l : scene.lights) {
+    switch (l.type) {
+      case Light::Type::Point:
+      case Light::Type::Spot:
+        f |= l.radius > 0.0f ? kSceneAnalyticLights : kSceneDeltaLights;
+        break;
+      case Light::Type::Sun:
+        f |= l.sun_angle > 0.0f ? kSceneAnalyticLights : kSceneDeltaLights;
+        break;
+      case Light::Type::Area:
+        f |= kSceneAnalyticLights;
+        break;
+    }
+  }
+  scene_features_ = f;
+  features_ = settings.force_all_features ? kAllFeatures : f;
+}
+
+SceneContext::~SceneContext() = default;
+
+Spectrum SceneContext::transmittance(Ray ray, ClosureSet& scratch, uint32_t& rays) const {
+  ++rays;
+  Spectrum tr(1.0f);
+  SurfaceHit h;
+  for (int crossing = 0; crossing <= kMaxTransparentBounces; ++crossing) {
+    if (!bvh_->intersect(ray, h)) return tr;
+    scratch.clear();
+    materials_[size_t(h.material)].evaluate(shading_context_of(h), scratch);
+    tr *= scratch.transparency();
+    if (is_black(tr)) return tr;
+    const Vec3f n =
+        dot(ray.direction, h.geometric_normal) > 0.0f ? h.geometric_normal : -h.geometric_normal;
+    ray.origin = offset_ray_origin(h.position, n);
+    ray.t_max -= h.t;
+    ++rays;
+  }
+  return Spectrum(0.0f);
+}
+
+}  // namespace gdpt

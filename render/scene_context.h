@@ -1,0 +1,83 @@
+// Everything an integrator needs about a scene, built once per render session: the Embree BVH,
+// the camera model, textures, compiled materials, the light sampler and the feature mask. PT and
+// G-PT both receive a const SceneContext; nothing in it changes while rendering.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/camera.h"
+#include "render/embree_scene.h"
+#include "render/film.h"
+#include "render/light_sampler.h"
+#include "scene/render_settings.h"
+#include "scene/scene.h"
+#include "shaders/material.h"
+#include "shaders/texture.h"
+
+namespace gdpt {
+
+// Cycles' default transparent_max_bounces: transparent crossings a path or shadow ray may make.
+constexpr int kMaxTransparentBounces = 8;
+
+// The kind of a BSDF-sampled ray (RayKind) from the lobe it was sampled from, as Cycles labels
+// it: transmission, else diffuse, else glossy (delta reflections included).
+inline uint32_t ray_kind_of_lobe(uint32_t lobe) {
+  if (lobe & kLobeTransmission) return kRayTransmission;
+  return (lobe & kLobeDiffuse) ? kRayDiffuse : kRayGlossy;
+}
+
+class SceneContext {
+ public:
+  // Validates and prepares `scene` (which must outlive the context). Throws std::invalid_argument
+  // with a clear message for an unusable scene (zero resolution, out-of-range mesh indices, ...).
+  SceneContext(const Scene& scene, const RenderSettings& settings);
+  ~SceneContext();
+
+  const Scene& scene() const { return scene_; }
+  // The data passes of pixel (x, y) from the camera hit of its sample 0 (Film::set_first_hit):
+  // view-axis depth, the instance's and the material's pass index (the default material has 0).
+  void record_first_hit(Film& film, int x, int y, const SurfaceHit& hit) const {
+    const float object =
+        hit.instance < scene_.instances.size() ? scene_.instances[hit.instance].pass_index : 0.0f;
+    const float material = hit.material >= 0 && size_t(hit.material) < scene_.materials.size()
+                               ? scene_.materials[size_t(hit.material)].pass_index
+                               : 0.0f;
+    film.set_first_hit(x, y, camera_.view_depth(hit.position), object, material);
+  }
+  // Fraction of light passing along the shadow ray `ray`: 0 if an opaque surface blocks it, else
+  // the product of the Transparent closure weights of the surfaces crossed (Cycles' transparent
+  // shadows), at most kMaxTransparentBounces of them. `scratch` holds their closures; `rays`
+  // counts the queries.
+  Spectrum transmittance(Ray ray, ClosureSet& scratch, uint32_t& rays) const;
+  // Holdout (Instance::holdout): whether the scene has any, and whether `hit` is on one.
+  bool has_holdout() const { return has_holdout_; }
+  bool is_holdout(const SurfaceHit& hit) const {
+    return hit.instance < scene_.instances.size() && scene_.instances[hit.instance].holdout;
+  }
+  const EmbreeScene& bvh() const { return *bvh_; }
+  const CameraModel& camera() const { return camera_; }
+  const LightSampler& lights() const { return *lights_; }
+  // Scene::materials followed by Blender's default grey material (index default_material()).
+  const std::vector<Material>& materials() const { return materials_; }
+  int32_t default_material() const { return int32_t(materials_.size()) - 1; }
+  const std::vector<Texture>& textures() const { return textures_; }
+  // Feature mask (features.h); with force_all_features every bit is set.
+  uint32_t features() const { return features_; }
+  uint32_t scene_features() const { return scene_features_; }  // what the scene really uses
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  const Scene& scene_;
+  std::vector<Texture> textures_;
+  std::vector<Material> materials_;
+  std::unique_ptr<EmbreeScene> bvh_;
+  std::unique_ptr<LightSampler> lights_;
+  bool has_holdout_ = false;
+  CameraModel camera_;
+  uint32_t features_ = 0, scene_features_ = 0;
+  std::vector<std::string> warnings_;
+};
+
+}  // namespace gdpt

@@ -1,0 +1,236 @@
+// Plain-data description of a material, translated from a Blender node tree by the add-on
+// (or built directly by tests). A material is a small expression tree of shader nodes; inputs are
+// constants, image-texture lookups, or small expression trees of colour / math nodes over them
+// (InputNode). shaders/ compiles it into closures at each hit point.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/transform.h"
+#include "core/vec.h"
+#include "scene/node_types.h"
+
+namespace gdpt {
+
+// Blender's Texture Coordinate outputs a texture can read (Cycles' names): UV is (u, v, 0) of the
+// mesh's UV map; Object the object-space position; Generated the object-space position mapped
+// from the mesh's texture space (Mesh::texspace_*) to [0, 1]^3; Position the world-space position
+// (the Geometry node's Position output); Node the result of an input node (InputNode), e.g. a
+// Vector Math node or coordinates distorted by a Noise Texture's colour.
+enum class TexCoordSource : uint8_t { UV, Generated, Object, Position, Node };
+
+// The vector a texture reads: a coordinate source through an optional Mapping node.
+struct TextureVector {
+  TexCoordSource source = TexCoordSource::UV;
+  int32_t node = -1;  // Node: index into MaterialDesc::inputs
+  Transform mapping;  // Blender's Mapping node (Point / Texture type) applied to the coordinates
+};
+
+// Texture lookup: Scene::images[image] sampled at (x, y) of its vector (Image Texture, Flat).
+struct TextureLookup {
+  int32_t image = -1;  // -1: no texture, use the constant
+  TextureVector vector;
+  enum class Interpolation : uint8_t { Linear, Closest } interpolation = Interpolation::Linear;
+  enum class Extension : uint8_t { Repeat, Extend, Clip } extension = Extension::Repeat;
+};
+
+struct ColorInput {
+  ColorInput() = default;
+  explicit ColorInput(Spectrum v) : value(v) {}
+  Spectrum value{0.8f, 0.8f, 0.8f};
+  TextureLookup texture;  // when texture.image >= 0, the texture's RGB replaces value
+  int32_t node = -1;      // when >= 0: MaterialDesc::inputs[node]'s result replaces both
+};
+
+struct FloatInput {
+  FloatInput() = default;
+  explicit FloatInput(float v) : value(v) {}
+  float value = 0.0f;
+  TextureLookup texture;  // when texture.image >= 0: the texture's channel below replaces value
+  enum class Channel : uint8_t { Luminance, Red, Alpha } channel = Channel::Luminance;
+  // When >= 0: MaterialDesc::inputs[node]'s result replaces value and texture (a colour result is
+  // read as its luminance, as Blender converts a colour socket to a float one).
+  int32_t node = -1;
+};
+
+// Colour and math nodes between textures / constants and shader inputs, with Cycles' semantics
+// (kernel/svm/mix.h, math_util.h, invert.h). Results are colours (a Math result is grey).
+enum class InputNodeKind : uint8_t {
+  Mix,         // Blender's Mix (colour) / MixRGB: blend of a and b by fac, `blend` below
+  Math,        // Blender's Math on value_a, value_b: `math` below
+  Invert,      // mix(a, 1 - a, fac)
+  Ramp,        // Blender's Color Ramp read at fac: `ramp` table, Cycles' lookup (rgb_ramp_lookup)
+  Separate,    // one channel (`channel`) of a, as grey (Separate RGB / Separate Color in RGB)
+  Combine,     // (value_a, value_b, value_c) (Combine RGB / Combine Color in RGB)
+  CombineXyz,  // the vector (value_a, value_b, value_c) (Combine XYZ)
+  Gamma,       // a^value_a per positive channel; 1 for gamma 0 (svm_math_gamma_color)
+  BrightContrast,  // max((1 + c) a + b - c / 2, 0), b = value_a, c = value_b
+  HueSaturation,   // Hue/Saturation/Value of a: hue value_a, saturation value_b, value value_c,
+                   // blended by fac (svm_node_hsv)
+  MapRange,        // linear Map Range of value_a from [bounds 0, 1] to [bounds 2, 3], clamp_result
+  Clamp,           // value_a clamped to [value_b, value_c] (Min Max; swapped bounds: Range)
+  ToBw,            // luminance of a, as grey (RGB to BW)
+  Attribute,       // the mesh's colour attribute (Color Attribute node; ShadingContext::color)
+  Checker,         // Checker Texture at `vector` x scale value_a: colour a or b (svm_checker)
+  Noise,           // Noise Texture of `noise_dimensions` at `vector` and W value_d, both x scale
+                   // value_a: detail value_b, roughness value_c, distortion fac (Blender 3.4's fBm
+                   // of Perlin noise, noise_texture_Nd)
+  Coordinates,     // `vector` itself as a colour (a Texture Coordinate / Mapping output plugged
+                   // into a colour or float input)
+  Voronoi,         // 3D Voronoi Texture `voronoi_feature` at `vector` x scale value_a: randomness
+                   // value_b, Minkowski exponent value_c, metric `voronoi_metric`, smoothness
+                   // value_d; Distance (fac_output), Color or Position (position_output)
+  Gradient,        // Gradient Texture of type `gradient_type` at `vector`, clamped to [0, 1]
+  Wave,            // Wave Texture `wave` at `vector` x scale value_a: distortion value_b, detail
+                   // value_c, detail scale value_d, detail roughness value_e, phase value_f
+  WhiteNoise,      // 3D White Noise Texture at `vector`: a hash of its bits, Value (fac_output)
+                   // or Color
+  Magic,           // Magic Texture at `vector` x scale value_a, distortion value_b, depth
+                   // `magic_depth`; Fac (the colour's mean) or Color
+  Musgrave,        // 3D Musgrave Texture `musgrave_type` at `vector` x scale value_a: detail
+                   // value_b, dimension value_c, lacunarity value_d, offset value_e, gain value_f
+  VectorMath,      // Vector Math `vector_math` of vectors a, b, c and scale value_a: the Vector,
+                   // or the Value (fac_output, as grey)
+  Brick,           // Brick Texture `brick` at `vector` x scale value_a: colours a, b, mortar c;
+                   // mortar size value_b, smooth value_c, bias value_d, brick width value_e, row
+                   // height value_f; Color, or the mortar factor (Fac, fac_output)
+};
+enum class MixBlend : uint8_t {
+  Mix,
+  Add,
+  Multiply,
+  Subtract,
+  Screen,
+  Divide,
+  Difference,
+  Darken,
+  Lighten,
+};
+
+struct InputNode {
+  InputNodeKind kind = InputNodeKind::Mix;
+  MixBlend blend = MixBlend::Mix;
+  MathOp math = MathOp::Add;
+  bool clamp_factor = true;   // Mix: fac clamped to [0, 1] first
+  bool clamp_result = false;  // result clamped to [0, 1] per channel
+  FloatInput fac{0.5f};       // Mix, Invert
+  ColorInput a, b;            // Mix (a, b), Invert (a), Vector Math (vectors a, b)
+  ColorInput c;               // Vector Math (vector c)
+  VectorMathOp vector_math = VectorMathOp::Add;
+  FloatInput value_a, value_b;  // Math, Gamma (a), Bright / Contrast (a, b), Combine (a, b)
+  FloatInput value_c;           // Combine
+  FloatInput value_d, value_e, value_f;  // Wave, Musgrave
+  uint8_t channel = 0;                   // Separate: 0 red, 1 green, 2 blue
+  // Ramp: RGBA at fac = i / (n - 1), i < n (Blender's ColorRamp.evaluate, as Cycles bakes it),
+  // interpolated linearly between entries unless the ramp is Constant; the result is the colour,
+  // or the alpha as grey for the node's Alpha output.
+  std::vector<float> ramp;  // 4 n floats
+  // MapRange: from min, from max, to min, to max (constants; Blender's default range).
+  std::array<float, 4> bounds{0.0f, 1.0f, 0.0f, 1.0f};
+  bool ramp_interpolate = true;
+  bool ramp_alpha = false;
+  bool clamp_range = false;  // Clamp: Range type (swapped bounds clamp to [max, min])
+  TextureVector vector;      // Checker, Noise: where they are read; Coordinates: the value
+  bool fac_output = false;   // a texture's grey output (Fac; Voronoi: Distance) instead of Color
+  bool position_output = false;  // Voronoi: the Position output
+  VoronoiMetric voronoi_metric = VoronoiMetric::Euclidean;
+  // Voronoi: F1, F2, Smooth F1 (smoothness value_d) or Distance to Edge (a Distance only).
+  enum class VoronoiFeature : uint8_t { F1, F2, SmoothF1, DistanceToEdge };
+  VoronoiFeature voronoi_feature = VoronoiFeature::F1;
+  GradientType gradient_type = GradientType::Linear;
+  WaveDesc wave;
+  uint8_t noise_dimensions = 3;  // Noise: 1, 2, 3 or 4
+  uint8_t magic_depth = 2;       // Magic: 0 to 10
+  MusgraveType musgrave_type = MusgraveType::Fbm;
+  BrickDesc brick;
+};
+
+enum class ShaderNodeKind : uint8_t {
+  Diffuse,      // Blender Diffuse BSDF: Lambert (roughness 0) or Oren-Nayar (roughness > 0)
+  Glossy,       // Blender Glossy BSDF, GGX (no Fresnel; colour scales), roughness -> alpha = r^2
+  Glass,        // Blender Glass BSDF, GGX dielectric; roughness 0 = smooth (delta)
+  Principled,   // Blender 3.4 Principled BSDF v1
+  Emission,     // colour * strength (radiance, W/m^2/sr per unit strength as in Cycles)
+  Transparent,  // straight-through transmission, colour scales
+  Mix,          // (1 - fac) * a + fac * b
+  Add,          // a + b
+};
+
+struct ShaderNode {
+  ShaderNodeKind kind = ShaderNodeKind::Diffuse;
+  ColorInput color;           // base colour for every BSDF, emission colour for Emission
+  FloatInput roughness;       // Diffuse, Glossy, Glass, Principled
+  FloatInput ior{1.45f};      // Glass, Principled
+  FloatInput strength{1.0f};  // Emission
+  FloatInput fac{0.5f};       // Mix
+  int32_t a = -1, b = -1;     // Mix / Add children (indices into Material::nodes)
+  // Whether the BSDF's Normal input (Principled: also its Clearcoat Normal) takes the material's
+  // normal map or bump; false: the interpolated normal, which Cycles gives an unlinked input.
+  bool normal_linked = true;
+  bool clearcoat_normal_linked = true;
+
+  // Principled BSDF v1 inputs beyond colour / roughness / ior (subsurface is ignored with a
+  // warning).
+  FloatInput metallic{0.0f};
+  FloatInput specular{0.5f};
+  FloatInput specular_tint{0.0f};
+  FloatInput transmission{0.0f};
+  FloatInput sheen{0.0f};
+  FloatInput sheen_tint{0.5f};
+  // Clearcoat (Cycles 3.4, shaders/bsdf_clearcoat.h): weight 0.25 clearcoat, on top of the
+  // other lobes.
+  FloatInput clearcoat{0.0f};
+  FloatInput clearcoat_roughness{0.03f};
+  FloatInput alpha{1.0f};
+  ColorInput emission{Spectrum(0.0f)};
+  FloatInput emission_strength{1.0f};
+};
+
+// Blender's Normal Map node in tangent space, feeding the material's BSDF Normal inputs: the
+// colour c, read as the tangent-space direction 2 (c - 0.5) (x along the UV map's tangent, y along
+// the bitangent, z along the interpolated normal), replaces the shading normal. Strength s scales
+// x and y by s and moves z from 1 to its value by clamp(s, 0, 1), as Cycles (svm_node_normal_map).
+struct NormalMapDesc {
+  bool enabled = false;
+  ColorInput color{Spectrum(0.5f, 0.5f, 1.0f)};  // non-colour data: used as stored
+  float strength = 1.0f;
+};
+
+// Blender's Bump node on the material's BSDF Normal inputs: the shading normal tilts against the
+// surface gradient of `height`, N' = normalize(N - distance grad h) (Cycles' svm_node_set_bump to
+// first order in its ray differentials; the gradient here is a forward difference in UV), then
+// mixed with N by strength. Invert negates the distance.
+struct BumpDesc {
+  bool enabled = false;
+  FloatInput height{0.0f};
+  float strength = 1.0f;
+  float distance = 1.0f;
+  bool invert = false;
+};
+
+struct MaterialDesc {
+  std::string name;
+  std::vector<ShaderNode> nodes;
+  int32_t root = -1;              // -1: Blender's default grey diffuse (0.8)
+  NormalMapDesc normal_map;       // needs the meshes' corner tangents (Mesh::corner_tangents)
+  BumpDesc bump;                  // needs UVs; not together with normal_map
+  std::vector<InputNode> inputs;  // referenced by ColorInput::node / FloatInput::node
+  float pass_index = 0.0f;        // Blender's Material > Settings > Pass Index (the IndexMA pass)
+};
+
+// Image pixels in scene-linear RGBA float (the loader converts from the file's colour space via
+// OCIO).
+struct ImageDesc {
+  std::string name;
+  int width = 0, height = 0;
+  std::vector<float> rgba;  // width * height * 4, row 0 at the bottom (Blender's convention)
+  // RGB holds sRGB-encoded values (an 8-bit sRGB image): lookups interpolate them encoded and
+  // decode the result with the sRGB curve, as Cycles does for such images (it keeps them as
+  // bytes and linearises after interpolation). Alpha is linear either way.
+  bool srgb_encoded = false;
+};
+
+}  // namespace gdpt

@@ -1,0 +1,38 @@
+// Render settings shared by the add-on (scene.gdpt), the tests and the benchmarks.
+#pragma once
+
+#include <cstdint>
+
+namespace gdpt {
+
+struct RenderSettings {
+  enum class Mode : uint8_t { PT, GPT } mode = Mode::GPT;
+  int samples = 64;         // samples per pixel
+  double time_limit = 0.0;  // seconds, 0 = none
+  int max_bounces = 8;      // path segments after the camera ray
+  // Per-kind limits (Cycles' Diffuse / Glossy / Transmission bounces; bounce_limits.h). The core's
+  // defaults leave only max_bounces in force; the add-on passes Blender's settings.
+  int max_diffuse_bounces = 1 << 20, max_glossy_bounces = 1 << 20,
+      max_transmission_bounces = 1 << 20;
+  uint32_t seed = 0;
+  int threads = 0;                           // 0 = all cores
+  float clamp = 0.0f;                        // max sample value, 0 = off
+  int rr_depth = 3;                          // Russian roulette from this vertex on
+  float shift_roughness_threshold = 0.001f;  // G-PT: GGX alpha below this = specular vertex
+  // Blender's Film > Transparent: the world seen directly by the camera is left out of the image,
+  // and the film's alpha is the fraction of the pixel covered by surfaces (Film::alpha).
+  bool transparent_background = false;
+  // Blender's Normal and Mist data passes (View Layer > Passes > Data), as Cycles computes them
+  // (integrators/common/data_passes.h); off: no cost. Mist: World > Mist Pass start, depth
+  // (distances from the camera) and falloff exponent (2 quadratic, 1 linear, 0.5 inverse
+  // quadratic).
+  bool normal_pass = false;
+  bool mist_pass = false;
+  float mist_start = 5.0f, mist_depth = 25.0f, mist_falloff = 2.0f;
+  int samples_per_pass = 1;  // progressive granularity (a pass = this many spp over the image)
+  // Debug / benchmark: run the kernel with every feature path on (same image, slower), to measure
+  // what the per-scene specialisation buys.
+  bool force_all_features = false;
+};
+
+}  // namespace gdpt
