@@ -1007,6 +1007,52 @@ TEST(Render, RayVisibilityHidesInstancesFromRayKinds) {
     }
 }
 
+// Each per-kind flag alone: a surface under a white world (radiance 1) is seen from above through
+// a black 100 x 100 lid that the camera never sees; the lid is visible to one kind of ray (and
+// to shadow rays, so the world's light samples are blocked too) or hidden from it. Diffuse floor
+// of albedo 0.5: 0.5 under the world, 0 under the lid. Mirror (Glossy, roughness 0, colour 0.7):
+// 0.7 or 0. Glass sheet (IOR 1.5, normal incidence, the lid below it): Fresnel R = 0.04 goes up
+// to the world in both cases, 1 - R down through the sheet to the world or the lid.
+TEST(Render, RayVisibilityEachKindAlone) {
+  struct Case {
+    const char* name;
+    MaterialDesc surface;
+    uint32_t kind;
+    float lid_z, under_world, under_lid, tolerance;
+  };
+  const float r = 0.04f;
+  const Case cases[] = {
+      {"diffuse", diffuse(Spectrum(0.5f)), kRayDiffuse, 2.0f, 0.5f, 0.0f, 0.01f},
+      {"glossy", glossy(Spectrum(0.7f), 0.0f), kRayGlossy, 2.0f, 0.7f, 0.0f, 1e-4f},
+      {"transmission", test::single_node(ShaderNodeKind::Glass, Spectrum(1.0f), 0.0f, 1.5f),
+       kRayTransmission, -2.0f, 1.0f, r, 0.01f}};
+  const uint32_t kinds = kRayDiffuse | kRayGlossy | kRayTransmission;
+  for (const Case& c : cases)
+    for (const bool visible : {true, false})
+      for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+        Scene scene;
+        scene.meshes.push_back(quad(50.0f));
+        scene.materials.push_back(c.surface);
+        scene.materials.push_back(diffuse(Spectrum(0.0f)));
+        scene.instances.push_back(place(0, 0));
+        scene.instances.push_back(place(0, 1, translation({0, 0, c.lid_z})));
+        // Visible: to this kind and to shadow rays only. Hidden: to the other two kinds only.
+        scene.instances[1].visibility = visible ? (c.kind | kRayShadow) : (kinds & ~c.kind);
+        scene.world.color = Spectrum(1.0f);
+        scene.world.strength = 1.0f;
+        scene.camera = top_camera(8, 2.0f, 5.0f);
+        RenderSettings s = pt(256);
+        s.mode = mode;
+        const Image img = render(scene, s);
+        double mean = 0.0;
+        for (int y = 0; y < 8; ++y)
+          for (int x = 0; x < 8; ++x) mean += img.at(x, y) / 64.0;
+        const float expect = visible ? c.under_lid : c.under_world;
+        EXPECT_NEAR(mean, expect, c.tolerance)
+            << c.name << (visible ? " visible" : " hidden") << ", mode " << int(mode);
+      }
+}
+
 // Light::cast_shadow off (Cycles' Cast Shadow): the sun's light samples skip the shadow ray, so
 // the floor under the sheet (hidden from the camera, direct light only) is lit as the floor
 // around it; on, it is in shadow. PT and G-PT.
@@ -1480,22 +1526,44 @@ TEST(Render, NeverNaNOrInf) {
   for (float v : img.emission) ASSERT_TRUE(std::isfinite(v));
 }
 
+// A render cancelled after three passes keeps exactly the image of a three-sample render with the
+// same seed (primal, emission and gradients), in PT and G-PT.
 TEST(Render, CancelKeepsFinishedPasses) {
   const Scene scene = cornell_like();
-  RenderSession session(scene, pt(1000));
-  std::atomic<bool> cancel{false};
-  int calls = 0;
-  session.render(
-      [&](const RenderProgress& p) {
-        ++calls;
-        EXPECT_EQ(p.samples_done, calls);
-        EXPECT_EQ(p.samples_total, 1000);
-        if (calls == 3) cancel = true;
-      },
-      cancel);
-  EXPECT_EQ(calls, 3);
-  for (int y = 0; y < session.film().height(); ++y)
-    for (int x = 0; x < session.film().width(); ++x) ASSERT_EQ(session.film().samples(x, y), 3u);
+  for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+    RenderSettings s = pt(1000);
+    s.mode = mode;
+    RenderSession session(scene, s);
+    std::atomic<bool> cancel{false};
+    int calls = 0;
+    session.render(
+        [&](const RenderProgress& p) {
+          ++calls;
+          EXPECT_EQ(p.samples_done, calls);
+          EXPECT_EQ(p.samples_total, 1000);
+          if (calls == 3) cancel = true;
+        },
+        cancel);
+    EXPECT_EQ(calls, 3);
+    const Film& film = session.film();
+    for (int y = 0; y < film.height(); ++y)
+      for (int x = 0; x < film.width(); ++x) ASSERT_EQ(film.samples(x, y), 3u);
+    s.samples = 3;
+    const Image full = render(scene, s);
+    std::vector<float> primal(film.pixel_count() * 3), emission(primal.size()), dx(primal.size());
+    film.primal_rgb(primal.data());
+    film.emission_rgb(emission.data());
+    film.gradient_x_rgb(dx.data());
+    ASSERT_EQ(primal.size(), full.primal.size());
+    double sum = 0.0;
+    for (size_t i = 0; i < primal.size(); ++i) {
+      ASSERT_EQ(primal[i], full.primal[i]) << "mode " << int(mode) << ", value " << i;
+      ASSERT_EQ(emission[i], full.emission[i]) << "mode " << int(mode) << ", value " << i;
+      ASSERT_EQ(dx[i], full.gradient_x[i]) << "mode " << int(mode) << ", value " << i;
+      sum += primal[i];
+    }
+    EXPECT_GT(sum, 0.0);  // a lit image, not two empty ones
+  }
 }
 
 TEST(Render, CancelFromAnotherThreadStopsQuickly) {
