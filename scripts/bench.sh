@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
 # `make bench`: runs every benchmark executable (bench_*) of the build, one after the other,
 # and every bench/*/*.sh script (e.g. the Blender-vs-Cycles comparison). Output goes to stdout
-# and to out/bench/<name>.txt.
+# and to out/bench/<name>.txt. QUICK=1 runs only the equal-time report, reduced
+# (bench/report/report.sh: two scenes, short budgets; under ten minutes on 2 cores).
 set -euo pipefail
 build=${1:-build}
 root=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$root/out/bench"
+if [ "${QUICK:-0}" = 1 ]; then
+  exec bash "$root/bench/report/report.sh" "$build"
+fi
 status=0
 while IFS= read -r exe; do
   name=$(basename "$exe")

@@ -9,7 +9,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools libopenexr-dev
   libopencolorio-dev
   libfftw3-dev
-  pybind11-dev python3-dev python3-numpy
+  pybind11-dev python3-dev python3-numpy python3-matplotlib
   libgtest-dev libgmock-dev libbenchmark-dev
   blender
 )

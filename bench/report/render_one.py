@@ -1,0 +1,66 @@
+# One timed render of the benchmark report (runs inside Blender, the add-on staged):
+#   blender -b --factory-startup --addons gdpt --python render_one.py -- \
+#       BLEND METHOD OUT.exr (--seconds T | --samples N) [--seed S]
+# METHOD: cycles_default (Cycles as a new scene has it, but denoising off: Debian's Blender has
+# no OpenImageDenoise), cycles_unbiased (the same with Filter Glossy 0 and no clamping), pt
+# (Gradient PT's path tracer), gpt (Gradient PT's G-PT, no reconstruction: the report solves
+# its passes with gdpt-reconstruct). Prints one line `BENCH {json}` with the render call's wall
+# time; the samples reached are parsed by the caller from the engines' console lines.
+import json
+import os
+import sys
+import time
+
+import bpy
+
+argv = sys.argv[sys.argv.index("--") + 1:]
+blend, method, out = argv[0], argv[1], os.path.abspath(argv[2])
+opts = dict(zip(argv[3::2], argv[4::2]))
+seconds = float(opts.get("--seconds", 0))
+samples = int(opts.get("--samples", 0))
+seed = int(opts.get("--seed", 1))
+if (seconds > 0) == (samples > 0):
+    sys.exit("render_one.py: give exactly one of --seconds and --samples")
+
+bpy.ops.wm.open_mainfile(filepath=blend)
+scene = bpy.context.scene
+many = 1 << 24  # a sample count the time limit ends first
+if method.startswith("cycles"):
+    scene.render.engine = 'CYCLES'
+    c = scene.cycles
+    c.device = 'CPU'
+    c.use_denoising = False
+    c.seed = seed
+    c.samples = samples or many
+    c.time_limit = seconds
+    if method == "cycles_unbiased":
+        c.blur_glossy = 0.0
+        c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
+    elif method != "cycles_default":
+        sys.exit(f"render_one.py: unknown method {method}")
+elif method in ("pt", "gpt"):
+    scene.render.engine = 'GDPT'
+    g = scene.gdpt
+    g.mode = method.upper()
+    g.reconstruction = 'NONE' if method == "gpt" else 'L2'
+    g.seed = seed
+    g.samples = samples or many
+    g.time_limit = seconds
+else:
+    sys.exit(f"render_one.py: unknown method {method}")
+scene.render.use_persistent_data = False
+s = scene.render.image_settings
+s.file_format = 'OPEN_EXR_MULTILAYER'
+s.color_depth = '32'
+s.exr_codec = 'ZIP'
+scene.render.use_file_extension = False
+scene.render.filepath = out
+if os.path.exists(out):
+    os.remove(out)
+t0 = time.perf_counter()
+bpy.ops.render.render(write_still=True)
+elapsed = time.perf_counter() - t0
+if not os.path.exists(out):
+    sys.exit(f"render_one.py: the render wrote no {out}")
+print("BENCH " + json.dumps({"method": method, "seconds": elapsed, "engine": scene.render.engine}),
+      flush=True)

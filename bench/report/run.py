@@ -1,0 +1,360 @@
+#!/usr/bin/python3
+"""The benchmark report: GDPT against Cycles at equal time on the scenes of bench/scenes.
+
+    python3 bench/report/run.py --build BUILD [--quick] [--scenes a,b] [--budgets 5,10]
+                                [--ref-seconds S] [--res WxH] [--out-doc docs/benchmarks.md]
+
+For each scene: builds its .blend (bench/scenes/build.py), renders each method's own converged
+reference as two independent halves (cached in bench/results/cache/), then for every wall-clock
+budget renders Cycles (defaults; unbiased), GDPT PT and GDPT G-PT, solves the G-PT passes with
+gdpt-reconstruct (L2, L1, weighted; the solve's time is added to the render's), and measures
+relMSE (against the method's own reference, the reference's noise subtracted) and SSIM. Writes
+bench/results/<scene>.json, the plots and crops under docs/benchmarks/, and docs/benchmarks.md.
+"""
+import argparse
+import datetime
+import json
+import os
+import platform
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(ROOT, "tests", "blender"))
+import exr  # noqa: E402
+import metrics as M  # noqa: E402
+
+SCENES = ["cornell_panel", "interior", "glossy", "glass_caustics", "difficult_light", "outdoor",
+          "instances"]
+# Rendered methods and the curves they give (G-PT gives one curve per reconstruction).
+RENDERED = ["cycles_default", "cycles_unbiased", "pt", "gpt"]
+CURVES = {"cycles_default": "Cycles (defaults)", "cycles_unbiased": "Cycles (unbiased)",
+          "pt": "GDPT PT", "gpt_l2": "GDPT G-PT + L2", "gpt_l1": "GDPT G-PT + L1",
+          "gpt_weighted": "GDPT G-PT + weighted"}
+SOLVES = ["l2", "l1", "weighted"]
+# Each curve's reference: Cycles' settings are biased differently, so each is measured against
+# its own converged image; every GDPT curve against GDPT PT's.
+REFERENCE_OF = {"cycles_default": "cycles_default", "cycles_unbiased": "cycles_unbiased",
+                "pt": "pt", "gpt_l2": "pt", "gpt_l1": "pt", "gpt_weighted": "pt"}
+# Cross-engine references are compared on 4x4 block means (pixel filters differ: Cycles'
+# Blackman-Harris against GDPT's box), their noise subtracted; above this relMSE the scene's
+# comparison is void.
+CROSS_BLOCK, CROSS_VOID = 4, 0.01
+
+
+class Blender:
+    """Runs bench scripts in headless Blender with the add-on staged from a build."""
+
+    def __init__(self, build):
+        self.build = build
+        self.scripts = tempfile.mkdtemp(prefix="gdpt-bench-")
+        subprocess.run(["bash", os.path.join(ROOT, "tests", "blender", "stage_addon.sh"), ROOT,
+                        build, self.scripts], check=True, stdout=subprocess.DEVNULL)
+
+    def run(self, script, *args):
+        env = dict(os.environ, BLENDER_USER_SCRIPTS=self.scripts)
+        cmd = ["blender", "-b", "--factory-startup", "--addons", "gdpt", "--python-exit-code", "1",
+               "--python", script, "--", *map(str, args)]
+        p = subprocess.run(cmd, env=env, capture_output=True, text=True)
+        if p.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd)} failed:\n{p.stdout[-3000:]}\n{p.stderr[-2000:]}")
+        return p.stdout
+
+    def close(self):
+        shutil.rmtree(self.scripts, ignore_errors=True)
+
+
+def samples_reached(log):
+    """The largest 'Sample N/M' of Blender's progress lines (GDPT's finished line wins)."""
+    done = re.findall(r"^GDPT: view layer .* finished: (\d+)/", log, re.M)
+    if done:
+        return int(done[-1])
+    counts = [int(n) for n in re.findall(r"Sample (\d+)/\d+", log)]
+    return max(counts) if counts else 0
+
+
+def render(blender, blend, method, out, seconds=0.0, samples=0, seed=1):
+    args = [blend, method, out] + (["--seconds", seconds] if seconds else ["--samples", samples])
+    log = blender.run(os.path.join(HERE, "render_one.py"), *args, "--seed", seed)
+    line = next(ln for ln in log.splitlines() if ln.startswith("BENCH "))
+    info = json.loads(line[6:])
+    expected = "GDPT" if method in ("pt", "gpt") else "CYCLES"
+    if info["engine"] != expected:
+        raise RuntimeError(f"{method} rendered with {info['engine']}, not {expected}")
+    info["samples"] = samples_reached(log)
+    return info
+
+
+def solve(build, exr_in, norm, out):
+    """gdpt-reconstruct on a G-PT render; returns (image, seconds)."""
+    cli = os.path.join(build, "reconstruct", "gdpt-reconstruct")
+    t0 = time.perf_counter()
+    subprocess.run([cli, exr_in, "-o", out, "--norm", norm], check=True,
+                   stdout=subprocess.DEVNULL)
+    return rgb(out, ""), time.perf_counter() - t0
+
+
+def rgb(path, prefix="ViewLayer.Combined."):
+    return exr.rgb(exr.read_exr(path), prefix)[..., :3].astype(np.float64)
+
+
+def pass_mean(path, name):
+    ch = exr.read_exr(path)
+    key = next((k for k in ch if k.startswith(f"ViewLayer.{name}.")), None)
+    return float(np.mean(ch[key])) if key else None
+
+
+def references(blender, build, blend, cache, seconds, log):
+    """{method: (half a, half b)}, each half `seconds` long with its own seed, cached."""
+    refs = {}
+    for method in ("cycles_default", "cycles_unbiased", "pt"):
+        halves = []
+        for seed in (1, 2):
+            path = os.path.join(cache, f"ref_{method}_{seed}_{int(seconds)}s.exr")
+            if not os.path.exists(path):
+                info = render(blender, blend, method, path + ".tmp.exr", seconds=seconds,
+                              seed=1000 + seed)
+                os.replace(path + ".tmp.exr", path)
+                log(f"  reference {method} half {seed}: {info['samples']} samples")
+            halves.append(rgb(path))
+        refs[method] = tuple(halves)
+    return refs
+
+
+def measure_scene(name, args, blender, log):
+    cache = os.path.join(args.cache, f"{name}_{args.res}")
+    os.makedirs(cache, exist_ok=True)
+    blend = os.path.join(cache, f"{name}.blend")
+    if not os.path.exists(blend):
+        blender.run(os.path.join(ROOT, "bench", "scenes", "build.py"), name, blend, args.res)
+    refs = references(blender, args.build, blend, cache, args.ref_seconds, log)
+    ref = {m: 0.5 * (a + b) for m, (a, b) in refs.items()}
+    result = {"scene": name, "resolution": args.res, "budgets": args.budgets,
+              "reference_seconds_per_half": args.ref_seconds, "curves": {c: [] for c in CURVES}}
+    result["cross_engine_relmse"] = {f"pt~{m}": M.rel_mse_between(refs["pt"], refs[m], CROSS_BLOCK)
+                                     for m in ("cycles_unbiased", "cycles_default")}
+    result["void"] = result["cross_engine_relmse"]["pt~cycles_unbiased"] > CROSS_VOID
+    result["predicted_improvement"] = M.gradient_energy_ratio(ref["pt"])
+    crops = {}
+    for budget in args.budgets:
+        for method in RENDERED:  # interleaved: every method once per budget, in turn
+            path = os.path.join(cache, f"{method}_{budget}s.exr")
+            info = render(blender, blend, method, path, seconds=budget, seed=7)
+            images = {}
+            if method == "gpt":
+                info["shift_failures"] = pass_mean(path, "Shift Failures")
+                for norm in SOLVES:
+                    img, secs = solve(args.build, path, norm, path[:-4] + f"_{norm}.exr")
+                    images[f"gpt_{norm}"] = (img, info["seconds"] + secs, secs)
+            else:
+                images[method] = (rgb(path), info["seconds"], 0.0)
+            for curve, (img, secs, solve_secs) in images.items():
+                r = REFERENCE_OF[curve]
+                point = {"budget": budget, "seconds": secs, "solve_seconds": solve_secs,
+                         "samples": info["samples"], "relmse": M.rel_mse(img, ref[r]),
+                         "relmse_denoised": M.rel_mse_denoised(img, *refs[r]),
+                         "ssim": M.ssim(img, ref[r])}
+                if "shift_failures" in info:
+                    point["shift_failures"] = info["shift_failures"]
+                result["curves"][curve].append(point)
+                if budget == args.crop_budget:
+                    crops[curve] = img
+                log(f"  {budget:>4} s {CURVES[curve]:24s} {secs:6.1f} s {info['samples']:6d} spp "
+                    f"relMSE {point['relmse_denoised']:.3e} SSIM {point['ssim']:.3f}")
+    crops["reference"] = ref["pt"]
+    summarise(result)
+    return result, crops
+
+
+def summarise(result):
+    """Equal-time ratios at 10 s and 40 s, the achieved G-PT improvement over PT, PT costs."""
+    def at(curve, t):
+        return M.at_time([(p["seconds"], p["relmse_denoised"]) for p in result["curves"][curve]], t)
+
+    result["equal_time"] = {}
+    for t in (10, 40):
+        row = {c: at(c, t) for c in CURVES}
+        row["improvement_over_cycles_default"] = {
+            c: row["cycles_default"] / row[c] if row["cycles_default"] and row[c] else None
+            for c in ("pt", "gpt_l2", "gpt_l1", "gpt_weighted")}
+        row["achieved_gpt_l2_over_pt"] = (row["pt"] / row["gpt_l2"]
+                                          if row["pt"] and row["gpt_l2"] else None)
+        result["equal_time"][str(t)] = row
+    pt, gpt = result["curves"]["pt"], result["curves"]["gpt_l2"]
+    result["gpt_cost_per_sample_over_pt"] = float(np.median(
+        [(g["seconds"] - g["solve_seconds"]) / max(g["samples"], 1) /
+         (p["seconds"] / max(p["samples"], 1)) for p, g in zip(pt, gpt)]))
+    result["solve_time_share"] = {
+        n: float(np.median([p["solve_seconds"] / p["seconds"] for p in result["curves"][f"gpt_{n}"]]))
+        for n in SOLVES}
+
+
+def plot(result, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    for curve, label in CURVES.items():
+        pts = [(p["seconds"], p["relmse_denoised"]) for p in result["curves"][curve]
+               if p["relmse_denoised"] > 0]
+        if pts:
+            ax.loglog(*zip(*pts), marker="o", label=label)
+    ax.set_xlabel("wall-clock seconds (whole render call + solve)")
+    ax.set_ylabel("relMSE against own reference")
+    ax.set_title(result["scene"])
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def save_crops(crops, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    order = [("cycles_default", "Cycles"), ("pt", "GDPT PT"), ("gpt_l1", "G-PT + L1"),
+             ("reference", "reference")]
+    fig, axes = plt.subplots(1, len(order), figsize=(3 * len(order), 2.6))
+    for ax, (key, label) in zip(axes, order):
+        img = crops.get(key)
+        if img is not None:
+            h, w = img.shape[:2]
+            crop = img[h // 4:3 * h // 4, w // 4:3 * w // 4]
+            ax.imshow(M.display(crop)[::-1], interpolation="nearest")  # rows bottom-first
+        ax.set_title(label, fontsize=9)
+        ax.axis("off")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def fmt(v, spec=".2f", suffix="x"):
+    return "-" if v is None else f"{v:{spec}}{suffix}"
+
+
+def write_doc(results, meta, path, figures):
+    lines = [
+        "# Benchmarks: GDPT against Cycles at equal time",
+        "",
+        f"Generated by `{meta['command']}` at commit {meta['commit']} on {meta['date']}, "
+        f"{meta['machine']}. Every figure below comes from `bench/results/<scene>.json` of that "
+        "run; rerun the command to regenerate this page.",
+        "",
+        "relMSE is measured against each method's own converged reference (two independent "
+        "halves, whose noise is subtracted); times are whole Blender render calls (export, "
+        "render, write) plus, for G-PT, the `gdpt-reconstruct` solve. Cycles' defaults include "
+        "Filter Glossy 1.0 and indirect clamping at 10 (biased, less noise); \"unbiased\" sets "
+        "both to 0. Denoising is off: Debian's Blender has no OpenImageDenoise.",
+        "",
+        "## Summary: relMSE improvement over Cycles (defaults) at equal time",
+        "",
+        "| scene | refs agree (relMSE PT~Cycles) | PT 10 s | G-PT+L1 10 s | G-PT+L2 40 s "
+        "| G-PT+L1 40 s | predicted / achieved G-PT over PT (40 s) |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for r in results:
+        e10, e40 = r["equal_time"]["10"], r["equal_time"]["40"]
+        i10, i40 = e10["improvement_over_cycles_default"], e40["improvement_over_cycles_default"]
+        cross = r["cross_engine_relmse"]["pt~cycles_unbiased"]
+        agree = f"{cross:.1e}" + (" (void)" if r["void"] else "")
+        lines.append(f"| {r['scene']} | {agree} | {fmt(i10['pt'])} | {fmt(i10['gpt_l1'])} | "
+                     f"{fmt(i40['gpt_l2'])} | {fmt(i40['gpt_l1'])} | "
+                     f"{fmt(r['predicted_improvement'], '.1f')} / "
+                     f"{fmt(e40['achieved_gpt_l2_over_pt'])} |")
+    lines += ["", "A ratio above 1x means a lower error than Cycles in the same time; \"-\" means "
+              "the budget range did not reach that time.", ""]
+    for r in results:
+        lines += [f"## {r['scene']}", ""]
+        if r["void"]:
+            lines += ["**The engines' references disagree on this scene (relMSE "
+                      f"{r['cross_engine_relmse']['pt~cycles_unbiased']:.2e} on 4x4 blocks): the "
+                      "comparison is void until the difference is explained.**", ""]
+        lines += [f"![relMSE against time]({figures[r['scene']][0]})", "",
+                  f"![equal-time crops at {meta['crop_budget']} s]({figures[r['scene']][1]})", "",
+                  "| method | " + " | ".join(f"{b} s" for b in r["budgets"]) + " |",
+                  "| --- |" + " --- |" * len(r["budgets"])]
+        for curve, label in CURVES.items():
+            cells = [f"{p['relmse_denoised']:.2e} ({p['samples']} spp, SSIM {p['ssim']:.3f})"
+                     for p in r["curves"][curve]]
+            lines.append(f"| {label} | " + " | ".join(cells) + " |")
+        fails = [p.get("shift_failures") for p in r["curves"]["gpt_l2"]]
+        lines += ["", f"G-PT cost per sample: {r['gpt_cost_per_sample_over_pt']:.2f}x PT's; "
+                  f"shift failures: {fmt(fails[-1], '.1%', '') if fails else '-'} of shifts; "
+                  "reconstruction share of the time: " +
+                  ", ".join(f"{n.upper()} {v:.1%}" for n, v in r["solve_time_share"].items()) +
+                  f". Predicted improvement of gradient sampling (||F||^2 / ||G||^2 of the "
+                  f"reference): {r['predicted_improvement']:.1f}x.", ""]
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
+
+
+def git(*args):
+    return subprocess.run(["git", "-C", ROOT, *args], capture_output=True, text=True).stdout.strip()
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--build", default=os.path.join(ROOT, "build"))
+    p.add_argument("--quick", action="store_true", help="two scenes, short budgets, 160x120")
+    p.add_argument("--scenes", help="comma-separated subset of " + ",".join(SCENES))
+    p.add_argument("--budgets", help="comma-separated seconds (default 5,10,20,40,80)")
+    p.add_argument("--ref-seconds", type=float, help="seconds per reference half (default 120)")
+    p.add_argument("--res", help="WIDTHxHEIGHT (default 320x240)")
+    p.add_argument("--out-doc", default=os.path.join(ROOT, "docs", "benchmarks.md"))
+    p.add_argument("--results", default=os.path.join(ROOT, "bench", "results"))
+    p.add_argument("--cache", default=os.path.join(ROOT, "bench", "results", "cache"),
+                   help="scenes, references and renders (references are reused)")
+    args = p.parse_args()
+    args.build = os.path.abspath(args.build)
+    quick = args.quick
+    args.scenes = (args.scenes or ("cornell_panel,interior" if quick else ",".join(SCENES))).split(",")
+    args.budgets = [float(b) if "." in b else int(b) for b in
+                    (args.budgets or ("2,4,8" if quick else "5,10,20,40,80")).split(",")]
+    args.ref_seconds = args.ref_seconds or (20.0 if quick else 120.0)
+    args.res = args.res or ("160x120" if quick else "320x240")
+    args.crop_budget = 40 if 40 in args.budgets else args.budgets[-1]
+    unknown = [s for s in args.scenes if s not in SCENES]
+    if unknown:
+        sys.exit(f"run.py: unknown scene(s) {', '.join(unknown)} (known: {', '.join(SCENES)})")
+    doc_dir = os.path.dirname(os.path.abspath(args.out_doc))
+    fig_dir = os.path.join(doc_dir, "benchmarks")
+    os.makedirs(fig_dir, exist_ok=True)
+    os.makedirs(args.results, exist_ok=True)
+    meta = {"commit": git("rev-parse", "--short", "HEAD") + ("+dirty" if git("status", "--porcelain",
+                                                                            "--untracked-files=no") else ""),
+            "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+            "machine": f"{platform.machine()}, {os.cpu_count()} cores",
+            "command": "make bench" + (" QUICK=1" if quick else ""), "crop_budget": args.crop_budget}
+    blender = Blender(args.build)
+    results, figures = [], {}
+    try:
+        for name in args.scenes:
+            print(f"scene {name}", flush=True)
+            result, crops = measure_scene(name, args, blender, lambda s: print(s, flush=True))
+            result["meta"] = meta
+            with open(os.path.join(args.results, f"{name}.json"), "w") as f:
+                json.dump(result, f, indent=1)
+            plot_path = os.path.join(fig_dir, f"{name}_relmse.png")
+            crop_path = os.path.join(fig_dir, f"{name}_crops.png")
+            plot(result, plot_path)
+            save_crops(crops, crop_path)
+            rel = os.path.relpath(fig_dir, doc_dir)
+            figures[name] = (f"{rel}/{name}_relmse.png", f"{rel}/{name}_crops.png")
+            results.append(result)
+    finally:
+        blender.close()
+    write_doc(results, meta, args.out_doc, figures)
+    print(f"wrote {args.out_doc} and {len(results)} result files in {args.results}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The benchmark report's harness end to end on one tiny scene at 1 s budgets: every method
+# renders with its own engine, the JSON holds finite errors for every curve, the engines'
+# references agree, and the page and its figures are written.
+#   test_harness.sh <build-dir> <out-dir>
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+build=$1 out=$2
+rm -rf "$out"
+mkdir -p "$out"
+/usr/bin/python3 "$root/bench/report/run.py" --build "$build" --scenes cornell_panel \
+  --budgets 1,2 --ref-seconds 3 --res 48x36 --results "$out/results" --cache "$out/cache" \
+  --out-doc "$out/doc/benchmarks.md"
+/usr/bin/python3 - "$out" <<'PY'
+import json, math, os, sys
+out = sys.argv[1]
+r = json.load(open(os.path.join(out, "results", "cornell_panel.json")))
+curves = ["cycles_default", "cycles_unbiased", "pt", "gpt_l2", "gpt_l1", "gpt_weighted"]
+for c in curves:
+    pts = r["curves"][c]
+    assert len(pts) == 2, (c, pts)
+    for p in pts:
+        assert p["samples"] > 0 and p["seconds"] > 0, (c, p)
+        assert math.isfinite(p["relmse"]) and 0 < p["relmse"] < 1, (c, p)
+        assert 0 < p["ssim"] <= 1, (c, p)
+    # Twice the time, less error (noise-dominated at these budgets).
+    assert pts[1]["relmse"] < pts[0]["relmse"], (c, pts)
+cross = r["cross_engine_relmse"]["pt~cycles_unbiased"]
+assert cross < 0.01 and not r["void"], cross
+assert 1 < r["predicted_improvement"] < 1e3, r["predicted_improvement"]
+assert 1 < r["gpt_cost_per_sample_over_pt"] < 10, r["gpt_cost_per_sample_over_pt"]
+doc = open(os.path.join(out, "doc", "benchmarks.md")).read()
+assert "## cornell_panel" in doc and "| cornell_panel |" in doc
+for f in ("cornell_panel_relmse.png", "cornell_panel_crops.png"):
+    assert os.path.getsize(os.path.join(out, "doc", "benchmarks", f)) > 1000, f
+print(f"ok: harness wrote every curve; references agree (relMSE {cross:.2e})")
+PY
