@@ -19,7 +19,7 @@
 # with RenderEngine.report; a render then clears the image to black, so a stale result is never
 # composited silently. (Blender's composite_pre handlers do not run for a render's compositing.)
 #
-# Reconstruction rule (docs/blender.md): Image = solve(Primal, Gradient X, Gradient Y) + Emission,
+# Reconstruction rule (docs/user-guide.md): Image = solve(Primal, Gradient X, Gradient Y) + Emission,
 # through `_gdpt.reconstruct`, the same C++ code as the engine and the gdpt-reconstruct CLI.
 import os
 import sys

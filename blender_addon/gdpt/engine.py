@@ -28,7 +28,7 @@ LAST_ERROR = {}  # the last error reported (message), for the same readers
 # Pixel-samples per progressive pass. Every pass ends in a barrier and a film commit, and with
 # 1 spp per pass each sample also finds its pixel's accumulator out of cache: 1-spp passes cost
 # 3% at 320x240 against passes of 13 spp, and several percent more in idle tails on small frames
-# (docs/blender.md, "Passes"). Passes of about this many pixel-samples (0.3-0.5 s on 2 cores)
+# (docs/user-guide.md, "Rendering"). Passes of about this many pixel-samples (0.3-0.5 s on 2 cores)
 # do not; a cancel discards at most one. Frames of 1024x1024 and up keep 1 spp per pass. The
 # count depends only on the frame size, never on time: pass sizes group the sums, so the image
 # stays the same for a seed.
@@ -38,7 +38,7 @@ PASS_PIXEL_SAMPLES = 1 << 20
 # Previews take Blender's thread, and in the solve every core, away from the render: the next one
 # is asked for no sooner than the last one's cost divided by this share after it ended. At
 # 1920x1080 on 2 cores a G-PT preview (L2 solve and write) takes about 0.4 s and cost 0.55 s of
-# render time each: every 3 s that was 20% of the render (docs/blender.md, "Rendering").
+# render time each: every 3 s that was 20% of the render (docs/user-guide.md, "Rendering").
 PREVIEW_MAX_SHARE = 0.05
 
 
@@ -173,7 +173,7 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         t_render = time.perf_counter()
         interval = settings.preview_interval
         # Background renders (blender -b) show no image until it is written, so they take no
-        # previews: at 1920x1080 on 2 cores each cost 0.5 s of G-PT render time (docs/blender.md,
+        # previews: at 1920x1080 on 2 cores each cost 0.5 s of G-PT render time (docs/user-guide.md,
         # "Rendering"). PREVIEWS_IN_BACKGROUND (the environment variable) takes them anyway.
         previews_on = not bpy.app.background or os.environ.get(PREVIEWS_IN_BACKGROUND) == "1"
         state = {"next_preview": t_render + min(1.0, interval), "cancelled": False,

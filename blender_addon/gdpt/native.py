@@ -2,7 +2,7 @@
 #
 # `make build` compiles the core twice on a machine that runs x86-64-v3 code (AVX2, FMA, BMI2):
 # the baseline build (any x86-64 CPU) next to this file, and an x86-64-v3 build in x86-64-v3/,
-# which renders a few percent faster (docs/blender.md, "Module builds"). The small `_gdpt_cpu`
+# which renders a few percent faster (docs/user-guide.md, "Install"). The small `_gdpt_cpu`
 # module, always baseline, reports the CPU's level, and the fastest build it runs is loaded.
 # GDPT_ISA=baseline or GDPT_ISA=x86-64-v3 in the environment forces one; forcing a build the CPU
 # cannot run is an error message, never a crash.

@@ -1,5 +1,5 @@
 # Render settings (scene.gdpt) and per-view-layer pass toggles (view_layer.gdpt).
-# The names of scene.gdpt are part of the contract with tests and tools (see docs/blender.md).
+# The names of scene.gdpt are part of the contract with tests and tools (see docs/conventions.md).
 
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
@@ -35,7 +35,7 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
     # Cycles' Min Light Bounces (Sampling > Advanced) with Cycles' meaning: Russian roulette may
     # end a path only after this many bounces past the first indirect hit (Cycles' kernel counts
     # min_light_bounces + 1), i.e. the core's rr_depth = min_light_bounces + 1. GDPT's default 2
-    # is the core's rr_depth 3, chosen by error at equal cost (docs/integrator.md, "Russian
+    # is the core's rr_depth 3, chosen by error at equal cost (docs/performance.md, "Russian
     # roulette"); Cycles' default is 0.
     min_light_bounces: IntProperty(
         name="Min Light Bounces", description="Minimum number of light bounces before Russian "

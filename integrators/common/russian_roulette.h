@@ -7,7 +7,7 @@
 // below 1 a bright path is never stopped. Against the former rule (q = min(throughput, 0.95) from
 // vertex 5), relMSE x instructions per sample on bench_integrator's scenes is 7% / 14% / 1% lower
 // (Cornell box / textured box / 4-bounce Blender scene), and bench_equal_time's G-PT errors are
-// unchanged within noise: docs/integrator.md, "Russian roulette".
+// unchanged within noise: docs/performance.md.
 #pragma once
 
 #include <algorithm>
@@ -32,7 +32,7 @@ inline float roulette_continuation(Vec3f beta) {
 // ray can find emission (`scene_features`, features.h). After a diffuse bounce next-event
 // estimation already carries nearly all of it, and the roulette takes effect at once. Blender
 // Cornell box: relMSE -3.2% for +0.4% rays; Cycles' order after every bounce gave the same
-// relMSE for +6.2% rays (docs/integrator.md, "Fifteenth session").
+// relMSE for +6.2% rays (docs/performance.md).
 inline bool roulette_past_next_hit(uint32_t lobe, uint32_t scene_features) {
   return !(lobe & kLobeDiffuse) &&
          (scene_features & (kSceneAnalyticLights | kSceneWorld | kSceneEmissiveTriangles)) != 0;

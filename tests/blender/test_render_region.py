@@ -10,7 +10,7 @@
 #
 # "Equal" here allows last-bit differences in a few values: inside Blender, renders of the same
 # scene are not bit-for-bit repeatable (1-3 values of ~3800 off by one ulp, 6e-8, in about a third
-# of the renders; cause not isolated, docs/integrator.md "Known limitations"), while outside
+# of the renders; cause not isolated, docs/conventions.md "Determinism"), while outside
 # Blender they are (the C++ region tests compare exactly). A wrong region offset changes nearly
 # every value.
 #  - the Gradient Reconstruct compositor node: its image is the cropped region, or the frame with
