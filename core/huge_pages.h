@@ -1,10 +1,8 @@
 // Large fresh buffers backed by transparent huge pages (Linux; elsewhere plain allocations).
 //
 // The first touch of fresh memory costs one page fault per 4 KB page. Debian's default THP mode
-// is `madvise`, so a buffer has to ask for huge pages before it is first written. On the 2-core
-// benchmark VM a fault took 10-19 us: zeroing two 1920x1080 PT films (330 MB) took 1.1 s, a
-// 166 MB pass buffer 0.43 s (6 ms touched again), 50 MB of a 1080p solve 200-300 ms; advised,
-// such buffers fault once per 2 MB (the films: 50-60 ms once the process has run a while).
+// is `madvise`, so a buffer has to ask for huge pages before it is first written. Advised, such
+// buffers fault once per 2 MB, which matters at full HD (bench_integrator 0 film measures it).
 // Header-only: the core, the reconstruction library and the Python module share it.
 #pragma once
 

@@ -14,7 +14,7 @@
 namespace gdpt {
 
 // The rotated normal, for valid_reflection_normal below (out of line: rare, and inlined it
-// cost the path loop ~3% more instructions through register pressure).
+// added register pressure to the path loop).
 [[gnu::noinline, gnu::cold]] inline Vec3f rotate_to_valid_reflection(Vec3f ns, Vec3f ng, Vec3f wi,
                                                                      float iz, float t) {
   // In the frame (x, ng), x the unit direction of ns's part orthogonal to ng, the new normal is

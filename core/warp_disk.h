@@ -12,7 +12,7 @@ namespace gdpt {
 
 // The angle is pi/4 * t or pi/2 - pi/4 * t with t in [-1, 1]: sin and cos of pi/4 * t by the
 // polynomials alone (sincos_quarter), the second case by swapping them. libm's sincosf with its
-// range reduction was ~2.4% of a diffuse path tracer's time.
+// range reduction is not needed for these arguments.
 inline Vec2f square_to_disk_concentric(Vec2f u) {
   const float a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
   if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f};

@@ -21,7 +21,7 @@ namespace gdpt::detail {
 
 // Flush-to-zero and denormals-are-zero for the duration of one chunk. CG residuals and IRLS
 // directions decay into the float denormal range late in a solve, and denormal arithmetic is
-// ~100x slower on x86: measured at 960x540, 270 L1 steps took 29 s with denormals, 12 s without.
+// far slower on x86 (docs/reconstruct.md, "Benchmark").
 // Values below 1e-38 are irrelevant to an image. MXCSR is per thread, so it is set per chunk and
 // restored, leaving the caller's threads as they were.
 class FlushDenormals {

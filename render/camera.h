@@ -25,7 +25,7 @@ struct Ray {
   Vec3f direction;  // unit, but for shadow rays to a finite point: the segment, t in [0, 1)
   // Before t_min: t_max and kind then do not sit next to each other as Embree's tfar and mask
   // do, so GCC does not copy them to Embree's ray as one 8-byte load of two fields just stored
-  // separately (a store-forwarding stall on every ray; ~0.5% render time).
+  // separately (a store-forwarding stall on every ray).
   uint32_t kind = kRayCamera;  // RayKind: which instances it sees (Instance::visibility)
   float t_min = 0.0f;
   float t_max = 1e30f;

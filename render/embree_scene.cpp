@@ -23,8 +23,8 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     : scene_(&scene), default_material_(default_material) {
   // Embree's device configuration: $GDPT_EMBREE_CONFIG when set (e.g. "isa=sse4.2", "verbose=2",
   // for benchmarking Embree's kernels on a given machine), else its AVX2 kernels at most. On an
-  // AVX-512 CPU Embree would pick its AVX-512 kernels, which render 1.5-2% slower on Zen 5
-  // (docs/integrator.md, "Fifteenth session").
+  // AVX-512 CPU Embree would pick its AVX-512 kernels, which render slower on Zen 5
+  // (docs/performance.md).
   const char* config = std::getenv("GDPT_EMBREE_CONFIG");
   device_ = rtcNewDevice(config ? config : "max_isa=avx2");
   if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
@@ -35,7 +35,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
   // (kFlattenBudget triangles over all their placements, e.g. a 12-triangle box placed twice) are
   // flattened too: the copies cost less memory than an instance's own bookkeeping, and a ray then
   // skips the instance transform and the second traversal (Cornell box with two instanced
-  // boxes: 12% fewer instructions per sample).
+  // boxes: fewer instructions per sample).
   constexpr size_t kFlattenBudget = 256;
   std::vector<size_t> uses(scene.meshes.size(), 0);
   for (const Instance& inst : scene.instances)
@@ -311,7 +311,7 @@ inline __m128 normalize_or(__m128 v, __m128 fallback) {
 
 void compute_unit_normals(const Vec3f* positions, const uint32_t* indices, size_t tris,
                           float winding, float (*out)[4]) {
-  // In parallel (the caller's arena): about 45 ms per million triangles on one core.
+  // In parallel (the caller's arena): large meshes would otherwise add to the export time.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, tris, 16384),
                     [&](const tbb::blocked_range<size_t>& r) {
                       const __m128 zero = _mm_setzero_ps(), w = _mm_set1_ps(winding);

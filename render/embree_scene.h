@@ -51,8 +51,8 @@ inline ShadingContext shading_context_of(const SurfaceHit& hit) {
 // Moves p off the surface along n (the side the new ray leaves to) by an amount proportional to
 // the floating-point spacing at p, in the spirit of Wächter & Binder (Ray Tracing Gems, ch. 6):
 // integer ULP steps away from the origin, a small absolute step near it.
-// The three components at once in SSE2 lanes (branch-free; the scalar form cost ~60
-// instructions a call, with a data-dependent branch per component); inline, since the call
+// The three components at once in SSE2 lanes (branch-free; the scalar form had
+// a data-dependent branch per component); inline, since the call
 // itself (Vec3f arguments split over registers, a stack round trip for the result) cost as much.
 [[gnu::always_inline]] inline Vec3f offset_ray_origin(const Vec3f& p, const Vec3f& n) {
   // Integer-ULP offset scale and the absolute fallback near the origin (positions whose magnitude

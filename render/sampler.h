@@ -13,9 +13,9 @@
 // with the even vertex's index shuffle and each coordinate Owen-scrambled. The first four
 // dimensions form a (2,m,4)-net, all six a (3,m,6)-net. So a bounce's direction is stratified
 // jointly with the next direction (diffuse interreflection; the floor -> glossy ball -> lamp
-// caustic) and with the lamp sample taken where it lands. In Blender at 32 spp (16 seeds) this
-// lowered relMSE by 4.6% (Cornell box) to 9.4% (textured box) against padded pairs
-// (docs/integrator.md, thirteenth session).
+// caustic) and with the lamp sample taken where it lands. This lowers the error per sample
+// against padded pairs
+// (docs/performance.md).
 //
 // Where SSSE3 and SSE4.1 are available (the x86-64-v3 module build) the coordinate scrambles of
 // a pair, or of a vertex's two pairs, run in SSE lanes (GDPT_SAMPLER_SIMD): the same integer

@@ -4,14 +4,14 @@
 //
 // Drawn one path at a time, each vertex's numbers are a ~70-cycle chain of dependent multiplies
 // (hash, index shuffle, Sobol matrix, Owen scramble); a timing-only variant with an LCG in their
-// place rendered the Blender Cornell box 8% faster. Here the hashes, which depend on the pixel and
-// the dimension but not on the sample index, are computed once per segment (prepare), and each
-// sample's numbers (fill) run eight pixels per AVX2 register: the same integer steps, so the same
-// values, at a fraction of the cost. Numbers of vertices a path never reaches are wasted, hence
-// only the first kMaxVertices; later vertices draw from the Sampler as before.
+// place rendered measurably faster (docs/performance.md). Here the hashes, which depend on the
+// pixel and the dimension but not on the sample index, are computed once per segment (prepare), and
+// each sample's numbers (fill) run eight pixels per AVX2 register: the same integer steps, so the
+// same values, at a fraction of the cost. Numbers of vertices a path never reaches are wasted,
+// hence only the first kMaxVertices; later vertices draw from the Sampler.
 //
 // Without AVX2 (the x86-64 baseline build) no vertex is batched (vertices() is 0: every vertex
-// draws from the Sampler, as fast as before there) and fill() takes each pixel's camera jitter from
+// draws from the Sampler, at no extra cost there) and fill() takes each pixel's camera jitter from
 // its Sampler.
 #pragma once
 

@@ -46,11 +46,9 @@ struct AreaLight {
   static constexpr float kMinSphericalSolidAngle = 1e-3f;
   // Spherical sampling only where the rectangle subtends at least this much, estimated as
   // area cos / d^2 from its centre: its set-up is a chain of square roots, divisions and two
-  // atan2 whose latency cost ~45% of a Cornell-box sample, while below ~0.1 sr (an angular
+  // atan2 on the sample's critical path, while below ~0.1 sr (an angular
   // radius of ~10 degrees) the cosines and 1 / d^2 barely vary over the light, so area sampling
-  // is almost as good (bench_integrator, Cornell box, 16 spp: luminance MSE +2% against
-  // spherical sampling everywhere, +8% for area sampling everywhere; samples per CPU-second
-  // 1.27x, as fast as area sampling everywhere; docs/lights.md).
+  // is almost as good for much less time (docs/lights.md has the measurement).
   static constexpr float kSphericalSolidAngle = 0.1f;
 
   // Whether ref (to = ref - center, h = dot(to, normal) > 0 its height over the plane) samples the
