@@ -4,7 +4,7 @@
 // Images are interleaved RGB float, `width * height * 3`, in rows as stored (the gradient
 // convention dy(x, y) = I(x, y + 1) - I(x, y) refers to those rows).
 //
-// Norms (docs/reconstruct.md has the details and measured numbers):
+// Norms (docs/reconstruct.md has the details and the benchmark):
 //   L2        exact direct solve by the 2-D DCT, in double precision.
 //   L1        IRLS from the L2 solution. The L1 term of a pixel is the Euclidean norm of its RGB
 //             residual (the reweighting weights are shared across RGB, so this is the objective

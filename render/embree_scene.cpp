@@ -261,8 +261,7 @@ namespace {
 
 // complete_hit()'s vector work in SSE2 lanes (x, y, z; w = 0). Each lane does the scalar code's
 // operations in the same order (no FMA contraction on the x86-64 baseline), so hits are
-// bit-identical to the Vec3f form, which GCC half-vectorised with shuffles and spills (~190
-// instructions a hit on the Cornell box).
+// bit-identical to the Vec3f form, which GCC half-vectorised with shuffles and spills.
 inline __m128 load3(const Vec3f& v) {
   const __m128 xy = _mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(&v.x));
   return _mm_movelh_ps(xy, _mm_load_ss(&v.z));
