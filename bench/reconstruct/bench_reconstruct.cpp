@@ -1,6 +1,6 @@
 // bench_reconstruct: cost of the reconstruction solvers at 1920x1080 RGB on 1 and 2 threads.
 //
-//   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] [--l2-only]
+//   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] [--l2-only] [--memory]
 //
 // Reports, per thread count:
 //   - one bare FFTW forward + inverse 2-D DCT of the 3 planes (double, the same cached plans the
@@ -13,8 +13,11 @@
 //   - Weighted time, iterations, exit residual and objective.
 // --sweep also prints the L1 objective and time for a grid of (reweightings, CG steps);
 // --l2-only stops after the DCT pair and the L2 solve (for quick runs while tuning L2).
+// --memory only measures the peak resident memory (getrusage) after one solve of each norm, in the
+// order L2, Weighted, L1: each figure is the process's peak so far, inputs included.
 // Synthetic data: a smooth image with edges; primal noise sigma 0.2 (0.05 in the right half),
 // gradient noise sigma 0.02 plus 1% outliers of +-2 (fireflies); variances match the noise.
+#include <sys/resource.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -121,11 +124,46 @@ Data make_data(int w, int h) {
   return d;
 }
 
+// Peak resident set size of the process so far, in MiB.
+double peak_rss_mib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_maxrss) / 1024.0;
+}
+
+// --memory: the inputs' size, then each solve's time and the peak RSS after it.
+int measure_memory(const Data& d, int threads) {
+  const double mpix = double(d.w) * d.h / 1e6;
+  const double before = peak_rss_mib();
+  std::printf(
+      "memory: %dx%d (%.1f Mpx), inputs %.0f MiB, peak before solving %.0f MiB\n", d.w, d.h, mpix,
+      double(d.truth.size() + d.primal.size() + d.gx.size() + d.gy.size() + d.variance.size()) * 4 /
+          (1 << 20),
+      before);
+  gdpt::ReconstructionInput input{
+      d.w, d.h, d.primal.data(), d.gx.data(), d.gy.data(), d.variance.data(), nullptr};
+  for (const auto norm : {gdpt::ReconstructionNorm::L2, gdpt::ReconstructionNorm::Weighted,
+                          gdpt::ReconstructionNorm::L1}) {
+    gdpt::ReconstructionSettings s;
+    s.threads = threads;
+    s.norm = norm;
+    const auto start = Clock::now();
+    const std::vector<float> out = gdpt::reconstruct(input, s);
+    const double t = seconds_since(start), peak = peak_rss_mib();
+    std::printf("memory: %-8s %.1f s, peak %.0f MiB, %.0f MiB above the inputs (%.1f MiB/Mpx)\n",
+                norm == gdpt::ReconstructionNorm::L2
+                    ? "L2"
+                    : (norm == gdpt::ReconstructionNorm::L1 ? "L1" : "Weighted"),
+                t, peak, peak - before, (peak - before) / mpix);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int width = 1920, height = 1080, only_threads = 0;
-  bool sweep = false, l2_only = false;
+  bool sweep = false, l2_only = false, memory = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--width" && i + 1 < argc)
@@ -138,15 +176,18 @@ int main(int argc, char** argv) {
       sweep = true;
     else if (a == "--l2-only")
       l2_only = true;
+    else if (a == "--memory")
+      memory = true;
     else {
       std::fprintf(stderr,
                    "usage: bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] "
-                   "[--l2-only]\n");
+                   "[--l2-only] [--memory]\n");
       return 2;
     }
   }
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress is visible when piped to a file
   const Data d = make_data(width, height);
+  if (memory) return measure_memory(d, only_threads);
   const size_t px = size_t(width) * height;
   gdpt::ReconstructionInput input{
       width, height, d.primal.data(), d.gx.data(), d.gy.data(), d.variance.data(), nullptr};

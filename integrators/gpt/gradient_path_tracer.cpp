@@ -175,10 +175,6 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   bool rotated;
   Vec3f ns = valid_reflection_normal(hit.front_facing ? hit.shading_normal : -hit.shading_normal,
                                      v.ng, wi_world, rotated);
-  if (dot(ns, wi_world) <= 1e-4f) {
-    ns = v.ng;
-    rotated = true;
-  }
   v.frame = Frame(ns);
   v.wi = v.frame.to_local(wi_world);
   // With bump shadowing where the normal is not the interpolated one, as in PT.
