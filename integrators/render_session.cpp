@@ -24,10 +24,8 @@ namespace {
 // (polled between tiles) is seen almost immediately.
 constexpr int kTileSize = 16;
 // Every pass ends in a barrier, and its idle tail is about half a tile per worker. On small frames
-// tiles are therefore 8 or 4 pixels tall, until each worker has at least this many per pass: a
-// 96x72 frame on 2 workers has 30 16x16 tiles, and its 108 16x4 tiles render 1.5-3% faster
-// (docs/performance.md). Large frames keep 16x16 tiles, whose per-task
-// overhead is smaller.
+// tiles are therefore 8 or 4 pixels tall, until each worker has at least this many per pass.
+// Large frames keep 16x16 tiles, whose per-task overhead is smaller.
 constexpr int kTilesPerWorker = 32;
 // Pixel-samples per render_tile call (16 spp of a full tile): a few milliseconds of PT or G-PT.
 constexpr uint32_t kChunkSamples = 16 * kTileSize * kTileSize;

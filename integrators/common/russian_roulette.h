@@ -4,10 +4,8 @@
 // `rr_depth` and later ones (vertex 0 is the camera ray's hit; RenderSettings::rr_depth, 3), PT
 // and G-PT alike (after glossy bounces it takes effect past the next hit: roulette_past_next_hit).
 // The square root (Cycles' rule) ends dim paths less eagerly than q = throughput, and with no cap
-// below 1 a bright path is never stopped. Against the former rule (q = min(throughput, 0.95) from
-// vertex 5), relMSE x instructions per sample on bench_integrator's scenes is 7% / 14% / 1% lower
-// (Cornell box / textured box / 4-bounce Blender scene), and bench_equal_time's G-PT errors are
-// unchanged within noise: docs/performance.md.
+// below 1 a bright path is never stopped; it beat q = min(throughput, 0.95) in relMSE x cost
+// (docs/integrator.md, "Russian roulette").
 #pragma once
 
 #include <algorithm>
@@ -30,9 +28,8 @@ inline float roulette_continuation(Vec3f beta) {
 // the world) counts undivided, and only what follows is stopped or divided by q. So after glossy
 // and specular bounces, whose lamp light comes mostly from their sampled rays, in scenes where a
 // ray can find emission (`scene_features`, features.h). After a diffuse bounce next-event
-// estimation already carries nearly all of it, and the roulette takes effect at once. Blender
-// Cornell box: relMSE -3.2% for +0.4% rays; Cycles' order after every bounce gave the same
-// relMSE for +6.2% rays (docs/performance.md).
+// estimation already carries nearly all of it, and the roulette takes effect at once (Cycles'
+// order after every bounce costs more rays for the same error).
 inline bool roulette_past_next_hit(uint32_t lobe, uint32_t scene_features) {
   return !(lobe & kLobeDiffuse) &&
          (scene_features & (kSceneAnalyticLights | kSceneWorld | kSceneEmissiveTriangles)) != 0;

@@ -54,6 +54,16 @@ inline double length(Vec3d v) {
 inline Vec3d normalize(Vec3d v) {
   return v / length(v);
 }
+// Component-wise products (throughput times a BSDF value or radiance).
+inline Vec3d mul(Vec3d a, Vec3d b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+inline Vec3d mul(Vec3d a, Vec3f b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+inline bool is_zero(Vec3d a) {
+  return a.x == 0.0 && a.y == 0.0 && a.z == 0.0;
+}
 
 // ---------------------------------------------------------------------------------------------
 // Vertex classification.
@@ -254,7 +264,7 @@ inline HalfVectorShift half_vector_shift(Vec3d base_wi, Vec3d base_wo, Vec3d off
 // The weights of a pair's four techniques sum to one for any density used in place of p_L, p'_L
 // as long as all four see the same function of the light point and its vertex: the integrator
 // weighs area lights with their area-sampling density (mis_light_pdf in
-// gradient_path_tracer.cpp) and passes p_mis^2 / pdf as the light technique's `technique_pdf`,
+// mis_weights.h) and passes p_mis^2 / pdf as the light technique's `technique_pdf`,
 // so that the base term stays divided by the density it was sampled with.
 // ---------------------------------------------------------------------------------------------
 struct PathDensities {

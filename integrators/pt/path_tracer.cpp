@@ -7,11 +7,12 @@
 #include <utility>
 
 #include "core/frame.h"
-#include "core/valid_reflection.h"
-#include "integrators/common/bounce_limits.h"
 #include "integrators/common/bump_shadowing.h"
 #include "integrators/common/data_passes.h"
-#include "integrators/common/russian_roulette.h"
+#include "integrators/common/mis.h"
+#include "integrators/common/path_state.h"
+#include "integrators/common/shadow_ray.h"
+#include "integrators/common/surface_frame.h"
 #include "render/features.h"
 #include "render/sampler.h"
 #include "render/scene_context.h"
@@ -111,6 +112,25 @@ class PathTracer final : public Integrator {
     return ctx_.camera().generate_ray({float(px) + jitter.x, float(py) + jitter.y}, lens);
   }
 
+  // The path's state between vertices.
+  struct Path {
+    PathState state;
+    Spectrum beta{1.0f};                // path throughput f / p
+    float prev_pdf = 0.0f;              // solid-angle pdf of the BSDF sample that spawned the ray
+    bool prev_delta = true;             // no MIS for camera rays and delta lobes
+    Vec3f prev_position;                // the last scattering vertex (NEE ran from there)
+    bool crossed_since_vertex = false;  // transparent crossings since prev_position
+  };
+
+  // A light sample whose shadow ray is traced after the BSDF sample, which does not depend on
+  // it: the sampling and the next ray's set-up then run while Embree traverses the shadow ray.
+  struct PendingShadow {
+    Ray ray;
+    bool pending = false, cast = false;
+    Spectrum beta_f, radiance;  // beta f before this vertex's sample updates beta
+    float scale = 0.0f;         // MIS weight / light pdf
+  };
+
   // The path of one camera sample, from its camera ray already traced (`camera_found`, and `hit`
   // holding the hit when found); `hit` is the path's working hit record from there on.
   // `numbers` holds the pixel's Sampler and first vertices' numbers in lane `lane`.
@@ -118,249 +138,188 @@ class PathTracer final : public Integrator {
                    ClosureSet& closure_scratch, ClosureSet& scratch, SurfaceHit& hit) const {
     const Sampler& sampler = numbers.sampler(lane);
     const EmbreeScene& bvh = ctx_.bvh();
-    const LightSampler& lights = ctx_.lights();
-    const auto& materials = ctx_.materials();
-    const int max_bounces = settings_.max_bounces;
-    const bool has_lights = !lights.empty();
-    const bool needs_selection = lights.needs_selection();
-
     PathResult out;
-    Spectrum beta(1.0f);     // path throughput f / p
-    float prev_pdf = 0.0f;   // solid-angle pdf of the BSDF sample that spawned `ray`
-    bool prev_delta = true;  // no MIS for camera rays and delta lobes
-    Vec3f prev_position = ray.origin;
-
-    int bounce = 0;           // Cycles' bounce count: scattering events, transparent ones excluded
-    int transparent = 0;      // transparent crossings (Cycles' transparent bounces)
-    BounceCounts kinds;       // scattering events by kind, for the per-kind limits
-    bool camera_path = true;  // nothing but transparent crossings since the camera
-    bool crossed_since_vertex = false;  // transparent crossings since prev_position
-    // A roulette that takes effect past the next hit (roulette_past_next_hit): stopped, that hit
-    // is the path's last, traced like the one past the bounce limit; survived, what follows the
-    // hit's emission is divided by the continuation probability.
-    bool rr_stop = false;
-    float rr_divide = 1.0f;
-
-    // `vertex` numbers every surface interaction (sampler dimensions); `bounce` follows Cycles.
+    Path path;
+    path.prev_position = ray.origin;
+    // `vertex` numbers every surface interaction (sampler dimensions); state.bounce follows Cycles.
     for (int vertex = 0;; ++vertex) {
-      // Past the bounce limits a vertex only ends the path: without emissive triangles its hit
-      // needs no record, only the distance (analytic lights in front of it, the world behind).
-      const bool last = rr_stop || bounce > max_bounces || transparent > kMaxTransparentBounces ||
-                        kinds.over(settings_);
+      const bool last = path.state.last(settings_);
       // Drawn before the ray is traced, to run alongside it (Sampler::vertex_numbers).
       Sampler::VertexNumbers u;
       if (!last) u = numbers.vertex_numbers(lane, vertex);
-      const bool found = vertex == 0          ? camera_found
-                         : !kEmissive && last ? bvh.intersect_distance(ray, hit.t)
-                                              : bvh.intersect(ray, hit);
+      const bool found = vertex == 0                      ? camera_found
+                         : distance_only(last, kEmissive) ? bvh.intersect_distance(ray, hit.t)
+                                                          : bvh.intersect(ray, hit);
       ++out.rays;
-      const float t_hit = found ? hit.t : ray.t_max;
-
-      // --- Analytic lights in front of the surface (camera rays see a lamp only when its object
-      // is visible to the camera, Blender's Object.visible_camera, off by default as in Cycles) ---
-      if constexpr (kAnalytic) {
-        LightHit lh;
-        if (lights.intersect(ray.origin, ray.direction, t_hit, lh)) {
-          if (camera_path) {
-            if (lh.camera_visible) out.emission += beta * lh.radiance;
-          } else {
-            float light_pdf = lh.pdf;
-            if (!prev_delta && crossed_since_vertex) {
-              // NEE ran from prev_position, behind the transparent surfaces just crossed: its
-              // density for this light is the one seen from there along the same line.
-              LightHit from_vertex;
-              if (lights.intersect(prev_position, ray.direction, kInf, from_vertex) &&
-                  std::fabs(from_vertex.distance - length(lh.position - prev_position)) <=
-                      1e-3f * from_vertex.distance)
-                light_pdf = from_vertex.pdf;
-            }
-            const float w = prev_delta ? 1.0f : power_heuristic(prev_pdf, light_pdf);
-            out.primal += beta * lh.radiance * w;
-          }
-        }
-      }
-
-      // --- Escape: the world (with a transparent background, a camera path that gets here
-      // leaves it out and reports the transparency it crossed: Cycles' alpha) ---
+      if constexpr (kAnalytic) lamps_before(path, ray, found ? hit.t : ray.t_max, out);
       if (!found) {
-        if (camera_path && settings_.transparent_background) out.alpha = uncovered_alpha(beta);
-        if constexpr (kWorld) {
-          if (camera_path) {  // the world as camera rays see it (World::camera_view)
-            if (!settings_.transparent_background)
-              out.emission += beta * lights.camera_environment(ray.direction);
-          } else if (const Spectrum le = lights.environment(ray.direction); !is_black(le)) {
-            const float w = prev_delta
-                                ? 1.0f
-                                : power_heuristic(prev_pdf, lights.pdf_environment(ray.direction));
-            out.primal += beta * le * w;
-          }
-        }
+        escape(path, ray, out);
         break;
       }
-
-      if (!kEmissive && last) break;
-
-      // --- Holdout: the camera path ends here with nothing added; with a transparent
-      // background the coverage is what the transparent surfaces crossed so far took (Cycles) ---
-      if (camera_path && ctx_.has_holdout() && ctx_.is_holdout(hit)) {
-        if (settings_.transparent_background) out.alpha = uncovered_alpha(beta);
+      if (distance_only(last, kEmissive)) break;
+      if (holdout_ends_path(ctx_, path.state.camera_path, hit)) {
+        // Nothing added; the coverage is what the transparent surfaces crossed so far took.
+        path.state.set_alpha(settings_, path.beta, out.alpha);
         break;
       }
 
       // --- Shading point ---
       const ShadingContext sc = shading_context_of(hit);
-      const Material& material = materials[size_t(hit.material)];
-      if constexpr (kEmissive) {
-        if (material.is_emissive()) {
-          const Spectrum le = material.emission(sc);
-          if (camera_path) {
-            out.emission += beta * le;
-          } else if (!is_black(le)) {
-            float w = 1.0f;
-            if (!prev_delta)
-              w = power_heuristic(prev_pdf,
-                                  lights.pdf_triangle(hit.instance, hit.primitive, prev_position,
-                                                      hit.position, hit.geometric_normal));
-            out.primal += beta * le * w;
-          }
-        }
-      }
+      const Material& material = ctx_.materials()[size_t(hit.material)];
+      if constexpr (kEmissive)
+        if (material.is_emissive()) emitter_hit(path, hit, material.emission(sc), out);
       if (last) break;
-      if (rr_divide != 1.0f) [[unlikely]] {  // survived the roulette: what follows is divided
-        beta /= rr_divide;
-        rr_divide = 1.0f;
-      }
+      if (const float q = path.state.take_deferred_division(); q != 1.0f) [[unlikely]]
+        path.beta /= q;
       const ClosureSet& material_closures = material.closures(sc, closure_scratch);
-      if (camera_path && data_.active()) data_.at_surface(hit, material_closures, beta, out.data);
+      if (path.state.camera_path && data_.active())
+        data_.at_surface(hit, material_closures, path.beta, out.data);
       if (!material_closures.has_bsdf()) break;
-
-      // Frame facing the incoming ray (Cycles flips N and Ng for back faces; materials learn the
-      // side from ShadingContext::front_facing). A shading normal that would mirror wi below the
-      // surface is rotated towards ng as Cycles does (valid_reflection_normal), which keeps
-      // smooth shading continuous at silhouettes, instead of snapping to the flat normal.
       const Vec3f wi_world = -ray.direction;
-      const Vec3f ng = hit.front_facing ? hit.geometric_normal : -hit.geometric_normal;
-      bool rotated;
-      const Vec3f ns = valid_reflection_normal(
-          hit.front_facing ? hit.shading_normal : -hit.shading_normal, ng, wi_world, rotated);
-      const Frame frame(ns);
+      const SurfaceFrame sf = facing_frame(hit, wi_world);
+      const Frame frame(sf.ns);
       const Vec3f wi = frame.to_local(wi_world);
       // With bump shadowing where the normal is not the interpolated one (bump_shadowing.h).
-      const ClosureSet& closures =
-          shading_closures(material_closures, closure_scratch, hit, frame, ng, wi_world, rotated);
+      const ClosureSet& closures = shading_closures(material_closures, closure_scratch, hit, frame,
+                                                    sf.ng, wi_world, sf.rotated);
 
-      // --- Next-event estimation: the light sample and its BSDF value. Its shadow ray is traced
-      // after the BSDF sample below, which does not depend on it: the sampling and the next
-      // ray's set-up then run while Embree traverses the shadow ray, instead of delaying the
-      // next traversal.
-      Ray shadow;
-      bool shadow_pending = false;
-      bool shadow_cast = false;
-      Spectrum nee_beta_f, nee_radiance;  // beta f before this vertex's sample updates beta
-      float nee_scale = 0.0f;             // MIS weight / light pdf
-      if (has_lights) {
-        // Dimensions are indexed, not streamed: skipping an unused one changes no other value.
-        const float u_select =
-            needs_selection ? sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kLightSelect))
-                            : 0.0f;
-        const LightSample ls = lights.sample(hit.position, u_select, u.light);
-        if (ls.valid && ls.pdf > 0.0f && !is_black(ls.radiance)) {
-          const Vec3f wo = frame.to_local(ls.direction);
-          const float cos_ng = dot(ls.direction, ng);
-          // The geometric and shading hemispheres must agree, or light leaks through the surface.
-          if (closures.side_ok(wo, cos_ng)) {
-            float bsdf_pdf;
-            const Spectrum f = closures.eval_pdf(wi, wo, bsdf_pdf);
-            if (!is_black(f)) {
-              shadow.origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);
-              shadow.direction = ls.direction;
-              shadow.t_min = 0.0f;
-              shadow.kind = kRayShadow;
-              // Stop short of the light's own surface (emissive triangles are geometry too),
-              // aiming from the offset origin: the offset shortens the path to a light surface
-              // by up to offset / cos, which at grazing angles (a ceiling just above a panel)
-              // exceeded the 1e-4 margin and made the emitter occlude itself.
-              // A finite light point is aimed at with the segment itself as the direction, t in
-              // [0, 1): no normalisation for an occlusion query.
-              shadow.t_max = kInf;
-              if (!ls.is_infinite) {
-                shadow.direction = ls.position - shadow.origin;
-                shadow.t_max = 1.0f - 1e-4f;
-              }
-              shadow_pending = true;
-              shadow_cast = ls.cast_shadow;
-              nee_beta_f = beta * f;
-              nee_radiance = ls.radiance;
-              nee_scale = (ls.is_delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf)) / ls.pdf;
-            }
-          }
-        }
-      }
-
-      // --- BSDF sampling: the direction the path continues in ---
-      const float u_lobe = closures.uses_lobe_choice()
-                               ? sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kBsdfLobe))
-                               : 0.0f;
-      const BsdfSample bs = closures.sample(wi, u_lobe, u.dir);
-      bool continues = bs.valid && bs.pdf > 0.0f && !is_black(bs.value);
-      const Vec3f wo_world = frame.to_world(bs.wo);
-      const float cos_wo_ng = dot(wo_world, ng);
-      continues = continues && closures.side_ok(bs.wo, cos_wo_ng);
-      if (continues) {
-        beta *= bs.value / bs.pdf;
-        // A transparent crossing (straight through, eta 1) is not a bounce, keeps the
-        // camera-path status and keeps the MIS state of the last real scattering vertex: shadow
-        // rays see through transparent surfaces too (transmittance()), so the NEE density from
-        // that vertex is still the competing technique.
-        const bool crossing = bs.is_straight_crossing();
-        if (crossing) {
-          ++transparent;
-          crossed_since_vertex = true;
-        } else {
-          crossed_since_vertex = false;
-          prev_delta = bs.is_delta();
-          prev_pdf = bs.pdf;
-          prev_position = hit.position;
-          camera_path = false;
-          ++bounce;
-        }
-
-        // --- Russian roulette (real bounces only) ---
-        if (!crossing && bounce - 1 >= settings_.rr_depth) {
-          const float q = roulette_continuation(beta);
-          if (q < 1.0f) {
-            // Either order is unbiased, as long as the survivors match the stopped paths.
-            const bool last_ray = roulette_past_next_hit(bs.lobe, ctx_.scene_features());
-            const bool survive = sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kRoulette)) < q;
-            if (survive && last_ray)
-              rr_divide = q;  // from after the next hit's emission on
-            else if (survive)
-              beta /= q;
-            else if (last_ray)
-              rr_stop = true;  // the last ray, for the lamp, emitter or world it may find
-            else
-              continues = false;
-          }
-        }
-
-        ray.origin = offset_ray_origin(hit.position, cos_wo_ng > 0.0f ? ng : -ng);
-        ray.direction = normalize(wo_world);
-        ray.t_min = 0.0f;
-        ray.t_max = kInf;
-        if (!crossing) {  // a crossing keeps the kind and counts for no limit
-          ray.kind = ray_kind_of_lobe(bs.lobe);
-          kinds.add(ray.kind);
-        }
-      }
-
-      // --- The NEE's shadow ray ---
-      if (shadow_pending) {
-        const Spectrum tr = shadow_cast ? transmittance(shadow, scratch, out.rays) : Spectrum(1.0f);
-        if (!is_black(tr)) out.primal += nee_beta_f * tr * nee_radiance * nee_scale;
+      const PendingShadow nee =
+          sample_light(path, hit, frame, sf.ng, wi, closures, sampler, u, vertex);
+      const bool continues = extend(path, hit, frame, sf.ng, wi, closures, sampler, u, vertex, ray);
+      if (nee.pending) {
+        const Spectrum tr = nee.cast ? transmittance(nee.ray, scratch, out.rays) : Spectrum(1.0f);
+        if (!is_black(tr)) out.primal += nee.beta_f * tr * nee.radiance * nee.scale;
       }
       if (!continues) break;
     }
     return out;
+  }
+
+  // Analytic lights the ray crosses before `t_hit`. Camera rays see a lamp only when its object
+  // is visible to the camera (Blender's Object.visible_camera, off by default as in Cycles).
+  void lamps_before(const Path& path, const Ray& ray, float t_hit, PathResult& out) const {
+    const LightSampler& lights = ctx_.lights();
+    LightHit lh;
+    if (!lights.intersect(ray.origin, ray.direction, t_hit, lh)) return;
+    if (path.state.camera_path) {
+      if (lh.camera_visible) out.emission += path.beta * lh.radiance;
+      return;
+    }
+    float light_pdf = lh.pdf;
+    if (!path.prev_delta && path.crossed_since_vertex) {
+      // NEE ran from prev_position, behind the transparent surfaces just crossed: its density
+      // for this light is the one seen from there along the same line.
+      LightHit from_vertex;
+      if (lights.intersect(path.prev_position, ray.direction, kInf, from_vertex) &&
+          std::fabs(from_vertex.distance - length(lh.position - path.prev_position)) <=
+              1e-3f * from_vertex.distance)
+        light_pdf = from_vertex.pdf;
+    }
+    const float w = path.prev_delta ? 1.0f : power_heuristic(path.prev_pdf, light_pdf);
+    out.primal += path.beta * lh.radiance * w;
+  }
+
+  // The ray left the scene: the world (with a transparent background a camera path leaves it
+  // out and reports the transparency it crossed).
+  void escape(const Path& path, const Ray& ray, PathResult& out) const {
+    path.state.set_alpha(settings_, path.beta, out.alpha);
+    if constexpr (kWorld) {
+      const LightSampler& lights = ctx_.lights();
+      if (path.state.camera_path) {  // the world as camera rays see it (World::camera_view)
+        if (!settings_.transparent_background)
+          out.emission += path.beta * lights.camera_environment(ray.direction);
+      } else if (const Spectrum le = lights.environment(ray.direction); !is_black(le)) {
+        const float w = path.prev_delta
+                            ? 1.0f
+                            : power_heuristic(path.prev_pdf, lights.pdf_environment(ray.direction));
+        out.primal += path.beta * le * w;
+      }
+    }
+  }
+
+  // Emission `le` of an emissive triangle the ray hit.
+  void emitter_hit(const Path& path, const SurfaceHit& hit, Spectrum le, PathResult& out) const {
+    if (path.state.camera_path) {
+      out.emission += path.beta * le;
+    } else if (!is_black(le)) {
+      float w = 1.0f;
+      if (!path.prev_delta)
+        w = power_heuristic(path.prev_pdf, ctx_.lights().pdf_triangle(
+                                               hit.instance, hit.primitive, path.prev_position,
+                                               hit.position, hit.geometric_normal));
+      out.primal += path.beta * le * w;
+    }
+  }
+
+  // Next-event estimation: the light sample and its BSDF value; the shadow ray is the caller's.
+  PendingShadow sample_light(const Path& path, const SurfaceHit& hit, const Frame& frame, Vec3f ng,
+                             Vec3f wi, const ClosureSet& closures, const Sampler& sampler,
+                             const Sampler::VertexNumbers& u, int vertex) const {
+    PendingShadow nee;
+    const LightSampler& lights = ctx_.lights();
+    if (lights.empty()) return nee;
+    // Dimensions are indexed, not streamed: skipping an unused one changes no other value.
+    const float u_select = lights.needs_selection()
+                               ? sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kLightSelect))
+                               : 0.0f;
+    const LightSample ls = lights.sample(hit.position, u_select, u.light);
+    if (!ls.valid || !(ls.pdf > 0.0f) || is_black(ls.radiance)) return nee;
+    const Vec3f wo = frame.to_local(ls.direction);
+    const float cos_ng = dot(ls.direction, ng);
+    // The geometric and shading hemispheres must agree, or light leaks through the surface.
+    if (!closures.side_ok(wo, cos_ng)) return nee;
+    float bsdf_pdf;
+    const Spectrum f = closures.eval_pdf(wi, wo, bsdf_pdf);
+    if (is_black(f)) return nee;
+    const Vec3f origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);
+    nee.ray = ls.is_infinite ? shadow_ray_to_infinity(origin, ls.direction, kRayShadow)
+                             : shadow_ray_to_point(origin, ls.position, kRayShadow);
+    nee.pending = true;
+    nee.cast = ls.cast_shadow;
+    nee.beta_f = path.beta * f;
+    nee.radiance = ls.radiance;
+    nee.scale = (ls.is_delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf)) / ls.pdf;
+    return nee;
+  }
+
+  // BSDF sampling, the roulette and the next ray. False when the path ends here.
+  bool extend(Path& path, const SurfaceHit& hit, const Frame& frame, Vec3f ng, Vec3f wi,
+              const ClosureSet& closures, const Sampler& sampler, const Sampler::VertexNumbers& u,
+              int vertex, Ray& ray) const {
+    const float u_lobe = closures.uses_lobe_choice()
+                             ? sampler.get1d(Sampler::bounce_dim(vertex, Sampler::kBsdfLobe))
+                             : 0.0f;
+    const BsdfSample bs = closures.sample(wi, u_lobe, u.dir);
+    const Vec3f wo_world = frame.to_world(bs.wo);
+    const float cos_wo_ng = dot(wo_world, ng);
+    if (!(bs.valid && bs.pdf > 0.0f && !is_black(bs.value)) || !closures.side_ok(bs.wo, cos_wo_ng))
+      return false;
+    path.beta *= bs.value / bs.pdf;
+    // A transparent crossing keeps the MIS state of the last real scattering vertex: shadow rays
+    // see through transparent surfaces too (transmittance()), so the NEE density from that
+    // vertex is still the competing technique.
+    const bool crossing = bs.is_straight_crossing();
+    const uint32_t kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
+    path.state.count_event(crossing, kind);
+    path.crossed_since_vertex = crossing;
+    bool continues = true;
+    if (!crossing) {
+      path.prev_delta = bs.is_delta();
+      path.prev_pdf = bs.pdf;
+      path.prev_position = hit.position;
+      const float q = path.state.roulette(settings_, ctx_.scene_features(), path.beta, bs.lobe,
+                                          sampler, vertex);
+      if (q == 0.0f)
+        continues = false;
+      else if (q != 1.0f)
+        path.beta /= q;
+    }
+    ray.origin = offset_ray_origin(hit.position, cos_wo_ng > 0.0f ? ng : -ng);
+    ray.direction = normalize(wo_world);
+    ray.t_min = 0.0f;
+    ray.t_max = kInf;
+    ray.kind = kind;  // a crossing keeps the kind
+    return continues;
   }
 
   const SceneContext& ctx_;

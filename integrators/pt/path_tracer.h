@@ -29,10 +29,5 @@ namespace gdpt {
 
 // Features the path tracer kernel is specialised on (a subset of features.h bits).
 uint32_t path_tracer_specialised_features(uint32_t scene_features);
-// Power heuristic with one sample per technique: a^2 / (a^2 + b^2), 0 when both are 0.
-inline float power_heuristic(float a, float b) {
-  const float a2 = a * a, b2 = b * b;
-  return a2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
-}
 
 }  // namespace gdpt

@@ -1,0 +1,93 @@
+// A shading point of a G-PT path (base or offset): its hit, the frame facing the incoming ray and
+// its closures, set up as the path tracer sets up its vertices.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "core/frame.h"
+#include "render/embree_scene.h"
+#include "render/scene_context.h"
+#include "shaders/bsdf.h"
+
+namespace gdpt {
+
+struct Vertex {
+  SurfaceHit hit;
+  Frame frame;
+  Vec3f ng;  // geometric normal on the side of the incoming ray
+  Vec3f wi;  // local incoming direction
+  // The closures: a constant material's own set (no copy), else `own` filled by evaluate().
+  // A Vertex is never copied or moved (it lives in PathScratch), so `closures` may point into it.
+  const ClosureSet* closures = nullptr;
+  ClosureSet own;
+  float roughness = 1.0f;  // ClosureSet::roughness(), 1 for a vertex without BSDF
+  // A single Lambert lobe: eval() and pdf() depend on wi only through the sign of wi.z * wo.z,
+  // so an offset sharing this vertex with another wi reuses the base's values (same_side()).
+  bool lambert = false;
+  // offset_ray_origin() on the side of ng, computed on first use (ray_origin()): light samples,
+  // the extension ray and reconnection rays of a vertex mostly leave on that side.
+  mutable bool origin_set = false;
+  mutable Vec3f origin;
+};
+
+// Origin of a ray leaving `v` on the side of ng (`front`) or the other side.
+inline Vec3f ray_origin(const Vertex& v, bool front) {
+  if (!front) return offset_ray_origin(v.hit.position, -v.ng);
+  if (!v.origin_set) {
+    v.origin = offset_ray_origin(v.hit.position, v.ng);
+    v.origin_set = true;
+  }
+  return v.origin;
+}
+
+// Whether a single-Lambert vertex gives wi_a and wi_b the same eval() and pdf() for wo: the
+// lobe's only use of wi is the test wi.z * wo.z > 0 (shaders/bsdf_lambert.h), so equal test
+// outcomes mean bit-identical values.
+inline bool same_side(const Vertex& v, Vec3f wi_a, Vec3f wi_b, Vec3f wo) {
+  return v.lambert && (wi_a.z * wo.z > 0.0f) == (wi_b.z * wo.z > 0.0f);
+}
+
+// Local outgoing direction at `v` for world `dir`; false when the geometric and shading
+// hemispheres disagree (the path tracer's leak test).
+inline bool local_dir(const Vertex& v, Vec3f dir, Vec3f& wo) {
+  wo = v.frame.to_local(dir);
+  return v.closures->side_ok(wo, dot(dir, v.ng));
+}
+
+// What a vertex needs of a material side whose closures do not vary over the surface
+// (Material::closures returns its cached set): the set itself, its roughness and whether it is a
+// single Lambert lobe, computed once per material and side. `set` is null for a material that
+// is evaluated per hit (textures).
+struct MaterialSide {
+  const ClosureSet* set = nullptr;
+  float roughness = 1.0f;
+  bool lambert = false;
+};
+
+// Indexed by 2 * material + front_facing.
+std::vector<MaterialSide> material_sides(const SceneContext& ctx);
+
+// ClosureSet::roughness(), 1 for a set without BSDF.
+float vertex_roughness(const ClosureSet& cs);
+
+// The roughness of the material at `h` without setting up a vertex there.
+float hit_roughness(const SceneContext& ctx, std::span<const MaterialSide> sides,
+                    const SurfaceHit& h);
+
+// Sets up `v` at its hit v.hit reached along `dir` (world, unit). (The base's next hit is traced
+// into v.hit directly: no copy.)
+void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides, const Vec3f& dir,
+                   Vertex& v);
+
+// The same at a copy of `hit`.
+inline void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
+                         const SurfaceHit& hit, const Vec3f& dir, Vertex& v) {
+  v.hit = hit;
+  finish_vertex(ctx, sides, dir, v);
+}
+
+// Emitted radiance of an emissive triangle at `hit` towards the point `from`.
+Spectrum triangle_emission(const SceneContext& ctx, const SurfaceHit& hit, Vec3f from);
+
+}  // namespace gdpt
