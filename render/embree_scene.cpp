@@ -180,6 +180,12 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
   const RTCError err = rtcGetDeviceError(device_);
   if (err != RTC_ERROR_NONE)
     throw std::runtime_error("Embree: scene build failed with error " + std::to_string(int(err)));
+  RTCBounds b;
+  rtcGetSceneBounds(top_, &b);
+  const float extent = std::max({std::fabs(b.lower_x), std::fabs(b.lower_y), std::fabs(b.lower_z),
+                                 std::fabs(b.upper_x), std::fabs(b.upper_y), std::fabs(b.upper_z)});
+  // An empty scene has inverted (infinite) bounds: keep the unit scale.
+  if (std::isfinite(extent) && extent > 0.0f) offset_scale_ = std::min(extent, 1.0f);
 }
 
 void EmbreeScene::set_materials(std::span<const Material> materials) {

@@ -50,11 +50,13 @@ inline ShadingContext shading_context_of(const SurfaceHit& hit) {
 
 // Moves p off the surface along n (the side the new ray leaves to) by an amount proportional to
 // the floating-point spacing at p, in the spirit of Wächter & Binder (Ray Tracing Gems, ch. 6):
-// integer ULP steps away from the origin, a small absolute step near it.
+// integer ULP steps away from the origin, a small absolute step near it. `scale`
+// (EmbreeScene::offset_scale()) shrinks that absolute step and region with scenes smaller than a
+// unit, so a scene modelled in tenths of a millimetre is not offset by a tenth of its size.
 // The three components at once in SSE2 lanes (branch-free; the scalar form had
 // a data-dependent branch per component); inline, since the call
 // itself (Vec3f arguments split over registers, a stack round trip for the result) cost as much.
-[[gnu::always_inline]] inline Vec3f offset_ray_origin(const Vec3f& p, const Vec3f& n) {
+[[gnu::always_inline]] inline Vec3f offset_ray_origin(const Vec3f& p, const Vec3f& n, float scale) {
   // Integer-ULP offset scale and the absolute fallback near the origin (positions whose magnitude
   // is below kOriginRegion have too few ULPs to step by integers meaningfully).
   constexpr float kOriginRegion = 1.0f / 32.0f;
@@ -69,9 +71,9 @@ inline ShadingContext shading_context_of(const SurfaceHit& hit) {
   const __m128 stepped =
       _mm_castsi128_ps(_mm_add_epi32(bits, _mm_sub_epi32(_mm_xor_si128(of, sign), sign)));
   // Near the origin an absolute step.
-  const __m128 absolute = _mm_add_ps(P, _mm_mul_ps(N, _mm_set1_ps(kFloatScale)));
+  const __m128 absolute = _mm_add_ps(P, _mm_mul_ps(N, _mm_set1_ps(kFloatScale * scale)));
   const __m128 abs_p = _mm_andnot_ps(_mm_set1_ps(-0.0f), P);
-  const __m128 near = _mm_cmplt_ps(abs_p, _mm_set1_ps(kOriginRegion));
+  const __m128 near = _mm_cmplt_ps(abs_p, _mm_set1_ps(kOriginRegion * scale));
   const __m128 r = _mm_or_ps(_mm_and_ps(near, absolute), _mm_andnot_ps(near, stepped));
   alignas(16) float out[4];
   _mm_store_ps(out, r);
@@ -127,6 +129,9 @@ class EmbreeScene {
     t = rh.ray.tfar;
     return true;
   }
+  // The scale of offset_ray_origin(): the largest coordinate magnitude of the scene's bounds,
+  // at most 1 (larger scenes keep the unit step, which their integer ULP steps already exceed).
+  float offset_scale() const { return offset_scale_; }
   // True when something blocks the segment (t_min, t_max).
   [[gnu::always_inline]] bool occluded(const Ray& ray) const {
     RTCIntersectContext ctx;
@@ -229,6 +234,7 @@ class EmbreeScene {
   };
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;
+  float offset_scale_ = 1.0f;
   std::vector<RTCScene> mesh_scenes_;
   std::vector<HugePageVector<UnitNormal>> unit_normals_;  // InstanceData::unit_normals' storage
   std::vector<InstanceData> instances_;                   // indexed by top-level Embree geometry id

@@ -128,7 +128,7 @@ Spectrum SceneContext::transmittance(Ray ray, ClosureSet& scratch, uint32_t& ray
     if (is_black(tr)) return tr;
     const Vec3f n =
         dot(ray.direction, h.geometric_normal) > 0.0f ? h.geometric_normal : -h.geometric_normal;
-    ray.origin = offset_ray_origin(h.position, n);
+    ray.origin = offset_ray_origin(h.position, n, bvh_->offset_scale());
     ray.t_max -= h.t;
     ++rays;
   }

@@ -65,6 +65,7 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   // A lobe about its own normal reads more of wi than the side (same_side()).
   if (v.closures->has_own_frames()) v.lambert = false;
   v.origin_set = false;
+  v.offset_scale = ctx.bvh().offset_scale();
 }
 
 Spectrum triangle_emission(const SceneContext& ctx, const SurfaceHit& hit, Vec3f from) {

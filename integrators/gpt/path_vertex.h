@@ -29,13 +29,14 @@ struct Vertex {
   // the extension ray and reconnection rays of a vertex mostly leave on that side.
   mutable bool origin_set = false;
   mutable Vec3f origin;
+  float offset_scale = 1.0f;  // EmbreeScene::offset_scale(), for offset_ray_origin()
 };
 
 // Origin of a ray leaving `v` on the side of ng (`front`) or the other side.
 inline Vec3f ray_origin(const Vertex& v, bool front) {
-  if (!front) return offset_ray_origin(v.hit.position, -v.ng);
+  if (!front) return offset_ray_origin(v.hit.position, -v.ng, v.offset_scale);
   if (!v.origin_set) {
-    v.origin = offset_ray_origin(v.hit.position, v.ng);
+    v.origin = offset_ray_origin(v.hit.position, v.ng, v.offset_scale);
     v.origin_set = true;
   }
   return v.origin;

@@ -271,7 +271,8 @@ class PathTracer final : public Integrator {
     float bsdf_pdf;
     const Spectrum f = closures.eval_pdf(wi, wo, bsdf_pdf);
     if (is_black(f)) return nee;
-    const Vec3f origin = offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng);
+    const Vec3f origin =
+        offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng, ctx_.bvh().offset_scale());
     nee.ray = ls.is_infinite ? shadow_ray_to_infinity(origin, ls.direction, kRayShadow)
                              : shadow_ray_to_point(origin, ls.position, kRayShadow);
     nee.pending = true;
@@ -314,7 +315,8 @@ class PathTracer final : public Integrator {
       else if (q != 1.0f)
         path.beta /= q;
     }
-    ray.origin = offset_ray_origin(hit.position, cos_wo_ng > 0.0f ? ng : -ng);
+    ray.origin =
+        offset_ray_origin(hit.position, cos_wo_ng > 0.0f ? ng : -ng, ctx_.bvh().offset_scale());
     ray.direction = normalize(wo_world);
     ray.t_min = 0.0f;
     ray.t_max = kInf;

@@ -102,7 +102,7 @@ TEST(HardCases, MegawattLightsScaleTheImageLinearly) {
 // A scene modelled in 0.1 mm or in 10 km units renders the same image: ray offsets, shadow-ray
 // ends, light-sample distances and clipping must be relative to the scene, not absolute. The
 // scaled render (same seed) must be as close to the unit-scale one as a second seed is.
-TEST(HardCases, DISABLED_UnitScaleDoesNotChangeTheImage) {
+TEST(HardCases, UnitScaleDoesNotChangeTheImage) {
   const Scene base = make_scene(SceneKind::MixedLights, 24);
   for (const Mode m : kModes) {
     const Passes ref = render(base, settings(m, 256, 21));

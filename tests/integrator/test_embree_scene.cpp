@@ -240,7 +240,7 @@ TEST(EmbreeScene, OffsetRaysDoNotSelfIntersectFarFromTheOrigin) {
     const float phi = 2.0f * kPi * v.x, cos_t = 0.001f + 0.05f * v.y;
     const float sin_t = std::sqrt(1.0f - cos_t * cos_t);
     Ray out;
-    out.origin = offset_ray_origin(hit.position, n);
+    out.origin = offset_ray_origin(hit.position, n, bvh.offset_scale());
     out.direction = f.to_world({sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t});
     SurfaceHit again;
     if (bvh.intersect(out, again)) ++self_hits;
