@@ -42,6 +42,11 @@ install-addon: build
 test: build install-addon
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
+# libFuzzer targets (clang, in build-fuzz/), each run for FUZZ_SECONDS (scripts/fuzz.sh).
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	FUZZ_SECONDS=$(FUZZ_SECONDS) JOBS=$(JOBS) bash scripts/fuzz.sh build-fuzz
+
 demo: build install-addon
 	bash scripts/demo.sh $(BUILD)
 

@@ -5,6 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   cmake make g++ pkg-config clang-format
+  clang libclang-rt-14-dev llvm
   libembree-dev libtbb-dev
   libopenimageio-dev openimageio-tools libopenexr-dev
   libopencolorio-dev

@@ -37,3 +37,15 @@ def light_dict(obj, matrix, warn):
         d["size_x"] = float(light.size)
         d["size_y"] = float(light.size_y if light.shape in {'RECTANGLE', 'ELLIPSE'} else light.size)
     return d
+
+
+def light_problem(obj):
+    """Why light object `obj` cannot light anything (a message), or None."""
+    light = obj.data
+    if light.energy == 0.0 or max(light.color) <= 0.0:
+        return f"light '{obj.name}' has zero strength: it adds no light"
+    if light.type == 'AREA':
+        size_y = light.size_y if light.shape in {'RECTANGLE', 'ELLIPSE'} else light.size
+        if light.size <= 0.0 or size_y <= 0.0:
+            return f"light '{obj.name}' has zero area: it emits nothing (skipped)"
+    return None

@@ -253,7 +253,13 @@ class GeometryExporter:
         return index
 
     def _add_mesh(self, mesh, tangents, colors):
-        return add_mesh(self.builder, mesh, tangents, self.warn, colors)
+        # The module rejects malformed arrays (NaN vertices, indices out of range) with a
+        # ValueError naming the array: the render goes on without that mesh.
+        try:
+            return add_mesh(self.builder, mesh, tangents, self.warn, colors)
+        except ValueError as e:
+            self.warn(f"mesh '{mesh.name}' skipped: {e}")
+            return -1
 
     def visit(self, inst, obj, matrix):
         """Adds one instance of geometry object `obj` placed by `matrix` (already copied)."""

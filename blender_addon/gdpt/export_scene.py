@@ -38,11 +38,17 @@ def export_scene(module, depsgraph, camera_object, warn):
         # The matrix must be copied inside the loop: the instance iterator reuses its storage.
         matrix = inst.matrix_world.copy()
         if obj.type == 'LIGHT':
+            problem = export_lights.light_problem(obj)
+            if problem:
+                warn(problem)
+                continue
             builder.add_light(export_lights.light_dict(obj, matrix, warn))
             lights += 1
         else:
             geometry.visit(inst, obj, matrix)
 
+    if builder.instance_count == 0 and lights == 0:
+        warn("the scene has no visible objects and no lights: nothing to render but the world")
     stats = ExportStats()
     stats.seconds = time.perf_counter() - t0
     stats.cpu_seconds = time.thread_time() - c0

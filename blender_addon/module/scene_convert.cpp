@@ -7,10 +7,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
-#include <type_traits>
 
 #include <pybind11/stl.h>  // lists to std::vector (colour ramp tables)
 
+#include "blender_addon/module/mesh_ingest.h"
 #include "core/huge_pages.h"
 #include "shaders/image_io.h"
 
@@ -359,173 +359,44 @@ py::array empty_array(py::ssize_t count, const py::dtype& dtype) {
 
 // --- Geometry ----------------------------------------------------------------------------------
 
+namespace {
+
+template <typename T>
+std::span<const T> view(const py::array_t<T, py::array::c_style>& a) {
+  return {a.data(), size_t(a.size())};
+}
+
+template <typename T>
+std::span<const T> view(const std::optional<py::array_t<T, py::array::c_style>>& a) {
+  return a ? view(*a) : std::span<const T>{};
+}
+
+ingest::LoopArrays loop_arrays(const FloatArray& positions, const IntArray& loop_vertex,
+                               const FloatArray& normals, bool normals_per_loop,
+                               const FloatArray& loop_uvs,
+                               const std::optional<FloatArray>& loop_tangents,
+                               const std::optional<FloatArray>& loop_colors) {
+  return {view(positions), view(loop_vertex),   view(normals),    normals_per_loop,
+          view(loop_uvs),  view(loop_tangents), view(loop_colors)};
+}
+
+}  // namespace
+
+// The ingest functions validate every array (std::invalid_argument -> ValueError) and read only
+// numpy buffers the caller keeps alive, so they run without the GIL.
 int SceneBuilder::add_mesh(const FloatArray& positions, const IntArray& indices,
                            const std::optional<FloatArray>& corner_normals,
                            const std::optional<FloatArray>& corner_uvs,
                            const std::optional<IntArray>& material_slot) {
-  if (positions.size() % 3 != 0) throw std::invalid_argument("positions: size not a multiple of 3");
-  if (indices.size() % 3 != 0) throw std::invalid_argument("indices: size not a multiple of 3");
-  const size_t vertex_count = size_t(positions.size()) / 3;
-  const size_t triangle_count = size_t(indices.size()) / 3;
-
   Mesh mesh;
-  // Vec3f / Vec2f are trivially copyable packed floats: the numpy buffers are copied as bytes.
-  static_assert(sizeof(Vec3f) == 3 * sizeof(float) && sizeof(Vec2f) == 2 * sizeof(float));
-  static_assert(std::is_trivially_copyable_v<Vec3f> && std::is_trivially_copyable_v<Vec2f>);
-  mesh.positions.resize(vertex_count);
-  std::memcpy(static_cast<void*>(mesh.positions.data()), positions.data(),
-              vertex_count * sizeof(Vec3f));
-
-  mesh.indices.resize(triangle_count * 3);
-  const int32_t* idx = indices.data();
-  for (size_t i = 0; i < triangle_count * 3; ++i) {
-    // Validated here once, so the BVH build and the shading code can trust the indices.
-    if (idx[i] < 0 || size_t(idx[i]) >= vertex_count)
-      throw std::invalid_argument("indices: vertex index out of range");
-    mesh.indices[i] = uint32_t(idx[i]);
-  }
-  if (corner_normals && corner_normals->size() > 0) {
-    const float* n = checked_data(*corner_normals, triangle_count * 9, "corner_normals");
-    mesh.corner_normals.resize(triangle_count * 3);
-    std::memcpy(static_cast<void*>(mesh.corner_normals.data()), n,
-                triangle_count * 9 * sizeof(float));
-  }
-  if (corner_uvs && corner_uvs->size() > 0) {
-    const float* uv = checked_data(*corner_uvs, triangle_count * 6, "corner_uvs");
-    mesh.corner_uvs.resize(triangle_count * 3);
-    std::memcpy(static_cast<void*>(mesh.corner_uvs.data()), uv, triangle_count * 6 * sizeof(float));
-  }
-  if (material_slot && material_slot->size() > 0) {
-    const int32_t* s = checked_data(*material_slot, triangle_count, "material_slot");
-    mesh.material_slot.assign(s, s + triangle_count);
+  {
+    py::gil_scoped_release no_gil;
+    mesh = ingest::mesh_from_triangles(view(positions), view(indices), view(corner_normals),
+                                       view(corner_uvs), view(material_slot));
   }
   scene_.meshes.push_back(std::move(mesh));
   return int(scene_.meshes.size()) - 1;
 }
-
-// Blender's own arrays -> Mesh, one pass per output array. A 1M-triangle mesh writes about 80 MB
-// of fresh memory (per-corner normals and UVs are most of it), and on Linux first touching fresh
-// memory in 4 KB pages costs more than the gathering itself: the buffers are reserved first and
-// advised as huge pages (advise_huge_pages), then filled in order with no zero-fill and no
-// temporary arrays. Runs without the GIL: only numpy buffers the caller keeps alive are read.
-namespace {
-
-struct CornerSource {
-  const float* positions = nullptr;
-  size_t vertex_count = 0;
-  const int32_t* loop_vertex = nullptr;
-  size_t loop_count = 0;
-  const float* normals = nullptr;  // per loop or per vertex, or null
-  bool normals_per_loop = false;
-  const float* loop_uvs = nullptr;       // per loop, or null
-  const float* loop_tangents = nullptr;  // 4 per loop (tangent, bitangent sign), or null
-  const float* loop_colors = nullptr;    // 3 per loop (colour attribute, linear RGB), or null
-};
-
-CornerSource corner_source(const FloatArray& positions, const IntArray& loop_vertex,
-                           const FloatArray& normals, bool normals_per_loop,
-                           const FloatArray& loop_uvs,
-                           const std::optional<FloatArray>& loop_tangents,
-                           const std::optional<FloatArray>& loop_colors) {
-  if (positions.size() % 3 != 0) throw std::invalid_argument("positions: size not a multiple of 3");
-  CornerSource s;
-  s.positions = positions.data();
-  s.vertex_count = size_t(positions.size()) / 3;
-  s.loop_vertex = loop_vertex.data();
-  s.loop_count = size_t(loop_vertex.size());
-  // Every loop's vertex is validated once here, so the gathers below index without checks.
-  for (size_t l = 0; l < s.loop_count; ++l)
-    if (s.loop_vertex[l] < 0 || size_t(s.loop_vertex[l]) >= s.vertex_count)
-      throw std::invalid_argument("loop_vertex: vertex index out of range");
-  if (normals.size() > 0) {
-    const size_t expected = (normals_per_loop ? s.loop_count : s.vertex_count) * 3;
-    s.normals = checked_data(normals, expected, "normals");
-    s.normals_per_loop = normals_per_loop;
-  }
-  if (loop_uvs.size() > 0) s.loop_uvs = checked_data(loop_uvs, s.loop_count * 2, "loop_uvs");
-  if (loop_tangents && loop_tangents->size() > 0)
-    s.loop_tangents = checked_data(*loop_tangents, s.loop_count * 4, "loop_tangents");
-  if (loop_colors && loop_colors->size() > 0)
-    s.loop_colors = checked_data(*loop_colors, s.loop_count * 3, "loop_colors");
-  return s;
-}
-
-// Fills `mesh` from `triangles` triangles whose corner loops `corners(emit)` produces in order
-// (emit(loop) per corner, emit_material(slot) per triangle). Loops must be in range.
-template <typename Corners>
-Mesh gather_mesh(const CornerSource& src, size_t triangles, bool with_material,
-                 const Corners& corners) {
-  Mesh mesh;
-  const size_t corner_count = triangles * 3;
-  reserve_fresh(mesh.positions, src.vertex_count);
-  mesh.positions.resize(src.vertex_count);
-  std::memcpy(static_cast<void*>(mesh.positions.data()), src.positions,
-              src.vertex_count * sizeof(Vec3f));
-  reserve_fresh(mesh.indices, corner_count);
-  if (src.normals && src.normals_per_loop) reserve_fresh(mesh.corner_normals, corner_count);
-  if (src.loop_uvs) reserve_fresh(mesh.corner_uvs, corner_count);
-  if (with_material) reserve_fresh(mesh.material_slot, triangles);
-  // One loop per output array: each streams through its own buffer.
-  corners([&](int32_t loop) { mesh.indices.push_back(uint32_t(src.loop_vertex[loop])); },
-          [](int32_t) {});
-  if (src.normals && src.normals_per_loop) {
-    const float* n = src.normals;
-    corners(
-        [&](int32_t loop) {
-          const size_t i = 3 * size_t(loop);
-          mesh.corner_normals.emplace_back(n[i], n[i + 1], n[i + 2]);
-        },
-        [](int32_t) {});
-  } else if (src.normals) {
-    // Vertex normals stay per vertex (Mesh::vertex_normals): no per-corner copy.
-    reserve_fresh(mesh.vertex_normals, src.vertex_count);
-    mesh.vertex_normals.resize(src.vertex_count);
-    std::memcpy(static_cast<void*>(mesh.vertex_normals.data()), src.normals,
-                src.vertex_count * sizeof(Vec3f));
-  }
-  if (src.loop_uvs) {
-    const float* uv = src.loop_uvs;
-    corners(
-        [&](int32_t loop) {
-          mesh.corner_uvs.emplace_back(uv[2 * size_t(loop)], uv[2 * size_t(loop) + 1]);
-        },
-        [](int32_t) {});
-  }
-  if (src.loop_tangents) {
-    const float* t = src.loop_tangents;
-    reserve_fresh(mesh.corner_tangents, corner_count);
-    reserve_fresh(mesh.corner_tangent_signs, corner_count);
-    corners(
-        [&](int32_t loop) {
-          const size_t i = 4 * size_t(loop);
-          mesh.corner_tangents.emplace_back(t[i], t[i + 1], t[i + 2]);
-          mesh.corner_tangent_signs.push_back(t[i + 3]);
-        },
-        [](int32_t) {});
-  }
-  if (src.loop_colors) {
-    const float* c = src.loop_colors;
-    reserve_fresh(mesh.corner_colors, corner_count);
-    corners(
-        [&](int32_t loop) {
-          const size_t i = 3 * size_t(loop);
-          mesh.corner_colors.emplace_back(c[i], c[i + 1], c[i + 2]);
-        },
-        [](int32_t) {});
-  }
-  if (with_material)
-    corners([](int32_t) {}, [&](int32_t slot) { mesh.material_slot.push_back(slot); });
-  return mesh;
-}
-
-bool any_nonzero(const IntArray& a) {
-  const int32_t* p = a.data();
-  for (py::ssize_t i = 0; i < a.size(); ++i)
-    if (p[i] != 0) return true;
-  return false;
-}
-
-}  // namespace
 
 int SceneBuilder::add_mesh_loops(const FloatArray& positions, const IntArray& loop_vertex,
                                  const IntArray& corner_loops, const FloatArray& normals,
@@ -533,30 +404,12 @@ int SceneBuilder::add_mesh_loops(const FloatArray& positions, const IntArray& lo
                                  const IntArray& material_slot,
                                  const std::optional<FloatArray>& loop_tangents,
                                  const std::optional<FloatArray>& loop_colors) {
-  if (corner_loops.size() % 3 != 0)
-    throw std::invalid_argument("corner_loops: size not a multiple of 3");
-  if (material_slot.size() > 0 && material_slot.size() * 3 != corner_loops.size())
-    throw std::invalid_argument("material_slot: expected one value per triangle");
   Mesh mesh;
   {
     py::gil_scoped_release no_gil;
-    const CornerSource src = corner_source(positions, loop_vertex, normals, normals_per_loop,
-                                           loop_uvs, loop_tangents, loop_colors);
-    const int32_t* corners = corner_loops.data();
-    const size_t triangles = size_t(corner_loops.size()) / 3;
-    for (size_t i = 0; i < triangles * 3; ++i)
-      if (corners[i] < 0 || size_t(corners[i]) >= src.loop_count)
-        throw std::invalid_argument("corner_loops: loop index out of range");
-    const int32_t* slot = material_slot.data();
-    mesh = gather_mesh(src, triangles, any_nonzero(material_slot),
-                       [&](const auto& emit, const auto& emit_material) {
-                         for (size_t t = 0; t < triangles; ++t) {
-                           emit(corners[3 * t]);
-                           emit(corners[3 * t + 1]);
-                           emit(corners[3 * t + 2]);
-                           emit_material(slot[t]);
-                         }
-                       });
+    mesh = ingest::mesh_from_loops(loop_arrays(positions, loop_vertex, normals, normals_per_loop,
+                                               loop_uvs, loop_tangents, loop_colors),
+                                   view(corner_loops), view(material_slot));
   }
   scene_.meshes.push_back(std::move(mesh));
   return int(scene_.meshes.size()) - 1;
@@ -568,83 +421,12 @@ int SceneBuilder::add_mesh_polys(const FloatArray& positions, const IntArray& lo
                                  const FloatArray& loop_uvs, const IntArray& poly_material,
                                  const std::optional<FloatArray>& loop_tangents,
                                  const std::optional<FloatArray>& loop_colors) {
-  const size_t poly_count = size_t(loop_start.size());
-  if (size_t(loop_total.size()) != poly_count)
-    throw std::invalid_argument("loop_start / loop_total differ in size");
-  if (poly_material.size() > 0 && size_t(poly_material.size()) != poly_count)
-    throw std::invalid_argument("poly_material: expected one value per polygon");
   Mesh mesh;
   {
     py::gil_scoped_release no_gil;
-    const CornerSource src = corner_source(positions, loop_vertex, normals, normals_per_loop,
-                                           loop_uvs, loop_tangents, loop_colors);
-    const int32_t* start = loop_start.data();
-    const int32_t* total = loop_total.data();
-    size_t triangles = 0;
-    for (size_t p = 0; p < poly_count; ++p) {
-      if (total[p] < 3 || total[p] > 4 || start[p] < 0 ||
-          size_t(start[p]) + size_t(total[p]) > src.loop_count)
-        throw std::invalid_argument("add_mesh_polys: only triangles and quads, loops in range");
-      triangles += size_t(total[p] - 2);
-    }
-    // Quads split as Blender 3.4's loop triangles do when its face normals are up to date (they
-    // are once anything read the mesh's normals, as the export and renderers do): along 0-2
-    // (0-1-2 + 0-2-3) unless, seen along the face normal n = (v0 - v2) x (v1 - v3), v1 and v3 are
-    // not strictly on opposite sides of the 0-2 diagonal; then along 1-3 (0-1-3 + 1-2-3). That
-    // covers folded and concave quads and degenerate ones (two corners at one position, as at
-    // the poles of a quad sphere), where the 1-3 split keeps the real triangle's own corners.
-    // (Quads within rounding of such a tie may split either way, as in Blender, whose result
-    // depends on how its cached face normal was computed.)
-    // The choice is made once per quad, not once per output array.
-    std::vector<uint8_t> flip(poly_count, 0);
-    const float* co = src.positions;
-    const int32_t* lv = src.loop_vertex;
-    auto vertex = [&](int32_t loop) {
-      const size_t v = 3 * size_t(lv[loop]);
-      return Vec3f(co[v], co[v + 1], co[v + 2]);
-    };
-    for (size_t p = 0; p < poly_count; ++p) {
-      if (total[p] != 4) continue;
-      const int32_t s = start[p];
-      const Vec3f v0 = vertex(s), v1 = vertex(s + 1), v2 = vertex(s + 2), v3 = vertex(s + 3);
-      Vec3f n = cross(v0 - v2, v1 - v3);  // Blender's normal_quad_v3
-      const float len2 = dot(n, n);
-      n = len2 > 1e-35f ? n * (1.0f / std::sqrt(len2)) : Vec3f(0.0f);  // and normalize_v3
-      const Vec3f tangent = cross(v2 - v0, n);
-      const float d = dot(v0, tangent);
-      flip[p] = dot(v3, tangent) >= d || dot(v1, tangent) <= d;
-    }
-    const int32_t* material = poly_material.data();
-    mesh = gather_mesh(src, triangles, poly_material.size() > 0 && any_nonzero(poly_material),
-                       [&](const auto& emit, const auto& emit_material) {
-                         for (size_t p = 0; p < poly_count; ++p) {
-                           const int32_t s = start[p];
-                           if (total[p] == 3) {
-                             emit(s);
-                             emit(s + 1);
-                             emit(s + 2);
-                             emit_material(material[p]);
-                           } else if (!flip[p]) {
-                             emit(s);
-                             emit(s + 1);
-                             emit(s + 2);
-                             emit_material(material[p]);
-                             emit(s);
-                             emit(s + 2);
-                             emit(s + 3);
-                             emit_material(material[p]);
-                           } else {
-                             emit(s);
-                             emit(s + 1);
-                             emit(s + 3);
-                             emit_material(material[p]);
-                             emit(s + 1);
-                             emit(s + 2);
-                             emit(s + 3);
-                             emit_material(material[p]);
-                           }
-                         }
-                       });
+    mesh = ingest::mesh_from_polys(loop_arrays(positions, loop_vertex, normals, normals_per_loop,
+                                               loop_uvs, loop_tangents, loop_colors),
+                                   view(loop_start), view(loop_total), view(poly_material));
   }
   scene_.meshes.push_back(std::move(mesh));
   return int(scene_.meshes.size()) - 1;
@@ -700,8 +482,11 @@ void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::li
   inst.slot_material.reserve(py::len(slot_material));
   for (const auto& m : slot_material) {
     const int32_t index = m.cast<int32_t>();
-    if (index >= int32_t(scene_.materials.size()))
-      throw std::invalid_argument("add_instance: material index out of range");
+    if (index < -1 || index >= int32_t(scene_.materials.size()))
+      throw std::invalid_argument(
+          "slot_material: value " + std::to_string(inst.slot_material.size()) + " is " +
+          std::to_string(index) + ", out of range [-1, " + std::to_string(scene_.materials.size()) +
+          ") (the scene's materials; -1: default)");
     inst.slot_material.push_back(index);
   }
   scene_.instances.push_back(std::move(inst));

@@ -28,6 +28,7 @@ def render_finished(scene, path):
     """Renders 8 spp with Gradient PT, checks that the render finished; (image path, warnings)."""
     import gdpt.engine as engine
     S.setup_gdpt(scene, 8)
+    engine.LAST_RENDER.clear()  # so a render by another engine cannot pass as ours
     path = S.render(scene, path)
     info = engine.LAST_RENDER
     check(info.get("status") == "finished", f"render finished ({info.get('status')})")
@@ -254,15 +255,111 @@ def test_geometry_types(out):
           f"text, curve and metaball exported ({info['triangles']} triangles in all)")
 
 
+def check_lit(path, what):
+    """A frame of a scene with light: finite and not black."""
+    img = S.read_rgb(path)
+    check(np.isfinite(img).all(), f"{what}: every pixel finite")
+    check(img.mean() > 0.01, f"{what}: not a black frame (mean {img.mean():.4f})")
+    return img
+
+
+def test_empty_scene(out):
+    """No object and no light, only a camera and a grey world: finishes, reported, the world
+    shows."""
+    scene = S.clear()
+    S.camera((0, -5.5, 2.0), (0, 0, 1.6), lens=30)
+    scene.world.color = (0.3, 0.3, 0.3)
+    path, warnings = render_finished(scene, os.path.join(out, "empty.exr"))
+    check(any("nothing to render" in w for w in warnings), "the empty scene is reported")
+    img = check_lit(path, "empty scene")
+    check(abs(img.mean() - 0.3) < 0.01, f"the world colour shows ({img.mean():.4f})")
+
+
+def test_degenerate_lights(out):
+    """A zero-size area light, a zero-radius point light and lights of zero strength next to a
+    normal light: each reported by name, the frame lit by the normal one, no NaN."""
+    scene = S.clear()
+    basic_scene(scene)
+    S.light('AREA', (0.5, 0, 3.5), 100.0, target=(0, 0, 0), size=0.0).name = "Flat Area"
+    S.light('AREA', (-0.5, 0, 3.5), 100.0, target=(0, 0, 0), shape='RECTANGLE', size=1.0,
+            size_y=0.0).name = "Thin Area"
+    S.light('POINT', (0, 0.5, 2.0), 0.0).name = "Dark Point"
+    S.light('SPOT', (0, -0.5, 2.0), 0.0, target=(0, 0, 0)).name = "Dark Spot"
+    S.light('SUN', (0, 0, 3.0), 0.0).name = "Dark Sun"
+    S.uv_sphere("ball", 0.6, (0, 0.3, 0.6), S.diffuse("ball", (0.8, 0.8, 0.8)))
+    path, warnings = render_finished(scene, os.path.join(out, "degenerate_lights.exr"))
+    for name in ("Flat Area", "Thin Area", "Dark Point", "Dark Spot", "Dark Sun"):
+        check(sum(f"'{name}'" in w for w in warnings) == 1, f"one warning names light '{name}'")
+    check_lit(path, "degenerate lights")
+
+
+def test_nan_mesh(out):
+    """A mesh with a NaN vertex is skipped with a warning naming it and the vertex; the rest of
+    the scene renders."""
+    scene = S.clear()
+    basic_scene(scene)
+    nan = float("nan")
+    S.mesh_object("broken", [(0, 0, 1), (1, 0, 1), (1, 0, nan), (0, 0, 2)], [(0, 1, 2, 3)],
+                  S.diffuse("broken", (0.8, 0.8, 0.8)))
+    path, warnings = render_finished(scene, os.path.join(out, "nan_mesh.exr"))
+    check(sum("mesh 'broken' skipped" in w and "vertex 2" in w for w in warnings) == 1,
+          "one warning names the mesh and its NaN vertex")
+    check_lit(path, "NaN mesh")
+
+
+def test_extreme_resolutions(out):
+    """1x1 and 16384x16 frames finish with the size asked for, lit."""
+    import gdpt.engine as engine
+    scene = S.clear()
+    basic_scene(scene)
+    # Blender's resolution is at least 4x4: 1x1 is 4x4 at 25%.
+    for w, h, percent in ((1, 1, 25), (16384, 16, 100)):
+        r = scene.render
+        r.resolution_x, r.resolution_y, r.resolution_percentage = w * 100 // percent, \
+            h * 100 // percent, percent
+        path, _ = render_finished(scene, os.path.join(out, f"resolution_{w}x{h}.exr"))
+        img = check_lit(path, f"{w}x{h}")
+        check(img.shape[:2] == (h, w), f"{w}x{h}: the image is {img.shape[1]}x{img.shape[0]}")
+        check(engine.LAST_RENDER.get("samples") == 8, f"{w}x{h}: all 8 samples rendered")
+
+
+def test_missing_image(out):
+    """An Image Texture whose file is missing: reported by image name, shown as Cycles shows it
+    (magenta), the render finishes."""
+    scene = S.clear()
+    basic_scene(scene)
+    image = bpy.data.images.new("Lost Texture", 4, 4)
+    image.source = 'FILE'  # as a .blend whose texture file was moved away opens
+    image.filepath = os.path.join(out, "no_such_file.png")
+    S.uv_sphere("ball", 0.8, (0, 0.3, 0.8), S.image_material("lost", image))
+    path, warnings = render_finished(scene, os.path.join(out, "missing_image.exr"))
+    check(sum("Lost Texture" in w for w in warnings) == 1, "one warning names the image")
+    img = check_lit(path, "missing image")
+    ball = img[img.shape[0] // 2 - 4:img.shape[0] // 2 + 4, img.shape[1] // 2 - 4:
+               img.shape[1] // 2 + 4]
+    r, g, b = ball[..., 0].mean(), ball[..., 1].mean(), ball[..., 2].mean()
+    check(r > 2 * g and b > 2 * g, f"the ball is magenta ({r:.3f}, {g:.3f}, {b:.3f})")
+
+
 def main():
     out = S.args()["out"]
     os.makedirs(out, exist_ok=True)
+    only = S.args().get("only")  # one test by name, while working on it
+    if only:
+        globals()["test_" + only](out)
+        print("ALL ROBUSTNESS CHECKS PASSED", flush=True)
+        sys.exit(0)
     test_unsupported_node(out)
     test_texture_limits(out)
     test_normal_map_limits(out)
     test_no_camera(out)
     test_time_limit(out)
     test_geometry_types(out)
+    test_empty_scene(out)
+    test_degenerate_lights(out)
+    test_nan_mesh(out)
+    test_extreme_resolutions(out)
+    test_missing_image(out)
     test_cancel(out)  # last: Blender's break flag stays set afterwards
     print("ALL ROBUSTNESS CHECKS PASSED", flush=True)
     # Blender turns the SIGINT break flag into a non-zero exit status at quit; every check has
