@@ -1012,6 +1012,95 @@ def voronoi_regions(image):
     return strip_regions(image, [label for label, *_ in VORONOIS], BRICK_ROWS, BRICK_HEIGHT)
 
 
+def _curve(mapping, index, points):
+    """Replaces curve `index` of a curve mapping by `points` ((x, y), at least two)."""
+    curve = mapping.curves[index]
+    while len(curve.points) > 2:
+        curve.points.remove(curve.points[-1])
+    curve.points[0].location, curve.points[1].location = points[0], points[1]
+    for p in points[2:]:
+        curve.points.new(*p)
+    mapping.update()
+
+
+def _span(nt, generated, scale, offset):
+    v = nt.nodes.new("ShaderNodeVectorMath")
+    v.operation = 'MULTIPLY_ADD'
+    nt.links.new(generated, v.inputs[0])
+    v.inputs[1].default_value = scale
+    v.inputs[2].default_value = offset
+    return v.outputs["Vector"]
+
+
+def curves_rgb(nt, emit, generated):
+    # Each channel its own curve, the combined curve first; input beyond [0, 1] (extrapolated).
+    node = nt.nodes.new("ShaderNodeRGBCurve")
+    _curve(node.mapping, 0, [(0.0, 0.1), (0.4, 0.8), (1.0, 0.3)])
+    _curve(node.mapping, 1, [(0.0, 0.0), (0.7, 0.2), (1.0, 1.0)])
+    _curve(node.mapping, 3, [(0.0, 0.2), (1.0, 0.9)])
+    node.inputs["Fac"].default_value = 0.85
+    nt.links.new(_span(nt, generated, (1.4, 0.8, 1.2), (-0.2, 0.1, 0.0)), node.inputs["Color"])
+    nt.links.new(node.outputs[0], emit.inputs["Color"])
+
+
+def curves_rgb_wide(nt, emit, generated):
+    # Points beyond [0, 1] widen the table's range (Cycles bakes it over the points' span).
+    node = nt.nodes.new("ShaderNodeRGBCurve")
+    node.mapping.clip_min_x, node.mapping.clip_max_x = -1.0, 2.0
+    node.mapping.use_clip = False
+    _curve(node.mapping, 2, [(-0.5, 0.0), (0.5, 0.6), (1.5, 0.2)])
+    nt.links.new(_span(nt, generated, (2.0, 1.0, 2.0), (-0.5, 0.0, -0.5)), node.inputs["Color"])
+    nt.links.new(node.outputs[0], emit.inputs["Color"])
+
+
+def curves_vector(nt, emit, generated):
+    node = nt.nodes.new("ShaderNodeVectorCurve")
+    _curve(node.mapping, 0, [(-1.0, 0.0), (0.0, 0.8), (1.0, 0.3)])
+    _curve(node.mapping, 2, [(-1.0, 1.0), (1.0, 0.1)])
+    nt.links.new(_span(nt, generated, (2.0, 2.0, 2.0), (-1.0, -1.0, -1.0)), node.inputs["Vector"])
+    nt.links.new(node.outputs[0], emit.inputs["Color"])
+
+
+def curves_float(nt, emit, generated):
+    # Float Curve of Generated x (as a float: the vector's mean) as the emission strength.
+    node = nt.nodes.new("ShaderNodeFloatCurve")
+    _curve(node.mapping, 0, [(0.0, 0.9), (0.3, 0.1), (0.8, 0.7), (1.0, 0.4)])
+    node.inputs[0].default_value = 0.9
+    xyz = nt.nodes.new("ShaderNodeSeparateXYZ")
+    nt.links.new(generated, xyz.inputs[0])
+    nt.links.new(xyz.outputs["X"], node.inputs["Value"])
+    nt.links.new(node.outputs[0], emit.inputs["Strength"])
+    emit.inputs["Color"].default_value = (0.9, 0.7, 0.4, 1.0)
+
+
+def blackbody(nt, emit, generated):
+    # Temperature 500 .. 13000 K along the strip: both constant ends and all seven fits.
+    xyz = nt.nodes.new("ShaderNodeSeparateXYZ")
+    nt.links.new(generated, xyz.inputs[0])
+    ramp = nt.nodes.new("ShaderNodeMapRange")
+    nt.links.new(xyz.outputs["X"], ramp.inputs["Value"])
+    ramp.inputs["To Min"].default_value, ramp.inputs["To Max"].default_value = 500.0, 13000.0
+    node = nt.nodes.new("ShaderNodeBlackbody")
+    nt.links.new(ramp.outputs[0], node.inputs["Temperature"])
+    nt.links.new(node.outputs[0], emit.inputs["Color"])
+
+
+CURVE_STRIPS = [("RGB Curves", curves_rgb), ("RGB Curves over a wide range", curves_rgb_wide),
+                ("Vector Curves", curves_vector), ("Float Curve", curves_float),
+                ("Blackbody", blackbody)]
+CURVE_ROWS = 3
+
+
+def case_curve_nodes(scene):
+    # RGB / Vector / Float Curves and Blackbody (CURVE_STRIPS) on emissive strips.
+    emissive_strips(scene, [build for _, build in CURVE_STRIPS], CURVE_ROWS, BRICK_HEIGHT)
+    return 1
+
+
+def curve_regions(image):
+    return strip_regions(image, [label for label, _ in CURVE_STRIPS], CURVE_ROWS, BRICK_HEIGHT)
+
+
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
 
 # Cases whose noise floor at the default counts lies near the threshold render more samples on
@@ -1033,7 +1122,7 @@ CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case
 # (Smooth F1 hashes 125 cells per lookup: 37 s for GDPT at the default counts).
 SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map": 4,
                 "input_nodes": 2, "adjust_nodes": 2, "bump": 4, "math_nodes": 0.5,
-                "voronoi_features": 0.5}
+                "voronoi_features": 0.5, "curve_nodes": 0.5}
 
 # Cases whose image holds many independent features, each of which must agree on its own (one
 # wrong feature can hide in the relMSE of the whole image): name -> function(image) returning
@@ -1042,7 +1131,8 @@ SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map
 # total internal reflection, the distorted checker's edges) carry anti-aliasing noise, 1e-4 - 2e-4
 # at half the default counts.
 REGIONS = {"math_nodes": (math_regions, 1e-4), "vector_math": (vector_regions, 5e-4),
-           "brick_texture": (brick_regions, 5e-4), "voronoi_features": (voronoi_regions, 5e-4)}
+           "brick_texture": (brick_regions, 5e-4), "voronoi_features": (voronoi_regions, 5e-4),
+           "curve_nodes": (curve_regions, 5e-4)}
 
 
 # Per-kind bounce limits (diffuse, glossy, transmission) set on both engines after the common
