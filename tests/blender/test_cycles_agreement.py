@@ -148,6 +148,24 @@ def case_mesh_light(scene):
     return 3
 
 
+def case_empty_mix_input(scene):
+    # A Mix Shader with an unlinked input: no closure there (Cycles: that share is black), on
+    # the ball and on a Mix-of-nothing-and-Emission panel lighting the room.
+    lit_room(scene)
+    panel = S.emission("panel", (1, 0.9, 0.8), 20.0)
+    S.plane("panel", 1.2, (0, 0, 3.9), (math.pi, 0, 0), panel)
+    for m, fac in ((panel, 0.6), (S.diffuse("ball", (0.8, 0.8, 0.8)), 0.3)):
+        nt = m.node_tree
+        mix = nt.nodes.new("ShaderNodeMixShader")
+        mix.inputs[0].default_value = fac
+        out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
+        nt.links.new(out.inputs["Surface"].links[0].from_socket, mix.inputs[2])
+        nt.links.new(mix.outputs[0], out.inputs["Surface"])
+        if m is not panel:
+            S.uv_sphere("ball", 0.7, (0, 0.3, 0.7), m)
+    return 3
+
+
 def case_world_color(scene):
     S.plane("floor", 6.0, (0, 0, 0), material=S.diffuse("floor", (0.6, 0.6, 0.6)))
     S.uv_sphere("ball", 0.8, (0, 0, 0.8), S.diffuse("ball", (0.8, 0.5, 0.3)))
