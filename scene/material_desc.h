@@ -164,6 +164,7 @@ enum class ShaderNodeKind : uint8_t {
   Principled,   // Blender 3.4 Principled BSDF v1
   Emission,     // colour * strength (radiance, W/m^2/sr per unit strength as in Cycles)
   Transparent,  // straight-through transmission, colour scales
+  Translucent,  // Blender Translucent BSDF: Lambertian transmission (diffuse, to the far side)
   Mix,          // (1 - fac) * a + fac * b
   Add,          // a + b
 };

@@ -454,6 +454,11 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       c.weight = in.color(n.color) * w;
       out.add(c);
       return;
+    case ShaderNodeKind::Translucent:
+      c.type = ClosureType::Translucent;
+      c.weight = in.color(n.color) * w;
+      out.add(c);
+      return;
     case ShaderNodeKind::Principled: {
       PrincipledParams p;
       p.base_color = in.color(n.color);
@@ -674,6 +679,10 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       case ShaderNodeKind::Transparent:
         note(n.color);
         features_ |= kFeatureTransparent | kFeatureDelta;
+        return;
+      case ShaderNodeKind::Translucent:
+        note(n.color);
+        features_ |= kFeatureTransmission;
         return;
       case ShaderNodeKind::Emission:
         note(n.color);

@@ -25,7 +25,7 @@ IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 
 _SHADERS = {
     'BSDF_PRINCIPLED', 'BSDF_DIFFUSE', 'BSDF_GLOSSY', 'BSDF_GLASS', 'EMISSION',
-    'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER',
+    'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSLUCENT',
 }
 _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
@@ -186,6 +186,11 @@ class _Translator:
     def _emission(self, n):
         return self._add({"kind": "EMISSION", "color": self.color(n.inputs["Color"]),
                           "strength": self.value(n.inputs["Strength"])})
+
+    def _bsdf_translucent(self, n):
+        linked = self.normal(n.inputs["Normal"])
+        return self._add({"kind": "TRANSLUCENT", "color": self.color(n.inputs["Color"]),
+                          "normal_linked": linked})
 
     def _bsdf_transparent(self, n):
         return self._add({"kind": "TRANSPARENT", "color": self.color(n.inputs["Color"])})

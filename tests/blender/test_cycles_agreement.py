@@ -166,6 +166,27 @@ def case_empty_mix_input(scene):
     return 3
 
 
+def case_translucent(scene):
+    # A Translucent sheet seen from below, lit through from the ceiling lamp, and a ball of
+    # Diffuse and Translucent mixed (light crossing its inside).
+    lit_room(scene)
+    area_ceiling(size=1.5, energy=250.0)
+    sheet = S.shader_material("sheet", "ShaderNodeBsdfTranslucent", Color=(0.9, 0.8, 0.5, 1))
+    S.plane("sheet", 1.6, (0.6, 0.0, 2.4), material=sheet)
+    m = S.diffuse("ball", (0.3, 0.6, 0.9))
+    nt = m.node_tree
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    mix.inputs[0].default_value = 0.5
+    translucent = nt.nodes.new("ShaderNodeBsdfTranslucent")
+    translucent.inputs["Color"].default_value = (0.9, 0.5, 0.2, 1)
+    out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
+    nt.links.new(out.inputs["Surface"].links[0].from_socket, mix.inputs[1])
+    nt.links.new(translucent.outputs[0], mix.inputs[2])
+    nt.links.new(mix.outputs[0], out.inputs["Surface"])
+    S.uv_sphere("ball", 0.7, (-0.6, 0.3, 0.7), m)
+    return 5
+
+
 def case_world_color(scene):
     S.plane("floor", 6.0, (0, 0, 0), material=S.diffuse("floor", (0.6, 0.6, 0.6)))
     S.uv_sphere("ball", 0.8, (0, 0, 0.8), S.diffuse("ball", (0.8, 0.5, 0.3)))
