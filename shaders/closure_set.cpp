@@ -17,6 +17,7 @@
 #include "shaders/bsdf_principled_sheen.h"
 #include "shaders/bsdf_translucent.h"
 #include "shaders/bsdf_transparent.h"
+#include "shaders/bsdf_velvet.h"
 
 namespace gdpt {
 
@@ -43,6 +44,8 @@ namespace {
       return transparent::call;          \
     case ClosureType::Translucent:       \
       return translucent::call;          \
+    case ClosureType::Velvet:            \
+      return velvet::call;               \
   }                                      \
   return {};
 
@@ -138,7 +141,7 @@ bool lobe_is_delta(const Closure& c) {
 bool lobe_is_diffuse(const Closure& c) {
   return c.type == ClosureType::Lambert || c.type == ClosureType::OrenNayar ||
          c.type == ClosureType::PrincipledDiffuse || c.type == ClosureType::PrincipledSheen ||
-         c.type == ClosureType::Translucent;
+         c.type == ClosureType::Translucent || c.type == ClosureType::Velvet;
 }
 
 // Unnormalised selection weights; returns their sum.

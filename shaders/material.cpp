@@ -459,6 +459,12 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       c.weight = in.color(n.color) * w;
       out.add(c);
       return;
+    case ShaderNodeKind::Velvet:
+      c.type = ClosureType::Velvet;
+      c.alpha = saturate(in.scalar(n.roughness));
+      c.weight = in.color(n.color) * w;
+      out.add(c);
+      return;
     case ShaderNodeKind::Principled: {
       PrincipledParams p;
       p.base_color = in.color(n.color);
@@ -683,6 +689,10 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       case ShaderNodeKind::Translucent:
         note(n.color);
         features_ |= kFeatureTransmission;
+        return;
+      case ShaderNodeKind::Velvet:
+        note(n.color);
+        note(n.roughness);
         return;
       case ShaderNodeKind::Emission:
         note(n.color);

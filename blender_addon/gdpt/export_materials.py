@@ -25,7 +25,7 @@ IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 
 _SHADERS = {
     'BSDF_PRINCIPLED', 'BSDF_DIFFUSE', 'BSDF_GLOSSY', 'BSDF_GLASS', 'EMISSION',
-    'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSLUCENT',
+    'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSLUCENT', 'BSDF_VELVET',
 }
 _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
@@ -191,6 +191,11 @@ class _Translator:
         linked = self.normal(n.inputs["Normal"])
         return self._add({"kind": "TRANSLUCENT", "color": self.color(n.inputs["Color"]),
                           "normal_linked": linked})
+
+    def _bsdf_velvet(self, n):
+        linked = self.normal(n.inputs["Normal"])
+        return self._add({"kind": "VELVET", "color": self.color(n.inputs["Color"]),
+                          "roughness": self.value(n.inputs["Sigma"]), "normal_linked": linked})
 
     def _bsdf_transparent(self, n):
         return self._add({"kind": "TRANSPARENT", "color": self.color(n.inputs["Color"])})

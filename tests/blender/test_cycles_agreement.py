@@ -187,6 +187,19 @@ def case_translucent(scene):
     return 5
 
 
+def case_velvet(scene):
+    # Velvet BSDFs: a ball (Sigma 0.5) and a floor seen at a low angle (Sigma 0.2, grazing
+    # sheen), lit by the ceiling lamp.
+    lit_room(scene)
+    area_ceiling(size=1.5, energy=250.0)
+    ball = S.shader_material("velvet", "ShaderNodeBsdfVelvet", Color=(0.8, 0.3, 0.4, 1),
+                             Sigma=0.5)
+    S.uv_sphere("ball", 0.8, (0, 0.3, 0.8), ball)
+    rug = S.shader_material("rug", "ShaderNodeBsdfVelvet", Color=(0.3, 0.5, 0.8, 1), Sigma=0.2)
+    S.plane("rug", 3.0, (0, 0, 0.01), material=rug)
+    return 4
+
+
 def case_world_color(scene):
     S.plane("floor", 6.0, (0, 0, 0), material=S.diffuse("floor", (0.6, 0.6, 0.6)))
     S.uv_sphere("ball", 0.8, (0, 0, 0.8), S.diffuse("ball", (0.8, 0.5, 0.3)))
