@@ -97,6 +97,14 @@ enum class InputNodeKind : uint8_t {
   Brick,           // Brick Texture `brick` at `vector` x scale value_a: colours a, b, mortar c;
                    // mortar size value_b, smooth value_c, bias value_d, brick width value_e, row
                    // height value_f; Color, or the mortar factor (Fac, fac_output)
+  // RGB / Vector Curves of a, Float Curve of value_a, mixed with the input by fac: each channel k
+  // looked up in column k (Float Curve: column 0) of the `ramp` table, the curve mapping sampled
+  // over [bounds 0, bounds 1] as Cycles bakes it (RGB Curves: the combined curve applied first),
+  // extrapolated linearly outside it (svm_node_curves, rgb_ramp_lookup).
+  RgbCurves,
+  VectorCurves,  // a vector result (a float socket reads the mean of its components)
+  FloatCurve,
+  Blackbody,  // Cycles' piecewise fit of the colour of a black body at value_a kelvin (Rec.709)
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -128,7 +136,8 @@ struct InputNode {
   // interpolated linearly between entries unless the ramp is Constant; the result is the colour,
   // or the alpha as grey for the node's Alpha output.
   std::vector<float> ramp;  // 4 n floats
-  // MapRange: from min, from max, to min, to max (constants; Blender's default range).
+  // MapRange: from min, from max, to min, to max (constants; Blender's default range). Curves:
+  // the table's input range in bounds 0 and 1.
   std::array<float, 4> bounds{0.0f, 1.0f, 0.0f, 1.0f};
   bool ramp_interpolate = true;
   bool ramp_alpha = false;
@@ -155,6 +164,8 @@ enum class ShaderNodeKind : uint8_t {
   Principled,   // Blender 3.4 Principled BSDF v1
   Emission,     // colour * strength (radiance, W/m^2/sr per unit strength as in Cycles)
   Transparent,  // straight-through transmission, colour scales
+  Translucent,  // Blender Translucent BSDF: Lambertian transmission (diffuse, to the far side)
+  Velvet,       // Blender Velvet BSDF: Ashikhmin velvet, sigma = saturated roughness (Sigma)
   Mix,          // (1 - fac) * a + fac * b
   Add,          // a + b
 };
@@ -166,7 +177,9 @@ struct ShaderNode {
   FloatInput ior{1.45f};      // Glass, Principled
   FloatInput strength{1.0f};  // Emission
   FloatInput fac{0.5f};       // Mix
-  int32_t a = -1, b = -1;     // Mix / Add children (indices into Material::nodes)
+  // Mix / Add children (indices into Material::nodes); -1: an unlinked shader input, no closure
+  // (black, as Cycles).
+  int32_t a = -1, b = -1;
   // Whether the BSDF's Normal input (Principled: also its Clearcoat Normal) takes the material's
   // normal map or bump; false: the interpolated normal, which Cycles gives an unlinked input.
   bool normal_linked = true;

@@ -29,6 +29,8 @@ enum class ClosureType : uint8_t {
   GGXDielectric,  // GGX glass: reflection + refraction by dielectric Fresnel; alpha 0 = smooth
   Clearcoat,      // Cycles' Principled v1 clearcoat: GTR1, fixed masking, Fresnel of IOR 1.5
   Transparent,    // straight through, delta
+  Translucent,    // diffuse transmission: color / pi on the far side
+  Velvet,         // Cycles' Ashikhmin velvet, alpha = Sigma
 };
 
 enum class FresnelMode : uint8_t {

@@ -15,7 +15,9 @@
 #include "shaders/bsdf_oren_nayar.h"
 #include "shaders/bsdf_principled_diffuse.h"
 #include "shaders/bsdf_principled_sheen.h"
+#include "shaders/bsdf_translucent.h"
 #include "shaders/bsdf_transparent.h"
+#include "shaders/bsdf_velvet.h"
 
 namespace gdpt {
 
@@ -40,6 +42,10 @@ namespace {
       return clearcoat::call;            \
     case ClosureType::Transparent:       \
       return transparent::call;          \
+    case ClosureType::Translucent:       \
+      return translucent::call;          \
+    case ClosureType::Velvet:            \
+      return velvet::call;               \
   }                                      \
   return {};
 
@@ -134,7 +140,8 @@ bool lobe_is_delta(const Closure& c) {
 
 bool lobe_is_diffuse(const Closure& c) {
   return c.type == ClosureType::Lambert || c.type == ClosureType::OrenNayar ||
-         c.type == ClosureType::PrincipledDiffuse || c.type == ClosureType::PrincipledSheen;
+         c.type == ClosureType::PrincipledDiffuse || c.type == ClosureType::PrincipledSheen ||
+         c.type == ClosureType::Translucent || c.type == ClosureType::Velvet;
 }
 
 // Unnormalised selection weights; returns their sum.

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "shaders/curves_node.h"
 #include "shaders/math_node.h"
 #include "shaders/microfacet.h"
 #include "shaders/principled.h"
@@ -303,6 +304,18 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
       r = n.fac_output ? Spectrum(t.fac) : t.color;
       break;
     }
+    case InputNodeKind::RgbCurves:
+    case InputNodeKind::VectorCurves:
+      r = curves_node(n.ramp, n.bounds[0], n.bounds[1], in.color(n.a), in.scalar(n.fac), 3);
+      break;
+    case InputNodeKind::FloatCurve:
+      r = Spectrum(curves_node(n.ramp, n.bounds[0], n.bounds[1], Vec3f(in.scalar(n.value_a)),
+                               in.scalar(n.fac), 1)
+                       .x);
+      break;
+    case InputNodeKind::Blackbody:
+      r = blackbody_color(in.scalar(n.value_a));
+      break;
     case InputNodeKind::BrightContrast: {
       const float contrast = in.scalar(n.value_b);
       const float a = 1.0f + contrast, b = in.scalar(n.value_a) - contrast * 0.5f;
@@ -320,12 +333,12 @@ template <class Inputs>
 float input_node_scalar(const InputNode& n, const Inputs& in) {
   const Spectrum r = input_node_result(n, in);
   if ((n.kind == InputNodeKind::Coordinates || n.kind == InputNodeKind::VectorMath ||
-       n.kind == InputNodeKind::CombineXyz) &&
+       n.kind == InputNodeKind::CombineXyz || n.kind == InputNodeKind::VectorCurves) &&
       !n.fac_output)
     return (r.x + r.y + r.z) * (1.0f / 3.0f);
   const bool grey = n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
                     n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
-                    n.kind == InputNodeKind::ToBw ||
+                    n.kind == InputNodeKind::ToBw || n.kind == InputNodeKind::FloatCurve ||
                     (n.kind == InputNodeKind::Ramp && n.ramp_alpha) ||
                     n.fac_output;  // a texture's Fac / Distance
   return grey ? r.x : luminance(r);
@@ -441,6 +454,17 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       c.weight = in.color(n.color) * w;
       out.add(c);
       return;
+    case ShaderNodeKind::Translucent:
+      c.type = ClosureType::Translucent;
+      c.weight = in.color(n.color) * w;
+      out.add(c);
+      return;
+    case ShaderNodeKind::Velvet:
+      c.type = ClosureType::Velvet;
+      c.alpha = saturate(in.scalar(n.roughness));
+      c.weight = in.color(n.color) * w;
+      out.add(c);
+      return;
     case ShaderNodeKind::Principled: {
       PrincipledParams p;
       p.base_color = in.color(n.color);
@@ -487,7 +511,7 @@ Spectrum walk(const std::vector<ShaderNode>& nodes, int32_t root, const Inputs& 
   stack[top++] = {root, 1.0f};
   while (top > 0) {
     const StackEntry e = stack[--top];
-    if (e.weight <= 0.0f) continue;
+    if (e.node < 0 || e.weight <= 0.0f) continue;  // an unlinked shader input: no closure
     const ShaderNode& n = nodes[size_t(e.node)];
     switch (n.kind) {
       case ShaderNodeKind::Mix: {
@@ -603,10 +627,16 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         features_ |= kFeatureTextures;
         note_vector(self, n.vector, depth);
       }
-      if (n.kind == InputNodeKind::Ramp && (n.ramp.size() < 8 || n.ramp.size() % 4 != 0))
-        throw std::invalid_argument(where + "colour ramp table of " +
+      const bool curves = n.kind == InputNodeKind::RgbCurves ||
+                          n.kind == InputNodeKind::VectorCurves ||
+                          n.kind == InputNodeKind::FloatCurve;
+      if ((n.kind == InputNodeKind::Ramp || curves) &&
+          (n.ramp.size() < 8 || n.ramp.size() % 4 != 0))
+        throw std::invalid_argument(where + "colour ramp or curve table of " +
                                     std::to_string(n.ramp.size()) +
                                     " floats (expected 4 per entry, at least 2 entries)");
+      if (curves && !(n.bounds[1] > n.bounds[0]))
+        throw std::invalid_argument(where + "curve table over an empty range");
       for (const FloatInput* f :
            {&n.fac, &n.value_a, &n.value_b, &n.value_c, &n.value_d, &n.value_e, &n.value_f})
         self(self, *f, depth + 1);
@@ -631,8 +661,8 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       case ShaderNodeKind::Mix:
       case ShaderNodeKind::Add:
         if (n.kind == ShaderNodeKind::Mix) note(n.fac);
-        self(self, n.a, depth + 1);
-        self(self, n.b, depth + 1);
+        for (const int32_t child : {n.a, n.b})
+          if (child != -1) self(self, child, depth + 1);
         return;
       case ShaderNodeKind::Diffuse:
         note(n.color);
@@ -655,6 +685,14 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       case ShaderNodeKind::Transparent:
         note(n.color);
         features_ |= kFeatureTransparent | kFeatureDelta;
+        return;
+      case ShaderNodeKind::Translucent:
+        note(n.color);
+        features_ |= kFeatureTransmission;
+        return;
+      case ShaderNodeKind::Velvet:
+        note(n.color);
+        note(n.roughness);
         return;
       case ShaderNodeKind::Emission:
         note(n.color);

@@ -1,15 +1,21 @@
 # Blender material node trees -> MaterialDesc dicts (see blender_addon/module/scene_convert.h).
 #
-# Walks from the active Material Output's Surface input. Supported shader nodes: Principled BSDF,
-# Diffuse, Glossy, Glass, Emission, Transparent, Mix Shader, Add Shader. Inputs may be constants,
-# RGB / Value nodes, colour / math nodes, Image / Checker / Noise (3D) textures read at UV,
-# Generated or Object coordinates (Texture Coordinate, UV Map), optionally through a Mapping node
-# (Point / Texture type). Reroutes and muted nodes are
-# followed. Anything else is reported once per material (naming the node) and followed through its
-# mute pass-through link when it has one; otherwise a magenta diffuse (shaders) or the socket's
-# own value (inputs) stands in, so the render still completes.
+# Walks from the active Material Output's Surface input over the tree with its node groups
+# flattened (export_node_groups.py). Supported shader nodes: Principled BSDF, Diffuse, Glossy,
+# Glass, Emission (and, reported, Background: Cycles shows it as one on a surface), Transparent,
+# Mix Shader, Add Shader; a colour or float output on a shader
+# socket becomes an Emission, and an unlinked shader input is no closure (black), as in Cycles.
+# Inputs may be constants, RGB / Value nodes, colour / math / curve nodes, Blackbody, image and
+# procedural textures read at UV, Generated or Object coordinates, optionally through a Mapping
+# node. Reroutes and muted nodes are followed. Anything else is reported once per material
+# (naming the node) and followed through its mute pass-through link when it has one; otherwise a
+# magenta diffuse (shaders) or the socket's own value (inputs) stands in, so the render still
+# completes. A material whose translation fails (or that the core rejects) renders magenta, with
+# a warning naming it and the node.
 
 from mathutils import Euler, Matrix
+
+from . import export_node_groups as groups
 
 MAGENTA = (1.0, 0.0, 1.0)
 # A second Normal Map / Bump node in one material: its input keeps the interpolated normal.
@@ -19,7 +25,7 @@ IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 
 _SHADERS = {
     'BSDF_PRINCIPLED', 'BSDF_DIFFUSE', 'BSDF_GLOSSY', 'BSDF_GLASS', 'EMISSION',
-    'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER',
+    'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSLUCENT', 'BSDF_VELVET',
 }
 _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
@@ -28,7 +34,7 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
                 'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH', 'COMBXYZ',
-                'TEX_BRICK'}
+                'TEX_BRICK', 'CURVE_RGB', 'CURVE_VEC', 'CURVE_FLOAT', 'BLACKBODY'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _VORONOI_FEATURES = {'F1', 'F2', 'SMOOTH_F1', 'DISTANCE_TO_EDGE'}  # 3D
 _MAPPING_TYPES = {'POINT', 'TEXTURE', 'VECTOR'}  # Normal normalises: not a fixed transform
@@ -59,6 +65,7 @@ class _Translator:
         self.inputs = []  # colour / math input nodes (MaterialDesc::inputs)
         self.color_attribute = None  # name read by Color Attribute nodes ("": the render one)
         self.input_index = {}  # node name -> index in self.inputs
+        self.current = None  # the node being translated (named when translation fails)
 
     # --- reporting ---------------------------------------------------------------------------
 
@@ -72,34 +79,15 @@ class _Translator:
 
     # --- link following ----------------------------------------------------------------------
 
-    def _source(self, socket):
-        """The output socket feeding `socket`, through reroutes and muted nodes; None if
-        unlinked."""
-        seen = 0
-        while socket.is_linked and seen < 64:
-            seen += 1
-            link = socket.links[0]
-            if not link.is_valid or link.is_muted:
-                return None
-            out = link.from_socket
-            node = out.node
-            if node.type == 'REROUTE' or node.mute:
-                passthrough = self._passthrough_input(node, out)
-                if passthrough is None:
-                    return None
-                socket = passthrough
-                continue
-            return out
-        return None
+    @staticmethod
+    def _source(socket):
+        """The output socket feeding `socket` in the group-flattened tree, through reroutes
+        and muted nodes; None if unlinked."""
+        return groups.source(socket)
 
     @staticmethod
     def _passthrough_input(node, output):
-        for link in node.internal_links:
-            if link.to_socket == output:
-                return link.from_socket
-        if node.type == 'REROUTE':
-            return node.inputs[0]
-        return None
+        return node.passthrough(output)
 
     # --- shaders -----------------------------------------------------------------------------
 
@@ -109,10 +97,26 @@ class _Translator:
         if out is None:
             return -1
         node = out.node
+        self.current = node
+        if out.type != 'SHADER':
+            # Cycles converts a colour (or vector) on a shader socket to an Emission of that
+            # colour, a float to the strength of a white one (ShaderGraph::connect).
+            if out.type == 'VALUE':
+                return self._add({"kind": "EMISSION", "color": {"value": (1.0, 1.0, 1.0)},
+                                  "strength": self._value_of(out, {"value": 1.0})})
+            return self._add({"kind": "EMISSION", "strength": {"value": 1.0},
+                              "color": self._color_of(out, {"value": (0.0, 0.0, 0.0)})})
+        if node.type == 'BACKGROUND':
+            # On a surface Cycles shows a Background closure as an Emission of colour x
+            # strength, but lights the scene with less of it (one measure: 8% less light in a
+            # room than the same Emission): an approximation, reported.
+            self.warn(node, "Background shader on a surface (rendered as Emission; Cycles "
+                      "lights the scene less with it) in an object material:")
+            return self._emission(node)
         if node.type not in _SHADERS:
             self.warn(node, "shader node")
             passthrough = self._passthrough_input(node, out)
-            if passthrough is not None:
+            if passthrough is not None and passthrough.type == 'SHADER':
                 return self.shader(passthrough)
             return self._add({"kind": "DIFFUSE", "color": {"value": MAGENTA}})
         return getattr(self, "_" + node.type.lower())(node)
@@ -182,6 +186,16 @@ class _Translator:
     def _emission(self, n):
         return self._add({"kind": "EMISSION", "color": self.color(n.inputs["Color"]),
                           "strength": self.value(n.inputs["Strength"])})
+
+    def _bsdf_translucent(self, n):
+        linked = self.normal(n.inputs["Normal"])
+        return self._add({"kind": "TRANSLUCENT", "color": self.color(n.inputs["Color"]),
+                          "normal_linked": linked})
+
+    def _bsdf_velvet(self, n):
+        linked = self.normal(n.inputs["Normal"])
+        return self._add({"kind": "VELVET", "color": self.color(n.inputs["Color"]),
+                          "roughness": self.value(n.inputs["Sigma"]), "normal_linked": linked})
 
     def _bsdf_transparent(self, n):
         return self._add({"kind": "TRANSPARENT", "color": self.color(n.inputs["Color"])})
@@ -255,7 +269,14 @@ class _Translator:
         out = self._source(socket)
         if out is None:
             return d
+        return self._color_of(out, d)
+
+    def _color_of(self, out, d):
+        """A colour input fed by output `out`; d holds the input's own value."""
         node = out.node
+        self.current = node
+        if node.type == 'LIGHT_FALLOFF' and self._falloff_is_strength(node, out):
+            return self.color(node.inputs["Strength"])
         if node.type == 'RGB':
             d["value"] = tuple(out.default_value)[:3]
         elif node.type == 'VALUE':
@@ -284,7 +305,14 @@ class _Translator:
         out = self._source(socket)
         if out is None:
             return d
+        return self._value_of(out, d)
+
+    def _value_of(self, out, d):
+        """A float input fed by output `out`; d holds the input's own value."""
         node = out.node
+        self.current = node
+        if node.type == 'LIGHT_FALLOFF' and self._falloff_is_strength(node, out):
+            return self.value(node.inputs["Strength"])
         if node.type == 'VALUE':
             d["value"] = float(out.default_value)
         elif node.type == 'RGB':
@@ -302,6 +330,34 @@ class _Translator:
             if passthrough is not None and passthrough.type in {'RGBA', 'VALUE'}:
                 return self.value(passthrough)
         return d
+
+    def _falloff_is_strength(self, node, out):
+        """Light Falloff: its Quadratic output without smoothing is its Strength whatever the
+        ray length; the others scale by the ray length, which the shading context lacks
+        (reported; the Strength stands in)."""
+        smooth = node.inputs["Smooth"]
+        if out.name != "Quadratic" or smooth.is_linked or smooth.default_value != 0.0:
+            self.warn(node, f"output {out.name} (needs the ray length; its Strength is used) "
+                      f"with Smooth {smooth.default_value:g} of")
+        return True
+
+    def _curve_table(self, node, channels, combined=False):
+        """Cycles' baked table of a curve mapping: RAMP_TABLE_SIZE entries over the curves'
+        x range (at least [0, 1]); RGB Curves apply the combined curve (the 4th) first."""
+        mapping = node.mapping
+        mapping.initialize()
+        curves = list(mapping.curves)
+        xs = [p.location[0] for c in curves[:channels + (1 if combined else 0)] for p in c.points]
+        lo, hi = min([0.0] + xs), max([1.0] + xs)
+        table = []
+        evaluate = mapping.evaluate
+        for i in range(_RAMP_TABLE_SIZE):
+            t = lo + i / (_RAMP_TABLE_SIZE - 1) * (hi - lo)
+            if combined:
+                t = evaluate(curves[3], t)
+            row = [evaluate(curves[k], t) for k in range(channels)]
+            table.extend(row + [0.0] * (4 - channels))
+        return table, [lo, hi, 0.0, 1.0]
 
     def _input_node(self, node, out):
         """Index of a Mix / MixRGB / Math / Invert / Color Ramp node's output `out` in
@@ -477,6 +533,19 @@ class _Translator:
                 (node.type == 'MAPPING' and node.vector_type in _MAPPING_TYPES):
             # A coordinate used as a colour or value (e.g. through Separate XYZ).
             d = {"kind": "COORDINATES", "vector": self._vector_of(out)}
+        elif node.type in {'CURVE_RGB', 'CURVE_VEC', 'CURVE_FLOAT'}:
+            kind = {'CURVE_RGB': "RGB_CURVES", 'CURVE_VEC': "VECTOR_CURVES",
+                    'CURVE_FLOAT': "FLOAT_CURVE"}[node.type]
+            table, bounds = self._curve_table(node, 1 if kind == "FLOAT_CURVE" else 3,
+                                              combined=kind == "RGB_CURVES")
+            d = {"kind": kind, "fac": self.value(node.inputs[0]), "ramp": table,
+                 "bounds": bounds}
+            if kind == "FLOAT_CURVE":
+                d["value_a"] = self.value(node.inputs["Value"])
+            else:
+                d["a"] = self.color(node.inputs[1])
+        elif node.type == 'BLACKBODY':
+            d = {"kind": "BLACKBODY", "value_a": self.value(node.inputs["Temperature"])}
         elif node.type == 'RGBTOBW':
             d = {"kind": "RGB_TO_BW", "a": self.color(node.inputs["Color"])}
         elif node.type == 'BRIGHTCONTRAST':
@@ -607,6 +676,21 @@ def _translate_surface(material, images, warn):
                            "roughness": {"value": material.roughness}}],
                 "root": 0}
     t = _Translator(material, images, warn)
+    try:
+        return _translate_tree(material, t, warn)
+    except Exception as e:  # a node this code does not expect must not stop the render
+        where = f"node '{t.current.name}' ({t.current.bl_idname})" if t.current else "its tree"
+        warn(f"material '{material.name}': translating {where} failed ({type(e).__name__}: {e}); "
+             f"rendered magenta")
+        return magenta_material(material.name)
+
+
+def magenta_material(name):
+    """The stand-in for a material that cannot be translated."""
+    return {"name": name, "nodes": [{"kind": "DIFFUSE", "color": {"value": MAGENTA}}], "root": 0}
+
+
+def _translate_tree(material, t, warn):
     out = _output_node(material.node_tree)
     if out is None:
         warn(f"material '{material.name}' has no Material Output node; rendered black")
@@ -615,7 +699,7 @@ def _translate_surface(material, images, warn):
         warn(f"material '{material.name}': volumes are not supported by Gradient PT (ignored)")
     if out.inputs["Displacement"].is_linked:
         warn(f"material '{material.name}': displacement is not supported by Gradient PT (ignored)")
-    root = t.shader(out.inputs["Surface"])
+    root = t.shader(groups.wrap(out.inputs["Surface"]))
     if root < 0:
         # Nothing connected: Cycles renders such a surface black. A black diffuse does the same.
         root = t._add({"kind": "DIFFUSE", "color": {"value": (0.0, 0.0, 0.0)}})
@@ -631,6 +715,7 @@ def _translate_surface(material, images, warn):
 
 class MaterialCache:
     def __init__(self, builder, images, warn):
+        groups.reset()
         self.builder = builder
         self.images = images
         self.warn = warn
@@ -645,7 +730,12 @@ class MaterialCache:
         key = material.original.as_pointer()
         if key not in self.index:
             desc = translate_material(material, self.images, self.warn)
-            self.index[key] = self.builder.add_material(desc)
+            try:
+                self.index[key] = self.builder.add_material(desc)
+            except ValueError as e:  # rejected by the core's checks: reported, not fatal
+                self.warn(f"material '{material.name}': {e}; rendered magenta")
+                desc = dict(magenta_material(material.name), pass_index=material.pass_index)
+                self.index[key] = self.builder.add_material(desc)
             if "normal_map" in desc:
                 self.normal_mapped.add(self.index[key])
             if "color_attribute" in desc:

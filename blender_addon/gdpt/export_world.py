@@ -4,22 +4,15 @@
 import numpy as np
 from mathutils import Euler
 
+from . import export_node_groups as groups
+
 IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 
 
 def _source(socket):
-    while socket.is_linked:
-        link = socket.links[0]
-        if link.is_muted or not link.is_valid:
-            return None
-        node = link.from_node
-        if node.type == 'REROUTE' or node.mute:
-            if not node.inputs:
-                return None
-            socket = node.inputs[0]
-            continue
-        return link.from_socket
-    return None
+    """The output feeding `socket` in the group-flattened tree (export_node_groups), through
+    reroutes and muted nodes; None if unlinked."""
+    return groups.source(socket)
 
 
 BLACK = {"color": (0.0, 0.0, 0.0), "strength": 0.0}
@@ -32,6 +25,7 @@ def world_dict(world, images, warn):
     second)."""
     if world is None:
         return dict(BLACK)
+    groups.reset()
     if not world.use_nodes or world.node_tree is None:
         return {"color": tuple(world.color), "strength": 1.0}
     outputs = [n for n in world.node_tree.nodes

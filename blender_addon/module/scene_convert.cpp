@@ -13,6 +13,7 @@
 #include "blender_addon/module/mesh_ingest.h"
 #include "core/huge_pages.h"
 #include "shaders/image_io.h"
+#include "shaders/material.h"
 
 namespace gdpt::python {
 
@@ -151,7 +152,11 @@ InputNode read_input_node(const py::dict& d) {
       {"WHITE_NOISE", InputNodeKind::WhiteNoise},
       {"MAGIC", InputNodeKind::Magic},
       {"VECTOR_MATH", InputNodeKind::VectorMath},
-      {"BRICK", InputNodeKind::Brick}};
+      {"BRICK", InputNodeKind::Brick},
+      {"RGB_CURVES", InputNodeKind::RgbCurves},
+      {"VECTOR_CURVES", InputNodeKind::VectorCurves},
+      {"FLOAT_CURVE", InputNodeKind::FloatCurve},
+      {"BLACKBODY", InputNodeKind::Blackbody}};
   n.kind = get_enum(d, "kind", "MIX", kKinds, "input node kind");
   static const std::pair<const char*, MixBlend> kBlends[] = {{"MIX", MixBlend::Mix},
                                                              {"ADD", MixBlend::Add},
@@ -334,6 +339,8 @@ ShaderNodeKind to_kind(const std::string& kind) {
   if (kind == "PRINCIPLED") return ShaderNodeKind::Principled;
   if (kind == "EMISSION") return ShaderNodeKind::Emission;
   if (kind == "TRANSPARENT") return ShaderNodeKind::Transparent;
+  if (kind == "TRANSLUCENT") return ShaderNodeKind::Translucent;
+  if (kind == "VELVET") return ShaderNodeKind::Velvet;
   if (kind == "MIX") return ShaderNodeKind::Mix;
   if (kind == "ADD") return ShaderNodeKind::Add;
   bad_enum("shader node kind", kind);
@@ -500,6 +507,17 @@ size_t SceneBuilder::triangle_count() const {
 
 // --- Materials and images ----------------------------------------------------------------------
 
+// Compiles the material once against 1x1 stand-ins for the images, so what the render would
+// reject (cyclic or too deep trees, malformed tables) is reported now, naming the material, and
+// the add-on can put a stand-in in its place instead of failing the render.
+void SceneBuilder::validate_material(const MaterialDesc& desc) {
+  ImageDesc pixel;
+  pixel.width = pixel.height = 1;
+  pixel.rgba = {0.0f, 0.0f, 0.0f, 1.0f};
+  while (image_stand_ins_.size() < scene_.images.size()) image_stand_ins_.emplace_back(pixel);
+  Material(desc, std::span<const Texture>(image_stand_ins_.data(), scene_.images.size()));
+}
+
 int SceneBuilder::add_material(const py::dict& material) {
   MaterialDesc desc;
   desc.name = get_str(material, "name", "");
@@ -578,6 +596,7 @@ int SceneBuilder::add_material(const py::dict& material) {
           &node.value_d.texture, &node.value_e.texture, &node.value_f.texture})
       if (t->image >= int32_t(scene_.images.size()))
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
+  validate_material(desc);
   scene_.materials.push_back(std::move(desc));
   return int(scene_.materials.size()) - 1;
 }

@@ -30,6 +30,7 @@
 #include <string>
 
 #include "scene/scene.h"
+#include "shaders/texture.h"
 
 namespace gdpt::python {
 
@@ -99,7 +100,10 @@ class SceneBuilder {
   const Scene& scene() const { return scene_; }
 
  private:
+  void validate_material(const MaterialDesc& desc);
+
   Scene scene_;
+  std::vector<Texture> image_stand_ins_;  // validate_material()'s images
 };
 
 }  // namespace gdpt::python

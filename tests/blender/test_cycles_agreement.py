@@ -148,6 +148,58 @@ def case_mesh_light(scene):
     return 3
 
 
+def case_empty_mix_input(scene):
+    # A Mix Shader with an unlinked input: no closure there (Cycles: that share is black), on
+    # the ball and on a Mix-of-nothing-and-Emission panel lighting the room.
+    lit_room(scene)
+    panel = S.emission("panel", (1, 0.9, 0.8), 20.0)
+    S.plane("panel", 1.2, (0, 0, 3.9), (math.pi, 0, 0), panel)
+    for m, fac in ((panel, 0.6), (S.diffuse("ball", (0.8, 0.8, 0.8)), 0.3)):
+        nt = m.node_tree
+        mix = nt.nodes.new("ShaderNodeMixShader")
+        mix.inputs[0].default_value = fac
+        out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
+        nt.links.new(out.inputs["Surface"].links[0].from_socket, mix.inputs[2])
+        nt.links.new(mix.outputs[0], out.inputs["Surface"])
+        if m is not panel:
+            S.uv_sphere("ball", 0.7, (0, 0.3, 0.7), m)
+    return 3
+
+
+def case_translucent(scene):
+    # A Translucent sheet seen from below, lit through from the ceiling lamp, and a ball of
+    # Diffuse and Translucent mixed (light crossing its inside).
+    lit_room(scene)
+    area_ceiling(size=1.5, energy=250.0)
+    sheet = S.shader_material("sheet", "ShaderNodeBsdfTranslucent", Color=(0.9, 0.8, 0.5, 1))
+    S.plane("sheet", 1.6, (0.6, 0.0, 2.4), material=sheet)
+    m = S.diffuse("ball", (0.3, 0.6, 0.9))
+    nt = m.node_tree
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    mix.inputs[0].default_value = 0.5
+    translucent = nt.nodes.new("ShaderNodeBsdfTranslucent")
+    translucent.inputs["Color"].default_value = (0.9, 0.5, 0.2, 1)
+    out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
+    nt.links.new(out.inputs["Surface"].links[0].from_socket, mix.inputs[1])
+    nt.links.new(translucent.outputs[0], mix.inputs[2])
+    nt.links.new(mix.outputs[0], out.inputs["Surface"])
+    S.uv_sphere("ball", 0.7, (-0.6, 0.3, 0.7), m)
+    return 5
+
+
+def case_velvet(scene):
+    # Velvet BSDFs: a ball (Sigma 0.5) and a floor seen at a low angle (Sigma 0.2, grazing
+    # sheen), lit by the ceiling lamp.
+    lit_room(scene)
+    area_ceiling(size=1.5, energy=250.0)
+    ball = S.shader_material("velvet", "ShaderNodeBsdfVelvet", Color=(0.8, 0.3, 0.4, 1),
+                             Sigma=0.5)
+    S.uv_sphere("ball", 0.8, (0, 0.3, 0.8), ball)
+    rug = S.shader_material("rug", "ShaderNodeBsdfVelvet", Color=(0.3, 0.5, 0.8, 1), Sigma=0.2)
+    S.plane("rug", 3.0, (0, 0, 0.01), material=rug)
+    return 4
+
+
 def case_world_color(scene):
     S.plane("floor", 6.0, (0, 0, 0), material=S.diffuse("floor", (0.6, 0.6, 0.6)))
     S.uv_sphere("ball", 0.8, (0, 0, 0.8), S.diffuse("ball", (0.8, 0.5, 0.3)))
@@ -1012,6 +1064,95 @@ def voronoi_regions(image):
     return strip_regions(image, [label for label, *_ in VORONOIS], BRICK_ROWS, BRICK_HEIGHT)
 
 
+def _curve(mapping, index, points):
+    """Replaces curve `index` of a curve mapping by `points` ((x, y), at least two)."""
+    curve = mapping.curves[index]
+    while len(curve.points) > 2:
+        curve.points.remove(curve.points[-1])
+    curve.points[0].location, curve.points[1].location = points[0], points[1]
+    for p in points[2:]:
+        curve.points.new(*p)
+    mapping.update()
+
+
+def _span(nt, generated, scale, offset):
+    v = nt.nodes.new("ShaderNodeVectorMath")
+    v.operation = 'MULTIPLY_ADD'
+    nt.links.new(generated, v.inputs[0])
+    v.inputs[1].default_value = scale
+    v.inputs[2].default_value = offset
+    return v.outputs["Vector"]
+
+
+def curves_rgb(nt, emit, generated):
+    # Each channel its own curve, the combined curve first; input beyond [0, 1] (extrapolated).
+    node = nt.nodes.new("ShaderNodeRGBCurve")
+    _curve(node.mapping, 0, [(0.0, 0.1), (0.4, 0.8), (1.0, 0.3)])
+    _curve(node.mapping, 1, [(0.0, 0.0), (0.7, 0.2), (1.0, 1.0)])
+    _curve(node.mapping, 3, [(0.0, 0.2), (1.0, 0.9)])
+    node.inputs["Fac"].default_value = 0.85
+    nt.links.new(_span(nt, generated, (1.4, 0.8, 1.2), (-0.2, 0.1, 0.0)), node.inputs["Color"])
+    nt.links.new(node.outputs[0], emit.inputs["Color"])
+
+
+def curves_rgb_wide(nt, emit, generated):
+    # Points beyond [0, 1] widen the table's range (Cycles bakes it over the points' span).
+    node = nt.nodes.new("ShaderNodeRGBCurve")
+    node.mapping.clip_min_x, node.mapping.clip_max_x = -1.0, 2.0
+    node.mapping.use_clip = False
+    _curve(node.mapping, 2, [(-0.5, 0.0), (0.5, 0.6), (1.5, 0.2)])
+    nt.links.new(_span(nt, generated, (2.0, 1.0, 2.0), (-0.5, 0.0, -0.5)), node.inputs["Color"])
+    nt.links.new(node.outputs[0], emit.inputs["Color"])
+
+
+def curves_vector(nt, emit, generated):
+    node = nt.nodes.new("ShaderNodeVectorCurve")
+    _curve(node.mapping, 0, [(-1.0, 0.0), (0.0, 0.8), (1.0, 0.3)])
+    _curve(node.mapping, 2, [(-1.0, 1.0), (1.0, 0.1)])
+    nt.links.new(_span(nt, generated, (2.0, 2.0, 2.0), (-1.0, -1.0, -1.0)), node.inputs["Vector"])
+    nt.links.new(node.outputs[0], emit.inputs["Color"])
+
+
+def curves_float(nt, emit, generated):
+    # Float Curve of Generated x (as a float: the vector's mean) as the emission strength.
+    node = nt.nodes.new("ShaderNodeFloatCurve")
+    _curve(node.mapping, 0, [(0.0, 0.9), (0.3, 0.1), (0.8, 0.7), (1.0, 0.4)])
+    node.inputs[0].default_value = 0.9
+    xyz = nt.nodes.new("ShaderNodeSeparateXYZ")
+    nt.links.new(generated, xyz.inputs[0])
+    nt.links.new(xyz.outputs["X"], node.inputs["Value"])
+    nt.links.new(node.outputs[0], emit.inputs["Strength"])
+    emit.inputs["Color"].default_value = (0.9, 0.7, 0.4, 1.0)
+
+
+def blackbody(nt, emit, generated):
+    # Temperature 500 .. 13000 K along the strip: both constant ends and all seven fits.
+    xyz = nt.nodes.new("ShaderNodeSeparateXYZ")
+    nt.links.new(generated, xyz.inputs[0])
+    ramp = nt.nodes.new("ShaderNodeMapRange")
+    nt.links.new(xyz.outputs["X"], ramp.inputs["Value"])
+    ramp.inputs["To Min"].default_value, ramp.inputs["To Max"].default_value = 500.0, 13000.0
+    node = nt.nodes.new("ShaderNodeBlackbody")
+    nt.links.new(ramp.outputs[0], node.inputs["Temperature"])
+    nt.links.new(node.outputs[0], emit.inputs["Color"])
+
+
+CURVE_STRIPS = [("RGB Curves", curves_rgb), ("RGB Curves over a wide range", curves_rgb_wide),
+                ("Vector Curves", curves_vector), ("Float Curve", curves_float),
+                ("Blackbody", blackbody)]
+CURVE_ROWS = 3
+
+
+def case_curve_nodes(scene):
+    # RGB / Vector / Float Curves and Blackbody (CURVE_STRIPS) on emissive strips.
+    emissive_strips(scene, [build for _, build in CURVE_STRIPS], CURVE_ROWS, BRICK_HEIGHT)
+    return 1
+
+
+def curve_regions(image):
+    return strip_regions(image, [label for label, _ in CURVE_STRIPS], CURVE_ROWS, BRICK_HEIGHT)
+
+
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
 
 # Cases whose noise floor at the default counts lies near the threshold render more samples on
@@ -1033,7 +1174,7 @@ CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case
 # (Smooth F1 hashes 125 cells per lookup: 37 s for GDPT at the default counts).
 SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map": 4,
                 "input_nodes": 2, "adjust_nodes": 2, "bump": 4, "math_nodes": 0.5,
-                "voronoi_features": 0.5}
+                "voronoi_features": 0.5, "curve_nodes": 0.5}
 
 # Cases whose image holds many independent features, each of which must agree on its own (one
 # wrong feature can hide in the relMSE of the whole image): name -> function(image) returning
@@ -1042,7 +1183,8 @@ SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map
 # total internal reflection, the distorted checker's edges) carry anti-aliasing noise, 1e-4 - 2e-4
 # at half the default counts.
 REGIONS = {"math_nodes": (math_regions, 1e-4), "vector_math": (vector_regions, 5e-4),
-           "brick_texture": (brick_regions, 5e-4), "voronoi_features": (voronoi_regions, 5e-4)}
+           "brick_texture": (brick_regions, 5e-4), "voronoi_features": (voronoi_regions, 5e-4),
+           "curve_nodes": (curve_regions, 5e-4)}
 
 
 # Per-kind bounce limits (diffuse, glossy, transmission) set on both engines after the common

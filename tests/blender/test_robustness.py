@@ -43,28 +43,31 @@ def test_unsupported_node(out):
     # Toon BSDF: unsupported shader, no shader pass-through -> magenta stand-in.
     toon = S.shader_material("toon", "ShaderNodeBsdfToon", Color=(0.2, 0.8, 0.2, 1))
     S.uv_sphere("ball", 0.6, (-0.8, 0.3, 0.6), toon)
-    # RGB Curves between an RGB node and the Diffuse colour: followed through its pass-through.
+    # A Mix (Overlay, a blend Gradient PT lacks) between an RGB node and the Diffuse colour:
+    # followed through its pass-through (its first colour).
     m, nt, outn = S._material("bc")
     rgb = nt.nodes.new("ShaderNodeRGB")
     rgb.outputs[0].default_value = (0.1, 0.2, 0.9, 1)
-    bc = nt.nodes.new("ShaderNodeRGBCurve")
-    bc.name = "My RGB Curves"
+    bc = nt.nodes.new("ShaderNodeMixRGB")
+    bc.blend_type = 'OVERLAY'
+    bc.name = "My Overlay"
     bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
-    nt.links.new(rgb.outputs[0], bc.inputs["Color"])
+    nt.links.new(rgb.outputs[0], bc.inputs["Color1"])
     nt.links.new(bc.outputs[0], bsdf.inputs["Color"])
     nt.links.new(bsdf.outputs[0], outn.inputs["Surface"])
     # An unsupported colour node between a texture-free colour and a float input (Roughness):
     # its pass-through is a colour socket, read as a float.
-    curves = nt.nodes.new("ShaderNodeRGBCurve")
-    curves.name = "Roughness Curves"
-    nt.links.new(rgb.outputs[0], curves.inputs["Color"])
+    curves = nt.nodes.new("ShaderNodeMixRGB")
+    curves.blend_type = 'OVERLAY'
+    curves.name = "Roughness Overlay"
+    nt.links.new(rgb.outputs[0], curves.inputs["Color1"])
     nt.links.new(curves.outputs[0], bsdf.inputs["Roughness"])
     S.uv_sphere("ball2", 0.6, (0.8, 0.3, 0.6), m)
     path, warnings = render_finished(scene, os.path.join(out, "unsupported.exr"))
     toon_w = [w for w in warnings if "Toon BSDF" in w and "'toon'" in w]
-    bc_w = [w for w in warnings if "My RGB Curves" in w]
+    bc_w = [w for w in warnings if "My Overlay" in w]
     check(len(toon_w) == 1, "one warning names the Toon BSDF node of material 'toon'")
-    check(len(bc_w) == 1, "one warning names the RGB Curves node")
+    check(len(bc_w) == 1, "one warning names the Overlay Mix node")
     img = S.read_rgb(path)
     check(img.mean() > 0.01, "the image was written")
     # The pass-through keeps the RGB node's blue: the right sphere is bluer than it is red.

@@ -72,6 +72,19 @@ inline Closure transparent(Spectrum c = Spectrum(1.0f)) {
   k.weight = c;
   return k;
 }
+inline Closure translucent(Spectrum c = Spectrum(1.0f)) {
+  Closure k;
+  k.type = ClosureType::Translucent;
+  k.weight = c;
+  return k;
+}
+inline Closure velvet(float sigma, Spectrum c = Spectrum(1.0f)) {
+  Closure k;
+  k.type = ClosureType::Velvet;
+  k.alpha = sigma;
+  k.weight = c;
+  return k;
+}
 
 // `c` as a lobe that keeps the interpolated normal under a bump (Closure::interpolated_normal).
 inline Closure kept(Closure c) {

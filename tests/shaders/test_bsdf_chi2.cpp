@@ -24,6 +24,12 @@ std::vector<Case> lobe_cases() {
   cases.push_back({"OrenNayar1", set_of({oren_nayar(1.0f)})});
   cases.push_back({"PrincipledDiffuse05", set_of({principled_diffuse(0.5f)})});
   cases.push_back({"PrincipledSheen", set_of({principled_sheen()})});
+  cases.push_back({"Translucent", set_of({translucent()})});
+  cases.push_back({"Velvet02", set_of({velvet(0.2f)})});
+  cases.push_back({"Velvet1", set_of({velvet(1.0f)})});
+  cases.push_back(
+      {"MixLambertTranslucentVelvet", set_of({lambert(Spectrum(0.3f)), translucent(Spectrum(0.5f)),
+                                              velvet(0.5f, Spectrum(0.4f))})});
   for (float a : {0.05f, 0.2f, 0.5f, 1.0f}) {
     const std::string s = std::to_string(int(a * 100 + 0.5f));
     cases.push_back({"GGX" + s, set_of({ggx(a)})});

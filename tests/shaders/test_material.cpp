@@ -575,6 +575,74 @@ TEST(Material, InputNodesFollowCycles) {
   EXPECT_THROW(Material(d, textures), std::invalid_argument);
 }
 
+TEST(Material, UnlinkedShaderInputsAreNoClosure) {
+  // Mix(unlinked, Emission 2 x (1, 1, 1), fac 0.25) inside Add(that, unlinked): Cycles gives an
+  // unlinked shader input no closure, so only a quarter of the emission is left, no lobe.
+  MaterialDesc d;
+  d.nodes.push_back(node(ShaderNodeKind::Add));  // 0
+  d.nodes[0].a = 1;
+  d.nodes.push_back(node(ShaderNodeKind::Mix));  // 1
+  d.nodes[1].fac = FloatInput(0.25f);
+  d.nodes[1].b = 2;
+  d.nodes.push_back(node(ShaderNodeKind::Emission, Spectrum(1.0f)));  // 2
+  d.nodes[2].strength = FloatInput(2.0f);
+  d.root = 0;
+  const Material m(d, {});
+  const ClosureSet s = eval(m);
+  EXPECT_EQ(s.count(), 0);
+  expect_spectrum(s.emission(), Spectrum(0.5f));
+  d.nodes[1].b = -1;  // both unlinked: black
+  const ClosureSet black = eval(Material(d, {}));
+  EXPECT_EQ(black.count(), 0);
+  expect_spectrum(black.emission(), Spectrum(0.0f));
+}
+
+TEST(Material, CurveAndBlackbodyNodes) {
+  // A 3-entry table over [-1, 1]: column 0 is 0, 0.5, 2 (x -1, 0, 1), column 1 constant 0.3.
+  InputNode curve;
+  curve.kind = InputNodeKind::RgbCurves;
+  curve.ramp = {0.0f, 0.3f, 0.0f, 0.0f, 0.5f, 0.3f, 0.0f, 0.0f, 2.0f, 0.3f, 0.0f, 0.0f};
+  curve.bounds = {-1.0f, 1.0f, 0.0f, 1.0f};
+  curve.fac = FloatInput(1.0f);
+  MaterialDesc d;
+  d.nodes.push_back(node(ShaderNodeKind::Emission));
+  d.nodes[0].color.node = 0;
+  d.root = 0;
+  auto emission_of = [&](Spectrum in, float fac) {
+    d.inputs = {curve};
+    d.inputs[0].a = ColorInput(in);
+    d.inputs[0].fac = FloatInput(fac);
+    return eval(Material(d, {})).emission();
+  };
+  // Interpolated inside, extrapolated along the end segments outside, mixed by fac.
+  expect_spectrum(emission_of(Spectrum(0.5f, 0.0f, 0.0f), 1.0f), Spectrum(1.25f, 0.3f, 0.0f));
+  expect_spectrum(emission_of(Spectrum(2.0f, 0.0f, 0.0f), 1.0f), Spectrum(3.5f, 0.3f, 0.0f));
+  expect_spectrum(emission_of(Spectrum(-2.0f, 0.0f, 0.0f), 1.0f), Spectrum(-0.5f, 0.3f, 0.0f));
+  expect_spectrum(emission_of(Spectrum(0.5f, 0.0f, 0.0f), 0.5f), Spectrum(0.875f, 0.15f, 0.0f));
+  curve.bounds[1] = -1.0f;  // an empty range is malformed
+  d.inputs = {curve};
+  EXPECT_THROW(Material(d, {}), std::invalid_argument);
+
+  // Blackbody: Cycles' fit, continuous across its ranges, constant beyond 12000 K, clamped at 0.
+  InputNode bb;
+  bb.kind = InputNodeKind::Blackbody;
+  auto blackbody = [&](float kelvin) {
+    d.inputs = {bb};
+    d.inputs[0].value_a = FloatInput(kelvin);
+    return eval(Material(d, {})).emission();
+  };
+  for (float t : {965.0f, 1167.0f, 1449.0f, 1902.0f, 3315.0f, 6365.0f}) {
+    const Spectrum below = blackbody(t * 0.9999f), above = blackbody(t);
+    expect_spectrum(below, above, 0.02f);
+  }
+  expect_spectrum(blackbody(20000.0f), Spectrum(0.8262955f, 0.9945081f, 1.5663077f));
+  const Spectrum candle = blackbody(1500.0f);
+  EXPECT_GT(candle.x, candle.y);
+  EXPECT_GT(candle.y, candle.z);
+  EXPECT_GE(candle.z, 0.0f);
+  EXPECT_EQ(blackbody(500.0f).y, 0.0f);  // negative green below 800 K, clamped
+}
+
 TEST(Material, MalformedTreesThrow) {
   MaterialDesc d;
   d.name = "broken";
