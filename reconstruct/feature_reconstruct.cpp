@@ -58,15 +58,15 @@ std::vector<float> solve_guide(const ReconstructionInput& in, const Reconstructi
 }  // namespace
 
 std::vector<detail::CandidateFilter> default_feature_candidates() {
-  return {{1, 1.f, false, 0.f}, {1, 1.f, true, 0.05f}, {2, 1.f, false, 0.f}, {2, 1.f, true, 0.05f}};
+  return {{1, 1.f}, {2, 1.f}};
 }
 
 FeatureReconstruction feature_regression(const ReconstructionInput& input, const float* guide,
                                          const std::vector<detail::CandidateFilter>& candidates) {
   if (!input.primal_a || !input.primal_b)
     throw std::invalid_argument("reconstruct: the Feature norm needs both primal halves (A and B)");
-  if (candidates.empty() || candidates.size() > 255)
-    throw std::invalid_argument("reconstruct: 1 to 255 candidate filters");
+  if (candidates.empty() || candidates.size() > 127)
+    throw std::invalid_argument("reconstruct: 1 to 127 candidate filters");
   FeatureReconstruction r;
   auto t = std::chrono::steady_clock::now();
   const detail::FeatureBuffers fb = detail::prepare_feature_buffers(input, guide);
@@ -75,17 +75,21 @@ FeatureReconstruction feature_regression(const ReconstructionInput& input, const
   r.prepare_seconds = since(t);
 
   const size_t n = size_t(input.width) * input.height;
-  std::vector<float> fa(3 * n), fbh(3 * n);
+  const int variants = detail::has_guide(fb) ? 2 : 1;
+  std::vector<float> fa(variants * 3 * n), fbh(variants * 3 * n);
+  float* const out_a[2] = {fa.data(), fa.data() + 3 * n * (variants - 1)};
+  float* const out_b[2] = {fbh.data(), fbh.data() + 3 * n * (variants - 1)};
   detail::CandidateChoice choice;
   for (size_t k = 0; k < candidates.size(); ++k) {
     t = std::chrono::steady_clock::now();
     detail::cross_filter_half(fb, fb.a.data(), fb.smooth_b.data(), fb.patch_var_b.data(),
-                              candidates[k], fa.data());
+                              candidates[k], out_a);
     detail::cross_filter_half(fb, fb.b.data(), fb.smooth_a.data(), fb.patch_var_a.data(),
-                              candidates[k], fbh.data());
+                              candidates[k], out_b);
     r.filter_seconds += since(t);
     t = std::chrono::steady_clock::now();
-    detail::offer_candidate(fb, int(k), fa.data(), fbh.data(), choice);
+    for (int v = 0; v < variants; ++v)
+      detail::offer_candidate(fb, int(k) * variants + v, out_a[v], out_b[v], choice);
     r.select_seconds += since(t);
   }
   r.image = std::move(choice.image);

@@ -28,8 +28,8 @@ struct FeatureReconstruction {
   double prepare_seconds = 0.0, filter_seconds = 0.0, select_seconds = 0.0;
 };
 
-// The candidate filters tried per pixel: windows 9 and 17 pixels wide, each with and without
-// the guide among the features.
+// The candidate windows tried per pixel: 9 and 17 pixels wide, each with and without the guide
+// among the features (chosen[i] = 2 x window + with guide, when there is a guide).
 std::vector<detail::CandidateFilter> default_feature_candidates();
 
 // Steps 2 and 3 for given `guide` (RGB, may be null: no guide feature), in the caller's TBB

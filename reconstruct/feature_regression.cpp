@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "reconstruct/parallel.h"
@@ -21,6 +23,20 @@ constexpr uint8_t kUsable = kHalvesValid | kFeaturesValid;
 // feature explains), the result falls back to the unbiased noisy value instead of a wrong one.
 constexpr float kSelfWeight = 0.01f;
 
+// exp(-x) for x >= 0 within 0.3%: 2^-t from a quadratic on the fraction and the exponent bits.
+// The weights need neither more accuracy nor the libm call's cost (two per sample and pixel).
+inline float exp_neg(float x) {
+  const float t = -std::min(x * 1.4426950f, 125.f);
+  const float i = std::floor(t), f = t - i;
+  const float p = 1.f + f * (0.6565f + f * 0.3435f);
+  int32_t bits;
+  std::memcpy(&bits, &p, sizeof bits);
+  bits += int32_t(i) * (1 << 23);
+  float r;
+  std::memcpy(&r, &bits, sizeof r);
+  return r;
+}
+
 // NLM weight of pixel q seen from pixel p: the squared difference of the 3x3 patch means, less
 // its expected noise, relative to that noise (NFOR's form, patch means for speed).
 inline float nlm_weight(const float* mean, const float* var, size_t p, size_t q, float k2) {
@@ -30,7 +46,7 @@ inline float nlm_weight(const float* mean, const float* var, size_t p, size_t q,
     const float diff = mp - mq, v = var[3 * p + c] + var[3 * q + c];
     d += (diff * diff - v) / (k2 * v + 1e-4f * (mp * mp + mq * mq) + 1e-12f);
   }
-  return std::exp(-std::max(0.f, d * (1.f / 3.f)));
+  return exp_neg(std::max(0.f, d * (1.f / 3.f)));
 }
 
 struct CenterGrid {
@@ -80,17 +96,20 @@ struct FilterArgs {
   const CandidateFilter& filter;
 };
 
-// Fits the model of the centre at pixel c: beta (D x 3) with colour = beta_0 + beta_k (f - f_c).
-// Returns false when the window has no usable sample.
-bool fit_center(const FilterArgs& a, int cx, int cy, float* beta) {
+// The weighted normal equations of a centre's window: rows [1, f - f_c] against [1, f - f_c, RGB].
+struct WindowSums {
+  alignas(64) float m[kMaxD][kCols] = {};
+  float wsum = 0.f;
+};
+
+WindowSums accumulate_window(const FilterArgs& a, int cx, int cy) {
   const FeatureBuffers& fb = a.fb;
   const int W = fb.width, H = fb.height, d = fb.count, D = d + 1, s = a.filter.stride;
   const size_t c = size_t(cy) * W + cx;
   const float* fc = fb.features.data() + d * c;
   const bool center_ok = fb.valid[c] & kHalvesValid;
   const float k2 = a.filter.bandwidth * a.filter.bandwidth;
-  alignas(64) float m[kMaxD][kCols] = {};
-  float wsum = 0.f;
+  WindowSums ws;
   for (int v = -kWindowRadius; v <= kWindowRadius; ++v) {
     const int y = cy + v * s;
     if (y < 0 || y >= H) continue;
@@ -104,27 +123,39 @@ bool fit_center(const FilterArgs& a, int cx, int cy, float* beta) {
       alignas(64) float z[kCols] = {};
       z[0] = 1.f;
       const float* fq = fb.features.data() + d * q;
-      for (int k = 0; k < d; ++k)
-        z[1 + k] = a.filter.use_guide || fb.guide_colour[k] < 0 ? fq[k] - fc[k] : 0.f;
+      for (int k = 0; k < d; ++k) z[1 + k] = fq[k] - fc[k];
       for (int ch = 0; ch < 3; ++ch) z[D + ch] = a.target[3 * q + ch];
       for (int j = 0; j < D; ++j) {
         const float wz = w * z[j];
-        for (int k = 0; k < kCols; ++k) m[j][k] += wz * z[k];
+        for (int k = 0; k < kCols; ++k) ws.m[j][k] += wz * z[k];
       }
-      wsum += w;
+      ws.wsum += w;
     }
   }
-  if (!(wsum > 0.f)) return false;
+  return ws;
+}
+
+// Solves a centre's ridge regression for beta (D x 3), colour = beta_0 + beta_k (f - f_c);
+// without the guide, its slopes are fixed at zero.
+void solve_model(const FilterArgs& a, const WindowSums& ws, size_t c, bool use_guide, float* beta) {
+  const FeatureBuffers& fb = a.fb;
+  const int d = fb.count, D = d + 1;
   double lhs[kMaxD][kMaxD] = {}, rhs[kMaxD][3] = {};
   for (int j = 0; j < D; ++j) {
-    for (int k = 0; k < D; ++k) lhs[j][k] = m[j][k];
-    for (int ch = 0; ch < 3; ++ch) rhs[j][ch] = m[j][D + ch];
+    for (int k = 0; k < D; ++k) lhs[j][k] = ws.m[j][k];
+    for (int ch = 0; ch < 3; ++ch) rhs[j][ch] = ws.m[j][D + ch];
   }
-  lhs[0][0] += 1e-6 * wsum;
+  lhs[0][0] += 1e-6 * ws.wsum;
   const float* noise = fb.noise.data() + d * c;
   for (int k = 0; k < d; ++k) {
-    const int colour = a.filter.use_guide ? fb.guide_colour[k] : -1;
-    const double ridge = wsum * ((colour >= 0 ? a.filter.guide_ridge : kFeatureRidge) + noise[k]);
+    const int colour = fb.guide_colour[k];
+    if (colour >= 0 && !use_guide) {
+      for (int j = 0; j < D; ++j) lhs[1 + k][j] = lhs[j][1 + k] = 0.0;
+      for (int ch = 0; ch < 3; ++ch) rhs[1 + k][ch] = 0.0;
+      lhs[1 + k][1 + k] = 1.0;
+      continue;
+    }
+    const double ridge = ws.wsum * ((colour >= 0 ? kGuideRidge : kFeatureRidge) + noise[k]);
     lhs[1 + k][1 + k] += ridge;
     if (colour >= 0) rhs[1 + k][colour] += ridge * fb.guide_slope[k];
   }
@@ -139,12 +170,13 @@ bool fit_center(const FilterArgs& a, int cx, int cy, float* beta) {
   }
   for (int j = 0; j < D; ++j)
     for (int ch = 0; ch < 3; ++ch) beta[3 * j + ch] = float(sol[j][ch]);
-  return true;
 }
 
-// Blends the models of the four centres around every pixel of rows [y0, y1).
-void apply_models(const FilterArgs& a, const CenterGrid& g, const std::vector<float>& betas,
-                  const std::vector<uint8_t>& fitted, int y0, int y1, float* out) {
+// Blends the models of the four centres around every pixel of rows [y0, y1); models and outputs
+// per variant (without, with the guide).
+void apply_models(const FilterArgs& a, const CenterGrid& g, int variants,
+                  const std::vector<float>& betas, const std::vector<uint8_t>& fitted, int y0,
+                  int y1, float* const* out) {
   const FeatureBuffers& fb = a.fb;
   const int W = fb.width, d = fb.count;
   const float k2 = a.filter.bandwidth * a.filter.bandwidth;
@@ -164,7 +196,7 @@ void apply_models(const FilterArgs& a, const CenterGrid& g, const std::vector<fl
       cell(x, g.nx, g.width, i0, tx);
       const size_t p = size_t(y) * W + x;
       const bool p_features = fb.valid[p] & kFeaturesValid, p_halves = fb.valid[p] & kHalvesValid;
-      float acc[3] = {0.f, 0.f, 0.f}, wsum = 0.f;
+      float acc[2][3] = {}, wsum = 0.f;
       for (int corner = 0; corner < 4; ++corner) {
         const int i = std::min(i0 + (corner & 1), g.nx - 1),
                   j = std::min(j0 + (corner >> 1), g.ny - 1);
@@ -176,43 +208,60 @@ void apply_models(const FilterArgs& a, const CenterGrid& g, const std::vector<fl
                               ? nlm_weight(a.weight_mean, a.weight_var, c, p, k2)
                               : 1.f;
         const float w = bil * std::max(nlm, 1e-4f);
-        const float* beta = betas.data() + ci * kMaxD * 3;
-        float pred[3] = {beta[0], beta[1], beta[2]};
-        if (p_features) {
-          const float *fp = fb.features.data() + d * p, *fc = fb.features.data() + d * c;
-          for (int k = 0; k < d; ++k) {
-            const float df = fp[k] - fc[k];
-            for (int ch = 0; ch < 3; ++ch) pred[ch] += beta[3 * (1 + k) + ch] * df;
-          }
-        }
-        for (int ch = 0; ch < 3; ++ch) acc[ch] += w * pred[ch];
         wsum += w;
+        for (int v = 0; v < variants; ++v) {
+          const float* beta = betas.data() + (ci * variants + v) * kMaxD * 3;
+          float pred[3] = {beta[0], beta[1], beta[2]};
+          if (p_features) {
+            const float *fp = fb.features.data() + d * p, *fc = fb.features.data() + d * c;
+            for (int k = 0; k < d; ++k) {
+              const float df = fp[k] - fc[k];
+              for (int ch = 0; ch < 3; ++ch) pred[ch] += beta[3 * (1 + k) + ch] * df;
+            }
+          }
+          for (int ch = 0; ch < 3; ++ch) acc[v][ch] += w * pred[ch];
+        }
       }
       if (p_halves) {
-        for (int ch = 0; ch < 3; ++ch) acc[ch] += kSelfWeight * a.target[3 * p + ch];
+        for (int v = 0; v < variants; ++v)
+          for (int ch = 0; ch < 3; ++ch) acc[v][ch] += kSelfWeight * a.target[3 * p + ch];
         wsum += kSelfWeight;
       }
-      for (int ch = 0; ch < 3; ++ch) out[3 * p + ch] = wsum > 0.f ? acc[ch] / wsum : 0.f;
+      for (int v = 0; v < variants; ++v)
+        for (int ch = 0; ch < 3; ++ch) out[v][3 * p + ch] = wsum > 0.f ? acc[v][ch] / wsum : 0.f;
     }
   }
 }
 
 }  // namespace
 
+bool has_guide(const FeatureBuffers& fb) {
+  for (int k = 0; k < fb.count; ++k)
+    if (fb.guide_colour[k] >= 0) return true;
+  return false;
+}
+
 void cross_filter_half(const FeatureBuffers& fb, const float* target, const float* weight_mean,
-                       const float* weight_var, const CandidateFilter& filter, float* out) {
+                       const float* weight_var, const CandidateFilter& filter, float* const* out) {
   const FilterArgs a{fb, target, weight_mean, weight_var, filter};
   const CenterGrid g(fb.width, fb.height);
-  std::vector<float> betas(size_t(g.nx) * g.ny * kMaxD * 3, 0.f);
+  const int variants = has_guide(fb) ? 2 : 1;
+  std::vector<float> betas(size_t(g.nx) * g.ny * variants * kMaxD * 3, 0.f);
   std::vector<uint8_t> fitted(size_t(g.nx) * g.ny, 0);
   parallel_rows(g.ny, [&](int j0, int j1) {
     for (int j = j0; j < j1; ++j)
       for (int i = 0; i < g.nx; ++i) {
         const size_t ci = size_t(j) * g.nx + i;
-        fitted[ci] = fit_center(a, g.x(i), g.y(j), betas.data() + ci * kMaxD * 3);
+        const WindowSums ws = accumulate_window(a, g.x(i), g.y(j));
+        if (!(ws.wsum > 0.f)) continue;
+        fitted[ci] = 1;
+        const size_t c = size_t(g.y(j)) * fb.width + g.x(i);
+        for (int v = 0; v < variants; ++v)
+          solve_model(a, ws, c, v == 1, betas.data() + (ci * variants + v) * kMaxD * 3);
       }
   });
-  parallel_rows(fb.height, [&](int y0, int y1) { apply_models(a, g, betas, fitted, y0, y1, out); });
+  parallel_rows(fb.height,
+                [&](int y0, int y1) { apply_models(a, g, variants, betas, fitted, y0, y1, out); });
 }
 
 }  // namespace gdpt::detail

@@ -17,16 +17,22 @@ namespace gdpt::detail {
 inline constexpr int kWindowRadius = 4;
 inline constexpr int kCenterSpacing = 4;
 
+// Pull of the guide's slope towards identity per unit weight, in units of its spread.
+inline constexpr float kGuideRidge = 0.05f;
+
+// One window; it yields two candidates when the buffers have a guide: the regression without
+// the guide and with it (the same weights and sums, two solves).
 struct CandidateFilter {
-  int stride = 1;             // window sample spacing: the window spans 2 kWindowRadius stride + 1
-  float bandwidth = 1.f;      // NLM k: larger accepts larger colour differences
-  bool use_guide = true;      // regress on the guide features too
-  float guide_ridge = 0.05f;  // pull of the guide slope towards identity, per unit weight
+  int stride = 1;         // window sample spacing: the window spans 2 kWindowRadius stride + 1
+  float bandwidth = 1.f;  // NLM k: larger accepts larger colour differences
 };
 
-// Writes the filtered RGB of `target` (fb.a or fb.b) to `out`; `weight_mean` / `weight_var` are
-// the other half's 3x3 patch means and their variances.
+bool has_guide(const FeatureBuffers& fb);
+
+// Writes the filtered RGB of `target` (fb.a or fb.b) without the guide to out[0] and, when
+// has_guide(fb), with it to out[1]; `weight_mean` / `weight_var` are the other half's 3x3 patch
+// means and their variances.
 void cross_filter_half(const FeatureBuffers& fb, const float* target, const float* weight_mean,
-                       const float* weight_var, const CandidateFilter& filter, float* out);
+                       const float* weight_var, const CandidateFilter& filter, float* const* out);
 
 }  // namespace gdpt::detail
