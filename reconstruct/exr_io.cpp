@@ -118,6 +118,29 @@ std::vector<float> read_pass(const RawExr& raw, const std::string& path, const s
   return {};
 }
 
+// The single channel of 1-channel `pass` in `layer` (Blender: `.Z` for depth, `.V` for values),
+// flipped to bottom-up, or empty when the pass is absent.
+std::vector<float> read_scalar_pass(const RawExr& raw, const std::string& path,
+                                    const std::string& layer, const std::string& pass) {
+  const std::string base = prefix_of(layer) + pass + ".";
+  std::vector<int> found;
+  for (size_t i = 0; i < raw.names.size(); ++i)
+    if (raw.names[i].rfind(base, 0) == 0 &&
+        raw.names[i].find('.', base.size()) == std::string::npos)
+      found.push_back(int(i));
+  if (found.empty()) return {};
+  if (found.size() != 1)
+    throw ExrError("'" + path + "': pass '" + pass + "' of layer '" + layer +
+                   "' is not a 1-channel pass (has " + std::to_string(found.size()) + " channels)");
+  const int W = raw.width, H = raw.height;
+  std::vector<float> v(size_t(W) * H);
+  for (int y = 0; y < H; ++y) {
+    const size_t src = size_t(H - 1 - y) * W, dst = size_t(y) * W;  // EXR top-down -> bottom-up
+    for (int x = 0; x < W; ++x) v[dst + x] = raw.channels[found[0]][src + x];
+  }
+  return v;
+}
+
 void write_image(const std::string& path, const OIIO::ImageSpec& spec, const float* data) {
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw ExrError("cannot write '" + path + "': " + one_line(OIIO::geterror()));
@@ -133,7 +156,8 @@ std::vector<std::string> exr_layers_with_primal(const std::string& path) {
 
 ExrPasses read_exr_passes(const std::string& path, const std::string& layer,
                           const std::vector<std::string>& required,
-                          const std::vector<std::string>& optional) {
+                          const std::vector<std::string>& optional,
+                          const std::vector<std::string>& scalar) {
   const RawExr raw = read_raw(path);
   ExrPasses result;
   result.width = raw.width;
@@ -149,14 +173,19 @@ ExrPasses read_exr_passes(const std::string& path, const std::string& layer,
                                     [&](const std::string& n) { return n.rfind(prefix, 0) == 0; });
     if (!exists) throw ExrError("'" + path + "' has no view layer '" + layer + "'");
   }
+  auto read = [&](const std::string& pass) {
+    return std::find(scalar.begin(), scalar.end(), pass) != scalar.end()
+               ? read_scalar_pass(raw, path, result.layer, pass)
+               : read_pass(raw, path, result.layer, pass);
+  };
   for (const std::string& pass : required) {
-    auto rgb = read_pass(raw, path, result.layer, pass);
+    auto rgb = read(pass);
     if (rgb.empty())
       throw ExrError("'" + path + "' has no pass '" + pass + "' in layer '" + result.layer + "'");
     result.passes[pass] = std::move(rgb);
   }
   for (const std::string& pass : optional) {
-    auto rgb = read_pass(raw, path, result.layer, pass);
+    auto rgb = read(pass);
     if (!rgb.empty()) result.passes[pass] = std::move(rgb);
   }
   return result;
@@ -183,24 +212,28 @@ void write_rgba_exr(const std::string& path, int width, int height, const std::v
 void write_multilayer_exr(const std::string& path, int width, int height, const std::string& layer,
                           const std::map<std::string, std::vector<float>>& passes,
                           const std::vector<std::string>& xyz_passes) {
-  const int nc = int(passes.size()) * 3;
+  const size_t pixels = size_t(width) * height;
+  int nc = 0;
+  for (const auto& [name, values] : passes) {
+    if (values.size() != pixels && values.size() != 3 * pixels)
+      throw ExrError("write_multilayer_exr: pass '" + name + "' has the wrong size");
+    nc += int(values.size() / pixels);
+  }
   OIIO::ImageSpec spec(width, height, nc, OIIO::TypeDesc::FLOAT);
   spec.channelnames.clear();
-  std::vector<float> data(size_t(width) * height * nc);
-  int pass_index = 0;
-  for (const auto& [name, rgb] : passes) {
-    if (rgb.size() != size_t(width) * height * 3)
-      throw ExrError("write_multilayer_exr: pass '" + name + "' has the wrong size");
+  std::vector<float> data(pixels * nc);
+  int first = 0;
+  for (const auto& [name, values] : passes) {
+    const int n = int(values.size() / pixels);
     const bool xyz = std::find(xyz_passes.begin(), xyz_passes.end(), name) != xyz_passes.end();
-    const char* set = xyz ? "XYZ" : "RGB";
-    for (int c = 0; c < 3; ++c) spec.channelnames.push_back(prefix_of(layer) + name + "." + set[c]);
+    const char* set = n == 1 ? "Z" : xyz ? "XYZ" : "RGB";
+    for (int c = 0; c < n; ++c) spec.channelnames.push_back(prefix_of(layer) + name + "." + set[c]);
     for (int y = 0; y < height; ++y) {
       const size_t src = size_t(height - 1 - y) * width, dst = size_t(y) * width;
       for (int x = 0; x < width; ++x)
-        for (int c = 0; c < 3; ++c)
-          data[(dst + x) * nc + 3 * pass_index + c] = rgb[3 * (src + x) + c];
+        for (int c = 0; c < n; ++c) data[(dst + x) * nc + first + c] = values[n * (src + x) + c];
     }
-    ++pass_index;
+    first += n;
   }
   spec.attribute("compression", "zip");
   write_image(path, spec, data.data());

@@ -24,24 +24,28 @@ struct ExrError : std::runtime_error {
 struct ExrPasses {
   int width = 0, height = 0;
   std::string layer;                                 // the view layer that was read
-  std::map<std::string, std::vector<float>> passes;  // pass name -> 3 floats per pixel, bottom-up
+  std::map<std::string, std::vector<float>> passes;  // pass name -> 3 (or 1) floats per pixel
 };
 
 // View layers of the file that have a `Primal` pass, in channel order ("" for un-prefixed
 // `Primal.R` channels).
 std::vector<std::string> exr_layers_with_primal(const std::string& path);
 
-// Reads the 3-channel passes `required` (an ExrError names the first one missing) and those of
-// `optional` that exist, from view layer `layer` (empty: the first layer that has a Primal pass).
+// Reads the passes `required` (an ExrError names the first one missing) and those of `optional`
+// that exist, from view layer `layer` (empty: the first layer that has a Primal pass). Passes
+// named in `scalar` are 1-channel (e.g. `Denoising Depth.Z`, 1 float per pixel), the others
+// 3-channel.
 ExrPasses read_exr_passes(const std::string& path, const std::string& layer,
                           const std::vector<std::string>& required,
-                          const std::vector<std::string>& optional = {});
+                          const std::vector<std::string>& optional = {},
+                          const std::vector<std::string>& scalar = {});
 
 // Writes a single-part RGBA float EXR with channels R, G, B, A (A = 1) from bottom-up RGB.
 void write_rgba_exr(const std::string& path, int width, int height, const std::vector<float>& rgb);
 
-// Writes bottom-up 3-channel passes as Blender names them (`<layer>.<pass>.R/G/B`, or X/Y/Z for
-// the passes listed in `xyz_passes`), all in one part, as float. Used by tests and tools.
+// Writes bottom-up passes as Blender names them (`<layer>.<pass>.R/G/B`, or X/Y/Z for the passes
+// listed in `xyz_passes`, or `.Z` for a pass of 1 float per pixel), all in one part, as float.
+// Used by tests and tools.
 void write_multilayer_exr(const std::string& path, int width, int height, const std::string& layer,
                           const std::map<std::string, std::vector<float>>& passes,
                           const std::vector<std::string>& xyz_passes = {});

@@ -1,10 +1,11 @@
 // gdpt-reconstruct: screened Poisson reconstruction of a GDPT multilayer EXR.
 //
-//   gdpt-reconstruct IN.exr -o OUT.exr [--alpha A] [--norm l1|l2|weighted|none] [--layer NAME]
-//                    [--view V] [--threads N]
+//   gdpt-reconstruct IN.exr -o OUT.exr [--alpha A] [--norm l1|l2|weighted|feature|none]
+//                    [--layer NAME] [--view V] [--threads N]
 //
 // Reads `<layer>.Primal`, `<layer>.Gradient X`, `<layer>.Gradient Y` (and `Variance` for
 // --norm weighted, `Emission` when present), writes Combined = solve(...) + Emission.
+// --norm feature reads the passes of kFeaturePasses instead (see the usage text).
 // OUT.exr: single-part RGBA float EXR, scene linear. OUT.png / .jpg / .jpeg / .tif: 8-bit through
 // the OpenColorIO view transform.
 // Exit status: 0 success, 1 unreadable or invalid input (or unwritable output), 2 bad arguments.
@@ -32,7 +33,12 @@ constexpr const char* kUsage =
     "options:\n"
     "  -o, --output FILE     output image (required)\n"
     "  --alpha A             weight of the primal term, > 0 (default 0.2)\n"
-    "  --norm NORM           l1 (default), l2, weighted (needs a Variance pass), none\n"
+    "  --norm NORM           l1 (default), l2, weighted (needs a Variance pass), feature,\n"
+    "                        none\n"
+    "                        feature: regression on Primal A / Primal B (the samples' two\n"
+    "                        halves), Gradient X / Y, Denoising Albedo, Denoising Normal and\n"
+    "                        Denoising Depth (1 channel), all required; Primal A / B Variance and\n"
+    "                        Denoising Albedo / Normal / Depth Variance used when present\n"
     "  --layer NAME          view layer (default: the first layer with a Primal pass)\n"
     "  --view V              OCIO view transform for PNG/JPEG, e.g. Filmic or Standard\n"
     "                        (default: the config's default view; config from $OCIO or\n"
@@ -41,6 +47,19 @@ constexpr const char* kUsage =
     "  -h, --help            this help\n"
     "\n"
     "exit status: 0 ok, 1 unreadable or invalid input, 2 bad arguments\n";
+
+// --norm feature: the passes it needs, and those it uses when present.
+const std::vector<std::string> kFeaturePasses = {
+    "Primal A",         "Primal B",         "Gradient X",     "Gradient Y",
+    "Denoising Albedo", "Denoising Normal", "Denoising Depth"};
+const std::vector<std::string> kFeatureOptional = {"Primal",
+                                                   "Emission",
+                                                   "Primal A Variance",
+                                                   "Primal B Variance",
+                                                   "Denoising Albedo Variance",
+                                                   "Denoising Normal Variance",
+                                                   "Denoising Depth Variance"};
+const std::vector<std::string> kScalarPasses = {"Denoising Depth", "Denoising Depth Variance"};
 
 struct Options {
   std::string input, output, layer, view;
@@ -98,8 +117,10 @@ Options parse(int argc, char** argv) {
         o.settings.norm = gdpt::ReconstructionNorm::Weighted;
       else if (n == "none")
         o.settings.norm = gdpt::ReconstructionNorm::None;
+      else if (n == "feature")
+        o.settings.norm = gdpt::ReconstructionNorm::Feature;
       else
-        bad_arguments("--norm must be l1, l2, weighted or none, got '" + n + "'");
+        bad_arguments("--norm must be l1, l2, weighted, feature or none, got '" + n + "'");
     } else if (a == "--layer") {
       o.layer = value();
       if (o.layer.empty()) bad_arguments("--layer needs a name");
@@ -149,6 +170,64 @@ class Progress {
   double last_ = -1.0;
 };
 
+gdpt::ExrPasses read_passes(const Options& o) {
+  std::vector<std::string> required = {"Primal"};
+  if (o.settings.norm != gdpt::ReconstructionNorm::None) {
+    required.push_back("Gradient X");
+    required.push_back("Gradient Y");
+  }
+  if (o.settings.norm == gdpt::ReconstructionNorm::Weighted) required.push_back("Variance");
+  return gdpt::read_exr_passes(o.input, o.layer, required, {"Emission"});
+}
+
+void set_input(const Options& o, const gdpt::ExrPasses& in, gdpt::ReconstructionInput& input) {
+  input.width = in.width;
+  input.height = in.height;
+  input.primal = in.passes.at("Primal").data();
+  if (o.settings.norm != gdpt::ReconstructionNorm::None) {
+    input.gradient_x = in.passes.at("Gradient X").data();
+    input.gradient_y = in.passes.at("Gradient Y").data();
+  }
+  if (o.settings.norm == gdpt::ReconstructionNorm::Weighted)
+    input.variance = in.passes.at("Variance").data();
+  if (auto it = in.passes.find("Emission"); it != in.passes.end())
+    input.emission = it->second.data();
+}
+
+// A missing pass is named, with the list of what --norm feature reads.
+gdpt::ExrPasses read_feature_passes(const Options& o) {
+  try {
+    return gdpt::read_exr_passes(o.input, o.layer, kFeaturePasses, kFeatureOptional, kScalarPasses);
+  } catch (const gdpt::ExrError& e) {
+    std::string needs;
+    for (const auto& p : kFeaturePasses) needs += (needs.empty() ? "" : ", ") + p;
+    throw gdpt::ExrError(std::string(e.what()) + " (--norm feature needs " + needs + ")");
+  }
+}
+
+void set_feature_input(const gdpt::ExrPasses& in, gdpt::ReconstructionInput& input) {
+  auto pass = [&](const char* name) -> const float* {
+    const auto it = in.passes.find(name);
+    return it == in.passes.end() ? nullptr : it->second.data();
+  };
+  input.width = in.width;
+  input.height = in.height;
+  input.primal = pass("Primal");
+  input.emission = pass("Emission");
+  input.gradient_x = pass("Gradient X");
+  input.gradient_y = pass("Gradient Y");
+  input.primal_a = pass("Primal A");
+  input.primal_b = pass("Primal B");
+  input.variance_a = pass("Primal A Variance");
+  input.variance_b = pass("Primal B Variance");
+  input.albedo = pass("Denoising Albedo");
+  input.albedo_variance = pass("Denoising Albedo Variance");
+  input.normal = pass("Denoising Normal");
+  input.normal_variance = pass("Denoising Normal Variance");
+  input.depth = pass("Denoising Depth");
+  input.depth_variance = pass("Denoising Depth Variance");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -169,31 +248,21 @@ int main(int argc, char** argv) {
   }
 
   try {
-    const bool weighted = o.settings.norm == gdpt::ReconstructionNorm::Weighted;
-    std::vector<std::string> required = {"Primal"};
-    if (o.settings.norm != gdpt::ReconstructionNorm::None) {
-      required.push_back("Gradient X");
-      required.push_back("Gradient Y");
-    }
-    if (weighted) required.push_back("Variance");
-    const gdpt::ExrPasses in = gdpt::read_exr_passes(o.input, o.layer, required, {"Emission"});
-    progress.stage("read", 1.f);
-
+    const bool feature = o.settings.norm == gdpt::ReconstructionNorm::Feature;
+    gdpt::ExrPasses in;
     gdpt::ReconstructionInput input;
-    input.width = in.width;
-    input.height = in.height;
-    input.primal = in.passes.at("Primal").data();
-    if (o.settings.norm != gdpt::ReconstructionNorm::None) {
-      input.gradient_x = in.passes.at("Gradient X").data();
-      input.gradient_y = in.passes.at("Gradient Y").data();
+    if (feature) {
+      in = read_feature_passes(o);
+      set_feature_input(in, input);
+    } else {
+      in = read_passes(o);
+      set_input(o, in, input);
     }
-    if (weighted) input.variance = in.passes.at("Variance").data();
-    if (auto it = in.passes.find("Emission"); it != in.passes.end())
-      input.emission = it->second.data();
+    progress.stage("read", 1.f);
 
     gdpt::ReconstructionSettings settings = o.settings;
     settings.progress = [&](float f) { progress.stage("solve", f); };
-    settings.compute_objective = true;  // printed in the summary line
+    settings.compute_objective = !feature;  // printed in the summary line
     gdpt::ReconstructionReport report;
     const std::vector<float> image = gdpt::reconstruct(input, settings, &report);
 
@@ -202,7 +271,7 @@ int main(int argc, char** argv) {
     else
       gdpt::write_rgba_exr(o.output, in.width, in.height, image);
 
-    static const char* kNames[] = {"l2", "l1", "weighted", "none"};
+    static const char* kNames[] = {"l2", "l1", "weighted", "none", "feature"};
     std::printf(
         "gdpt-reconstruct: %s layer '%s' %dx%d norm %s alpha %g: %d iterations, "
         "objective %.6g, %.2f s solve, %.2f s total%s%s\n",

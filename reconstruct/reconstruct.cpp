@@ -13,6 +13,7 @@
 
 #include "core/huge_pages.h"
 #include "reconstruct/dct_solver.h"
+#include "reconstruct/feature_reconstruct.h"
 #include "reconstruct/irls_reweight.h"
 #include "reconstruct/parallel.h"
 #include "reconstruct/weighted_cg.h"
@@ -230,6 +231,7 @@ double objective(const Prepared& pr, ReconstructionNorm norm, double alpha, cons
     }
     case ReconstructionNorm::L2:
     case ReconstructionNorm::None:
+    case ReconstructionNorm::Feature:
       return for_each_term(
           pr, x, [&](size_t, uint8_t t, const float* e0, const float* ex, const float* ey) {
             return ((t & kPrimal) ? alpha * alpha * squared3(e0) : 0.0) + squared3(ex) +
@@ -292,6 +294,8 @@ std::vector<float> l2_solution(const Prepared& pr, double alpha, bool measure,
 
 double reconstruction_objective(const ReconstructionInput& input, ReconstructionNorm norm,
                                 float alpha, const float* image) {
+  if (norm == ReconstructionNorm::Feature)
+    throw std::invalid_argument("reconstruct: the Feature norm has no objective");
   validate(input, norm == ReconstructionNorm::None ? ReconstructionNorm::L2 : norm, alpha);
   const Prepared pr = prepare(input, true);
   return objective(pr, norm, alpha, input.variance, image);
@@ -300,6 +304,8 @@ double reconstruction_objective(const ReconstructionInput& input, Reconstruction
 std::vector<float> reconstruct(const ReconstructionInput& input,
                                const ReconstructionSettings& settings,
                                ReconstructionReport* report) {
+  if (settings.norm == ReconstructionNorm::Feature)
+    return reconstruct_feature(input, settings, report);
   const auto start = std::chrono::steady_clock::now();
   validate(input, settings.norm, settings.alpha);
   const int threads = settings.threads > 0 ? settings.threads : tbb::info::default_concurrency();

@@ -15,6 +15,11 @@
 //             likelihood weighting); Jacobi-preconditioned CG from the L2 solution to
 //             `weighted_tolerance`.
 //   None      primal (+ emission).
+//   Feature   per-pixel first-order regression of the primal on feature buffers (albedo, normal,
+//             depth) and on a gradient-domain solution (feature_guide) as an extra feature, NFOR
+//             style: half A is regressed with weights from half B and vice versa, candidate
+//             filters are chosen per pixel by a cross-half error estimate, and the two halves'
+//             results averaged (feature_reconstruct.h).
 // Non-finite inputs are missing data: a term (primal, dx or dy of a pixel) with any non-finite
 // channel gets zero weight. The output is always finite.
 #pragma once
@@ -25,7 +30,7 @@
 
 namespace gdpt {
 
-enum class ReconstructionNorm : uint8_t { L2, L1, Weighted, None };
+enum class ReconstructionNorm : uint8_t { L2, L1, Weighted, None, Feature };
 
 struct ReconstructionSettings {
   ReconstructionNorm norm = ReconstructionNorm::L1;
@@ -46,6 +51,13 @@ struct ReconstructionSettings {
   // Fill ReconstructionReport::objective (one more pass over all buffers). Off by default: the
   // engine and the compositor node never read it; the CLI prints it, tests and benchmarks check it.
   bool compute_objective = false;
+  // Feature: the gradient-domain solution used as a guide feature (L1, L2 or None = no guide),
+  // solved with the settings above from `primal` (or the halves' mean) and the gradients.
+  ReconstructionNorm feature_guide = ReconstructionNorm::L1;
+  // The guide's alpha, lower than the image's: the guide then depends little on the halves'
+  // noise, which keeps the cross-half error estimate unbiased (the regression's intercept
+  // restores the level the guide drifts from).
+  float feature_guide_alpha = 0.02f;
   // Called with the completed fraction in [0, 1] (from the calling thread).
   std::function<void(float)> progress;
 };
@@ -57,6 +69,20 @@ struct ReconstructionInput {
   const float* gradient_y = nullptr;  // RGB
   const float* variance = nullptr;    // 3 per pixel (primal, dx, dy luminance); Weighted only
   const float* emission = nullptr;    // RGB, optional: added to the solution
+
+  // Feature norm. The primal as two independent halves (e.g. even / odd samples), each the mean
+  // of its half's samples, both required; `primal` may then be null (the halves' mean is used).
+  const float* primal_a = nullptr;    // RGB
+  const float* primal_b = nullptr;    // RGB
+  const float* variance_a = nullptr;  // RGB variance of primal_a's pixel mean, optional
+  const float* variance_b = nullptr;  // RGB, optional (both or none; else estimated from A - B)
+  // Optional guide features, each with an optional per-pixel variance of its pixel mean.
+  const float* albedo = nullptr;           // RGB
+  const float* albedo_variance = nullptr;  // RGB
+  const float* normal = nullptr;           // XYZ
+  const float* normal_variance = nullptr;  // XYZ
+  const float* depth = nullptr;            // 1 per pixel
+  const float* depth_variance = nullptr;   // 1 per pixel
 };
 
 struct ReconstructionReport {
@@ -65,6 +91,7 @@ struct ReconstructionReport {
   double seconds = 0.0;
   double relative_residual = 0.0;  // CG exit residual |b - A I| / |b| (0 for the direct solve)
   int missing_values = 0;          // non-finite input terms treated as missing
+  double guide_seconds = 0.0;      // Feature: of `seconds`, the gradient-domain guide's solve
 };
 
 // Returns RGB `width * height * 3`. Throws std::invalid_argument on bad input (alpha <= 0, sizes,

@@ -1,6 +1,7 @@
 // bench_reconstruct: cost of the reconstruction solvers at 1920x1080 RGB on 1 and 2 threads.
 //
-//   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] [--l2-only] [--memory]
+//   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] [--l2-only] [--feature-only]
+//                     [--memory]
 //
 // Reports, per thread count:
 //   - one bare FFTW forward + inverse 2-D DCT of the 3 planes (double, the same cached plans the
@@ -13,6 +14,10 @@
 //   - Weighted time, iterations, exit residual and objective.
 // --sweep also prints the L1 objective and time for a grid of (reweightings, CG steps);
 // --l2-only stops after the DCT pair and the L2 solve (for quick runs while tuning L2).
+//   - Feature (--norm feature): total time with the L1 guide and with the L2 guide, split into the
+//     guide solve, preparation, the cross-filtered candidates and the choice, on the synthetic
+//     room of testing/feature_scene.h (half noise 0.2, gradient noise 0.1), relMSE against L1;
+//     --feature-only runs just this case.
 // --memory only measures the peak resident memory (getrusage) after one solve of each norm, in the
 // order L2, Weighted, L1: each figure is the process's peak so far, inputs included.
 // Synthetic data: a smooth image with edges; primal noise sigma 0.2 (0.05 in the right half),
@@ -33,9 +38,11 @@
 #include <tbb/task_arena.h>
 
 #include "reconstruct/dct_solver.h"
+#include "reconstruct/feature_reconstruct.h"
 #include "reconstruct/parallel.h"
 #include "reconstruct/reconstruct.h"
 #include "reconstruct/weighted_cg.h"
+#include "testing/feature_scene.h"
 #include "testing/l1d_reference.h"
 #include "testing/test_images.h"
 
@@ -161,9 +168,62 @@ int measure_memory(const Data& d, int threads) {
 
 }  // namespace
 
+// The Feature reconstruction on the synthetic room: total time per guide and its split.
+void bench_feature(int width, int height, int threads) {
+  const gdpt::test::FeatureScene sc = gdpt::test::make_feature_scene(width, height, 0.2f, 0.1f, 7);
+  gdpt::ReconstructionInput in;
+  in.width = width;
+  in.height = height;
+  in.primal = sc.primal.data();
+  in.gradient_x = sc.gx.data();
+  in.gradient_y = sc.gy.data();
+  in.primal_a = sc.a.data();
+  in.primal_b = sc.b.data();
+  in.albedo = sc.albedo.data();
+  in.normal = sc.normal.data();
+  in.depth = sc.depth.data();
+  gdpt::ReconstructionSettings s;
+  s.threads = threads;
+  s.norm = gdpt::ReconstructionNorm::L1;
+  const auto t0 = Clock::now();
+  const double rel_l1 = gdpt::test::relative_mse(gdpt::reconstruct(in, s), sc.truth);
+  const double t_l1 = seconds_since(t0);
+  s.norm = gdpt::ReconstructionNorm::Feature;
+  for (auto guide : {gdpt::ReconstructionNorm::L1, gdpt::ReconstructionNorm::L2}) {
+    s.feature_guide = guide;
+    gdpt::ReconstructionReport r;
+    const auto t1 = Clock::now();
+    const double c1 = cpu_seconds();
+    const auto img = gdpt::reconstruct(in, s, &r);
+    const double total = seconds_since(t1), cpu_total = cpu_seconds() - c1;
+    // The split, from the regression alone on the same guide.
+    gdpt::ReconstructionSettings gs = s;
+    gs.norm = guide;
+    gs.alpha = s.feature_guide_alpha;
+    const auto g = gdpt::reconstruct(in, gs);
+    gdpt::FeatureReconstruction fr;
+    tbb::task_arena arena(threads);
+    const double c2 = cpu_seconds();
+    arena.execute([&] { fr = gdpt::feature_regression(in, g.data()); });
+    const double cpu_regression = cpu_seconds() - c2;
+    std::printf(
+        "Feature (guide %s): %8.1f ms = guide %.1f ms + regression %.1f ms (prepare %.1f, %zu "
+        "candidates x 2 halves %.1f, choice %.1f); relMSE %.5f vs L1 %.5f (%.1f ms): %.2fx lower\n",
+        guide == gdpt::ReconstructionNorm::L1 ? "L1" : "L2", 1e3 * total, 1e3 * r.guide_seconds,
+        1e3 * (total - r.guide_seconds), 1e3 * fr.prepare_seconds,
+        gdpt::default_feature_candidates().size(), 1e3 * fr.filter_seconds, 1e3 * fr.select_seconds,
+        gdpt::test::relative_mse(img, sc.truth), rel_l1, 1e3 * t_l1,
+        rel_l1 / gdpt::test::relative_mse(img, sc.truth));
+    // Wall time depends on what else runs; CPU time (all threads) / threads is the time on
+    // otherwise idle cores.
+    std::printf("  CPU time: total %.2f s, regression %.2f s (%.2f s per thread)\n", cpu_total,
+                cpu_regression, cpu_regression / threads);
+  }
+}
+
 int main(int argc, char** argv) {
   int width = 1920, height = 1080, only_threads = 0;
-  bool sweep = false, l2_only = false, memory = false;
+  bool sweep = false, l2_only = false, feature_only = false, memory = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--width" && i + 1 < argc)
@@ -172,6 +232,8 @@ int main(int argc, char** argv) {
       height = std::atoi(argv[++i]);
     else if (a == "--threads" && i + 1 < argc)
       only_threads = std::atoi(argv[++i]);
+    else if (a == "--feature-only")
+      feature_only = true;
     else if (a == "--sweep")
       sweep = true;
     else if (a == "--l2-only")
@@ -181,7 +243,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "usage: bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] "
-                   "[--l2-only] [--memory]\n");
+                   "[--l2-only] [--feature-only] [--memory]\n");
       return 2;
     }
   }
@@ -200,6 +262,10 @@ int main(int argc, char** argv) {
   for (int threads : thread_counts) {
     tbb::task_arena arena(threads);
     std::printf("\n== %d thread%s\n", threads, threads > 1 ? "s" : "");
+    if (feature_only) {
+      bench_feature(width, height, threads);
+      continue;
+    }
 
     // --- A float DCT pair for context, then the bare double DCT pair (the solver's plans) and the
     // L2 solve, timed alternately.
@@ -305,6 +371,8 @@ int main(int argc, char** argv) {
         s.weighted_tolerance, 1e3 * t_w, rw.iterations, rw.relative_residual,
         gdpt::reconstruction_objective(input, gdpt::ReconstructionNorm::Weighted, alpha, wt.data()),
         gdpt::test::rms_error(wt, d.truth));
+
+    bench_feature(width, height, threads);
 
     if (sweep) {
       std::printf(

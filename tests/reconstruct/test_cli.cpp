@@ -4,6 +4,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,8 @@
 #include <OpenImageIO/imageio.h>
 
 #include "reconstruct/exr_io.h"
+#include "reconstruct/reconstruct.h"
+#include "testing/feature_scene.h"
 #include "testing/test_images.h"
 
 namespace gdpt {
@@ -249,6 +252,55 @@ TEST_F(Cli, InvalidInputExit1WithOneLineReason) {
     // One line: a single trailing newline.
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
+}
+
+// --norm feature reads the halves, the gradients and the Denoising passes (depth as one `.Z`
+// channel), gives what reconstruct() gives for them, and names a missing pass.
+TEST_F(Cli, FeatureNormReadsTheDenoisingPasses) {
+  const test::FeatureScene sc = test::make_feature_scene(w_, h_, 0.1f, 0.05f, 9);
+  std::map<std::string, std::vector<float>> passes = {{"Primal", sc.primal},
+                                                      {"Primal A", sc.a},
+                                                      {"Primal B", sc.b},
+                                                      {"Gradient X", sc.gx},
+                                                      {"Gradient Y", sc.gy},
+                                                      {"Denoising Albedo", sc.albedo},
+                                                      {"Denoising Normal", sc.normal},
+                                                      {"Denoising Depth", sc.depth}};
+  write_multilayer_exr(path("in.exr"), w_, h_, "ViewLayer", passes, {"Denoising Normal"});
+  const CliResult r = run({path("in.exr"), "-o", path("out.exr"), "--norm", "feature"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("norm feature"), std::string::npos) << r.out;
+  const auto out = read_rgba(path("out.exr"));
+
+  ReconstructionInput in;
+  in.width = w_;
+  in.height = h_;
+  in.primal = sc.primal.data();
+  in.gradient_x = sc.gx.data();
+  in.gradient_y = sc.gy.data();
+  in.primal_a = sc.a.data();
+  in.primal_b = sc.b.data();
+  in.albedo = sc.albedo.data();
+  in.normal = sc.normal.data();
+  in.depth = sc.depth.data();
+  ReconstructionSettings settings;
+  settings.norm = ReconstructionNorm::Feature;
+  const auto expected = reconstruct(in, settings);
+  EXPECT_LT(test::rms_error(out, expected), 1e-6);
+  EXPECT_LT(test::relative_mse(out, sc.truth), 0.5 * test::relative_mse(sc.primal, sc.truth));
+
+  passes.erase("Denoising Normal");
+  write_multilayer_exr(path("no_normal.exr"), w_, h_, "ViewLayer", passes);
+  const CliResult missing = run({path("no_normal.exr"), "-o", path("x.exr"), "--norm", "feature"});
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("no pass 'Denoising Normal'"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("--norm feature needs"), std::string::npos) << missing.err;
+  EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
+  EXPECT_FALSE(fs::exists(path("x.exr")));
+
+  const CliResult bad = run({path("in.exr"), "-o", path("x.exr"), "--norm", "nfor"});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("feature"), std::string::npos) << bad.err;
 }
 
 }  // namespace

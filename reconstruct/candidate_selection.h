@@ -1,0 +1,35 @@
+// Per-pixel choice among candidate filters by an unbiased estimate of their error.
+//
+// With independent halves A and B (variances VA, VB) and their cross-filtered versions FA (from
+// A's values, B's weights) and FB, E[(FA - B)^2] = MSE(FA) + VB when FA does not depend on B's
+// noise, and the mean of the shared bias and the halved independent noise gives, for the final
+// (FA + FB) / 2:
+//   e = ((FA - B)^2 + (FB - A)^2) / 2 - (VA + VB) / 2 - (FA - FB)^2 / 4.
+// e is unbiased but noisy per pixel; it is averaged over a window before candidates are compared.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "reconstruct/feature_buffers.h"
+
+namespace gdpt::detail {
+
+inline constexpr int kErrorSmoothingRadius = 10;
+
+struct CandidateChoice {
+  std::vector<float> image;    // RGB (FA + FB) / 2 of the chosen candidate
+  std::vector<float> error;    // per pixel, its smoothed error estimate (mean over RGB)
+  std::vector<uint8_t> index;  // per pixel, the chosen candidate
+};
+
+// Per pixel e (mean over RGB) of the candidate with filtered halves fa, fb_half; 0 where the
+// halves are missing.
+void candidate_error(const FeatureBuffers& fb, const float* fa, const float* fb_half, float* error);
+
+// Offers candidate `index`: pixels whose smoothed error beats the current choice take it (the
+// first candidate offered is taken everywhere; ties keep the earlier one).
+void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const float* fb_half,
+                     CandidateChoice& choice);
+
+}  // namespace gdpt::detail
