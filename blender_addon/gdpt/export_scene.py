@@ -16,8 +16,9 @@ class ExportStats:
         self.materials = 0
 
 
-def export_scene(module, depsgraph, camera_object, warn):
-    """Builds and returns (builder, stats). `camera_object` is the evaluated scene camera."""
+def export_scene(module, depsgraph, camera_object, warn, camera=None):
+    """Builds and returns (builder, stats). `camera_object` is the evaluated scene camera;
+    `camera`, when given, is the camera dict to use instead (the viewport's view)."""
     t0 = time.perf_counter()
     c0 = time.thread_time()
     scene = depsgraph.scene
@@ -29,7 +30,9 @@ def export_scene(module, depsgraph, camera_object, warn):
 
     # World first: its image must exist before set_world references it.
     builder.set_world(export_world.world_dict(scene.world, images, warn))
-    builder.set_camera(export_camera.camera_dict(scene, camera_object, warn))
+    if camera is None:
+        camera = export_camera.camera_dict(scene, camera_object, warn)
+    builder.set_camera(camera)
 
     for inst in depsgraph.object_instances:
         obj = inst.object
