@@ -16,7 +16,7 @@ import bpy
 import gpu
 from gpu_extras.presets import draw_texture_2d
 
-from . import export_scene, native, properties, viewport_camera
+from . import export_mesh, export_scene, native, properties, viewport_camera
 
 MARKER = "GDPT:"
 # Seconds between the redraw timer's looks at the jobs.
@@ -29,6 +29,14 @@ _live = weakref.WeakSet()  # sessions with a job, stopped at exit
 # test and benchmark.
 LAST_DRAW = {}
 _jobs_started = [0]  # jobs started in this process (LAST_DRAW["job"])
+# The last viewport export: meshes read from Blender and meshes kept from the export before.
+LAST_EXPORT = {}
+# Datablock types whose geometry updates leave every kept mesh valid (objects, and the data of
+# objects, drop their objects' meshes; any other type, e.g. a geometry node tree or a collection,
+# drops them all).
+_OBJECT_DATA_TYPES = (bpy.types.Mesh, bpy.types.Curve, bpy.types.MetaBall)
+_MESH_NEUTRAL_TYPES = (bpy.types.Scene, bpy.types.World, bpy.types.Material, bpy.types.Light,
+                       bpy.types.Camera, bpy.types.Image)
 
 
 def render_settings(scene):
@@ -55,6 +63,23 @@ def _restart_key(scene):
             tuple(sorted(display_settings(scene).items())))
 
 
+def _forget_changed_meshes(store, depsgraph):
+    """Drops the kept meshes whose geometry the depsgraph updates changed."""
+    for update in depsgraph.updates:
+        if not update.is_updated_geometry:
+            continue
+        if isinstance(update.id, bpy.types.Object):
+            store.forget(update.id.original.name_full)
+        elif isinstance(update.id, _OBJECT_DATA_TYPES):
+            data = update.id.original
+            for obj in bpy.data.objects:
+                if obj.data is not None and obj.data.original == data:
+                    store.forget(obj.name_full)
+        elif not isinstance(update.id, _MESH_NEUTRAL_TYPES):
+            store.meshes.clear()
+            return
+
+
 def _needs_export(depsgraph):
     """Whether the depsgraph updates change what the job renders (the scene camera moving only
     changes the view, which view_draw handles)."""
@@ -77,6 +102,8 @@ class ViewportSession:
         self.image = None  # the latest dict from the job, minus its pixels
         self.samples_total = 0
         self.error = None
+        self.mesh_store = export_mesh.MeshStore()
+        self.job_number = 0
 
     # --- view_update ----------------------------------------------------------------------------
 
@@ -96,9 +123,11 @@ class ViewportSession:
         if camera is None:
             return
         warnings = set()
+        _forget_changed_meshes(self.mesh_store, depsgraph)
+        self.mesh_store.reused = self.mesh_store.exported = 0
         try:
             builder, stats = export_scene.export_scene(module, depsgraph, None, warnings.add,
-                                                       camera=camera)
+                                                       camera=camera, mesh_store=self.mesh_store)
             self.job = module.ViewportJob(builder, render_settings(scene),
                                           display_settings(scene))
         except Exception as e:  # a broken datablock must not take Blender down
@@ -106,8 +135,11 @@ class ViewportSession:
             return
         for w in sorted(warnings):
             print(f"{MARKER} viewport warning: {w}", flush=True)
-        print(f"{MARKER} viewport: exported {stats.instances} instances, {stats.lights} lights "
-              f"in {stats.seconds:.3f} s", flush=True)
+        store = self.mesh_store
+        LAST_EXPORT.update(exported=store.exported, reused=store.reused, seconds=stats.seconds)
+        print(f"{MARKER} viewport: exported {stats.instances} instances ({store.exported} meshes "
+              f"read, {store.reused} kept), {stats.lights} lights in {stats.seconds:.3f} s",
+              flush=True)
         self.error = None
         self.camera_key = viewport_camera.camera_key(camera)
         self.restart_key = _restart_key(scene)

@@ -88,6 +88,8 @@ py::dict read_exr_passes_dict(const std::string& path, const std::string& layer,
 PYBIND11_MODULE(_gdpt, m) {
   m.doc() = "GDPT core bindings: build a scene from flat arrays, render it, reconstruct passes.";
 
+  py::class_<StoredMesh>(m, "StoredMesh");
+
   py::class_<SceneBuilder>(m, "SceneBuilder")
       .def(py::init<>())
       .def("add_mesh", &SceneBuilder::add_mesh, py::arg("positions").noconvert(),
@@ -116,6 +118,8 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("set_camera", &SceneBuilder::set_camera)
       .def("set_world", &SceneBuilder::set_world)
       .def("mesh_arrays", &SceneBuilder::mesh_arrays, py::arg("index"))
+      .def("stored_mesh", &SceneBuilder::stored_mesh, py::arg("index"))
+      .def("add_stored_mesh", &SceneBuilder::add_stored_mesh, py::arg("stored"))
       .def("set_mesh_texspace", &SceneBuilder::set_mesh_texspace, py::arg("index"),
            py::arg("location"), py::arg("size"))
       .def_property_readonly("mesh_count", &SceneBuilder::mesh_count)

@@ -187,11 +187,15 @@ class Steps:
               f"{time.perf_counter() - self.wait_from:.2f} s, frame {d['rect']}, "
               f"{d['size'][0]}x{d['size'][1]} px, solved {d['solved']}", flush=True)
         if len(self.shots) == 1:
+            check(viewport.LAST_EXPORT["exported"] == 3 and viewport.LAST_EXPORT["reused"] == 0,
+                  f"the first export reads the 3 meshes: {viewport.LAST_EXPORT}")
             self.compare(self.shots[0], "f12_left.png")
             self.job = d["job"]  # the lamp move must start a new job
             self.lamp.location = LAMP_RIGHT
             self.wait_from = time.perf_counter()
             return 0.2
+        check(viewport.LAST_EXPORT["exported"] == 0 and viewport.LAST_EXPORT["reused"] == 3,
+              f"the lamp move keeps the 3 meshes: {viewport.LAST_EXPORT}")
         self.compare(self.shots[1], "f12_right.png")
         before, after = block_means(self.shots[0]), block_means(self.shots[1])
         change = (after - before).mean(axis=2)
@@ -235,6 +239,20 @@ class Steps:
         f12_right = f12_right[:, f12_right.shape[1] // 2:]
         self.compare_to(frame_of_screenshot(path, area, region), f12_right,
                         "the right half of f12_right.png")
+        # An edit of the cube's mesh: only that mesh is read again.
+        self.job = viewport.LAST_DRAW["job"]
+        cube = next(o for o in self.scene.objects if o.name.startswith("Cube"))
+        cube.data.vertices[0].co.z += 0.1
+        cube.data.update()
+        self.stage = "wait_geometry_edit"
+        return 0.2
+
+    def wait_geometry_edit(self):
+        from gdpt import viewport
+        if viewport.LAST_DRAW["job"] <= self.job:
+            return 0.2
+        check(viewport.LAST_EXPORT["exported"] == 1 and viewport.LAST_EXPORT["reused"] == 2,
+              f"a mesh edit reads that mesh again and keeps the others: {viewport.LAST_EXPORT}")
         view3d()[1].spaces.active.shading.type = 'SOLID'
         self.stage = "left_mode"
         return 1.0
@@ -306,7 +324,20 @@ class Steps:
     def left_mode(self):
         from gdpt import viewport
         check(len(viewport._live) == 0, "leaving Rendered mode stopped the viewport job")
-        print("viewport test passed", flush=True)
+        # Quitting while a render runs (no sample limit) must stop it and exit 0 (the shell
+        # script checks the exit code).
+        self.job = viewport.LAST_DRAW["job"]
+        self.scene.gdpt.preview_samples = 0
+        view3d()[1].spaces.active.shading.type = 'RENDERED'
+        self.stage = "quit_while_rendering"
+        return 0.2
+
+    def quit_while_rendering(self):
+        from gdpt import viewport
+        d = viewport.LAST_DRAW
+        if d["job"] <= self.job or d["size"][0] < 10 or not d["rendering"]:
+            return 0.2
+        print("viewport test passed (quitting while the viewport renders)", flush=True)
         bpy.ops.wm.quit_blender()
         return None
 
