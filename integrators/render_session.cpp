@@ -49,6 +49,8 @@ struct RenderSession::Impl {
   std::vector<std::string> warnings;
   // settings.threads worker slots (0 = all cores): used for the BVH build and every pass.
   std::unique_ptr<tbb::task_arena> arena;
+  // The integrator, films and tiles for scene.camera (at construction and on set_camera).
+  void setup_for_camera();
 };
 
 RenderSession::RenderSession(Scene scene, RenderSettings settings)
@@ -70,20 +72,32 @@ RenderSession::RenderSession(Scene scene, RenderSettings settings)
   // Embree builds with TBB: inside the arena it uses no more threads than the user allowed.
   d.arena->execute([&] { d.context = std::make_unique<SceneContext>(d.scene, d.settings); });
   d.warnings = d.context->warnings();
+  d.setup_for_camera();
+}
+
+void RenderSession::Impl::setup_for_camera() {
   // Mode dispatch: G-PT estimates the gradients itself; PT derives them from the primal (Film).
-  d.integrator = d.settings.mode == RenderSettings::Mode::GPT
-                     ? make_gradient_path_tracer(*d.context, d.settings)
-                     : make_path_tracer(*d.context, d.settings);
-  const int w = d.scene.camera.image_width(), h = d.scene.camera.image_height();
-  const bool gradients_from_primal = !d.integrator->estimates_gradients();
-  d.film = Film(w, h, gradients_from_primal);
-  d.pass_film = Film(w, h, gradients_from_primal);  // the output film's layout (take_rows)
-  for (Film* f : {&d.film, &d.pass_film})
-    f->enable_data_passes(d.settings.normal_pass, d.settings.mist_pass);
-  const int th = tile_height(w, h, d.arena->max_concurrency());
+  integrator = settings.mode == RenderSettings::Mode::GPT
+                   ? make_gradient_path_tracer(*context, settings)
+                   : make_path_tracer(*context, settings);
+  const int w = scene.camera.image_width(), h = scene.camera.image_height();
+  const bool gradients_from_primal = !integrator->estimates_gradients();
+  film = Film(w, h, gradients_from_primal);
+  pass_film = Film(w, h, gradients_from_primal);  // the output film's layout (take_rows)
+  for (Film* f : {&film, &pass_film})
+    f->enable_data_passes(settings.normal_pass, settings.mist_pass);
+  tiles.clear();
+  const int th = tile_height(w, h, arena->max_concurrency());
   for (int y = 0; y < h; y += th)
     for (int x = 0; x < w; x += kTileSize)
-      d.tiles.push_back({x, y, std::min(x + kTileSize, w), std::min(y + th, h)});
+      tiles.push_back({x, y, std::min(x + kTileSize, w), std::min(y + th, h)});
+}
+
+void RenderSession::set_camera(const Camera& camera) {
+  Impl& d = *impl_;
+  d.context->set_camera(camera);  // validates first: a bad camera leaves the session as it was
+  d.scene.camera = camera;
+  d.setup_for_camera();
 }
 
 RenderSession::~RenderSession() = default;

@@ -32,6 +32,10 @@ class RenderSession {
   void render(const std::function<void(const RenderProgress&)>& on_pass,
               const std::atomic<bool>& cancel);
 
+  // Replaces the camera (its resolution may differ) and clears the film, keeping the BVH, lights
+  // and materials: the viewport restarts this way when only the view moved. Not during render().
+  void set_camera(const Camera& camera);
+
   const Film& film() const;
   const RenderSettings& settings() const;
   // Human-readable list of what the scene uses (for logs and the feature benchmark).

@@ -10,8 +10,7 @@ namespace gdpt {
 
 namespace {
 
-void validate(const Scene& scene, std::vector<std::string>& warnings) {
-  const Camera& cam = scene.camera;
+void validate_camera(const Camera& cam) {
   if (cam.width <= 0 || cam.height <= 0)
     throw std::invalid_argument("scene: camera resolution must be positive, got " +
                                 std::to_string(cam.width) + "x" + std::to_string(cam.height));
@@ -19,6 +18,18 @@ void validate(const Scene& scene, std::vector<std::string>& warnings) {
     throw std::invalid_argument("scene: camera focal length must be positive");
   if (cam.projection == Camera::Projection::Orthographic && !(cam.ortho_scale > 0.0f))
     throw std::invalid_argument("scene: orthographic scale must be positive");
+}
+
+// The feature bits the camera decides (features.h).
+uint32_t camera_features(const Camera& cam) {
+  uint32_t f = 0;
+  if (cam.aperture_radius > 0.0f) f |= kSceneDoF;
+  if (cam.projection == Camera::Projection::Orthographic) f |= kSceneOrthographic;
+  return f;
+}
+
+void validate(const Scene& scene, std::vector<std::string>& warnings) {
+  validate_camera(scene.camera);
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
     const std::string name = "scene: mesh " + std::to_string(m);
@@ -92,8 +103,7 @@ SceneContext::SceneContext(const Scene& scene, const RenderSettings& settings) :
   for (int uses : mesh_uses)
     if (uses > 1) f |= kSceneInstances;
   if (f & kFeatureEmission) f |= kSceneEmissiveTriangles;
-  if (scene.camera.aperture_radius > 0.0f) f |= kSceneDoF;
-  if (scene.camera.projection == Camera::Projection::Orthographic) f |= kSceneOrthographic;
+  f |= camera_features(scene.camera);
   if (lights_->has_environment() || lights_->has_camera_environment()) f |= kSceneWorld;
   if (scene.world.image >= 0) f |= kSceneWorldImage | kSceneWorld;
   for (const Light& l : scene.lights) {
@@ -115,6 +125,13 @@ SceneContext::SceneContext(const Scene& scene, const RenderSettings& settings) :
 }
 
 SceneContext::~SceneContext() = default;
+
+void SceneContext::set_camera(const Camera& camera) {
+  validate_camera(camera);
+  camera_ = CameraModel(camera);
+  scene_features_ = (scene_features_ & ~(kSceneDoF | kSceneOrthographic)) | camera_features(camera);
+  if (features_ != kAllFeatures) features_ = scene_features_;  // else force_all_features
+}
 
 Spectrum SceneContext::transmittance(Ray ray, ClosureSet& scratch, uint32_t& rays) const {
   ++rays;

@@ -34,6 +34,9 @@ class SceneContext {
   // with a clear message for an unusable scene (zero resolution, out-of-range mesh indices, ...).
   SceneContext(const Scene& scene, const RenderSettings& settings);
   ~SceneContext();
+  // Replaces the camera (the viewport's view moved), keeping the BVH, lights and materials.
+  // Throws std::invalid_argument for an unusable camera. Not while an integrator renders.
+  void set_camera(const Camera& camera);
 
   const Scene& scene() const { return scene_; }
   // The data passes of pixel (x, y) from the camera hit of its sample 0 (Film::set_first_hit):

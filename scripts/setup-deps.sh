@@ -13,6 +13,8 @@ PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-matplotlib
   libgtest-dev libgmock-dev libbenchmark-dev
   blender
+  # The viewport test: Blender with a window on Xvfb and Mesa's software OpenGL.
+  xvfb xauth libgl1-mesa-dri libglx-mesa0
 )
 
 missing=()

@@ -25,13 +25,13 @@ if "bpy" in locals():
     import importlib
 
     for _module in (properties, passes, export_images, export_materials, export_mesh,  # noqa: F821
-                    export_lights, export_camera, export_world, export_scene, engine, ui,
-                    compositor_node):  # noqa: F821
+                    export_lights, export_camera, export_world, export_scene,
+                    viewport_camera, viewport, engine, ui, compositor_node):  # noqa: F821
         importlib.reload(_module)
 else:
     from . import (properties, passes, export_images, export_materials, export_mesh,
-                   export_lights, export_camera, export_world, export_scene, engine, ui,
-                   compositor_node)
+                   export_lights, export_camera, export_world, export_scene, viewport_camera,
+                   viewport, engine, ui, compositor_node)
 
 import bpy  # noqa: E402
 

@@ -13,7 +13,7 @@ import time
 import bpy
 import numpy as np
 
-from . import compositor_node, export_camera, export_scene, native, passes, properties
+from . import compositor_node, export_camera, export_scene, native, passes, properties, viewport
 
 MARKER = "GDPT:"  # every console line of the engine starts with it (tests look for it)
 # Set to 1, background renders take progressive previews too (tests, benchmarks of their cost).
@@ -69,6 +69,27 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
     bl_use_preview = False
     bl_use_shading_nodes_custom = False  # materials use Blender's (Cycles') shader nodes
     bl_use_eevee_viewport = True  # Material Preview / Rendered viewport fall back to EEVEE
+
+    def __init__(self):
+        self._viewport = None  # viewport.ViewportSession, in the 3D viewport's Rendered mode
+
+    def __del__(self):
+        # Blender frees the engine when its viewport leaves Rendered mode, the file closes or
+        # Blender quits: the viewport's render thread must stop with it.
+        session = getattr(self, "_viewport", None)
+        if session is not None:
+            session.free()
+
+    # --- the 3D viewport's Rendered mode (viewport.py) -----------------------------------------
+
+    def view_update(self, context, depsgraph):
+        if self._viewport is None:
+            self._viewport = viewport.ViewportSession()
+        self._viewport.update(self, context, depsgraph)
+
+    def view_draw(self, context, depsgraph):
+        if self._viewport is not None:
+            self._viewport.draw(self, context, depsgraph)
 
     def update_render_passes(self, scene=None, renderlayer=None):
         passes.register_passes(self, scene, renderlayer)

@@ -27,7 +27,7 @@ def render_region(render):
     return x0, y0, x1 - x0, y1 - y0
 
 
-def _rigid_matrix12(m):
+def rigid_matrix12(m):
     # The camera's scale must not scale the image plane or the lens: keep rotation + position.
     loc, rot, _scale = m.decompose()
     r = rot.to_matrix()
@@ -55,7 +55,7 @@ def camera_dict(scene, cam_obj, warn):
     d = {
         "projection": 'ORTHO' if cam.type == 'ORTHO' else 'PERSP',
         "sensor_fit": cam.sensor_fit,
-        "matrix": _rigid_matrix12(cam_obj.matrix_world),
+        "matrix": rigid_matrix12(cam_obj.matrix_world),
         "focal_length_mm": float(cam.lens),
         "sensor_width_mm": float(cam.sensor_width),
         "sensor_height_mm": float(cam.sensor_height),

@@ -219,15 +219,41 @@ def _matrix12(m):
     return np.ascontiguousarray(a[:3, :4]).ravel()
 
 
+class MeshStore:
+    """The viewport's meshes from its last export, by (object name, tangents, colours): a later
+    export adds them back without reading Blender's mesh, unless `forget` dropped the object
+    (its geometry changed)."""
+
+    def __init__(self):
+        self.meshes = {}  # key -> _gdpt.StoredMesh, or None for an object without faces
+        self.reused = 0
+        self.exported = 0
+
+    def add_to(self, builder, key):
+        self.reused += 1
+        stored = self.meshes[key]
+        return -1 if stored is None else builder.add_stored_mesh(stored)
+
+    def keep(self, builder, key, index):
+        self.exported += 1
+        self.meshes[key] = None if index < 0 else builder.stored_mesh(index)
+
+    def forget(self, object_name):
+        for key in [k for k in self.meshes if k[0] == object_name]:
+            del self.meshes[key]
+
+
 class GeometryExporter:
     """Collects meshes and instances; `visit` is called for each depsgraph object instance."""
 
-    def __init__(self, builder, materials, warn):
+    def __init__(self, builder, materials, warn, store=None):
         self.builder = builder
         self.materials = materials
         self.warn = warn
         self.mesh_index = {}  # evaluated data pointer -> scene mesh index (-1: empty)
         self.export_seconds = 0.0
+        # MeshStore of the viewport (meshes kept from its last export), or None.
+        self.store = store
 
     def _mesh_for(self, obj, tangents, colors):
         # Meshes: the evaluated mesh datablock (modifiers applied) is what instances share.
@@ -240,6 +266,11 @@ class GeometryExporter:
             key = ("object", obj.original.as_pointer(), tangents, colors)
         if key in self.mesh_index:
             return self.mesh_index[key]
+        stored_key = (obj.original.name_full, tangents, colors)
+        if self.store is not None and stored_key in self.store.meshes:
+            index = self.store.add_to(self.builder, stored_key)
+            self.mesh_index[key] = index
+            return index
         if obj.type == 'MESH':
             mesh = obj.data
             index = self._add_mesh(mesh, tangents, colors)
@@ -250,6 +281,8 @@ class GeometryExporter:
             finally:
                 obj.to_mesh_clear()
         self.mesh_index[key] = index
+        if self.store is not None:
+            self.store.keep(self.builder, stored_key, index)
         return index
 
     def _add_mesh(self, mesh, tangents, colors):

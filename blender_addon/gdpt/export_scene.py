@@ -16,20 +16,24 @@ class ExportStats:
         self.materials = 0
 
 
-def export_scene(module, depsgraph, camera_object, warn):
-    """Builds and returns (builder, stats). `camera_object` is the evaluated scene camera."""
+def export_scene(module, depsgraph, camera_object, warn, camera=None, mesh_store=None):
+    """Builds and returns (builder, stats). `camera_object` is the evaluated scene camera;
+    `camera`, when given, is the camera dict to use instead (the viewport's view); `mesh_store`
+    (export_mesh.MeshStore, the viewport's) gives the meshes kept from the last export."""
     t0 = time.perf_counter()
     c0 = time.thread_time()
     scene = depsgraph.scene
     builder = module.SceneBuilder()
     images = export_images.ImageCache(builder, warn)
     materials = export_materials.MaterialCache(builder, images, warn)
-    geometry = export_mesh.GeometryExporter(builder, materials, warn)
+    geometry = export_mesh.GeometryExporter(builder, materials, warn, mesh_store)
     lights = 0
 
     # World first: its image must exist before set_world references it.
     builder.set_world(export_world.world_dict(scene.world, images, warn))
-    builder.set_camera(export_camera.camera_dict(scene, camera_object, warn))
+    if camera is None:
+        camera = export_camera.camera_dict(scene, camera_object, warn)
+    builder.set_camera(camera)
 
     for inst in depsgraph.object_instances:
         obj = inst.object

@@ -77,6 +77,27 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
                     "saved)",
         default=3.0, min=0.5, max=600.0)
 
+    # The 3D viewport's Rendered mode (viewport.py), as Cycles' Sampling > Viewport.
+    preview_samples: IntProperty(
+        name="Viewport Samples", description="Samples per pixel in the viewport's Rendered mode "
+        "(0 = until stopped)", default=256, min=0, max=1 << 24, soft_max=4096)
+    preview_start_divider: IntProperty(
+        name="Start Resolution Divider", description="After a change, the viewport first "
+        "renders one pass at the resolution divided by this, for an image at once (1 = off)",
+        default=4, min=1, max=64)
+    preview_mode: EnumProperty(
+        name="Viewport Integrator",
+        items=[('GPT', "Gradient-Domain", "Gradient-domain path tracing, reconstructed"),
+               ('PT', "Path Tracing", "Plain path tracing (Primal + Emission)")],
+        default='GPT')
+    preview_reconstruction: EnumProperty(
+        name="Viewport Reconstruction",
+        items=[('L2', "L2", "Unbiased screened Poisson solve (exact DCT, fast)"),
+               ('L1', "L1", "Robust iteratively reweighted solve (slower)"),
+               ('WEIGHTED', "Variance Weighted", "Each term weighted by its per-pixel variance"),
+               ('NONE', "None", "Primal + Emission")],
+        default='L2')
+
 
 class GDPTViewLayerSettings(bpy.types.PropertyGroup):
     use_pass_primal: BoolProperty(name="Primal", default=True, update=_update_passes)

@@ -43,6 +43,24 @@ class GDPT_PT_sampling(_RenderPanel, Panel):
         col.prop(s, "min_light_bounces")
 
 
+class GDPT_PT_sampling_viewport(_RenderPanel, Panel):
+    """Sampling > Viewport: the 3D viewport's Rendered mode (as Cycles' panel of that name)."""
+    bl_label = "Viewport"
+    bl_parent_id = "GDPT_PT_sampling"
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        s = context.scene.gdpt
+        col = layout.column(align=True)
+        col.prop(s, "preview_samples", text="Samples")
+        col.prop(s, "preview_start_divider", text="Start Divider")
+        col = layout.column()
+        col.prop(s, "preview_mode", text="Integrator")
+        sub = col.column()
+        sub.active = s.preview_mode == 'GPT'
+        sub.prop(s, "preview_reconstruction", text="Reconstruction")
+
+
 class GDPT_PT_light_paths(_RenderPanel, Panel):
     bl_label = "Light Paths"
     bl_options = {'DEFAULT_CLOSED'}
@@ -164,7 +182,7 @@ class GDPT_PT_light_shadow(_Panel, Panel):
         layout.prop(context.light.cycles, "cast_shadow")
 
 
-_classes = (GDPT_PT_sampling, GDPT_PT_light_paths, GDPT_PT_film, GDPT_PT_gradient_domain,
+_classes = (GDPT_PT_sampling, GDPT_PT_sampling_viewport, GDPT_PT_light_paths, GDPT_PT_film, GDPT_PT_gradient_domain,
             GDPT_PT_reconstruction, GDPT_PT_performance, GDPT_PT_passes, GDPT_PT_ray_visibility,
             GDPT_PT_light_shadow)
 

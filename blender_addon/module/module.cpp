@@ -7,6 +7,7 @@
 
 #include "blender_addon/module/render_job.h"
 #include "blender_addon/module/scene_convert.h"
+#include "blender_addon/module/viewport_job.h"
 #include "reconstruct/exr_io.h"
 
 namespace py = pybind11;
@@ -50,6 +51,15 @@ RenderSettings settings_from_dict(const py::dict& d) {
   return s;
 }
 
+ViewportDisplay display_from_dict(const py::dict& d) {
+  ViewportDisplay v;
+  if (d.contains("norm")) v.norm = d["norm"].cast<std::string>();
+  if (d.contains("alpha")) v.alpha = d["alpha"].cast<float>();
+  if (d.contains("start_divider")) v.start_divider = d["start_divider"].cast<int>();
+  if (!(v.alpha > 0.0f)) throw std::invalid_argument("viewport: alpha must be > 0");
+  return v;
+}
+
 // The passes of one view layer of a multilayer EXR (the compositor node reads files behind an
 // Image node through this): {pass name: float32 (height, width, 3)}, rows bottom-up as Blender
 // stores them. A missing required pass raises RuntimeError naming it.
@@ -77,6 +87,8 @@ py::dict read_exr_passes_dict(const std::string& path, const std::string& layer,
 
 PYBIND11_MODULE(_gdpt, m) {
   m.doc() = "GDPT core bindings: build a scene from flat arrays, render it, reconstruct passes.";
+
+  py::class_<StoredMesh>(m, "StoredMesh");
 
   py::class_<SceneBuilder>(m, "SceneBuilder")
       .def(py::init<>())
@@ -106,6 +118,8 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("set_camera", &SceneBuilder::set_camera)
       .def("set_world", &SceneBuilder::set_world)
       .def("mesh_arrays", &SceneBuilder::mesh_arrays, py::arg("index"))
+      .def("stored_mesh", &SceneBuilder::stored_mesh, py::arg("index"))
+      .def("add_stored_mesh", &SceneBuilder::add_stored_mesh, py::arg("stored"))
       .def("set_mesh_texspace", &SceneBuilder::set_mesh_texspace, py::arg("index"),
            py::arg("location"), py::arg("size"))
       .def_property_readonly("mesh_count", &SceneBuilder::mesh_count)
@@ -123,6 +137,17 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("features_summary", &RenderJob::features_summary)
       .def("rays_traced", &RenderJob::rays_traced)
       .def("warnings", &RenderJob::warnings);
+
+  py::class_<ViewportJob>(m, "ViewportJob")
+      .def(py::init([](SceneBuilder& builder, const py::dict& settings, const py::dict& display) {
+             return std::make_unique<ViewportJob>(builder, settings_from_dict(settings),
+                                                  display_from_dict(display));
+           }),
+           py::arg("builder"), py::arg("settings"), py::arg("display"))
+      .def("set_camera", &ViewportJob::set_camera, py::arg("camera"))
+      .def("latest", &ViewportJob::latest, py::arg("seen") = -1)
+      .def("status", &ViewportJob::status)
+      .def("stop", &ViewportJob::stop);
 
   m.def("empty", &empty_array, py::arg("count"), py::arg("dtype"),
         "numpy.empty((count,), dtype), its large pages advised as huge pages (faster first touch)");

@@ -239,6 +239,14 @@ py::list RenderJob::warnings() const {
   return out;
 }
 
+ReconstructionNorm parse_norm(const std::string& norm) {
+  if (norm == "L1") return ReconstructionNorm::L1;
+  if (norm == "L2") return ReconstructionNorm::L2;
+  if (norm == "WEIGHTED") return ReconstructionNorm::Weighted;
+  if (norm == "NONE") return ReconstructionNorm::None;
+  throw std::invalid_argument("unknown reconstruction norm '" + norm + "'");
+}
+
 py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray& gradient_x,
                                       const FloatArray& gradient_y,
                                       const std::optional<FloatArray>& variance,
@@ -255,16 +263,7 @@ py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray
     throw std::invalid_argument("emission: expected 3 values per pixel");
 
   ReconstructionSettings settings;
-  if (norm == "L1")
-    settings.norm = ReconstructionNorm::L1;
-  else if (norm == "L2")
-    settings.norm = ReconstructionNorm::L2;
-  else if (norm == "WEIGHTED")
-    settings.norm = ReconstructionNorm::Weighted;
-  else if (norm == "NONE")
-    settings.norm = ReconstructionNorm::None;
-  else
-    throw std::invalid_argument("unknown reconstruction norm '" + norm + "'");
+  settings.norm = parse_norm(norm);
   settings.alpha = alpha;
   settings.threads = threads;
 

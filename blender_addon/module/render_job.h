@@ -20,6 +20,7 @@
 #include "blender_addon/module/scene_convert.h"
 #include "core/huge_pages.h"
 #include "integrators/render_session.h"
+#include "reconstruct/reconstruct.h"
 
 namespace gdpt::python {
 
@@ -63,6 +64,10 @@ class RenderJob {
   std::unique_ptr<State> state_;
   FilmPasses shown_;  // the snapshot Python's views see (snapshot())
 };
+
+// A reconstruction norm from its name in the add-on: L1, L2, WEIGHTED or NONE (else
+// std::invalid_argument).
+ReconstructionNorm parse_norm(const std::string& norm);
 
 // Screened Poisson reconstruction of numpy passes (the same code as the CLI and the engine).
 py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray& gradient_x,

@@ -721,4 +721,16 @@ void SceneBuilder::set_world(const py::dict& d) {
   }
 }
 
+StoredMesh SceneBuilder::stored_mesh(int index) const {
+  if (index < 0 || size_t(index) >= scene_.meshes.size())
+    throw std::out_of_range("stored_mesh: no mesh " + std::to_string(index));
+  return StoredMesh{std::make_shared<const Mesh>(scene_.meshes[size_t(index)])};
+}
+
+int SceneBuilder::add_stored_mesh(const StoredMesh& stored) {
+  if (!stored.mesh) throw std::invalid_argument("add_stored_mesh: an empty stored mesh");
+  scene_.meshes.push_back(*stored.mesh);
+  return int(scene_.meshes.size()) - 1;
+}
+
 }  // namespace gdpt::python

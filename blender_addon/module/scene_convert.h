@@ -25,6 +25,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -42,6 +43,12 @@ using IntArray = py::array_t<int32_t, py::array::c_style>;
 // numpy.empty(count, dtype) for arrays that Blender's foreach_get fills: large ones are advised as
 // transparent huge pages before their first touch (see advise_huge_pages in scene_convert.cpp).
 py::array empty_array(py::ssize_t count, const py::dtype& dtype);
+
+// A copy of one exported mesh, kept by the viewport across exports so that a change that leaves
+// the geometry alone does not read the mesh from Blender again (SceneBuilder::stored_mesh).
+struct StoredMesh {
+  std::shared_ptr<const Mesh> mesh;
+};
 
 // Incrementally filled scene; handed over (moved) to a render session.
 class SceneBuilder {
@@ -96,6 +103,9 @@ class SceneBuilder {
   size_t mesh_count() const { return scene_.meshes.size(); }
   size_t instance_count() const { return scene_.instances.size(); }
   size_t triangle_count() const;
+  // A copy of mesh `index` as exported, and the mesh added back from such a copy (its index).
+  StoredMesh stored_mesh(int index) const;
+  int add_stored_mesh(const StoredMesh& stored);
   Scene take() { return std::move(scene_); }
   const Scene& scene() const { return scene_; }
 

@@ -1496,6 +1496,45 @@ TEST(Render, RenderRegionIsTheFramesPixels) {
   EXPECT_THROW(render(scene, pt(1)), std::invalid_argument);
 }
 
+// The viewport's restart on a moved view: after set_camera (another position, resolution and
+// projection) a session renders bit for bit what a new session with that camera renders, in PT
+// and G-PT; an unusable camera is refused and the session keeps rendering its own.
+TEST(Render, SetCameraRendersAsANewSession) {
+  for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+    const Scene scene = cornell_like();
+    RenderSettings s = pt(2, 5);
+    s.mode = mode;
+    Scene moved = scene;
+    moved.camera.width = 20;
+    moved.camera.height = 14;
+    moved.camera.camera_to_world.m[0][3] += 0.3f;
+    moved.camera.projection = Camera::Projection::Orthographic;
+    moved.camera.ortho_scale = 3.0f;
+
+    RenderSession session(scene, s);
+    std::atomic<bool> cancel{false};
+    session.render(nullptr, cancel);
+    Camera bad = moved.camera;
+    bad.width = 0;
+    EXPECT_THROW(session.set_camera(bad), std::invalid_argument);
+    session.set_camera(moved.camera);
+    ASSERT_EQ(session.film().min_samples(), 0u);  // the film starts over
+    session.render(nullptr, cancel);
+    const Image fresh = render(moved, s);
+    ASSERT_EQ(session.film().width(), fresh.w);
+    ASSERT_EQ(session.film().height(), fresh.h);
+    std::vector<float> primal(session.film().pixel_count() * 3), gx(primal.size());
+    session.film().primal_rgb(primal.data());
+    session.film().gradient_x_rgb(gx.data());
+    EXPECT_EQ(primal, fresh.primal);
+    EXPECT_EQ(gx, fresh.gradient_x);
+    Scene resized = scene;  // the first view at the new size: the view really changed
+    resized.camera.width = moved.camera.width;
+    resized.camera.height = moved.camera.height;
+    EXPECT_NE(primal, render(resized, s).primal);
+  }
+}
+
 TEST(Render, NeverNaNOrInf) {
   Scene scene = cornell_like();
   // Degenerate triangles, zero-length and inverted shading normals, zero-roughness glossy,

@@ -1,0 +1,256 @@
+# The 3D viewport's Rendered mode: one ViewportSession per viewport engine (engine.py's
+# view_update / view_draw, Cycles' split).
+#
+# view_update (a depsgraph change): exports the scene with the view's camera and starts a
+# _gdpt.ViewportJob, which builds the BVH and renders progressive passes on its own thread and
+# publishes the display image (a G-PT reconstruction, or the primal) under a lock.
+# view_draw (every redraw): a moved view only restarts the job with a new camera (the BVH is
+# kept); the newest image is uploaded into a GPUTexture and drawn with Blender's display shader,
+# so the viewport's view transform applies. A timer tags the Rendered viewports for redraw while
+# a job has unseen images; the job stops when its engine is freed (leaving Rendered mode,
+# closing the file, quitting) or when no viewport shows Gradient PT any more.
+import atexit
+import weakref
+
+import bpy
+import gpu
+from gpu_extras.presets import draw_texture_2d
+
+from . import export_mesh, export_scene, native, properties, viewport_camera
+
+MARKER = "GDPT:"
+# Seconds between the redraw timer's looks at the jobs.
+REDRAW_INTERVAL = 0.05
+# Viewport Samples 0: until stopped (the largest sample count the settings allow).
+UNLIMITED_SAMPLES = 1 << 24
+
+_live = weakref.WeakSet()  # sessions with a job, stopped at exit
+# The last image drawn (job, restart, version, samples, solved, rect, size): read by the viewport
+# test and benchmark.
+LAST_DRAW = {}
+_jobs_started = [0]  # jobs started in this process (LAST_DRAW["job"])
+# The last viewport export: meshes read from Blender and meshes kept from the export before.
+LAST_EXPORT = {}
+# Datablock types whose geometry updates leave every kept mesh valid (objects, and the data of
+# objects, drop their objects' meshes; any other type, e.g. a geometry node tree or a collection,
+# drops them all).
+_OBJECT_DATA_TYPES = (bpy.types.Mesh, bpy.types.Curve, bpy.types.MetaBall)
+_MESH_NEUTRAL_TYPES = (bpy.types.Scene, bpy.types.World, bpy.types.Material, bpy.types.Light,
+                       bpy.types.Camera, bpy.types.Image)
+
+
+def render_settings(scene):
+    """The settings dict of a viewport job: the render's, with the viewport's samples and mode,
+    one sample per pass (the first image after one pass)."""
+    s = scene.gdpt
+    d = properties.settings_dict(scene)
+    d["mode"] = s.preview_mode
+    d["samples"] = int(s.preview_samples) or UNLIMITED_SAMPLES
+    d["time_limit"] = 0.0
+    d["samples_per_pass"] = 1
+    return d
+
+
+def display_settings(scene):
+    s = scene.gdpt
+    norm = s.preview_reconstruction if s.preview_mode == 'GPT' else 'NONE'
+    return {"norm": norm, "alpha": float(s.alpha), "start_divider": int(s.preview_start_divider)}
+
+
+def _restart_key(scene):
+    """What restarts the job when it changes, besides the depsgraph's own updates."""
+    return (tuple(sorted(render_settings(scene).items())),
+            tuple(sorted(display_settings(scene).items())))
+
+
+def _forget_changed_meshes(store, depsgraph):
+    """Drops the kept meshes whose geometry the depsgraph updates changed."""
+    for update in depsgraph.updates:
+        if not update.is_updated_geometry:
+            continue
+        if isinstance(update.id, bpy.types.Object):
+            store.forget(update.id.original.name_full)
+        elif isinstance(update.id, _OBJECT_DATA_TYPES):
+            data = update.id.original
+            for obj in bpy.data.objects:
+                if obj.data is not None and obj.data.original == data:
+                    store.forget(obj.name_full)
+        elif not isinstance(update.id, _MESH_NEUTRAL_TYPES):
+            store.meshes.clear()
+            return
+
+
+def _needs_export(depsgraph):
+    """Whether the depsgraph updates change what the job renders (the scene camera moving only
+    changes the view, which view_draw handles)."""
+    for update in depsgraph.updates:
+        if isinstance(update.id, bpy.types.Object) and update.id.type == 'CAMERA':
+            continue
+        if update.is_updated_geometry or update.is_updated_transform or \
+                update.is_updated_shading:
+            return True
+    return False
+
+
+class ViewportSession:
+    def __init__(self):
+        self.job = None
+        self.camera_key = None
+        self.restart_key = None
+        self.seen = -1  # version of the image in the texture
+        self.texture = None
+        self.image = None  # the latest dict from the job, minus its pixels
+        self.samples_total = 0
+        self.error = None
+        self.mesh_store = export_mesh.MeshStore()
+        self.job_number = 0
+
+    # --- view_update ----------------------------------------------------------------------------
+
+    def update(self, engine, context, depsgraph):
+        scene = depsgraph.scene
+        restart = self.restart_key != _restart_key(scene)
+        if self.job is not None and not restart and not _needs_export(depsgraph):
+            return
+        module, _build, error = native.load()
+        if module is None:
+            self._fail(engine, error)
+            return
+        camera, _rect = viewport_camera.view_camera(scene, depsgraph, context.space_data,
+                                                    context.region, context.region_data,
+                                                    lambda m: None)
+        self.stop()
+        if camera is None:
+            return
+        warnings = set()
+        _forget_changed_meshes(self.mesh_store, depsgraph)
+        self.mesh_store.reused = self.mesh_store.exported = 0
+        try:
+            builder, stats = export_scene.export_scene(module, depsgraph, None, warnings.add,
+                                                       camera=camera, mesh_store=self.mesh_store)
+            self.job = module.ViewportJob(builder, render_settings(scene),
+                                          display_settings(scene))
+        except Exception as e:  # a broken datablock must not take Blender down
+            self._fail(engine, f"viewport export failed: {e}")
+            return
+        for w in sorted(warnings):
+            print(f"{MARKER} viewport warning: {w}", flush=True)
+        store = self.mesh_store
+        LAST_EXPORT.update(exported=store.exported, reused=store.reused, seconds=stats.seconds)
+        print(f"{MARKER} viewport: exported {stats.instances} instances ({store.exported} meshes "
+              f"read, {store.reused} kept), {stats.lights} lights in {stats.seconds:.3f} s",
+              flush=True)
+        self.error = None
+        self.camera_key = viewport_camera.camera_key(camera)
+        self.restart_key = _restart_key(scene)
+        self.samples_total = int(scene.gdpt.preview_samples)
+        self.seen = -1
+        _jobs_started[0] += 1
+        self.job_number = _jobs_started[0]
+        _live.add(self)
+        _start_timer()
+
+    def _fail(self, engine, message):
+        self.stop()
+        if message != self.error:
+            print(f"{MARKER} viewport error: {message}", flush=True)
+            engine.report({'ERROR'}, f"Gradient PT: {message}")
+        self.error = message
+        engine.update_stats("", f"Error: {message}")
+
+    # --- view_draw ------------------------------------------------------------------------------
+
+    def draw(self, engine, context, depsgraph):
+        scene = depsgraph.scene
+        camera, rect = viewport_camera.view_camera(scene, depsgraph, context.space_data,
+                                                   context.region, context.region_data,
+                                                   lambda m: None)
+        if self.job is None or camera is None:
+            return
+        key = viewport_camera.camera_key(camera)
+        if key != self.camera_key:
+            self.camera_key = key
+            self.job.set_camera(camera)
+        status = self.job.status()
+        if status["error"]:
+            self._fail(engine, status["error"])
+            return
+        latest = self.job.latest(self.seen)
+        if latest is not None:
+            self._upload(latest)
+        if self.texture is None:
+            return
+        gpu.state.blend_set('ALPHA_PREMULT')
+        engine.bind_display_space_shader(scene)
+        draw_texture_2d(self.texture, (rect[0], rect[1]), rect[2], rect[3])
+        engine.unbind_display_space_shader()
+        gpu.state.blend_set('NONE')
+        total = self.samples_total or "∞"
+        kind = "reconstructed" if self.image["solved"] else "primal"
+        engine.update_stats("", f"Sample {self.image['samples']}/{total} ({kind})")
+        LAST_DRAW.update(job=self.job_number, restart=self.image["restart"], version=self.seen,
+                         samples=self.image["samples"], solved=self.image["solved"],
+                         rect=tuple(rect),
+                         size=(self.image["width"], self.image["height"]),
+                         rendering=status["rendering"])
+
+    def _upload(self, latest):
+        pixels = latest.pop("image")
+        buffer = gpu.types.Buffer('FLOAT', pixels.size, pixels.reshape(-1))
+        self.texture = gpu.types.GPUTexture((latest["width"], latest["height"]),
+                                            format='RGBA16F', data=buffer)
+        self.image = latest
+        self.seen = latest["version"]
+
+    # --- redraw and stop ------------------------------------------------------------------------
+
+    def wants_redraw(self):
+        """True while the job has an image the texture does not show yet."""
+        return self.job is not None and self.job.status()["version"] > self.seen
+
+    def stop(self):
+        if self.job is not None:
+            self.job.stop()
+            self.job = None
+        _live.discard(self)
+
+    def free(self):
+        self.stop()
+        self.texture = None
+
+
+def _rendered_views():
+    """The 3D viewport areas in Rendered mode with Gradient PT as the engine."""
+    wm = bpy.context.window_manager
+    for window in (wm.windows if wm else ()):
+        if window.scene.render.engine != "GDPT":
+            continue
+        for area in window.screen.areas:
+            if area.type == 'VIEW_3D' and area.spaces.active.shading.type == 'RENDERED':
+                yield area
+
+
+def _redraw_timer():
+    if not _live:
+        return None
+    areas = list(_rendered_views())
+    if not areas:
+        # No viewport shows a job any more (the engine's __del__ may come later): stop them.
+        for session in list(_live):
+            session.stop()
+        return None
+    if any(session.wants_redraw() for session in list(_live)):
+        for area in areas:
+            area.tag_redraw()
+    return REDRAW_INTERVAL
+
+
+def _start_timer():
+    if not bpy.app.timers.is_registered(_redraw_timer):
+        bpy.app.timers.register(_redraw_timer, first_interval=REDRAW_INTERVAL)
+
+
+@atexit.register
+def _stop_all():
+    for session in list(_live):
+        session.stop()
