@@ -1,5 +1,5 @@
 // Gradient-domain path tracer: see gradient_path_tracer.h for the estimator and the film layout,
-// docs/gradient-code.md for the files of its phases and their names in the paper's notation.
+// docs/gradient.md ("The code and the paper's notation") for its phases' files and names.
 //
 // Parameters (RenderSettings): max_bounces and the per-kind limits (path_state.h), rr_depth
 // (Russian roulette decided by the base path, its probability multiplied into base and offset
