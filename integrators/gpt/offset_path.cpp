@@ -87,7 +87,7 @@ void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t&
       o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
       o.seg_pdf = pdf;
       // Visibility, a single occlusion query (4-ray packets of these cost more).
-      o.seg_visible = !occluded(g, y, dir, float(r.distance) * (1.0f - 1e-4f), st.kind, rays);
+      o.seg_visible = !occluded(g, shadow_ray_to(y, dir, next.position, st.kind), rays);
     } else {
       // Reconnection at infinity: the same direction, J = 1, visibility from y_d.
       Vec3f wo;
@@ -100,7 +100,7 @@ void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t&
       float pdf = 0.0f;
       o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
       o.seg_pdf = pdf;
-      o.seg_visible = !occluded(g, y, wo_world, kInf, st.kind, rays);
+      o.seg_visible = !occluded(g, shadow_ray_along(y, wo_world, st.kind), rays);
     }
     return;
   }
