@@ -181,6 +181,45 @@ inline Scene make_scene(SceneKind kind, int res, float object_roughness = 0.3f,
   return s;
 }
 
+// A diffuse box [-1, 1]^3 open towards +z whose only light is an emissive mesh panel (Emission
+// shader only, two-sided, strength `strength`) of half-size 0.3 a hair (`gap`) below the ceiling,
+// facing down, as a Blender user models a ceiling lamp. The camera inside the box looks straight
+// up at the panel's edge x = 0.3: half the frame sees the panel, half the ceiling beside it, whose
+// light arrives at grazing angles past the panel. `at` moves the whole scene: far from the origin
+// (as Blender scenes often are) positions carry rounding errors far above a short segment's length.
+inline Scene make_panel_scene(int res, Vec3f at = {0, 0, 0}, float gap = 1e-3f,
+                              float strength = 10.0f) {
+  Scene s;
+  s.world.color = Spectrum(0.0f);
+  s.meshes.push_back(quad(1.0f));  // 0: wall
+  s.meshes.push_back(quad(0.3f));  // 1: panel
+  s.materials.push_back(diffuse({0.75f, 0.75f, 0.75f}));
+  s.materials.push_back(diffuse({0.7f, 0.15f, 0.12f}));
+  s.materials.push_back(diffuse({0.15f, 0.6f, 0.15f}));
+  s.materials.push_back(emissive({1.0f, 1.0f, 1.0f}, strength));
+  const float h = kPi / 2;
+  s.instances.push_back(place(0, 0, transform(-h, 0, {0, -1, 0})));         // floor
+  s.instances.push_back(place(0, 0, transform(h, 0, {0, 1, 0})));           // ceiling
+  s.instances.push_back(place(0, 0, transform(0, 0, {0, 0, -1})));          // back
+  s.instances.push_back(place(0, 1, transform(0, h, {-1, 0, 0})));          // left (red)
+  s.instances.push_back(place(0, 2, transform(0, -h, {1, 0, 0})));          // right (green)
+  s.instances.push_back(place(1, 3, transform(h, 0, {0, 1.0f - gap, 0})));  // panel
+  Camera& c = s.camera;
+  c.width = c.height = res;
+  c.focal_length_mm = 50.0f;
+  c.sensor_width_mm = 36.0f;
+  c.camera_to_world = transform(h, 0, {0.3f, -0.6f, 0.0f});  // looks up (+y)
+  for (Instance& i : s.instances) {
+    i.object_to_world.m[0][3] += at.x;
+    i.object_to_world.m[1][3] += at.y;
+    i.object_to_world.m[2][3] += at.z;
+  }
+  c.camera_to_world.m[0][3] += at.x;
+  c.camera_to_world.m[1][3] += at.y;
+  c.camera_to_world.m[2][3] += at.z;
+  return s;
+}
+
 struct Passes {
   int w = 0, h = 0;
   std::vector<float> primal, dx, dy, emission, variance, failures;

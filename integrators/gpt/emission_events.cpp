@@ -30,7 +30,7 @@ void reconnect_to_light(const GptContext& g, Offset& o, const Vertex& base, Vec3
     if (!local_dir(y, base_dir, wo)) return;
     float pdf_o = 0.0f;
     const Spectrum fo = y.closures->eval_pdf(y.wi, wo, pdf_o);
-    const bool vis = !occluded(g, y, base_dir, kInf, kind, rays);
+    const bool vis = !occluded(g, shadow_ray_along(y, base_dir, kind), rays);
     co = vis ? mul(mul(o.f, fo), lh.radiance) : Vec3d();
     d_off = shift::offset_densities(o.p, 1.0, pl_pair, vis ? pdf_o : 0.0f);
     return;
@@ -50,7 +50,7 @@ void reconnect_to_light(const GptContext& g, Offset& o, const Vertex& base, Vec3
                        length_squared(lo.normal - lh.normal) <= kSameNormal2;
   float pdf_o = 0.0f;
   const Spectrum fo = y.closures->eval_pdf(y.wi, wo, pdf_o);
-  const bool vis = reaches && !occluded(g, y, dir, d * (1.0f - 1e-4f), kind, rays);
+  const bool vis = reaches && !occluded(g, shadow_ray_to(y, dir, lh.position, kind), rays);
   co = vis ? mul(mul(o.f, fo), lo.radiance) * r.jacobian : Vec3d();
   // Light sampling from y produces this point only where the light emits towards y (a spot's
   // cone), as the base's pl is counted only for a lit hit.

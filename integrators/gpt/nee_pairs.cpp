@@ -88,8 +88,7 @@ void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, cons
   if (local_dir(base, ls.direction, wo)) {
     fs = bc.eval_pdf(base.wi, wo, pdf_fs);
     if (!is_black(fs) && !is_black(ls.radiance))
-      visible = lamp_visible(g, base, ls, ls.direction, ls.distance, ls.is_infinite,
-                             scratch.shadow_closures, le, out.rays);
+      visible = lamp_visible(g, base, ls, ls, scratch.shadow_closures, le, out.rays);
   }
   const float pdf_bsdf = (!ls.is_delta && visible) ? pdf_fs : 0.0f;
   if (visible) {
@@ -153,8 +152,8 @@ void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, cons
       if (!is_black(fo[k]) && !is_black(lo[k].radiance)) {
         test[k] = true;
         // The same lamp as the base's sample (its cast_shadow and is_delta).
-        blocked[k] = !lamp_visible(g, o.v, ls, lo[k].direction, lo[k].distance, lo[k].is_infinite,
-                                   scratch.shadow_closures, lo[k].radiance, out.rays);
+        blocked[k] =
+            !lamp_visible(g, o.v, ls, lo[k], scratch.shadow_closures, lo[k].radiance, out.rays);
       }
     }
   }

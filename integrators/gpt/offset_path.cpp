@@ -13,22 +13,11 @@ using shift::Vec3d;
 using shift::VertexType;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-}  // namespace
-
-void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t& rays) {
-  const EmbreeScene& bvh = g.ctx.bvh();
+// Connected or recently connected: the base's own segment, seen from the offset's direction at
+// a shared vertex.
+void shift_merged(Offset& o, const BaseStep& st) {
   const Vertex& base = *st.base;
   const BsdfSample& bs = *st.bs;
-  const VertexType xd_type = st.xd_type, next_type = st.next_type;
-  const Vec3f wo_world = st.wo_world;
-  const bool found = st.found;
-  const SurfaceHit& next = *st.next;
-  const float u_lobe = st.u_lobe;
-  const Vec2f u_dir = st.u_dir;
-  o.seg_jacobian = 1.0;
-  o.seg_visible = true;
-  o.killed = false;
-  o.next_found = o.holdout_end = false;
   switch (o.link) {
     case Link::Connected:
       o.shift = Shift::Follow;
@@ -57,55 +46,66 @@ void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t&
     case Link::NotConnected:
       break;
   }
+}
 
+// Reconnection (x_d, y_d and x_{d+1} all diffuse): y_d connects to the base's x_{d+1}, or to the
+// same direction when the base escaped.
+void reconnect(const GptContext& g, Offset& o, const BaseStep& st, uint32_t& rays) {
   const Vertex& y = o.v;
-  const VertexType yd_type =
-      bs.is_delta() && y.closures->has_delta() ? VertexType::Specular : g.classify(y.roughness);
-
-  // --- Reconnection: x_d, y_d and x_{d+1} all diffuse ---
-  if (xd_type == VertexType::Diffuse && yd_type == VertexType::Diffuse &&
-      next_type == VertexType::Diffuse) {
-    if (found) {
-      const shift::Reconnection r = shift::reconnect(st.target, y.hit.position);
-      if (!r.valid) {
-        o.shift = Shift::Failed;
-        return;
-      }
-      const Vec3f dir = r.direction.to_float();
-      o.seg_dir = dir;
-      // The offset must arrive on the same side of x_{d+1} as the base (the closures there
-      // depend on the side).
-      const bool off_front = dot(y.hit.position - next.position, next.geometric_normal) > 0;
-      Vec3f wo;
-      if (st.base_front != off_front || !local_dir(y, dir, wo)) {
-        o.shift = Shift::Failed;
-        return;
-      }
-      o.shift = Shift::Reconnect;
-      o.seg_jacobian = r.jacobian;
-      float pdf = 0.0f;
-      o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
-      o.seg_pdf = pdf;
-      // Visibility, a single occlusion query (4-ray packets of these cost more).
-      o.seg_visible = !occluded(g, y, dir, float(r.distance) * (1.0f - 1e-4f), st.kind, rays);
-    } else {
-      // Reconnection at infinity: the same direction, J = 1, visibility from y_d.
-      Vec3f wo;
-      o.seg_dir = wo_world;
-      if (!local_dir(y, wo_world, wo)) {
-        o.shift = Shift::Failed;
-        return;
-      }
-      o.shift = Shift::ReconnectEnv;
-      float pdf = 0.0f;
-      o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
-      o.seg_pdf = pdf;
-      o.seg_visible = !occluded(g, y, wo_world, kInf, st.kind, rays);
+  const SurfaceHit& next = *st.next;
+  const Vec3f wo_world = st.wo_world;
+  const bool found = st.found;
+  if (found) {
+    const shift::Reconnection r = shift::reconnect(st.target, y.hit.position);
+    if (!r.valid) {
+      o.shift = Shift::Failed;
+      return;
     }
-    return;
+    const Vec3f dir = r.direction.to_float();
+    o.seg_dir = dir;
+    // The offset must arrive on the same side of x_{d+1} as the base (the closures there
+    // depend on the side).
+    const bool off_front = dot(y.hit.position - next.position, next.geometric_normal) > 0;
+    Vec3f wo;
+    if (st.base_front != off_front || !local_dir(y, dir, wo)) {
+      o.shift = Shift::Failed;
+      return;
+    }
+    o.shift = Shift::Reconnect;
+    o.seg_jacobian = r.jacobian;
+    float pdf = 0.0f;
+    o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
+    o.seg_pdf = pdf;
+    // Visibility, a single occlusion query (4-ray packets of these cost more).
+    o.seg_visible = !occluded(g, shadow_ray_to(y, dir, next.position, st.kind), rays);
+  } else {
+    // Reconnection at infinity: the same direction, J = 1, visibility from y_d.
+    Vec3f wo;
+    o.seg_dir = wo_world;
+    if (!local_dir(y, wo_world, wo)) {
+      o.shift = Shift::Failed;
+      return;
+    }
+    o.shift = Shift::ReconnectEnv;
+    float pdf = 0.0f;
+    o.seg_value = Vec3d(y.closures->eval_pdf(y.wi, wo, pdf));
+    o.seg_pdf = pdf;
+    o.seg_visible = !occluded(g, shadow_ray_along(y, wo_world, st.kind), rays);
   }
+}
 
-  // --- Half-vector copy in the local frames ---
+// Half-vector copy in the local frames (x_d or y_d specular, or x_{d+1} specular), then the
+// offset's own segment and the kills that keep the shift invertible.
+void half_vector_copy(const GptContext& g, Offset& o, const BaseStep& st, VertexType yd_type,
+                      uint32_t& rays) {
+  const EmbreeScene& bvh = g.ctx.bvh();
+  const Vertex& base = *st.base;
+  const BsdfSample& bs = *st.bs;
+  const Vertex& y = o.v;
+  const VertexType xd_type = st.xd_type;
+  const bool found = st.found;
+  const float u_lobe = st.u_lobe;
+  const Vec2f u_dir = st.u_dir;
   Vec3f wo;
   if (bs.is_delta()) {
     // Delta lobe: the same discrete event (reflection / transmission) at y_d, J = 1. The
@@ -170,6 +170,23 @@ void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t&
     const VertexType yn_type = o.next_found ? g.classify_hit(o.next_hit) : VertexType::Diffuse;
     if (yn_type == VertexType::Diffuse) o.killed = true;
   }
+}
+
+}  // namespace
+
+void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t& rays) {
+  o.seg_jacobian = 1.0;
+  o.seg_visible = true;
+  o.killed = false;
+  o.next_found = o.holdout_end = false;
+  if (o.link != Link::NotConnected) return shift_merged(o, st);
+  const Vertex& y = o.v;
+  const VertexType yd_type =
+      st.bs->is_delta() && y.closures->has_delta() ? VertexType::Specular : g.classify(y.roughness);
+  if (st.xd_type == VertexType::Diffuse && yd_type == VertexType::Diffuse &&
+      st.next_type == VertexType::Diffuse)
+    return reconnect(g, o, st, rays);
+  half_vector_copy(g, o, st, yd_type, rays);
 }
 
 void advance(const GptContext& g, Offset& o, bool last) {

@@ -44,6 +44,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "reconstruct/reconstruct.h"
 #include "render/camera.h"
 #include "testing/gradient_scenes.h"
 
@@ -173,8 +174,11 @@ void print_comparison(const char* name, const Comparison& c, bool primal) {
   std::printf("\n");
 }
 
+// `max_failure_rate`: the mean fraction of failed shifts per pixel, measured for the case and set
+// about 15% above it (an average over 256 pixels x 1024 samples moves far less across seeds): a
+// shift rule that starts failing more (a lost reconnection, a wrong kill) exceeds it.
 void expect_unbiased(const char* name, const Scene& scene, int ref_spp, int gpt_spp,
-                     float max_failure_rate = 1.0f, int rr_depth = RenderSettings{}.rr_depth) {
+                     float max_failure_rate, int rr_depth = RenderSettings{}.rr_depth) {
   RenderSettings pt = settings(RenderSettings::Mode::PT, ref_spp, 7 + seed_offset());
   RenderSettings gpt = settings(RenderSettings::Mode::GPT, gpt_spp, 11 + seed_offset());
   pt.rr_depth = gpt.rr_depth = rr_depth;
@@ -201,13 +205,15 @@ void expect_unbiased(const char* name, const Scene& scene, int ref_spp, int gpt_
 }
 
 TEST(GradientUnbiased, DiffuseCornellBox) {
-  expect_unbiased("cornell", make_scene(SceneKind::CornellDiffuse, 16), 4096, 1024, 0.5f);
+  expect_unbiased("cornell", make_scene(SceneKind::CornellDiffuse, 16), 4096, 1024, 0.23f);
 }
 
 TEST(GradientUnbiased, GlossyReconnectedAndHalfVector) {
   // roughness 0.3 -> alpha 0.09: reconnection; roughness 0.02 -> alpha 4e-4: half-vector copy.
-  expect_unbiased("glossy-rough", make_scene(SceneKind::CornellGlossy, 16, 0.3f), 4096, 1024);
-  expect_unbiased("glossy-smooth", make_scene(SceneKind::CornellGlossy, 16, 0.02f), 4096, 1024);
+  expect_unbiased("glossy-rough", make_scene(SceneKind::CornellGlossy, 16, 0.3f), 4096, 1024,
+                  0.23f);
+  expect_unbiased("glossy-smooth", make_scene(SceneKind::CornellGlossy, 16, 0.02f), 4096, 1024,
+                  0.28f);
 }
 
 // Russian roulette after a glossy bounce takes effect past the emission the next segment finds
@@ -221,22 +227,22 @@ TEST(GradientUnbiased, RouletteAfterGlossyBounces) {
     Scene scene = make_scene(SceneKind::CornellGlossy, 16, roughness);
     scene.materials[3] = glossy({0.25f, 0.25f, 0.25f}, roughness);
     expect_unbiased(roughness > 0.1f ? "roulette-glossy-rough" : "roulette-glossy-smooth", scene,
-                    4096, 1024, 1.0f, 0);
+                    4096, 1024, roughness > 0.1f ? 0.22f : 0.24f, 0);
   }
 }
 
 TEST(GradientUnbiased, SmoothGlass) {
-  expect_unbiased("glass", make_scene(SceneKind::CornellGlass, 16, 0.0f), 4096, 1024);
+  expect_unbiased("glass", make_scene(SceneKind::CornellGlass, 16, 0.0f), 4096, 1024, 0.27f);
 }
 
 TEST(GradientUnbiased, EnvironmentLight) {
-  expect_unbiased("environment", make_scene(SceneKind::Environment, 16), 4096, 1024);
+  expect_unbiased("environment", make_scene(SceneKind::Environment, 16), 4096, 1024, 0.12f);
 }
 
 TEST(GradientUnbiased, MixedLights) {
   // Emissive triangles (offset light samples by resampling), a point light (delta), a sphere light
   // (evaluated by intersection) and a soft sun (infinite): every shifted-NEE path.
-  expect_unbiased("mixed-lights", make_scene(SceneKind::MixedLights, 16), 4096, 1024);
+  expect_unbiased("mixed-lights", make_scene(SceneKind::MixedLights, 16), 4096, 1024, 0.23f);
 }
 
 // The Cornell box lit by one spot light under the ceiling pointing down, its cone edge (with
@@ -265,9 +271,9 @@ Scene spot_scene(float radius, float blend) {
 TEST(GradientUnbiased, SpotLight) {
   // The hard cone edge makes a wrongly weighted pair (an offset outside the cone keeping a light
   // density) a strong, coherent bias in dy: before the fix 108/240 outliers, global z -44.
-  expect_unbiased("spot-point", spot_scene(0.0f, 0.3f), 4096, 1024);
-  expect_unbiased("spot-radius", spot_scene(0.08f, 0.3f), 4096, 1024);
-  expect_unbiased("spot-radius-hard", spot_scene(0.08f, 0.0f), 4096, 1024);
+  expect_unbiased("spot-point", spot_scene(0.0f, 0.3f), 4096, 1024, 0.02f);
+  expect_unbiased("spot-radius", spot_scene(0.08f, 0.3f), 4096, 1024, 0.02f);
+  expect_unbiased("spot-radius-hard", spot_scene(0.08f, 0.0f), 4096, 1024, 0.02f);
 }
 
 // A diffuse ceiling 0.1 m / 0.3 m above a two-sided emissive 1.2 m panel (the Blender mesh_light
@@ -317,12 +323,49 @@ TEST(ShadowRays, CeilingBesideEmissivePanel) {
   }
 }
 
+// An emissive mesh panel a hair below the ceiling, seen by the camera next to the ceiling beside
+// it (a ceiling lamp as Blender users model it): pairs there shift between a ceiling pixel and a
+// panel pixel, and their light samples and reconnections graze the panel. The gradients' and the
+// primal's expectation must be PT's per pixel, and the L2 reconstruction must converge to PT
+// beside the panel's edge. The scene sits 20 m from the origin: a shadow ray's end point placed
+// in world space (rounding ~2e-6 there) rather than along the segment then stops beyond a light
+// point a few millimetres away, and the panel occludes itself in some shadow rays but not in
+// their pairs' (G-PT + L2 was 14% below PT beside the edge).
+TEST(GradientUnbiased, CeilingBesideAVisibleEmissivePanel) {
+  const Scene scene = make_panel_scene(16, {20.0f, 20.0f, 20.0f});
+  expect_unbiased("emissive-panel", scene, 4096, 1024, 0.04f);
+  const Passes ref = render(scene, settings(RenderSettings::Mode::PT, 8192, 31 + seed_offset()));
+  const Passes g = render(scene, settings(RenderSettings::Mode::GPT, 2048, 37 + seed_offset()));
+  ReconstructionInput in;
+  in.width = g.w;
+  in.height = g.h;
+  in.primal = g.primal.data();
+  in.gradient_x = g.dx.data();
+  in.gradient_y = g.dy.data();
+  ReconstructionSettings rs;
+  rs.norm = ReconstructionNorm::L2;
+  rs.alpha = 0.2f;
+  rs.threads = 2;
+  const std::vector<float> img = reconstruct(in, rs);
+  // The ceiling columns beside the edge (the panel covers the left half of the frame).
+  for (int x = g.w / 2; x < g.w / 2 + 4; ++x) {
+    double rec = 0.0, pt = 0.0;
+    for (int y = 0; y < g.h; ++y) {
+      const size_t i = size_t(y * g.w + x) * 3;
+      rec += 0.2126 * img[i] + 0.7152 * img[i + 1] + 0.0722 * img[i + 2];
+      pt += ref.lum(ref.primal, x, y);
+    }
+    std::printf("[emissive-panel] column %d: G-PT + L2 %.4f, PT %.4f\n", x, rec / g.h, pt / g.h);
+    EXPECT_NEAR(rec, pt, 0.05 * pt) << "column " << x;
+  }
+}
+
 TEST(GradientUnbiased, ThinLensDepthOfField) {
   // Base and offsets share the lens sample: no camera Jacobian, still unbiased.
   Scene scene = make_scene(SceneKind::CornellDiffuse, 16);
   scene.camera.aperture_radius = 0.08f;
   scene.camera.focus_distance = 3.0f;
-  expect_unbiased("depth-of-field", scene, 4096, 1024);
+  expect_unbiased("depth-of-field", scene, 4096, 1024, 0.23f);
 }
 
 TEST(GradientUnbiased, EveryVertexHalfVector) {
@@ -412,16 +455,16 @@ MaterialDesc mix_of(MaterialDesc a, MaterialDesc b, float fac) {
 TEST(GradientUnbiased, MultiLobeMaterialsWithADeltaLobe) {
   Scene diffuse_glass = make_scene(SceneKind::CornellDiffuse, 16);
   diffuse_glass.materials[3] = mix_of(diffuse({0.5f, 0.5f, 0.8f}), glass(0.0f), 0.5f);
-  expect_unbiased("mix-diffuse-smooth-glass", diffuse_glass, 4096, 1024);
+  expect_unbiased("mix-diffuse-smooth-glass", diffuse_glass, 4096, 1024, 0.27f);
   Scene diffuse_mirror = make_scene(SceneKind::CornellDiffuse, 16);
   diffuse_mirror.materials[3] =
       mix_of(diffuse({0.5f, 0.5f, 0.8f}), glossy({0.9f, 0.9f, 0.9f}, 0.0f), 0.5f);
-  expect_unbiased("mix-diffuse-mirror", diffuse_mirror, 4096, 1024);
+  expect_unbiased("mix-diffuse-mirror", diffuse_mirror, 4096, 1024, 0.27f);
   // Principled v1 with half transmission at roughness 0: diffuse, specular and smooth glass.
   Scene principled = make_scene(SceneKind::CornellDiffuse, 16);
   principled.materials[3] = single_node(ShaderNodeKind::Principled, {0.8f, 0.6f, 0.5f}, 0.0f);
   principled.materials[3].nodes[0].transmission = FloatInput(0.5f);
-  expect_unbiased("principled-transmission", principled, 4096, 1024);
+  expect_unbiased("principled-transmission", principled, 4096, 1024, 0.26f);
 }
 
 TEST(GradientIntegrator, DeterministicAcrossThreadCounts) {
