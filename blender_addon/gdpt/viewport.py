@@ -10,6 +10,7 @@
 # a job has unseen images; the job stops when its engine is freed (leaving Rendered mode,
 # closing the file, quitting) or when no viewport shows Gradient PT any more.
 import atexit
+import time
 import weakref
 
 import bpy
@@ -25,6 +26,9 @@ REDRAW_INTERVAL = 0.05
 UNLIMITED_SAMPLES = 1 << 24
 
 _live = weakref.WeakSet()  # sessions with a job, stopped at exit
+# Jobs replaced by a new export: cancelled, dropped by the timer once their thread has returned
+# (so that Blender's thread never waits for a pass or a solve to end).
+_retiring = []
 # The last image drawn (job, restart, version, samples, solved, rect, size): read by the viewport
 # test and benchmark.
 LAST_DRAW = {}
@@ -119,7 +123,7 @@ class ViewportSession:
         camera, _rect = viewport_camera.view_camera(scene, depsgraph, context.space_data,
                                                     context.region, context.region_data,
                                                     lambda m: None)
-        self.stop()
+        self.retire()
         if camera is None:
             return
         warnings = set()
@@ -151,7 +155,7 @@ class ViewportSession:
         _start_timer()
 
     def _fail(self, engine, message):
-        self.stop()
+        self.retire()
         if message != self.error:
             print(f"{MARKER} viewport error: {message}", flush=True)
             engine.report({'ERROR'}, f"Gradient PT: {message}")
@@ -188,6 +192,8 @@ class ViewportSession:
         total = self.samples_total or "∞"
         kind = "reconstructed" if self.image["solved"] else "primal"
         engine.update_stats("", f"Sample {self.image['samples']}/{total} ({kind})")
+        if LAST_DRAW.get("job") != self.job_number:
+            LAST_DRAW["job_first_draw"] = time.perf_counter()  # for the benchmark
         LAST_DRAW.update(job=self.job_number, restart=self.image["restart"], version=self.seen,
                          samples=self.image["samples"], solved=self.image["solved"],
                          rect=tuple(rect),
@@ -208,14 +214,24 @@ class ViewportSession:
         """True while the job has an image the texture does not show yet."""
         return self.job is not None and self.job.status()["version"] > self.seen
 
+    def retire(self):
+        """Cancels the job without waiting for it (the timer drops it once it has ended)."""
+        if self.job is not None:
+            self.job.cancel()
+            _retiring.append(self.job)
+            self.job = None
+            _start_timer()
+        _live.discard(self)
+
     def stop(self):
+        """Cancels the job and waits for its thread (a pass's tile or a solve at most)."""
         if self.job is not None:
             self.job.stop()
             self.job = None
         _live.discard(self)
 
     def free(self):
-        self.stop()
+        self.retire()
         self.texture = None
 
 
@@ -231,14 +247,15 @@ def _rendered_views():
 
 
 def _redraw_timer():
+    _retiring[:] = [job for job in _retiring if not job.status()["finished"]]
     if not _live:
-        return None
+        return REDRAW_INTERVAL if _retiring else None
     areas = list(_rendered_views())
     if not areas:
         # No viewport shows a job any more (the engine's __del__ may come later): stop them.
         for session in list(_live):
-            session.stop()
-        return None
+            session.retire()
+        return REDRAW_INTERVAL
     if any(session.wants_redraw() for session in list(_live)):
         for area in areas:
             area.tag_redraw()
@@ -254,3 +271,5 @@ def _start_timer():
 def _stop_all():
     for session in list(_live):
         session.stop()
+    while _retiring:
+        _retiring.pop().stop()

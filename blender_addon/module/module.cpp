@@ -147,6 +147,7 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("set_camera", &ViewportJob::set_camera, py::arg("camera"))
       .def("latest", &ViewportJob::latest, py::arg("seen") = -1)
       .def("status", &ViewportJob::status)
+      .def("cancel", &ViewportJob::cancel)
       .def("stop", &ViewportJob::stop);
 
   m.def("empty", &empty_array, py::arg("count"), py::arg("dtype"),

@@ -55,6 +55,7 @@ struct ViewportJob::State {
   std::optional<Camera> pending;  // a restart asked for by set_camera (or the first start)
   bool stopping = false;
   bool rendering = true;
+  bool finished = false;  // run() returned
   std::atomic<bool> cancel{false};
   std::string error;
   int restart = 0;  // cameras taken by the worker (the first start is 1)
@@ -70,6 +71,7 @@ struct ViewportJob::State {
   std::vector<float> primal, gradient_x, gradient_y, emission, alpha, rgb, rgba;
 
   void run();
+  void work();
   void render_view(const Camera& camera);
   void publish(int samples_done, bool solve, Clock::time_point start);
   bool restart_pending() {
@@ -79,6 +81,13 @@ struct ViewportJob::State {
 };
 
 void ViewportJob::State::run() {
+  work();
+  std::lock_guard lock(mutex);
+  finished = true;
+  rendering = false;
+}
+
+void ViewportJob::State::work() {
   try {
     session = std::make_unique<RenderSession>(std::move(scene), settings);
   } catch (const std::exception& e) {
@@ -247,18 +256,22 @@ py::dict ViewportJob::status() {
   d["version"] = st.version;
   d["samples"] = st.samples;
   d["rendering"] = st.rendering && st.error.empty();
+  d["finished"] = st.finished;
   d["error"] = st.error;
   return d;
 }
 
+void ViewportJob::cancel() {
+  State& st = *state_;
+  std::lock_guard lock(st.mutex);
+  st.stopping = true;
+  st.cancel.store(true);
+  st.wake.notify_all();
+}
+
 void ViewportJob::stop() {
   State& st = *state_;
-  {
-    std::lock_guard lock(st.mutex);
-    st.stopping = true;
-    st.cancel.store(true);
-    st.wake.notify_all();
-  }
+  cancel();
   if (st.worker.joinable()) {
     py::gil_scoped_release no_gil;
     st.worker.join();

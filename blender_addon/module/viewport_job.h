@@ -47,8 +47,12 @@ class ViewportJob {
   // float32 (height, width, 4), rows bottom-up, alpha from the film, restart (1 for the first
   // camera, +1 for each set_camera the worker took up)}.
   py::object latest(int64_t seen);
-  // {version, samples, rendering (passes still to come), error ("" or the message)}.
+  // {version, samples, rendering (passes still to come), finished (the worker has returned),
+  // error ("" or the message)}.
   py::dict status();
+  // Asks the worker to end and returns at once (a solve in flight is not interrupted): the viewport
+  // retires a job this way and drops it once finished, so Blender's thread never waits on it.
+  void cancel();
   void stop();  // cancels and joins; idempotent
 
  private:
