@@ -165,6 +165,7 @@ enum class ShaderNodeKind : uint8_t {
   Emission,     // colour * strength (radiance, W/m^2/sr per unit strength as in Cycles)
   Transparent,  // straight-through transmission, colour scales
   Translucent,  // Blender Translucent BSDF: Lambertian transmission (diffuse, to the far side)
+  Refraction,   // Blender Refraction BSDF: the Glass BSDF's GGX refraction alone, no Fresnel
   Velvet,       // Blender Velvet BSDF: Ashikhmin velvet, sigma = saturated roughness (Sigma)
   Mix,          // (1 - fac) * a + fac * b
   Add,          // a + b

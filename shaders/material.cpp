@@ -431,7 +431,8 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       out.add(c);
       return;
     }
-    case ShaderNodeKind::Glass: {
+    case ShaderNodeKind::Glass:
+    case ShaderNodeKind::Refraction: {
       const float r = saturate(in.scalar(n.roughness));
       const float ior = std::max(in.scalar(n.ior), 1e-5f);
       c.weight = in.color(n.color) * w;
@@ -440,7 +441,8 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
         c.type = ClosureType::Transparent;
       } else {
         c.type = ClosureType::GGXDielectric;
-        c.fresnel = FresnelMode::Dielectric;
+        c.fresnel = n.kind == ShaderNodeKind::Refraction ? FresnelMode::RefractionOnly
+                                                         : FresnelMode::Dielectric;
         c.alpha = r * r;
         // The integrators orient the frame towards the incoming ray (as Cycles flips N for back
         // faces), so the closure's IOR is that of the far side: 1 / ior when leaving the object.
@@ -675,6 +677,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         if (may_be_delta(n.roughness)) features_ |= kFeatureDelta;
         return;
       case ShaderNodeKind::Glass:
+      case ShaderNodeKind::Refraction:
         note(n.color);
         note(n.roughness);
         note(n.ior);

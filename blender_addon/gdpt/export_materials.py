@@ -26,6 +26,7 @@ IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 _SHADERS = {
     'BSDF_PRINCIPLED', 'BSDF_DIFFUSE', 'BSDF_GLOSSY', 'BSDF_GLASS', 'EMISSION',
     'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSLUCENT', 'BSDF_VELVET',
+    'BSDF_REFRACTION',
 }
 _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
@@ -182,6 +183,11 @@ class _Translator:
         return self._add({"kind": "GLASS", "color": self.color(n.inputs["Color"]),
                           "roughness": roughness, "ior": self.value(n.inputs["IOR"]),
                           "normal_linked": linked})
+
+    def _bsdf_refraction(self, n):
+        index = self._bsdf_glass(n)  # the same inputs and distributions
+        self.nodes[index]["kind"] = "REFRACTION"
+        return index
 
     def _emission(self, n):
         return self._add({"kind": "EMISSION", "color": self.color(n.inputs["Color"]),

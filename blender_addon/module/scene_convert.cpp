@@ -340,6 +340,7 @@ ShaderNodeKind to_kind(const std::string& kind) {
   if (kind == "EMISSION") return ShaderNodeKind::Emission;
   if (kind == "TRANSPARENT") return ShaderNodeKind::Transparent;
   if (kind == "TRANSLUCENT") return ShaderNodeKind::Translucent;
+  if (kind == "REFRACTION") return ShaderNodeKind::Refraction;
   if (kind == "VELVET") return ShaderNodeKind::Velvet;
   if (kind == "MIX") return ShaderNodeKind::Mix;
   if (kind == "ADD") return ShaderNodeKind::Add;

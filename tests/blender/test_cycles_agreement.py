@@ -61,6 +61,16 @@ def case_glass(scene):
     return 6
 
 
+def case_refraction(scene):
+    # Refraction BSDF (GGX refraction alone, no Fresnel): a rough ball, as case glass.
+    lit_room(scene)
+    area_ceiling(size=2.0, energy=300.0)
+    m = S.shader_material("refraction", "ShaderNodeBsdfRefraction", Color=(0.9, 1, 0.8, 1),
+                          Roughness=0.3, IOR=1.45, distribution='GGX')
+    S.uv_sphere("ball", 0.9, (0, 0.2, 0.9), m)
+    return 6
+
+
 def case_principled_metal(scene):
     lit_room(scene)
     area_ceiling()
@@ -1172,7 +1182,7 @@ CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case
 # isolated; the same with the wall's invert off); 0.067 with the bumps ignored.
 # math_nodes, voronoi_features: directly seen emission only, at half the counts
 # (Smooth F1 hashes 125 cells per lookup: 37 s for GDPT at the default counts).
-SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map": 4,
+SAMPLE_SCALE = {"glass": 2, "refraction": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map": 4,
                 "input_nodes": 2, "adjust_nodes": 2, "bump": 4, "math_nodes": 0.5,
                 "voronoi_features": 0.5, "curve_nodes": 0.5}
 
