@@ -316,6 +316,12 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
     case InputNodeKind::Blackbody:
       r = blackbody_color(in.scalar(n.value_a));
       break;
+    case InputNodeKind::SeparateHsv:
+      r = Spectrum(rgb_to_hsv(in.color(n.a))[std::min<int>(n.channel, 2)]);
+      break;
+    case InputNodeKind::CombineHsv:
+      r = hsv_to_rgb(Vec3f(in.scalar(n.value_a), in.scalar(n.value_b), in.scalar(n.value_c)));
+      break;
     case InputNodeKind::BrightContrast: {
       const float contrast = in.scalar(n.value_b);
       const float a = 1.0f + contrast, b = in.scalar(n.value_a) - contrast * 0.5f;
@@ -339,6 +345,7 @@ float input_node_scalar(const InputNode& n, const Inputs& in) {
   const bool grey = n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
                     n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
                     n.kind == InputNodeKind::ToBw || n.kind == InputNodeKind::FloatCurve ||
+                    n.kind == InputNodeKind::SeparateHsv ||
                     (n.kind == InputNodeKind::Ramp && n.ramp_alpha) ||
                     n.fac_output;  // a texture's Fac / Distance
   return grey ? r.x : luminance(r);

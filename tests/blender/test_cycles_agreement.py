@@ -1147,9 +1147,34 @@ def blackbody(nt, emit, generated):
     nt.links.new(node.outputs[0], emit.inputs["Color"])
 
 
+def hsv_round_trip(nt, emit, generated):
+    # Separate HSV (legacy) of a colour ramp across the strip, its hue shifted by a Math node,
+    # then Combine Color in HSV mode.
+    ramp = nt.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].color = (0.9, 0.2, 0.1, 1.0)
+    ramp.color_ramp.elements[1].color = (0.1, 0.4, 0.9, 1.0)
+    xyz = nt.nodes.new("ShaderNodeSeparateXYZ")
+    nt.links.new(generated, xyz.inputs[0])
+    nt.links.new(xyz.outputs["X"], ramp.inputs["Fac"])
+    sep = nt.nodes.new("ShaderNodeSeparateHSV")
+    nt.links.new(ramp.outputs["Color"], sep.inputs[0])
+    shift = nt.nodes.new("ShaderNodeMath")
+    shift.operation = 'FRACT'
+    add = nt.nodes.new("ShaderNodeMath")
+    nt.links.new(sep.outputs["H"], add.inputs[0])
+    add.inputs[1].default_value = 0.3
+    nt.links.new(add.outputs[0], shift.inputs[0])
+    comb = nt.nodes.new("ShaderNodeCombineColor")
+    comb.mode = 'HSV'
+    nt.links.new(shift.outputs[0], comb.inputs[0])
+    nt.links.new(sep.outputs["S"], comb.inputs[1])
+    nt.links.new(sep.outputs["V"], comb.inputs[2])
+    nt.links.new(comb.outputs[0], emit.inputs["Color"])
+
+
 CURVE_STRIPS = [("RGB Curves", curves_rgb), ("RGB Curves over a wide range", curves_rgb_wide),
                 ("Vector Curves", curves_vector), ("Float Curve", curves_float),
-                ("Blackbody", blackbody)]
+                ("Blackbody", blackbody), ("HSV separated, hue shifted, combined", hsv_round_trip)]
 CURVE_ROWS = 3
 
 
