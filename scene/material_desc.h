@@ -104,7 +104,10 @@ enum class InputNodeKind : uint8_t {
   RgbCurves,
   VectorCurves,  // a vector result (a float socket reads the mean of its components)
   FloatCurve,
-  Blackbody,  // Cycles' piecewise fit of the colour of a black body at value_a kelvin (Rec.709)
+  Blackbody,    // Cycles' piecewise fit of the colour of a black body at value_a kelvin (Rec.709)
+  SeparateHsv,  // one channel (`channel`: hue, saturation, value) of a, as grey (Cycles'
+                // rgb_to_hsv)
+  CombineHsv,   // the colour of hue value_a, saturation value_b, value value_c (hsv_to_rgb)
 };
 enum class MixBlend : uint8_t {
   Mix,
@@ -165,6 +168,7 @@ enum class ShaderNodeKind : uint8_t {
   Emission,     // colour * strength (radiance, W/m^2/sr per unit strength as in Cycles)
   Transparent,  // straight-through transmission, colour scales
   Translucent,  // Blender Translucent BSDF: Lambertian transmission (diffuse, to the far side)
+  Refraction,   // Blender Refraction BSDF: the Glass BSDF's GGX refraction alone, no Fresnel
   Velvet,       // Blender Velvet BSDF: Ashikhmin velvet, sigma = saturated roughness (Sigma)
   Mix,          // (1 - fac) * a + fac * b
   Add,          // a + b

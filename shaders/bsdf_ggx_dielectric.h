@@ -23,6 +23,8 @@
 // sample), as in Cycles.
 // Smooth (alpha < kDeltaAlpha) or eta ~ 1: delta lobes; reflection is chosen with probability
 // P_R (Fresnel weighted by colour luminances), value = R F, transmission value = T (1 - F).
+// FresnelMode::RefractionOnly (Refraction BSDF): F = 0 throughout, so no reflection and the
+// transmission is T D G ... without (1 - F); total internal reflection still loses the sample.
 #pragma once
 
 #include "shaders/closure.h"
@@ -50,7 +52,7 @@ inline Setup setup(const Closure& c, float cos_i, bool entering) {
   Setup s;
   const float ior = std::max(c.ior, 1e-5f);
   s.eta = entering ? ior : 1.0f / ior;
-  s.fresnel = fresnel_dielectric(cos_i, s.eta);
+  s.fresnel = c.fresnel == FresnelMode::RefractionOnly ? 0.0f : fresnel_dielectric(cos_i, s.eta);
   s.smooth = is_delta_alpha(c.alpha);
   s.pass_through = std::fabs(s.eta - 1.0f) < 1e-4f;
   const float r = s.fresnel * selection_luminance(reflection_colour(c, s.eta, cos_i));

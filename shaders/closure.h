@@ -37,6 +37,9 @@ enum class FresnelMode : uint8_t {
   None,          // Glossy BSDF: colour only
   Dielectric,    // exact dielectric Fresnel with ior
   PrincipledV1,  // Cycles principled v1: mix(F0 tinted, base colour by metallic) via Schlick weight
+  // GGXDielectric without its reflection and without Fresnel on the refraction (Blender's
+  // Refraction BSDF, Cycles' refraction-only microfacet / sharp refraction closures).
+  RefractionOnly,
 };
 
 struct Closure {

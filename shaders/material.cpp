@@ -316,6 +316,12 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
     case InputNodeKind::Blackbody:
       r = blackbody_color(in.scalar(n.value_a));
       break;
+    case InputNodeKind::SeparateHsv:
+      r = Spectrum(rgb_to_hsv(in.color(n.a))[std::min<int>(n.channel, 2)]);
+      break;
+    case InputNodeKind::CombineHsv:
+      r = hsv_to_rgb(Vec3f(in.scalar(n.value_a), in.scalar(n.value_b), in.scalar(n.value_c)));
+      break;
     case InputNodeKind::BrightContrast: {
       const float contrast = in.scalar(n.value_b);
       const float a = 1.0f + contrast, b = in.scalar(n.value_a) - contrast * 0.5f;
@@ -339,6 +345,7 @@ float input_node_scalar(const InputNode& n, const Inputs& in) {
   const bool grey = n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
                     n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
                     n.kind == InputNodeKind::ToBw || n.kind == InputNodeKind::FloatCurve ||
+                    n.kind == InputNodeKind::SeparateHsv ||
                     (n.kind == InputNodeKind::Ramp && n.ramp_alpha) ||
                     n.fac_output;  // a texture's Fac / Distance
   return grey ? r.x : luminance(r);
@@ -431,7 +438,8 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       out.add(c);
       return;
     }
-    case ShaderNodeKind::Glass: {
+    case ShaderNodeKind::Glass:
+    case ShaderNodeKind::Refraction: {
       const float r = saturate(in.scalar(n.roughness));
       const float ior = std::max(in.scalar(n.ior), 1e-5f);
       c.weight = in.color(n.color) * w;
@@ -440,7 +448,8 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
         c.type = ClosureType::Transparent;
       } else {
         c.type = ClosureType::GGXDielectric;
-        c.fresnel = FresnelMode::Dielectric;
+        c.fresnel = n.kind == ShaderNodeKind::Refraction ? FresnelMode::RefractionOnly
+                                                         : FresnelMode::Dielectric;
         c.alpha = r * r;
         // The integrators orient the frame towards the incoming ray (as Cycles flips N for back
         // faces), so the closure's IOR is that of the far side: 1 / ior when leaving the object.
@@ -675,6 +684,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         if (may_be_delta(n.roughness)) features_ |= kFeatureDelta;
         return;
       case ShaderNodeKind::Glass:
+      case ShaderNodeKind::Refraction:
         note(n.color);
         note(n.roughness);
         note(n.ior);

@@ -26,6 +26,7 @@ IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 _SHADERS = {
     'BSDF_PRINCIPLED', 'BSDF_DIFFUSE', 'BSDF_GLOSSY', 'BSDF_GLASS', 'EMISSION',
     'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSLUCENT', 'BSDF_VELVET',
+    'BSDF_REFRACTION',
 }
 _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
@@ -34,7 +35,8 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'CLAMP', 'RGBTOBW', 'VERTEX_COLOR', 'ATTRIBUTE', 'TEX_CHECKER', 'TEX_NOISE',
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
                 'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH', 'COMBXYZ',
-                'TEX_BRICK', 'CURVE_RGB', 'CURVE_VEC', 'CURVE_FLOAT', 'BLACKBODY'}
+                'TEX_BRICK', 'CURVE_RGB', 'CURVE_VEC', 'CURVE_FLOAT', 'BLACKBODY', 'SEPHSV',
+                'COMBHSV'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _VORONOI_FEATURES = {'F1', 'F2', 'SMOOTH_F1', 'DISTANCE_TO_EDGE'}  # 3D
 _MAPPING_TYPES = {'POINT', 'TEXTURE', 'VECTOR'}  # Normal normalises: not a fixed transform
@@ -182,6 +184,11 @@ class _Translator:
         return self._add({"kind": "GLASS", "color": self.color(n.inputs["Color"]),
                           "roughness": roughness, "ior": self.value(n.inputs["IOR"]),
                           "normal_linked": linked})
+
+    def _bsdf_refraction(self, n):
+        index = self._bsdf_glass(n)  # the same inputs and distributions
+        self.nodes[index]["kind"] = "REFRACTION"
+        return index
 
     def _emission(self, n):
         return self._add({"kind": "EMISSION", "color": self.color(n.inputs["Color"]),
@@ -367,7 +374,7 @@ class _Translator:
                                    'TEX_NOISE', 'TEX_COORD', 'SEPXYZ', 'TEX_VORONOI',
                                    'TEX_GRADIENT', 'TEX_WAVE', 'TEX_MUSGRAVE',
                                    'TEX_WHITE_NOISE', 'NEW_GEOMETRY', 'TEX_MAGIC',
-                                   'VECT_MATH', 'TEX_BRICK'}
+                                   'VECT_MATH', 'TEX_BRICK', 'SEPHSV'}
         key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
@@ -425,6 +432,12 @@ class _Translator:
                 node.type == 'SEPARATE_COLOR' and node.mode == 'RGB'):
             channel = [o.name for o in node.outputs].index(out.name)
             d = {"kind": "SEPARATE", "a": self.color(node.inputs[0]), "channel": channel}
+        elif node.type == 'SEPHSV' or (node.type == 'SEPARATE_COLOR' and node.mode == 'HSV'):
+            channel = [o.name for o in node.outputs].index(out.name)
+            d = {"kind": "SEPARATE_HSV", "a": self.color(node.inputs[0]), "channel": channel}
+        elif node.type == 'COMBHSV' or (node.type == 'COMBINE_COLOR' and node.mode == 'HSV'):
+            d = {"kind": "COMBINE_HSV", "value_a": self.value(node.inputs[0]),
+                 "value_b": self.value(node.inputs[1]), "value_c": self.value(node.inputs[2])}
         elif node.type == 'COMBRGB' or (node.type == 'COMBINE_COLOR' and node.mode == 'RGB'):
             d = {"kind": "COMBINE", "value_a": self.value(node.inputs[0]),
                  "value_b": self.value(node.inputs[1]), "value_c": self.value(node.inputs[2])}

@@ -156,7 +156,9 @@ InputNode read_input_node(const py::dict& d) {
       {"RGB_CURVES", InputNodeKind::RgbCurves},
       {"VECTOR_CURVES", InputNodeKind::VectorCurves},
       {"FLOAT_CURVE", InputNodeKind::FloatCurve},
-      {"BLACKBODY", InputNodeKind::Blackbody}};
+      {"BLACKBODY", InputNodeKind::Blackbody},
+      {"SEPARATE_HSV", InputNodeKind::SeparateHsv},
+      {"COMBINE_HSV", InputNodeKind::CombineHsv}};
   n.kind = get_enum(d, "kind", "MIX", kKinds, "input node kind");
   static const std::pair<const char*, MixBlend> kBlends[] = {{"MIX", MixBlend::Mix},
                                                              {"ADD", MixBlend::Add},
@@ -340,6 +342,7 @@ ShaderNodeKind to_kind(const std::string& kind) {
   if (kind == "EMISSION") return ShaderNodeKind::Emission;
   if (kind == "TRANSPARENT") return ShaderNodeKind::Transparent;
   if (kind == "TRANSLUCENT") return ShaderNodeKind::Translucent;
+  if (kind == "REFRACTION") return ShaderNodeKind::Refraction;
   if (kind == "VELVET") return ShaderNodeKind::Velvet;
   if (kind == "MIX") return ShaderNodeKind::Mix;
   if (kind == "ADD") return ShaderNodeKind::Add;

@@ -61,6 +61,16 @@ def case_glass(scene):
     return 6
 
 
+def case_refraction(scene):
+    # Refraction BSDF (GGX refraction alone, no Fresnel): a rough ball, as case glass.
+    lit_room(scene)
+    area_ceiling(size=2.0, energy=300.0)
+    m = S.shader_material("refraction", "ShaderNodeBsdfRefraction", Color=(0.9, 1, 0.8, 1),
+                          Roughness=0.3, IOR=1.45, distribution='GGX')
+    S.uv_sphere("ball", 0.9, (0, 0.2, 0.9), m)
+    return 6
+
+
 def case_principled_metal(scene):
     lit_room(scene)
     area_ceiling()
@@ -1137,9 +1147,34 @@ def blackbody(nt, emit, generated):
     nt.links.new(node.outputs[0], emit.inputs["Color"])
 
 
+def hsv_round_trip(nt, emit, generated):
+    # Separate HSV (legacy) of a colour ramp across the strip, its hue shifted by a Math node,
+    # then Combine Color in HSV mode.
+    ramp = nt.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].color = (0.9, 0.2, 0.1, 1.0)
+    ramp.color_ramp.elements[1].color = (0.1, 0.4, 0.9, 1.0)
+    xyz = nt.nodes.new("ShaderNodeSeparateXYZ")
+    nt.links.new(generated, xyz.inputs[0])
+    nt.links.new(xyz.outputs["X"], ramp.inputs["Fac"])
+    sep = nt.nodes.new("ShaderNodeSeparateHSV")
+    nt.links.new(ramp.outputs["Color"], sep.inputs[0])
+    shift = nt.nodes.new("ShaderNodeMath")
+    shift.operation = 'FRACT'
+    add = nt.nodes.new("ShaderNodeMath")
+    nt.links.new(sep.outputs["H"], add.inputs[0])
+    add.inputs[1].default_value = 0.3
+    nt.links.new(add.outputs[0], shift.inputs[0])
+    comb = nt.nodes.new("ShaderNodeCombineColor")
+    comb.mode = 'HSV'
+    nt.links.new(shift.outputs[0], comb.inputs[0])
+    nt.links.new(sep.outputs["S"], comb.inputs[1])
+    nt.links.new(sep.outputs["V"], comb.inputs[2])
+    nt.links.new(comb.outputs[0], emit.inputs["Color"])
+
+
 CURVE_STRIPS = [("RGB Curves", curves_rgb), ("RGB Curves over a wide range", curves_rgb_wide),
                 ("Vector Curves", curves_vector), ("Float Curve", curves_float),
-                ("Blackbody", blackbody)]
+                ("Blackbody", blackbody), ("HSV separated, hue shifted, combined", hsv_round_trip)]
 CURVE_ROWS = 3
 
 
@@ -1172,7 +1207,7 @@ CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case
 # isolated; the same with the wall's invert off); 0.067 with the bumps ignored.
 # math_nodes, voronoi_features: directly seen emission only, at half the counts
 # (Smooth F1 hashes 125 cells per lookup: 37 s for GDPT at the default counts).
-SAMPLE_SCALE = {"glass": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map": 4,
+SAMPLE_SCALE = {"glass": 2, "refraction": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map": 4,
                 "input_nodes": 2, "adjust_nodes": 2, "bump": 4, "math_nodes": 0.5,
                 "voronoi_features": 0.5, "curve_nodes": 0.5}
 

@@ -25,6 +25,11 @@ std::vector<Case> lobe_cases() {
   cases.push_back({"PrincipledDiffuse05", set_of({principled_diffuse(0.5f)})});
   cases.push_back({"PrincipledSheen", set_of({principled_sheen()})});
   cases.push_back({"Translucent", set_of({translucent()})});
+  for (float a : {0.0f, 0.3f}) {  // Refraction BSDF: refraction alone, smooth and rough
+    Closure r = glass(a, 1.5f);
+    r.fresnel = FresnelMode::RefractionOnly;
+    cases.push_back({"Refraction" + std::to_string(int(a * 100 + 0.5f)), set_of({r})});
+  }
   cases.push_back({"Velvet02", set_of({velvet(0.2f)})});
   cases.push_back({"Velvet1", set_of({velvet(1.0f)})});
   cases.push_back(
