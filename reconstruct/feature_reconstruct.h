@@ -8,8 +8,10 @@
 //   3. per pixel the candidate with the smallest smoothed error estimate (candidate_selection.h);
 //      output = (FA + FB) / 2 of that candidate (+ emission).
 //
-// Memory, beyond the inputs: about 200 bytes per pixel (200 MB per megapixel) with all features,
-// plus the guide solve's own buffers.
+// Memory beyond the inputs, counted from the buffers with all features (10 channels): about
+// 290 bytes per pixel, 290 MB per megapixel (feature buffers 165, the two halves' candidate
+// outputs 48, the choice 17, the models of one half 17, guide and output 24, box-filter scratch
+// 12), plus the guide solve's own buffers while it runs.
 #pragma once
 
 #include <vector>

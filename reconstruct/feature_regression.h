@@ -15,7 +15,7 @@
 namespace gdpt::detail {
 
 inline constexpr int kWindowRadius = 4;
-inline constexpr int kCenterSpacing = 4;
+inline constexpr int kCenterSpacing = 5;
 
 // Pull of the guide's slope towards identity per unit weight, in units of its spread.
 inline constexpr float kGuideRidge = 0.05f;

@@ -87,7 +87,8 @@ struct ReconstructionInput {
 
 struct ReconstructionReport {
   int iterations = 0;      // total inner iterations
-  double objective = 0.0;  // objective of the chosen norm (0 unless settings.compute_objective)
+  double objective = 0.0;  // objective of the chosen norm (0 unless settings.compute_objective;
+                           // always 0 for Feature, which minimises no global objective)
   double seconds = 0.0;
   double relative_residual = 0.0;  // CG exit residual |b - A I| / |b| (0 for the direct solve)
   int missing_values = 0;          // non-finite input terms treated as missing
