@@ -68,7 +68,7 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
     bl_use_postprocess = True
     bl_use_preview = False
     bl_use_shading_nodes_custom = False  # materials use Blender's (Cycles') shader nodes
-    bl_use_eevee_viewport = True  # Material Preview / Rendered viewport fall back to EEVEE
+    bl_use_eevee_viewport = True  # Material Preview uses EEVEE; Rendered mode is view_draw below
 
     def __init__(self):
         self._viewport = None  # viewport.ViewportSession, in the 3D viewport's Rendered mode
