@@ -7,8 +7,6 @@
 #include <cstdlib>
 #include <string>
 
-#include <OpenImageIO/imageio.h>
-
 #include "reconstruct/exr_io.h"
 
 namespace {
@@ -28,14 +26,6 @@ void require(bool ok) {
 }
 
 }  // namespace
-
-// OpenImageIO and OpenEXR start worker threads per file by default; under ASan each new thread's
-// stack shadow costs far more than a small file's decoding, so this process reads single-threaded.
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  OIIO::attribute("threads", 1);
-  OIIO::attribute("exr_threads", -1);
-  return 0;
-}
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string& path = input_path();

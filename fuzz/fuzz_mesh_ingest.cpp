@@ -28,7 +28,9 @@ void check_mesh(const Mesh& m) {
   const size_t triangles = m.triangle_count();
   require(m.indices.size() == 3 * triangles && triangles > 0);
   for (uint32_t i : m.indices) require(i < m.positions.size());
-  for (const auto& p : m.positions) require(std::isfinite(p.x + p.y + p.z));
+  // Each coordinate on its own: a sum of finite coordinates near FLT_MAX overflows.
+  for (const auto& p : m.positions)
+    require(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
   for (size_t n : {m.corner_normals.size(), m.corner_uvs.size(), m.corner_tangents.size(),
                    m.corner_tangent_signs.size(), m.corner_colors.size()})
     require(n == 0 || n == 3 * triangles);

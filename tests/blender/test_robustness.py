@@ -344,6 +344,34 @@ def test_missing_image(out):
     check(r > 2 * g and b > 2 * g, f"the ball is magenta ({r:.3f}, {g:.3f}, {b:.3f})")
 
 
+def test_saved_blend(out):
+    """The NaN mesh and a zero-area light saved in a .blend and rendered from the command line with
+    `-E GDPT -f 1`, as a user would: exit status 0, the engine's own console lines (so not EEVEE
+    standing in), both warnings, a lit frame."""
+    import subprocess
+    scene = S.clear()
+    basic_scene(scene)
+    nan = float("nan")
+    S.mesh_object("broken", [(0, 0, 1), (1, 0, 1), (1, 0, nan), (0, 0, 2)], [(0, 1, 2, 3)])
+    S.light('AREA', (0.5, 0, 3.5), 100.0, target=(0, 0, 0), size=0.0).name = "Flat Area"
+    S.setup_gdpt(scene, 8)
+    scene.render.use_file_extension = True  # S.render turns it off
+    blend = os.path.join(out, "bad_content.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=blend, copy=True)
+    frame = os.path.join(out, "bad_content_")
+    if os.path.exists(frame + "0001.exr"):
+        os.remove(frame + "0001.exr")
+    run = subprocess.run([bpy.app.binary_path, "-b", "--factory-startup", "--addons", "gdpt",
+                          blend, "-E", "GDPT", "-o", frame + "####", "-F", "OPEN_EXR", "-f", "1"],
+                         capture_output=True, text=True, timeout=120)
+    log = run.stdout + run.stderr
+    check(run.returncode == 0, f"blender exited with {run.returncode}")
+    check("GDPT: view layer 'ViewLayer' finished: 8/8 samples" in log, "the GDPT engine rendered")
+    check("mesh 'broken' skipped" in log, "the NaN mesh is reported in the console")
+    check("light 'Flat Area' has zero area" in log, "the zero-area light is reported")
+    check_lit(frame + "0001.exr", "saved .blend")
+
+
 def main():
     out = S.args()["out"]
     os.makedirs(out, exist_ok=True)
@@ -363,6 +391,7 @@ def main():
     test_nan_mesh(out)
     test_extreme_resolutions(out)
     test_missing_image(out)
+    test_saved_blend(out)
     test_cancel(out)  # last: Blender's break flag stays set afterwards
     print("ALL ROBUSTNESS CHECKS PASSED", flush=True)
     # Blender turns the SIGINT break flag into a non-zero exit status at quit; every check has

@@ -224,5 +224,16 @@ TEST(MeshIngest, RejectsMaterialSlotsOutOfRange) {
                "poly_material", {"value 0 is -3"});
 }
 
+// Found by fuzz_mesh_ingest (a false alarm of its own check, which summed the coordinates): finite
+// coordinates near FLT_MAX are finite, so they are accepted and copied bit for bit.
+TEST(MeshIngest, AcceptsFiniteCoordinatesNearFloatMax) {
+  const float big = std::numeric_limits<float>::max();
+  const Floats p = {0, 0, 0, -9.1e-41f, -0.99999f * big, -1.06e37f, 2.3e-41f, 0, 0};
+  const Mesh m = mesh_from_triangles(p, Ints{0, 1, 2}, {}, {}, {});
+  ASSERT_EQ(m.positions.size(), 3u);
+  EXPECT_EQ(m.positions[1].y, -0.99999f * big);
+  EXPECT_EQ(m.positions[1].x, -9.1e-41f);  // denormals kept
+}
+
 }  // namespace
 }  // namespace gdpt::ingest
