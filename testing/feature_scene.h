@@ -12,12 +12,32 @@
 #include <random>
 #include <vector>
 
+#include "reconstruct/reconstruct.h"
+
 namespace gdpt::test {
 
 struct FeatureScene {
   int w = 0, h = 0;
   std::vector<float> truth, albedo, normal, depth;  // RGB / XYZ / 1 per pixel
   std::vector<float> a, b, primal, gx, gy;          // noisy halves, their mean, noisy gradients
+
+  // The reconstruction's input over these buffers (the features left out when `features` is off).
+  ReconstructionInput input(bool features = true) const {
+    ReconstructionInput in;
+    in.width = w;
+    in.height = h;
+    in.primal = primal.data();
+    in.gradient_x = gx.data();
+    in.gradient_y = gy.data();
+    in.primal_a = a.data();
+    in.primal_b = b.data();
+    if (features) {
+      in.albedo = albedo.data();
+      in.normal = normal.data();
+      in.depth = depth.data();
+    }
+    return in;
+  }
 };
 
 inline FeatureScene make_feature_scene(int w, int h, float sigma_half, float sigma_gradient,

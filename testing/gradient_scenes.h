@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "integrators/render_session.h"
+#include "reconstruct/reconstruct.h"
 #include "scene/scene.h"
 #include "testing/materials.h"
 
@@ -266,6 +267,22 @@ inline Passes render(const Scene& scene, const RenderSettings& s) {
   std::atomic<bool> cancel{false};
   session.render(nullptr, cancel);
   return read_film(session.film());
+}
+
+// The G-PT passes `g` solved by L2 (alpha 0.2); `with_emission` adds the Emission pass.
+inline std::vector<float> reconstruct_l2(const Passes& g, bool with_emission = false) {
+  ReconstructionInput in;
+  in.width = g.w;
+  in.height = g.h;
+  in.primal = g.primal.data();
+  in.gradient_x = g.dx.data();
+  in.gradient_y = g.dy.data();
+  if (with_emission) in.emission = g.emission.data();
+  ReconstructionSettings rs;
+  rs.norm = ReconstructionNorm::L2;
+  rs.alpha = 0.2f;
+  rs.threads = 2;
+  return reconstruct(in, rs);
 }
 
 // Relative MSE of the G-PT papers: mean over pixels and channels of (a - ref)^2 / (ref^2 + 0.01).

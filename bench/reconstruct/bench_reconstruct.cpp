@@ -171,17 +171,7 @@ int measure_memory(const Data& d, int threads) {
 // The Feature reconstruction on the synthetic room: total time per guide and its split.
 void bench_feature(int width, int height, int threads) {
   const gdpt::test::FeatureScene sc = gdpt::test::make_feature_scene(width, height, 0.2f, 0.1f, 7);
-  gdpt::ReconstructionInput in;
-  in.width = width;
-  in.height = height;
-  in.primal = sc.primal.data();
-  in.gradient_x = sc.gx.data();
-  in.gradient_y = sc.gy.data();
-  in.primal_a = sc.a.data();
-  in.primal_b = sc.b.data();
-  in.albedo = sc.albedo.data();
-  in.normal = sc.normal.data();
-  in.depth = sc.depth.data();
+  const gdpt::ReconstructionInput in = sc.input();
   gdpt::ReconstructionSettings s;
   s.threads = threads;
   s.norm = gdpt::ReconstructionNorm::L1;

@@ -17,17 +17,7 @@ TEST(GradientReconstruct, L2ConvergesToPathTracedReference) {
   const Scene scene = make_scene(SceneKind::CornellDiffuse, 16);
   const Passes ref = render(scene, settings(RenderSettings::Mode::PT, 8192, 21));
   const Passes g = render(scene, settings(RenderSettings::Mode::GPT, 1024, 22));
-  ReconstructionInput in;
-  in.width = g.w;
-  in.height = g.h;
-  in.primal = g.primal.data();
-  in.gradient_x = g.dx.data();
-  in.gradient_y = g.dy.data();
-  ReconstructionSettings rs;
-  rs.norm = ReconstructionNorm::L2;
-  rs.alpha = 0.2f;
-  rs.threads = 2;
-  const std::vector<float> img = reconstruct(in, rs);
+  const std::vector<float> img = reconstruct_l2(g);
   const double e_rec = rel_mse(img, ref.primal);
   const double e_primal = rel_mse(g.primal, ref.primal);
   std::printf("relMSE vs PT reference: G-PT + L2 %.3g, G-PT primal alone %.3g\n", e_rec, e_primal);

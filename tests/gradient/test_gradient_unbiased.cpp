@@ -336,17 +336,7 @@ TEST(GradientUnbiased, CeilingBesideAVisibleEmissivePanel) {
   expect_unbiased("emissive-panel", scene, 4096, 1024, 0.04f);
   const Passes ref = render(scene, settings(RenderSettings::Mode::PT, 8192, 31 + seed_offset()));
   const Passes g = render(scene, settings(RenderSettings::Mode::GPT, 2048, 37 + seed_offset()));
-  ReconstructionInput in;
-  in.width = g.w;
-  in.height = g.h;
-  in.primal = g.primal.data();
-  in.gradient_x = g.dx.data();
-  in.gradient_y = g.dy.data();
-  ReconstructionSettings rs;
-  rs.norm = ReconstructionNorm::L2;
-  rs.alpha = 0.2f;
-  rs.threads = 2;
-  const std::vector<float> img = reconstruct(in, rs);
+  const std::vector<float> img = reconstruct_l2(g);
   // The ceiling columns beside the edge (the panel covers the left half of the frame).
   for (int x = g.w / 2; x < g.w / 2 + 4; ++x) {
     double rec = 0.0, pt = 0.0;

@@ -170,10 +170,7 @@ void expect_l2_matches_pt(const char* name, const Scene& scene, int gpt_spp, int
   ASSERT_TRUE(all_finite(g)) << name;
   const Passes ref = render(scene, settings(Mode::PT, pt_spp, 32));
   ASSERT_TRUE(all_finite(ref)) << name;
-  ReconstructionSettings rs;
-  rs.norm = ReconstructionNorm::L2;
-  const std::vector<float> l2 = reconstruct(
-      {g.w, g.h, g.primal.data(), g.dx.data(), g.dy.data(), nullptr, g.emission.data()}, rs);
+  const std::vector<float> l2 = reconstruct_l2(g, true);
   std::vector<float> ref_total(ref.primal.size());
   for (size_t i = 0; i < ref_total.size(); ++i) ref_total[i] = ref.primal[i] + ref.emission[i];
   const double err = block_rel_mse(g, l2, ref_total, 4);

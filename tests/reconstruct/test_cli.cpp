@@ -272,20 +272,9 @@ TEST_F(Cli, FeatureNormReadsTheDenoisingPasses) {
   EXPECT_NE(r.out.find("norm feature"), std::string::npos) << r.out;
   const auto out = read_rgba(path("out.exr"));
 
-  ReconstructionInput in;
-  in.width = w_;
-  in.height = h_;
-  in.primal = sc.primal.data();
-  in.gradient_x = sc.gx.data();
-  in.gradient_y = sc.gy.data();
-  in.primal_a = sc.a.data();
-  in.primal_b = sc.b.data();
-  in.albedo = sc.albedo.data();
-  in.normal = sc.normal.data();
-  in.depth = sc.depth.data();
   ReconstructionSettings settings;
   settings.norm = ReconstructionNorm::Feature;
-  const auto expected = reconstruct(in, settings);
+  const auto expected = reconstruct(sc.input(), settings);
   EXPECT_LT(test::rms_error(out, expected), 1e-6);
   EXPECT_LT(test::relative_mse(out, sc.truth), 0.5 * test::relative_mse(sc.primal, sc.truth));
 

@@ -28,23 +28,6 @@ double mse(const std::vector<float>& x, const std::vector<float>& truth) {
   return s / double(x.size());
 }
 
-ReconstructionInput feature_input(const FeatureScene& s, bool features = true) {
-  ReconstructionInput in;
-  in.width = s.w;
-  in.height = s.h;
-  in.primal = s.primal.data();
-  in.gradient_x = s.gx.data();
-  in.gradient_y = s.gy.data();
-  in.primal_a = s.a.data();
-  in.primal_b = s.b.data();
-  if (features) {
-    in.albedo = s.albedo.data();
-    in.normal = s.normal.data();
-    in.depth = s.depth.data();
-  }
-  return in;
-}
-
 // Box filter of (A + B) / 2 over a (2 r + 1)^2 window clipped to the image.
 std::vector<float> box_of_mean(const FeatureScene& s, int r) {
   std::vector<float> out(s.primal.size());
@@ -64,7 +47,7 @@ TEST(Feature, RecoversAnImageLinearInTheFeatures) {
     s.b[i] = s.truth[i] + noise(rng);
     s.primal[i] = 0.5f * (s.a[i] + s.b[i]);
   }
-  const FeatureReconstruction r = feature_regression(feature_input(s), nullptr);
+  const FeatureReconstruction r = feature_regression(s.input(), nullptr);
   const double before = mse(s.primal, s.truth), after = mse(r.image, s.truth);
   std::printf("linear in features: MSE %.3g -> %.3g (ratio %.1f)\n", before, after, before / after);
   EXPECT_LT(after, before / 12.0);
@@ -98,7 +81,7 @@ bool near_edge(int x, int y, int w, int h) {
 
 TEST(Feature, KeepsAlbedoAndNormalEdges) {
   const FeatureScene s = make_feature_scene(160, 120, 0.1f, 0.f, 21, false);
-  const FeatureReconstruction r = feature_regression(feature_input(s), nullptr);
+  const FeatureReconstruction r = feature_regression(s.input(), nullptr);
   const double sigma = 0.1 / std::sqrt(2.0);  // noise of the halves' mean
   const double ours = band_rmse(r.image, s, near_edge);
   const double box = band_rmse(box_of_mean(s, 8), s, near_edge);
@@ -129,8 +112,8 @@ TEST(Feature, ErrorEstimateMatchesTheTrueError) {
   ReconstructionSettings guide;
   guide.norm = ReconstructionNorm::L1;
   guide.alpha = guide.feature_guide_alpha;
-  const std::vector<float> g = reconstruct(feature_input(s), guide);
-  const detail::FeatureBuffers fb = detail::prepare_feature_buffers(feature_input(s), g.data());
+  const std::vector<float> g = reconstruct(s.input(), guide);
+  const detail::FeatureBuffers fb = detail::prepare_feature_buffers(s.input(), g.data());
   const size_t n = size_t(s.w) * s.h;
   std::vector<float> fa(6 * n), fbh(6 * n), error(n), image(3 * n);
   float* const out_a[2] = {fa.data(), fa.data() + 3 * n};
@@ -164,7 +147,7 @@ TEST(Feature, ErrorEstimateMatchesTheTrueError) {
       EXPECT_GE(2 * within, blocks);
     }
   }
-  const FeatureReconstruction r = feature_regression(feature_input(s), g.data());
+  const FeatureReconstruction r = feature_regression(s.input(), g.data());
   double tru = 0.0;
   for (double t : true_error(r.image, s.truth)) tru += t;
   const double ratio = mean(r.error) / (tru / double(r.error.size()));
@@ -178,14 +161,14 @@ TEST(Feature, ErrorEstimateMatchesTheTrueError) {
 TEST(Feature, MissingFeaturesAndNonFiniteInputs) {
   FeatureScene s = make_feature_scene(96, 64, 0.1f, 0.02f, 41);
   const double noise = mse(s.primal, s.truth);
-  const FeatureReconstruction bare = feature_regression(feature_input(s, false), nullptr);
+  const FeatureReconstruction bare = feature_regression(s.input(false), nullptr);
   std::printf("no features, no guide: MSE %.3g -> %.3g\n", noise, mse(bare.image, s.truth));
   EXPECT_EQ(bare.features, 0);
   EXPECT_LT(mse(bare.image, s.truth), noise / 2.0);
 
   const float nan = std::numeric_limits<float>::quiet_NaN(),
               inf = std::numeric_limits<float>::infinity();
-  const FeatureReconstruction clean = feature_regression(feature_input(s), nullptr);
+  const FeatureReconstruction clean = feature_regression(s.input(), nullptr);
   for (int k = 0; k < 40; ++k) {
     const size_t i = size_t(k * 97 + 13) % (size_t(s.w) * s.h);
     if (k % 4 == 0) s.a[3 * i + 1] = nan;
@@ -193,7 +176,7 @@ TEST(Feature, MissingFeaturesAndNonFiniteInputs) {
     if (k % 4 == 2) s.albedo[3 * i + 2] = nan;
     if (k % 4 == 3) s.depth[i] = -inf;
   }
-  const FeatureReconstruction holes = feature_regression(feature_input(s), nullptr);
+  const FeatureReconstruction holes = feature_regression(s.input(), nullptr);
   EXPECT_EQ(holes.missing, 40);
   for (float v : holes.image) ASSERT_TRUE(std::isfinite(v));
   std::printf("with 40 holes: MSE %.3g (clean %.3g)\n", mse(holes.image, s.truth),
@@ -202,10 +185,10 @@ TEST(Feature, MissingFeaturesAndNonFiniteInputs) {
 
   ReconstructionSettings settings;
   settings.norm = ReconstructionNorm::Feature;
-  ReconstructionInput no_b = feature_input(s);
+  ReconstructionInput no_b = s.input();
   no_b.primal_b = nullptr;
   EXPECT_THROW(reconstruct(no_b, settings), std::invalid_argument);
-  ReconstructionInput no_gradients = feature_input(s);
+  ReconstructionInput no_gradients = s.input();
   no_gradients.gradient_y = nullptr;
   EXPECT_THROW(reconstruct(no_gradients, settings), std::invalid_argument);
   settings.feature_guide = ReconstructionNorm::None;
@@ -217,9 +200,9 @@ TEST(Feature, SameResultOnOneAndTwoThreads) {
   ReconstructionSettings settings;
   settings.norm = ReconstructionNorm::Feature;
   settings.threads = 1;
-  const std::vector<float> one = reconstruct(feature_input(s), settings);
+  const std::vector<float> one = reconstruct(s.input(), settings);
   settings.threads = 2;
-  const std::vector<float> two = reconstruct(feature_input(s), settings);
+  const std::vector<float> two = reconstruct(s.input(), settings);
   ASSERT_EQ(one.size(), two.size());
   EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
 }
@@ -231,11 +214,11 @@ TEST(Feature, BeatsL1AtEqualInput) {
   const FeatureScene s = make_feature_scene(256, 192, 0.2f, 0.1f, 61);
   ReconstructionSettings settings;
   settings.norm = ReconstructionNorm::L1;
-  const double l1 = relative_mse(reconstruct(feature_input(s), settings), s.truth);
+  const double l1 = relative_mse(reconstruct(s.input(), settings), s.truth);
   settings.norm = ReconstructionNorm::Feature;
-  const double feature = relative_mse(reconstruct(feature_input(s), settings), s.truth);
+  const double feature = relative_mse(reconstruct(s.input(), settings), s.truth);
   settings.feature_guide = ReconstructionNorm::None;
-  const double unguided = relative_mse(reconstruct(feature_input(s), settings), s.truth);
+  const double unguided = relative_mse(reconstruct(s.input(), settings), s.truth);
   std::printf(
       "relMSE: primal %.3g, L1 %.3g, feature %.3g (L1 / feature = %.2f), feature without guide "
       "%.3g\n",
