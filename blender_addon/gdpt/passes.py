@@ -29,7 +29,25 @@ _FILM_KEYS = {
     "IndexMA": "material_index",
     "Normal": "normal",
     "Mist": "mist",
+    "Denoising Albedo": "denoising_albedo",
+    "Denoising Normal": "denoising_normal",
+    "Denoising Depth": "denoising_depth",
 }
+
+# The feature passes, under the names Blender's Denoise node and Cycles use: registered when
+# the Feature reconstruction renders them (feature_passes_on).
+FEATURE_PASSES = (
+    ("Denoising Albedo", 3, "RGB", 'COLOR'),
+    ("Denoising Normal", 3, "XYZ", 'VECTOR'),
+    ("Denoising Depth", 1, "Z", 'VALUE'),
+)
+
+
+def feature_passes_on(scene):
+    """Whether the render computes the feature passes: the Feature reconstruction needs them."""
+    settings = getattr(scene, "gdpt", None)
+    return settings is not None and settings.reconstruction == 'FEATURE'
+
 
 
 def register_passes(engine, scene, view_layer):
@@ -49,6 +67,9 @@ def register_passes(engine, scene, view_layer):
         engine.register_pass(scene, view_layer, "Normal", 3, "XYZ", 'VECTOR')
     if view_layer.use_pass_mist:
         engine.register_pass(scene, view_layer, "Mist", 1, "Z", 'VALUE')
+    if feature_passes_on(scene):
+        for name, channels, chan_id, kind in FEATURE_PASSES:
+            engine.register_pass(scene, view_layer, name, channels, chan_id, kind)
 
 
 # World > Mist Pass falloff -> Cycles' exponent.
@@ -59,7 +80,8 @@ def data_pass_settings(scene, view_layer):
     """The render settings of the Normal and Mist passes for this view layer (Passes > Data) and
     the scene's World > Mist Pass (Blender's defaults without a world)."""
     d = {"normal_pass": bool(view_layer.use_pass_normal),
-         "mist_pass": bool(view_layer.use_pass_mist)}
+         "mist_pass": bool(view_layer.use_pass_mist),
+         "feature_passes": feature_passes_on(scene)}
     world = scene.world
     if world is not None:
         mist = world.mist_settings
