@@ -5,7 +5,9 @@
 #  - Normal of unit length wherever a surface is seen, Depth the camera distance there (0 where
 #    the camera sees nothing), the mirror's pixels the albedo of what they reflect;
 #  - a finite Combined image whose relMSE against a 1024-spp G-PT + L2 reference (unbiased) is lower than
-#    that of G-PT + L1 at the same 16 samples (both renders from the same seed).
+#    that of G-PT + L1 at the same 16 samples (both renders from the same seed);
+#  - the Gradient Reconstruct compositor node with norm Feature gives the engine's image from the
+#    Render Layers of a Feature render, and reports an error on an L1 render.
 import math
 import os
 import sys
@@ -77,7 +79,25 @@ def main():
     e_feature, e_l1 = S.rel_mse(feature, ref), S.rel_mse(l1, ref)
     check(e_feature < e_l1, f"relMSE at {SPP} spp: Feature {e_feature:.5f}, L1 {e_l1:.5f} "
                             f"(ratio {e_l1 / max(e_feature, 1e-12):.2f})")
+    test_compositor_node(scene)
     print("feature passes: all checks passed")
+
+
+def test_compositor_node(scene):
+    """The Gradient Reconstruct node with norm Feature on the Render Layers of a Feature render
+    gives the engine's Combined; on an L1 render (no feature passes) it reports why not."""
+    import gdpt.engine as engine_module
+    S.reconstruct_tree(scene, norm='FEATURE', alpha=0.2)
+    ch = exr.read_exr(S.render_engine(scene, "node", 'GDPT', SPP, reconstruction='FEATURE'))
+    composite = exr.rgb(ch, "Composite.Combined.")
+    engine_rgb = exr.rgb(ch, "ViewLayer.Combined.")
+    err = float(np.abs(composite - engine_rgb).max() / max(float(np.abs(engine_rgb).max()), 1e-6))
+    check(err < 1e-4, f"node (Feature) = the engine's Feature Combined (max diff / max {err:.2e})")
+    S.render_engine(scene, "node_l1", 'GDPT', SPP, reconstruction='L1')
+    warnings = engine_module.LAST_RENDER.get("warnings", [])
+    check(any("Feature norm needs" in w for w in warnings),
+          f"Feature node on an L1 render: reported ({warnings})")
+    scene.use_nodes = False
 
 
 main()
