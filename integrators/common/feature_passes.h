@@ -5,7 +5,9 @@
 //    kFeatureRoughness (GGX alpha; diffuse-like lobes count as rough) are non-specular. When they
 //    carry more than a quarter of the closures' weight (or the surface has no BSDF), the surface
 //    is the feature hit: Albedo = the feature throughput x the non-specular closures' colour
-//    weights, Normal = the world-space shading normal turned towards the ray. Otherwise the
+//    weights (Principled specular lobes scaled by their Fresnel colour at the viewing angle, as
+//    Cycles scales them: their weight alone is near 1 whatever they reflect), Normal = the
+//    world-space shading normal turned towards the ray. Otherwise the
 //    feature throughput is multiplied by the specular closures' weights and the path goes on
 //    (through mirrors, glass and transparent surfaces to what they show).
 //  - Depth: the camera distance (CameraModel::camera_distance) of the path's first surface.
@@ -16,6 +18,7 @@
 #include "render/embree_scene.h"
 #include "scene/render_settings.h"
 #include "shaders/bsdf.h"
+#include "shaders/bsdf_ggx_reflection.h"
 
 namespace gdpt {
 
@@ -38,8 +41,9 @@ class FeaturePasses {
 
   bool active() const { return on_; }
 
-  // A surface of the path (`first`: the camera ray's hit), its material's closures evaluated.
-  void at_surface(const SurfaceHit& hit, const ClosureSet& closures, bool first,
+  // A surface of the path (`first`: the camera ray's hit), its material's closures evaluated;
+  // `cos_wi`: |cosine| of the incoming ray with the shading normal.
+  void at_surface(const SurfaceHit& hit, const ClosureSet& closures, bool first, float cos_wi,
                   FeatureSample& out) const {
     if (out.done) return;
     if (first) out.depth = camera_.camera_distance(hit.position);
@@ -47,13 +51,15 @@ class FeaturePasses {
     float rough_weight = 0.0f, total_weight = 0.0f;
     for (int i = 0; i < closures.count(); ++i) {
       const Closure& c = closures[i];
-      const float w = (c.weight.x + c.weight.y + c.weight.z) / 3.0f;
+      Spectrum albedo = c.weight;
+      if (c.type == ClosureType::GGXReflection) albedo *= ggx_reflection::fresnel(c, cos_wi);
+      const float w = (albedo.x + albedo.y + albedo.z) / 3.0f;
       total_weight += w;
       if (is_rough(c)) {
-        rough += c.weight;
+        rough += albedo;
         rough_weight += w;
       } else {
-        specular += c.weight;
+        specular += albedo;
       }
     }
     if (total_weight > 0.0f && 4.0f * rough_weight <= total_weight) {

@@ -184,7 +184,8 @@ class PathTracer final : public Integrator {
       if (path.state.camera_path && data_.active())
         data_.at_surface(hit, material_closures, path.beta, out.data);
       if (features_.active())
-        features_.at_surface(hit, material_closures, vertex == 0, out.feature);
+        features_.at_surface(hit, material_closures, vertex == 0,
+                             std::fabs(dot(ray.direction, hit.shading_normal)), out.feature);
       if (!material_closures.has_bsdf()) break;
       const Vec3f wi_world = -ray.direction;
       const SurfaceFrame sf = facing_frame(hit, wi_world);

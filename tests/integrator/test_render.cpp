@@ -1073,6 +1073,30 @@ TEST(Render, FeaturePassesThroughAMirror) {
     }
 }
 
+// A Principled plane (base (0.3, 0.5, 0.7), specular 0.5, roughness 0.5) seen head-on: every
+// lobe is rough, and the albedo is the base colour plus the specular lobe's weight times its
+// Fresnel colour at normal incidence, F0 = 0.08 x 0.5 = 0.04 (Cycles scales it so: the weight
+// alone is 1 and would give base + 1).
+TEST(Render, FeatureAlbedoOfPrincipledCountsTheSpecularFresnel) {
+  Scene scene;
+  scene.meshes.push_back(quad(10.0f));
+  MaterialDesc m = test::single_node(ShaderNodeKind::Principled, Spectrum(0.3f, 0.5f, 0.7f), 0.5f);
+  m.nodes[0].specular = FloatInput(0.5f);
+  scene.materials.push_back(m);
+  scene.instances.push_back(place(0, 0));
+  scene.world.color = Spectrum(1.0f);
+  scene.camera = top_camera(4, 2.0f, 7.0f);
+  for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+    RenderSettings s = pt(2);
+    s.mode = mode;
+    const FeatureImage f = render_features(scene, s);
+    for (size_t i = 0; i < 16; ++i)
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(f.albedo[3 * i + c], 0.3f + 0.2f * float(c) + 0.04f, 1e-4f)
+            << i << " mode " << int(mode);
+  }
+}
+
 // The halves: A the even sample indices, B the odd ones, each the mean of its half, so that with
 // an even count their average is the primal exactly (up to float rounding); independent noise
 // (A != B), each half's variance of its mean positive. The image itself does not change when the
