@@ -10,11 +10,13 @@
 //    world-space shading normal turned towards the ray. Otherwise the
 //    feature throughput is multiplied by the specular closures' weights and the path goes on
 //    (through mirrors, glass and transparent surfaces to what they show).
-//  - Depth: the camera distance (CameraModel::camera_distance) of the path's first surface.
-// A path that leaves the scene before a feature hit leaves 0 in all three.
+//  - Depth: as Cycles' Denoising Depth, the length of the path up to the feature hit, each segment
+//    weighted by the mean feature throughput it was travelled with (through a mirror: the
+//    distance to the reflected surface, the depth of the mirror image).
+// A path that leaves the scene before a feature hit keeps the albedo and normal 0 and the depth
+// it had travelled (0 for a camera ray that meets nothing).
 #pragma once
 
-#include "render/camera.h"
 #include "render/embree_scene.h"
 #include "scene/render_settings.h"
 #include "shaders/bsdf.h"
@@ -36,17 +38,16 @@ struct FeatureSample {
 
 class FeaturePasses {
  public:
-  FeaturePasses(const RenderSettings& s, const CameraModel& camera)
-      : camera_(camera), on_(s.feature_passes) {}
+  explicit FeaturePasses(const RenderSettings& s) : on_(s.feature_passes) {}
 
   bool active() const { return on_; }
 
-  // A surface of the path (`first`: the camera ray's hit), its material's closures evaluated;
-  // `cos_wi`: |cosine| of the incoming ray with the shading normal.
-  void at_surface(const SurfaceHit& hit, const ClosureSet& closures, bool first, float cos_wi,
+  // A surface of the path, its material's closures evaluated, reached by a segment of length
+  // `segment`; `cos_wi`: |cosine| of the incoming ray with the shading normal.
+  void at_surface(const SurfaceHit& hit, const ClosureSet& closures, float segment, float cos_wi,
                   FeatureSample& out) const {
     if (out.done) return;
-    if (first) out.depth = camera_.camera_distance(hit.position);
+    out.depth += (out.throughput.x + out.throughput.y + out.throughput.z) / 3.0f * segment;
     Spectrum rough(0.0f), specular(0.0f);
     float rough_weight = 0.0f, total_weight = 0.0f;
     for (int i = 0; i < closures.count(); ++i) {
@@ -85,7 +86,6 @@ class FeaturePasses {
     }
   }
 
-  const CameraModel& camera_;
   bool on_;
 };
 

@@ -29,7 +29,7 @@ struct GptContext {
         transparent_shadows((c.features() & kFeatureTransparent) != 0),
         sides(material_sides(c)),
         data(s, c.camera()),
-        features(s, c.camera()) {}
+        features(s) {}
 
   const SceneContext& ctx;
   RenderSettings settings;

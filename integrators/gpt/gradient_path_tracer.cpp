@@ -162,7 +162,8 @@ class GradientPathTracer final : public Integrator {
       if (bounce > 0 && bp.state.camera_path && g_.data.active())
         g_.data.at_surface(base.hit, *base.closures, bp.beta, out.data);
       if (bounce > 0 && g_.features.active())
-        g_.features.at_surface(base.hit, *base.closures, false, std::fabs(base.wi.z), out.feature);
+        g_.features.at_surface(base.hit, *base.closures, length(base.hit.position - ray.origin),
+                               std::fabs(base.wi.z), out.feature);
       if (!base.closures->has_bsdf()) break;
       const VertexType base_type = g_.classify(base.roughness);
       const ClosureSet& bc = *base.closures;
@@ -351,7 +352,8 @@ class GradientPathTracer final : public Integrator {
     setup_vertex(g_.ctx, g_.sides, hit, cam_ray.direction, base);
     if (g_.data.active()) g_.data.at_surface(hit, *base.closures, Spectrum(1.0f), out.data);
     if (g_.features.active())
-      g_.features.at_surface(hit, *base.closures, true, std::fabs(base.wi.z), out.feature);
+      g_.features.at_surface(hit, *base.closures, length(hit.position - cam_ray.origin),
+                             std::fabs(base.wi.z), out.feature);
     out.emission += g_.triangle_le(hit, cam_ray.origin);
     return true;
   }

@@ -48,10 +48,7 @@ class PathTracer final : public Integrator {
 
  public:
   PathTracer(const SceneContext& ctx, const RenderSettings& settings)
-      : ctx_(ctx),
-        settings_(settings),
-        data_(settings, ctx.camera()),
-        features_(settings, ctx.camera()) {}
+      : ctx_(ctx), settings_(settings), data_(settings, ctx.camera()), features_(settings) {}
 
   // Camera rays go to Embree a row segment at a time (kStream pixels of one sample index) as one
   // coherent stream, which traverses neighbouring rays together; each path then continues from
@@ -184,7 +181,7 @@ class PathTracer final : public Integrator {
       if (path.state.camera_path && data_.active())
         data_.at_surface(hit, material_closures, path.beta, out.data);
       if (features_.active())
-        features_.at_surface(hit, material_closures, vertex == 0,
+        features_.at_surface(hit, material_closures, length(hit.position - ray.origin),
                              std::fabs(dot(ray.direction, hit.shading_normal)), out.feature);
       if (!material_closures.has_bsdf()) break;
       const Vec3f wi_world = -ray.direction;

@@ -1005,8 +1005,8 @@ FeatureImage render_features(const Scene& scene, RenderSettings s) {
 
 // A diffuse plane of colour (0.3, 0.5, 0.7) tilted by 0.4 rad about x under an orthographic top
 // camera: every sample's albedo is the colour and its normal the plane's (0, -sin 0.4, cos 0.4),
-// so the means are those and the variances 0; the depth is the view-axis distance, 7 at the
-// plane's centre line, varying over the pixels across the tilt.
+// so the means are those and the variances 0; the depth is the camera ray's length to the plane,
+// 7 at the plane's centre line, varying over the pixels across the tilt.
 TEST(Render, FeaturePassesOfADiffusePlane) {
   Scene scene;
   scene.meshes.push_back(quad(10.0f));
@@ -1039,8 +1039,9 @@ TEST(Render, FeaturePassesOfADiffusePlane) {
 // A mirror (Glossy, roughness 0, colour m) tilted 45 degrees under an orthographic top camera
 // sends every camera ray sideways onto a diffuse wall out of the view: the albedo is m x the
 // wall's colour (Cycles multiplies the specular weights crossed), the normal the wall's turned
-// towards the ray (0, 1, 0), the depth the mirror's. A rough glossy (alpha 0.25 > 0.075) in its
-// place is the feature hit itself: its colour and normal.
+// towards the ray (0, 1, 0), the depth the path's length to the wall (its second segment weighted
+// by m). A rough glossy (alpha 0.25 > 0.075) in its place is the feature hit itself: its colour,
+// normal and distance.
 TEST(Render, FeaturePassesThroughAMirror) {
   const Spectrum wall(0.25f, 0.5f, 0.75f);
   for (const float m : {1.0f, 0.8f})
@@ -1066,8 +1067,12 @@ TEST(Render, FeaturePassesThroughAMirror) {
                 << i << " m " << m << " rough " << roughness << " mode " << int(mode);
             EXPECT_NEAR(f.normal[3 * i + c], n[c], 1e-5f) << i << " rough " << roughness;
           }
-          EXPECT_GT(f.depth[i], 5.9f) << i;  // the mirror's, within 7 -+ 1.06
-          EXPECT_LT(f.depth[i], 8.1f) << i;
+          // Down 7 - y to the mirror (z = y), then y + 3 to the wall weighted by m: 10 for m = 1.
+          // The rough glossy: its own distance.
+          const float lo = !mirror ? 5.9f : m == 1.0f ? 10.0f - 1e-4f : 9.2f - 1e-4f;
+          const float hi = !mirror ? 8.1f : m == 1.0f ? 10.0f + 1e-4f : 9.6f + 1e-4f;
+          EXPECT_GE(f.depth[i], lo) << i << " m " << m << " rough " << roughness;
+          EXPECT_LE(f.depth[i], hi) << i << " m " << m << " rough " << roughness;
         }
       }
     }
