@@ -1,16 +1,16 @@
-# The Feature reconstruction in the engine, headless: a room (white walls of colour (0.2, 0.5, 0.8)) with a
-# mirror-like sphere and a diffuse ball, rendered with reconstruction Feature, writes the
-# Denoising Albedo / Normal / Depth passes under Blender's names, with:
+# The Feature reconstruction in the engine, headless: a room (white walls of colour
+# (0.2, 0.5, 0.8)) with a mirror sphere, a diffuse ball and an area light, rendered with
+# reconstruction Feature, writes the Denoising Albedo / Normal / Depth passes under Blender's
+# names, with:
 #  - the floor's albedo (0.2, 0.5, 0.8) where the normal pass is the floor's (0, 0, 1);
 #  - Normal of unit length wherever a surface is seen, Depth the path length to the feature hit
 #    there (0 where the camera sees nothing), the mirror's pixels the albedo of what they reflect;
-#  - a finite Combined image whose relMSE against a 1024-spp G-PT + L2 reference (unbiased) is lower than
-#    that of G-PT + L1 at the same 16 samples (both renders from the same seed); in PT mode the
-#    Feature image is finite with the reference's mean within 2% (its relMSE is not checked:
-#    one PT firefly the regression spreads dominates it on this scene);
+#  - a finite Combined image whose relMSE against a 1024-spp G-PT + L2 reference (unbiased) is
+#    lower than that of G-PT + L1 at the same 16 samples (both renders from the same seed); in PT
+#    mode the Feature image is finite with the reference's mean within 2% (its relMSE is not
+#    checked: the regression spreads the ceiling's hot spot over the lamp, see the commit);
 #  - the Gradient Reconstruct compositor node with norm Feature gives the engine's image from the
 #    Render Layers of a Feature render, and reports an error on an L1 render.
-import math
 import os
 import sys
 
