@@ -32,14 +32,30 @@ _FILM_KEYS = {
     "Denoising Albedo": "denoising_albedo",
     "Denoising Normal": "denoising_normal",
     "Denoising Depth": "denoising_depth",
+    "Denoising Albedo Variance": "denoising_albedo_variance",
+    "Denoising Normal Variance": "denoising_normal_variance",
+    "Denoising Depth Variance": "denoising_depth_variance",
+    "Primal A": "primal_a",
+    "Primal B": "primal_b",
+    "Primal A Variance": "primal_a_variance",
+    "Primal B Variance": "primal_b_variance",
 }
 
-# The feature passes, under the names Blender's Denoise node and Cycles use: registered when
-# the Feature reconstruction renders them (feature_passes_on).
+# The feature passes, registered when the Feature reconstruction renders them
+# (feature_passes_on): the guides under the names Blender's Denoise node and Cycles use, and
+# what `gdpt-reconstruct --norm feature` and the compositor node read besides (the primal's
+# halves over even / odd samples, each pass's variance of its pixel mean).
 FEATURE_PASSES = (
     ("Denoising Albedo", 3, "RGB", 'COLOR'),
     ("Denoising Normal", 3, "XYZ", 'VECTOR'),
     ("Denoising Depth", 1, "Z", 'VALUE'),
+    ("Primal A", 3, "RGB", 'COLOR'),
+    ("Primal B", 3, "RGB", 'COLOR'),
+    ("Primal A Variance", 3, "XYZ", 'VECTOR'),
+    ("Primal B Variance", 3, "XYZ", 'VECTOR'),
+    ("Denoising Albedo Variance", 3, "XYZ", 'VECTOR'),
+    ("Denoising Normal Variance", 3, "XYZ", 'VECTOR'),
+    ("Denoising Depth Variance", 1, "Z", 'VALUE'),
 )
 
 

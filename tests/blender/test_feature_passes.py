@@ -9,9 +9,12 @@
 #    lower than that of G-PT + L1 at the same 16 samples (both renders from the same seed); in PT
 #    mode the Feature image is finite with the reference's mean within 2% (its relMSE is not
 #    checked: the regression spreads the ceiling's hot spot over the lamp, see the commit);
+#  - the EXR also holds Primal A / B and every variance: gdpt-reconstruct --norm feature on it
+#    gives the engine's Combined;
 #  - the Gradient Reconstruct compositor node with norm Feature gives the engine's image from the
 #    Render Layers of a Feature render, and reports an error on an L1 render.
 import os
+import subprocess
 import sys
 
 import numpy as np
@@ -71,6 +74,7 @@ def main():
     grey = np.all(np.abs(albedo - 0.9) < 0.02, axis=-1)
     check(int(grey.sum()) == 0, f"no pixel has the mirror's albedo ({int(grey.sum())} do)")
     feature = combined(ch)
+    test_command_line(ch, feature)
 
     l1 = combined(exr.read_exr(S.render_engine(scene, "l1", 'GDPT', SPP, reconstruction='L1')))
     ref = combined(exr.read_exr(S.render_engine(scene, "reference", 'GDPT', 1024,
@@ -91,6 +95,23 @@ def main():
     check(mean_error < 0.02, f"PT + Feature: the reference's mean within {100 * mean_error:.2f}%")
     test_compositor_node(scene)
     print("feature passes: all checks passed")
+
+
+def test_command_line(ch, feature):
+    """The EXR holds what gdpt-reconstruct --norm feature reads; it gives the engine's image."""
+    for name in ("Primal A", "Primal B", "Primal A Variance", "Primal B Variance",
+                 "Denoising Albedo Variance", "Denoising Normal Variance"):
+        check(f"ViewLayer.{name}.X" in ch or f"ViewLayer.{name}.R" in ch, f"the EXR has {name}")
+    check("ViewLayer.Denoising Depth Variance.Z" in ch, "the EXR has Denoising Depth Variance")
+    a = S.args()
+    cli = os.path.join(a["build"], "reconstruct", "gdpt-reconstruct")
+    cli_out = os.path.join(a["out"], "cli_feature.exr")
+    subprocess.run([cli, os.path.join(a["out"], "feature.exr"), "-o", cli_out, "--norm", "feature",
+                    "--alpha", "0.2", "--layer", "ViewLayer"], check=True)
+    ref = exr.rgb(exr.read_exr(cli_out), "")
+    err = float(np.abs(feature - ref).max() / max(float(np.abs(ref).max()), 1e-6))
+    check(err < 1e-5, f"Combined = gdpt-reconstruct --norm feature on the EXR (max diff / max "
+                      f"{err:.2e})")
 
 
 def test_compositor_node(scene):
