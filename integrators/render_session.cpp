@@ -84,8 +84,10 @@ void RenderSession::Impl::setup_for_camera() {
   const bool gradients_from_primal = !integrator->estimates_gradients();
   film = Film(w, h, gradients_from_primal);
   pass_film = Film(w, h, gradients_from_primal);  // the output film's layout (take_rows)
-  for (Film* f : {&film, &pass_film})
+  for (Film* f : {&film, &pass_film}) {
     f->enable_data_passes(settings.normal_pass, settings.mist_pass);
+    f->enable_feature_passes(settings.feature_passes);
+  }
   tiles.clear();
   const int th = tile_height(w, h, arena->max_concurrency());
   for (int y = 0; y < h; y += th)

@@ -20,6 +20,14 @@ double variance_of_mean(double sum, double sum2, uint32_t n) {
   return var / n;
 }
 
+template <class T>
+void add_feature_sums(T& to, const T& from) {
+  static_assert(sizeof(T) % sizeof(double) == 0);
+  double* a = reinterpret_cast<double*>(&to);
+  const double* b = reinterpret_cast<const double*>(&from);
+  for (size_t k = 0; k < sizeof(T) / sizeof(double); ++k) a[k] += b[k];
+}
+
 }  // namespace
 
 Film::Film(int width, int height, bool gradients_from_primal)
@@ -44,7 +52,12 @@ void Film::enable_data_passes(bool normal, bool mist) {
   mist_.assign(mist ? pixel_count() : 0, 0.0);
 }
 
+void Film::enable_feature_passes(bool on) {
+  features_.assign(on ? pixel_count() : 0, FeatureAccumulator{});
+}
+
 void Film::clear() {
+  std::fill(features_.begin(), features_.end(), FeatureAccumulator{});
   std::fill(normal_.begin(), normal_.end(), 0.0);
   std::fill(mist_.begin(), mist_.end(), 0.0);
   std::fill(acc_.begin(), acc_.end(), Accumulator{});
@@ -89,6 +102,10 @@ void Film::take_rows(Film& pass, int y0, int y1) {
         normal_[c] += pass.normal_[c];
         pass.normal_[c] = 0.0;
       }
+    if (!features_.empty()) {
+      add_feature_sums(features_[i], pass.features_[i]);
+      pass.features_[i] = FeatureAccumulator{};
+    }
     if (!mist_.empty()) {
       mist_[i] += pass.mist_[i];
       pass.mist_[i] = 0.0;
@@ -219,6 +236,50 @@ void Film::variance3(float* out) const {
       out[3 * i + 1] = float(vdx);
       out[3 * i + 2] = float(vdy);
     }
+}
+
+void Film::feature_sums(FeaturePass pass, size_t i, const double*& sum, const double*& sum2,
+                        uint32_t& n) const {
+  const FeatureAccumulator& f = features_[i];
+  n = samples_[i];
+  switch (pass) {
+    case FeaturePass::PrimalA:
+      sum = f.half_a, sum2 = f.half_a2, n = (n + 1) / 2;  // even indices 0, 2, ...
+      break;
+    case FeaturePass::PrimalB:
+      sum = f.half_b, sum2 = f.half_b2, n = n / 2;
+      break;
+    case FeaturePass::Albedo:
+      sum = f.albedo, sum2 = f.albedo2;
+      break;
+    case FeaturePass::Normal:
+      sum = f.normal, sum2 = f.normal2;
+      break;
+    case FeaturePass::Depth:
+      sum = &f.depth, sum2 = &f.depth2;
+      break;
+  }
+}
+
+void Film::feature(FeaturePass pass, float* out) const {
+  const int channels = feature_channels(pass);
+  for (size_t i = 0; i < pixel_count(); ++i) {
+    const double *sum = nullptr, *sum2 = nullptr;
+    uint32_t n = 0;
+    if (!features_.empty()) feature_sums(pass, i, sum, sum2, n);
+    for (int c = 0; c < channels; ++c) out[size_t(channels) * i + c] = n ? float(sum[c] / n) : 0.0f;
+  }
+}
+
+void Film::feature_variance(FeaturePass pass, float* out) const {
+  const int channels = feature_channels(pass);
+  for (size_t i = 0; i < pixel_count(); ++i) {
+    const double *sum = nullptr, *sum2 = nullptr;
+    uint32_t n = 0;
+    if (!features_.empty()) feature_sums(pass, i, sum, sum2, n);
+    for (int c = 0; c < channels; ++c)
+      out[size_t(channels) * i + c] = n ? float(variance_of_mean(sum[c], sum2[c], n)) : 0.0f;
+  }
 }
 
 void Film::shift_failures(float* out) const {

@@ -56,6 +56,15 @@ class Film {
   // surface (0 without one), and 1 - the mean of the samples' (1 - mist) x surface coverage.
   void normal(float* out) const;
   void mist(float* out) const;
+  // Feature passes (enable_feature_passes; integrators/common/feature_passes.h), means over the
+  // samples and the variances of those means (unbiased, 0 below two samples), per channel:
+  // the primal's halves over the even (A) and odd (B) sample indices, 3 per pixel (their
+  // sample-weighted mean is primal_rgb()); Denoising Albedo and Normal 3, Depth 1 per pixel.
+  enum class FeaturePass : uint8_t { PrimalA, PrimalB, Albedo, Normal, Depth };
+  void feature(FeaturePass pass, float* out) const;
+  void feature_variance(FeaturePass pass, float* out) const;
+  static int feature_channels(FeaturePass pass) { return pass == FeaturePass::Depth ? 1 : 3; }
+  bool has_features() const { return !features_.empty(); }
   bool has_normal() const { return !normal_.empty(); }
   bool has_mist() const { return !mist_.empty(); }
   uint32_t samples(int x, int y) const { return samples_[size_t(y) * width_ + x]; }
@@ -72,8 +81,9 @@ class Film {
     // non-finite value would poison the pixel forever and is dropped (counted as black); with
     // clamp > 0 the primal is scaled so its largest component is at most clamp. alpha: see
     // Film::alpha().
-    void add_path(Spectrum primal_sample, Spectrum emission_sample, float clamp,
-                  float alpha_sample = 1.0f) {
+    // Returns the primal as added.
+    Spectrum add_path(Spectrum primal_sample, Spectrum emission_sample, float clamp,
+                      float alpha_sample = 1.0f) {
       if (!is_finite(primal_sample)) primal_sample = Spectrum(0.0f);
       if (!is_finite(emission_sample)) emission_sample = Spectrum(0.0f);
       if (clamp > 0.0f) {
@@ -87,6 +97,7 @@ class Film {
       }
       primal2 += lum * lum;
       alpha += std::isfinite(alpha_sample) ? alpha_sample : 1.0f;
+      return primal_sample;
     }
   };
   // What G-PT adds besides: gradient halves and shift statistics. Kept apart, and allocated only
@@ -120,6 +131,28 @@ class Film {
     if (!mist_.empty() && std::isfinite(mist)) mist_[i] += mist;  // as add_path: drop NaN / inf
   }
 
+  // One sample's feature values (only with the feature passes on): `primal` as add_path()
+  // returned it, `sample_index` picking its half; albedo, normal (3 each) and depth.
+  void add_features(int x, int y, uint32_t sample_index, Spectrum primal, Spectrum albedo,
+                    Vec3f normal, float depth) {
+    FeatureAccumulator& f = features_[size_t(y) * width_ + x];
+    double* half = sample_index % 2 ? f.half_b : f.half_a;
+    double* half2 = sample_index % 2 ? f.half_b2 : f.half_a2;
+    if (!is_finite(albedo)) albedo = Spectrum(0.0f);
+    if (!is_finite(normal)) normal = Vec3f();
+    if (!std::isfinite(depth)) depth = 0.0f;
+    for (int c = 0; c < 3; ++c) {
+      half[c] += primal[c];
+      half2[c] += double(primal[c]) * primal[c];
+      f.albedo[c] += albedo[c];
+      f.albedo2[c] += double(albedo[c]) * albedo[c];
+      f.normal[c] += normal[c];
+      f.normal2[c] += double(normal[c]) * normal[c];
+    }
+    f.depth += depth;
+    f.depth2 += double(depth) * depth;
+  }
+
   // --- Bookkeeping (RenderSession) ---
   // PT mode: the integrator does not estimate gradients; gradient_x/y_rgb() then return forward
   // differences of the primal pixel means (0 at the last column / row, the Neumann rows of the
@@ -132,6 +165,8 @@ class Film {
   void clear();  // zero every accumulator and sample count
   // Allocates the Normal / Mist sums (none by default: films without them cost nothing).
   void enable_data_passes(bool normal, bool mist);
+  // Allocates the feature passes' sums (none by default).
+  void enable_feature_passes(bool on);
   // Adds rows [y0, y1) of `pass` (same size) into this film and zeroes them in `pass`: how a
   // completed pass is committed.
   void take_rows(Film& pass, int y0, int y1);
@@ -151,6 +186,18 @@ class Film {
   };
   HugePageVector<FirstHit> first_hit_;
   HugePageVector<double> normal_, mist_;  // sums; empty when the pass is off
+  // Sums and sums of squares per channel (the halves: per half).
+  struct FeatureAccumulator {
+    double half_a[3] = {0, 0, 0}, half_a2[3] = {0, 0, 0};
+    double half_b[3] = {0, 0, 0}, half_b2[3] = {0, 0, 0};
+    double albedo[3] = {0, 0, 0}, albedo2[3] = {0, 0, 0};
+    double normal[3] = {0, 0, 0}, normal2[3] = {0, 0, 0};
+    double depth = 0, depth2 = 0;
+  };
+  // The sums of `pass` in pixel i and its sample count.
+  void feature_sums(FeaturePass pass, size_t i, const double*& sum, const double*& sum2,
+                    uint32_t& n) const;
+  HugePageVector<FeatureAccumulator> features_;  // empty when the feature passes are off
   bool gradients_from_primal_ = false;
 };
 

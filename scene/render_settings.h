@@ -29,6 +29,10 @@ struct RenderSettings {
   bool normal_pass = false;
   bool mist_pass = false;
   float mist_start = 5.0f, mist_depth = 25.0f, mist_falloff = 2.0f;
+  // The Feature reconstruction's passes (integrators/common/feature_passes.h): Denoising Albedo /
+  // Normal / Depth with their variances, and the primal as two halves (even / odd sample index);
+  // off: no cost.
+  bool feature_passes = false;
   int samples_per_pass = 1;  // progressive granularity (a pass = this many spp over the image)
   // Debug / benchmark: run the kernel with every feature path on (same image, slower), to measure
   // what the per-scene specialisation buys.

@@ -41,6 +41,11 @@ REQUIRED = INPUTS[:3]
 # Render Layers pass names the node can read, and their keys in the engine's film dict.
 FILM_KEYS = {"Primal": "primal", "Gradient X": "gradient_x", "Gradient Y": "gradient_y",
              "Emission": "emission"}
+# The Feature norm's inputs besides (engine film keys): a render with the Feature reconstruction
+# caches them; they are not Blender passes, so the node reads them only from Render Layers.
+FEATURE_KEYS = tuple(f"{k}{v}" for k in ("primal_a", "primal_b", "denoising_albedo",
+                                         "denoising_normal", "denoising_depth")
+                     for v in ("", "_variance"))
 
 # (scene name, view layer name) -> {film key: (height, width, 3) float32} of the last render, and
 # under "placement" (frame width, frame height, x, y) when it rendered an uncropped Render Region:
@@ -234,14 +239,21 @@ def reconstruct_node(scene, node, threads=0):
         raise InputError("the inputs differ in resolution: "
                          + ", ".join(f"{n} {a.shape[1]}x{a.shape[0]}" for n, a in arrays.items()))
     emission = arrays.get("Emission")
+    layers = {(src[1], src[2]) for src in srcs.values() if src[0] == 'LAYER'}
+    cached = _CACHE.get(layers.pop(), {}) if len(layers) == 1 else {}
+    features = None
+    if node.norm == 'FEATURE':
+        if not all(k in cached for k in FEATURE_KEYS) or \
+                any(src[0] != 'LAYER' for src in srcs.values()):
+            raise InputError("the Feature norm needs Render Layers inputs from a Gradient PT "
+                             "render with Reconstruction set to Feature (its feature passes)")
+        features = {k: cached[k] for k in FEATURE_KEYS}
     rgb = _module().reconstruct(
         np.ascontiguousarray(arrays["Primal"], dtype=np.float32),
         np.ascontiguousarray(arrays["Gradient X"], dtype=np.float32),
         np.ascontiguousarray(arrays["Gradient Y"], dtype=np.float32), None,
         None if emission is None else np.ascontiguousarray(emission, dtype=np.float32),
-        node.norm, float(node.alpha), int(threads))
-    layers = {(src[1], src[2]) for src in srcs.values() if src[0] == 'LAYER'}
-    cached = _CACHE.get(layers.pop(), {}) if len(layers) == 1 else {}
+        node.norm, float(node.alpha), int(threads), features=features)
     alpha = cached.get("alpha")
     if alpha is not None and alpha.shape[:2] != rgb.shape[:2]:
         alpha = None
@@ -282,6 +294,7 @@ def fill_after_render(scene, view_layer_name, film, threads, warn, placement=Non
         return
     key = (scene.name, view_layer_name)
     _CACHE[key] = {k: film[k] for k in FILM_KEYS.values()}
+    _CACHE[key].update({k: film[k] for k in FEATURE_KEYS if k in film})
     _CACHE[key]["placement"] = placement
     _CACHE[key]["alpha"] = film.get("alpha")
     for owner in bpy.data.scenes:
@@ -414,7 +427,9 @@ class GDPTReconstructNode(bpy.types.CompositorNodeCustomGroup):
         name="Norm",
         items=[('L1', "L1", "Robust iteratively reweighted solve (fewer outliers, slightly "
                 "biased)"),
-               ('L2', "L2", "Unbiased screened Poisson solve (exact DCT)")],
+               ('L2', "L2", "Unbiased screened Poisson solve (exact DCT)"),
+               ('FEATURE', "Feature", "Per-pixel regression on the feature passes, guided by L1 "
+                "(Render Layers of a render with the Feature reconstruction)")],
         default='L1', update=_update_setting)
 
     @classmethod

@@ -110,11 +110,12 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
 
     def _combined(self, module, film, norm, settings, out=None):
         """The Combined RGB image; `out` (optional) takes it when no solve is needed."""
-        if norm == 'NONE' or settings.mode == 'PT':
+        if norm == 'NONE' or (settings.mode == 'PT' and norm != 'FEATURE'):
             return np.add(film["primal"], film["emission"], out=out)
         return module.reconstruct(film["primal"], film["gradient_x"], film["gradient_y"],
                                   film["variance"], film["emission"], norm, settings.alpha,
-                                  settings.threads)
+                                  settings.threads,
+                                  features=film if norm == 'FEATURE' else None)
 
     def _write(self, result, layer, film, combined, layer_buffer, show=True):
         """Writes every pass into `result` through `layer_buffer` (passes.layer_buffer's `out`);

@@ -29,7 +29,41 @@ _FILM_KEYS = {
     "IndexMA": "material_index",
     "Normal": "normal",
     "Mist": "mist",
+    "Denoising Albedo": "denoising_albedo",
+    "Denoising Normal": "denoising_normal",
+    "Denoising Depth": "denoising_depth",
+    "Denoising Albedo Variance": "denoising_albedo_variance",
+    "Denoising Normal Variance": "denoising_normal_variance",
+    "Denoising Depth Variance": "denoising_depth_variance",
+    "Primal A": "primal_a",
+    "Primal B": "primal_b",
+    "Primal A Variance": "primal_a_variance",
+    "Primal B Variance": "primal_b_variance",
 }
+
+# The feature passes, registered when the Feature reconstruction renders them
+# (feature_passes_on): the guides under the names Blender's Denoise node and Cycles use, and
+# what `gdpt-reconstruct --norm feature` and the compositor node read besides (the primal's
+# halves over even / odd samples, each pass's variance of its pixel mean).
+FEATURE_PASSES = (
+    ("Denoising Albedo", 3, "RGB", 'COLOR'),
+    ("Denoising Normal", 3, "XYZ", 'VECTOR'),
+    ("Denoising Depth", 1, "Z", 'VALUE'),
+    ("Primal A", 3, "RGB", 'COLOR'),
+    ("Primal B", 3, "RGB", 'COLOR'),
+    ("Primal A Variance", 3, "XYZ", 'VECTOR'),
+    ("Primal B Variance", 3, "XYZ", 'VECTOR'),
+    ("Denoising Albedo Variance", 3, "XYZ", 'VECTOR'),
+    ("Denoising Normal Variance", 3, "XYZ", 'VECTOR'),
+    ("Denoising Depth Variance", 1, "Z", 'VALUE'),
+)
+
+
+def feature_passes_on(scene):
+    """Whether the render computes the feature passes: the Feature reconstruction needs them."""
+    settings = getattr(scene, "gdpt", None)
+    return settings is not None and settings.reconstruction == 'FEATURE'
+
 
 
 def register_passes(engine, scene, view_layer):
@@ -49,6 +83,9 @@ def register_passes(engine, scene, view_layer):
         engine.register_pass(scene, view_layer, "Normal", 3, "XYZ", 'VECTOR')
     if view_layer.use_pass_mist:
         engine.register_pass(scene, view_layer, "Mist", 1, "Z", 'VALUE')
+    if feature_passes_on(scene):
+        for name, channels, chan_id, kind in FEATURE_PASSES:
+            engine.register_pass(scene, view_layer, name, channels, chan_id, kind)
 
 
 # World > Mist Pass falloff -> Cycles' exponent.
@@ -59,7 +96,8 @@ def data_pass_settings(scene, view_layer):
     """The render settings of the Normal and Mist passes for this view layer (Passes > Data) and
     the scene's World > Mist Pass (Blender's defaults without a world)."""
     d = {"normal_pass": bool(view_layer.use_pass_normal),
-         "mist_pass": bool(view_layer.use_pass_mist)}
+         "mist_pass": bool(view_layer.use_pass_mist),
+         "feature_passes": feature_passes_on(scene)}
     world = scene.world
     if world is not None:
         mist = world.mist_settings

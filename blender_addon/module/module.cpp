@@ -48,6 +48,7 @@ RenderSettings settings_from_dict(const py::dict& d) {
   get("mist_start", s.mist_start);
   get("mist_depth", s.mist_depth);
   get("mist_falloff", s.mist_falloff);
+  get("feature_passes", s.feature_passes);
   return s;
 }
 
@@ -155,7 +156,8 @@ PYBIND11_MODULE(_gdpt, m) {
   m.def("reconstruct", &reconstruct_arrays, py::arg("primal").noconvert(),
         py::arg("gradient_x").noconvert(), py::arg("gradient_y").noconvert(),
         py::arg("variance").noconvert() = py::none(), py::arg("emission").noconvert() = py::none(),
-        py::arg("norm") = "L1", py::arg("alpha") = 0.2f, py::arg("threads") = 0);
+        py::arg("norm") = "L1", py::arg("alpha") = 0.2f, py::arg("threads") = 0,
+        py::arg("features") = py::none());
   m.def("read_exr_passes", &read_exr_passes_dict, py::arg("path"), py::arg("layer"),
         py::arg("required"), py::arg("optional") = std::vector<std::string>{});
 }

@@ -35,7 +35,19 @@ py::array_t<float> view_numpy(const HugePageVector<float>& v, int height, int wi
   return py::array_t<float>(image_shape(height, width, channels), v.data(), owner);
 }
 
-// Every pass with its channel count; normal and mist only when the render computes them.
+// Film keys of FilmPasses::feature, in Film::FeaturePass order.
+const char* const kFeatureKeys[FilmPasses::kFeatureCount] = {
+    "primal_a", "primal_b", "denoising_albedo", "denoising_normal", "denoising_depth"};
+const char* const kFeatureVarianceKeys[FilmPasses::kFeatureCount] = {
+    "primal_a_variance", "primal_b_variance", "denoising_albedo_variance",
+    "denoising_normal_variance", "denoising_depth_variance"};
+
+int feature_channels(int k) {
+  return Film::feature_channels(Film::FeaturePass(k));
+}
+
+// Every pass with its channel count; normal, mist and the feature passes only when the render
+// computes them.
 template <typename Passes, typename Add>
 void for_each_pass(Passes& p, Add&& add) {
   add("primal", p.primal, 3);
@@ -50,6 +62,11 @@ void for_each_pass(Passes& p, Add&& add) {
   add("material_index", p.material_index, 1);
   if (!p.normal.empty()) add("normal", p.normal, 3);
   if (!p.mist.empty()) add("mist", p.mist, 1);
+  for (int k = 0; k < FilmPasses::kFeatureCount; ++k)
+    if (!p.feature[k].empty()) {
+      add(kFeatureKeys[k], p.feature[k], feature_channels(k));
+      add(kFeatureVarianceKeys[k], p.feature_variance[k], feature_channels(k));
+    }
 }
 
 // The dict's size and sample count, before the passes.
@@ -86,6 +103,14 @@ void FilmPasses::read(const Film& film, int samples) {
   if (film.has_normal()) film.normal(normal.data());
   mist.resize(film.has_mist() ? n : 0);
   if (film.has_mist()) film.mist(mist.data());
+  for (int k = 0; k < kFeatureCount; ++k) {
+    const size_t size = film.has_features() ? n * size_t(feature_channels(k)) : 0;
+    feature[k].resize(size);
+    feature_variance[k].resize(size);
+    if (size == 0) continue;
+    film.feature(Film::FeaturePass(k), feature[k].data());
+    film.feature_variance(Film::FeaturePass(k), feature_variance[k].data());
+  }
   film.primal_rgb(primal.data());
   film.gradient_x_rgb(gradient_x.data());
   film.gradient_y_rgb(gradient_y.data());
@@ -244,6 +269,7 @@ ReconstructionNorm parse_norm(const std::string& norm) {
   if (norm == "L2") return ReconstructionNorm::L2;
   if (norm == "WEIGHTED") return ReconstructionNorm::Weighted;
   if (norm == "NONE") return ReconstructionNorm::None;
+  if (norm == "FEATURE") return ReconstructionNorm::Feature;
   throw std::invalid_argument("unknown reconstruction norm '" + norm + "'");
 }
 
@@ -251,7 +277,8 @@ py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray
                                       const FloatArray& gradient_y,
                                       const std::optional<FloatArray>& variance,
                                       const std::optional<FloatArray>& emission,
-                                      const std::string& norm, float alpha, int threads) {
+                                      const std::string& norm, float alpha, int threads,
+                                      const std::optional<py::dict>& features) {
   if (primal.ndim() < 2) throw std::invalid_argument("primal: expected a (height, width, 3) array");
   const int height = int(primal.shape(0)), width = int(primal.shape(1));
   const size_t rgb = size_t(width) * size_t(height) * 3;
@@ -275,6 +302,32 @@ py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray
   input.gradient_y = gradient_y.data();
   input.variance = variance ? variance->data() : nullptr;
   input.emission = emission ? emission->data() : nullptr;
+  // Feature: the arrays stay alive in `features` (the caller's dict) during the solve.
+  std::vector<FloatArray> held;
+  if (settings.norm == ReconstructionNorm::Feature) {
+    if (!features)
+      throw std::invalid_argument(
+          "FEATURE reconstruction needs the feature passes (render with "
+          "the Feature reconstruction)");
+    auto pass = [&](const char* key, int channels) -> const float* {
+      if (!features->contains(key))
+        throw std::invalid_argument(std::string("FEATURE reconstruction: missing pass ") + key);
+      held.push_back(py::cast<FloatArray>((*features)[key]));
+      if (size_t(held.back().size()) != rgb / 3 * size_t(channels))
+        throw std::invalid_argument(std::string(key) + ": wrong size");
+      return held.back().data();
+    };
+    held.reserve(2 * FilmPasses::kFeatureCount);
+    const float** inputs[FilmPasses::kFeatureCount] = {&input.primal_a, &input.primal_b,
+                                                       &input.albedo, &input.normal, &input.depth};
+    const float** variances[FilmPasses::kFeatureCount] = {
+        &input.variance_a, &input.variance_b, &input.albedo_variance, &input.normal_variance,
+        &input.depth_variance};
+    for (int k = 0; k < FilmPasses::kFeatureCount; ++k) {
+      *inputs[k] = pass(kFeatureKeys[k], feature_channels(k));
+      *variances[k] = pass(kFeatureVarianceKeys[k], feature_channels(k));
+    }
+  }
 
   std::vector<float> image;
   {

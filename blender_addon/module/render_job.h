@@ -32,6 +32,10 @@ struct FilmPasses {
   HugePageVector<float> primal, gradient_x, gradient_y, emission, variance, shift_failures, alpha,
       depth, object_index, material_index;
   HugePageVector<float> normal, mist;  // empty unless the render computes them
+  // The feature passes (RenderSettings::feature_passes), empty without them: the primal halves,
+  // Denoising Albedo / Normal / Depth, and each one's variance of its pixel mean.
+  static constexpr int kFeatureCount = 5;
+  HugePageVector<float> feature[kFeatureCount], feature_variance[kFeatureCount];
   void read(const Film& film, int samples);
   // numpy arrays that take the vectors over (this object is left empty).
   py::dict to_python_owning();
@@ -65,15 +69,18 @@ class RenderJob {
   FilmPasses shown_;  // the snapshot Python's views see (snapshot())
 };
 
-// A reconstruction norm from its name in the add-on: L1, L2, WEIGHTED or NONE (else
+// A reconstruction norm from its name in the add-on: L1, L2, WEIGHTED, FEATURE or NONE (else
 // std::invalid_argument).
 ReconstructionNorm parse_norm(const std::string& norm);
 
-// Screened Poisson reconstruction of numpy passes (the same code as the CLI and the engine).
+// Reconstruction of numpy passes (the same code as the CLI and the engine). FEATURE reads the
+// feature passes from `features`, a dict with the film keys of FilmPasses (primal_a, primal_b,
+// denoising_albedo, ... and their *_variance).
 py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray& gradient_x,
                                       const FloatArray& gradient_y,
                                       const std::optional<FloatArray>& variance,
                                       const std::optional<FloatArray>& emission,
-                                      const std::string& norm, float alpha, int threads);
+                                      const std::string& norm, float alpha, int threads,
+                                      const std::optional<py::dict>& features);
 
 }  // namespace gdpt::python

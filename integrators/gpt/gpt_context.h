@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "integrators/common/data_passes.h"
+#include "integrators/common/feature_passes.h"
 #include "integrators/gpt/path_vertex.h"
 #include "integrators/gpt/shift_mapping.h"
 #include "render/features.h"
@@ -27,7 +28,8 @@ struct GptContext {
         has_emissive((c.features() & kSceneEmissiveTriangles) != 0),
         transparent_shadows((c.features() & kFeatureTransparent) != 0),
         sides(material_sides(c)),
-        data(s, c.camera()) {}
+        data(s, c.camera()),
+        features(s) {}
 
   const SceneContext& ctx;
   RenderSettings settings;
@@ -35,6 +37,7 @@ struct GptContext {
   bool transparent_shadows;  // some material has a Transparent closure
   std::vector<MaterialSide> sides;
   DataPasses data;
+  FeaturePasses features;
 
   // Kettunen et al.'s vertex classification: specular (half-vector copy) or diffuse (reconnect).
   shift::VertexType classify(float roughness) const {

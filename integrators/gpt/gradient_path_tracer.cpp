@@ -86,7 +86,7 @@ class GradientPathTracer final : public Integrator {
             const CameraSample cs = grid_sample(grid, x, y, mask);
             if (s == 0 && cs.found)  // Depth and index passes: sample 0's camera hit, as Cycles
               g_.ctx.record_first_hit(film, x, y, *cs.hit);
-            rays += run_path(sampler, cs, x, y, *scratch, r, film);
+            rays += run_path(sampler, cs, x, y, s, *scratch, r, film);
           }
       }
     } else {
@@ -99,7 +99,7 @@ class GradientPathTracer final : public Integrator {
             for (int i = 0; i < n; ++i) {
               if (s == 0 && row.found[i])  // Depth and index passes: sample 0's camera hit
                 g_.ctx.record_first_hit(film, x0 + i, y, row.hit[i]);
-              rays += run_path(row.sampler[i], row_sample(row, i), x0 + i, y, *scratch, r, film);
+              rays += run_path(row.sampler[i], row_sample(row, i), x0 + i, y, s, *scratch, r, film);
             }
           }
     }
@@ -110,7 +110,7 @@ class GradientPathTracer final : public Integrator {
 
  private:
   // Runs pixel (x, y)'s base path and adds it to the film. Returns its rays past the camera's.
-  uint32_t run_path(const Sampler& sampler, const CameraSample& cs, int x, int y,
+  uint32_t run_path(const Sampler& sampler, const CameraSample& cs, int x, int y, uint32_t s,
                     PathScratch& scratch, SampleResult& r, Film& film) const {
     // The pixel's accumulators (4 cache lines) are read after the path: fetch them now.
     Film::Accumulator& acc = film.pixel(x, y);
@@ -120,8 +120,10 @@ class GradientPathTracer final : public Integrator {
     for (size_t b = 0; b < sizeof(grad); b += 64) __builtin_prefetch(grad_bytes + b, 1);
     trace(sampler, cs, scratch, r);
     // --- Primal, emission and statistics of the pixel's base path ---
-    acc.add_path(r.primal, r.emission, g_.settings.clamp, r.alpha);
+    const Spectrum added = acc.add_path(r.primal, r.emission, g_.settings.clamp, r.alpha);
     if (g_.data.active()) film.add_data(x, y, r.data.normal, r.data.mist);
+    if (g_.features.active())
+      film.add_features(x, y, s, added, r.feature.albedo, r.feature.normal, r.feature.depth);
     grad.shift_attempts += r.attempts;
     grad.shift_failures += r.failures;
     // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
@@ -159,6 +161,9 @@ class GradientPathTracer final : public Integrator {
       // (the camera hit's are recorded by start()).
       if (bounce > 0 && bp.state.camera_path && g_.data.active())
         g_.data.at_surface(base.hit, *base.closures, bp.beta, out.data);
+      if (bounce > 0 && g_.features.active())
+        g_.features.at_surface(base.hit, *base.closures, length(base.hit.position - ray.origin),
+                               std::fabs(base.wi.z), out.feature);
       if (!base.closures->has_bsdf()) break;
       const VertexType base_type = g_.classify(base.roughness);
       const ClosureSet& bc = *base.closures;
@@ -305,6 +310,7 @@ class GradientPathTracer final : public Integrator {
     out.attempts = out.failures = 0;
     out.rays = 0;  // camera rays are counted by render_tile()
     out.data = DataSample{};
+    out.feature = FeatureSample{};
     const Ray& cam_ray = *cs.ray;
     const SurfaceHit& hit = *cs.hit;
     // A holdout at the camera hit ends the path as an escape to a black world would (Cycles:
@@ -345,6 +351,9 @@ class GradientPathTracer final : public Integrator {
     Vertex& base = scratch.verts[0];
     setup_vertex(g_.ctx, g_.sides, hit, cam_ray.direction, base);
     if (g_.data.active()) g_.data.at_surface(hit, *base.closures, Spectrum(1.0f), out.data);
+    if (g_.features.active())
+      g_.features.at_surface(hit, *base.closures, length(hit.position - cam_ray.origin),
+                             std::fabs(base.wi.z), out.feature);
     out.emission += g_.triangle_le(hit, cam_ray.origin);
     return true;
   }

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "integrators/common/data_passes.h"
+#include "integrators/common/feature_passes.h"
 #include "integrators/common/path_state.h"
 #include "integrators/gpt/camera_rays.h"
 #include "integrators/gpt/offset_path.h"
@@ -20,7 +21,8 @@ struct SampleResult {
   float alpha;  // Film::alpha(): 0 for a camera ray that reaches a transparent background
   uint8_t attempts, failures;
   uint32_t rays;
-  DataSample data;  // Normal / Mist passes (DataPasses)
+  DataSample data;        // Normal / Mist passes (DataPasses)
+  FeatureSample feature;  // FeaturePasses
 };
 
 // The base path (the paper's x-bar) between vertices: the PT estimate's throughput beta = f / p,

@@ -9,6 +9,7 @@
 #include "core/frame.h"
 #include "integrators/common/bump_shadowing.h"
 #include "integrators/common/data_passes.h"
+#include "integrators/common/feature_passes.h"
 #include "integrators/common/mis.h"
 #include "integrators/common/path_state.h"
 #include "integrators/common/shadow_ray.h"
@@ -33,7 +34,8 @@ struct PathResult {
   Spectrum emission{0.0f};  // camera-visible emission
   float alpha = 1.0f;       // Film::alpha()
   uint32_t rays = 0;
-  DataSample data;  // Normal / Mist passes (DataPasses)
+  DataSample data;        // Normal / Mist passes (DataPasses)
+  FeatureSample feature;  // FeaturePasses
 };
 
 template <uint32_t kFeatures>
@@ -46,7 +48,7 @@ class PathTracer final : public Integrator {
 
  public:
   PathTracer(const SceneContext& ctx, const RenderSettings& settings)
-      : ctx_(ctx), settings_(settings), data_(settings, ctx.camera()) {}
+      : ctx_(ctx), settings_(settings), data_(settings, ctx.camera()), features_(settings) {}
 
   // Camera rays go to Embree a row segment at a time (kStream pixels of one sample index) as one
   // coherent stream, which traverses neighbouring rays together; each path then continues from
@@ -85,8 +87,12 @@ class PathTracer final : public Integrator {
             const PathResult r =
                 trace(numbers, j, camera_rays[j], found[j], closures, scratch, hits[j]);
             rays += r.rays;
-            film.pixel(x0 + j, y).add_path(r.primal, r.emission, clamp, r.alpha);
+            const Spectrum added =
+                film.pixel(x0 + j, y).add_path(r.primal, r.emission, clamp, r.alpha);
             if (data_.active()) film.add_data(x0 + j, y, r.data.normal, r.data.mist);
+            if (features_.active())
+              film.add_features(x0 + j, y, s, added, r.feature.albedo, r.feature.normal,
+                                r.feature.depth);
           }
         }
       }
@@ -174,6 +180,9 @@ class PathTracer final : public Integrator {
       const ClosureSet& material_closures = material.closures(sc, closure_scratch);
       if (path.state.camera_path && data_.active())
         data_.at_surface(hit, material_closures, path.beta, out.data);
+      if (features_.active())
+        features_.at_surface(hit, material_closures, length(hit.position - ray.origin),
+                             std::fabs(dot(ray.direction, hit.shading_normal)), out.feature);
       if (!material_closures.has_bsdf()) break;
       const Vec3f wi_world = -ray.direction;
       const SurfaceFrame sf = facing_frame(hit, wi_world);
@@ -327,6 +336,7 @@ class PathTracer final : public Integrator {
   const SceneContext& ctx_;
   RenderSettings settings_;
   DataPasses data_;
+  FeaturePasses features_;
 };
 
 // --- Dispatch: one instantiation per subset of kSpecialised, picked once per session ---

@@ -969,6 +969,174 @@ TEST(Render, NormalAndMistPassesAsCycles) {
   EXPECT_FALSE(plain.film().has_mist());
 }
 
+// Feature passes (integrators/common/feature_passes.h), PT and G-PT.
+struct FeatureImage {
+  std::vector<float> primal, a, b, albedo, normal, depth;
+  std::vector<float> var_a, var_albedo, var_normal, var_depth;
+};
+
+FeatureImage render_features(const Scene& scene, RenderSettings s) {
+  s.feature_passes = true;
+  RenderSession session(scene, s);
+  std::atomic<bool> cancel{false};
+  session.render(nullptr, cancel);
+  const Film& film = session.film();
+  EXPECT_TRUE(film.has_features());
+  using P = Film::FeaturePass;
+  auto get = [&](P p, bool variance) {
+    std::vector<float> v(film.pixel_count() * size_t(Film::feature_channels(p)));
+    variance ? film.feature_variance(p, v.data()) : film.feature(p, v.data());
+    return v;
+  };
+  FeatureImage f;
+  f.primal.resize(film.pixel_count() * 3);
+  film.primal_rgb(f.primal.data());
+  f.a = get(P::PrimalA, false);
+  f.b = get(P::PrimalB, false);
+  f.albedo = get(P::Albedo, false);
+  f.normal = get(P::Normal, false);
+  f.depth = get(P::Depth, false);
+  f.var_a = get(P::PrimalA, true);
+  f.var_albedo = get(P::Albedo, true);
+  f.var_normal = get(P::Normal, true);
+  f.var_depth = get(P::Depth, true);
+  return f;
+}
+
+// A diffuse plane of colour (0.3, 0.5, 0.7) tilted by 0.4 rad about x under an orthographic top
+// camera: every sample's albedo is the colour and its normal the plane's (0, -sin 0.4, cos 0.4),
+// so the means are those and the variances 0; the depth is the camera ray's length to the plane,
+// 7 at the plane's centre line, varying over the pixels across the tilt.
+TEST(Render, FeaturePassesOfADiffusePlane) {
+  Scene scene;
+  scene.meshes.push_back(quad(10.0f));
+  scene.materials.push_back(diffuse(Spectrum(0.3f, 0.5f, 0.7f)));
+  scene.instances.push_back(place(0, 0, rotation_x(0.4f)));
+  scene.world.color = Spectrum(1.0f);
+  scene.camera = top_camera(8, 2.0f, 7.0f);
+  for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+    RenderSettings s = pt(6);
+    s.mode = mode;
+    const FeatureImage f = render_features(scene, s);
+    for (size_t i = 0; i < 64; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_FLOAT_EQ(f.albedo[3 * i + c], 0.3f + 0.2f * float(c)) << i << " mode " << int(mode);
+        EXPECT_NEAR(f.var_albedo[3 * i + c], 0.0f, 1e-12f) << i;
+        EXPECT_NEAR(f.var_normal[3 * i + c], 0.0f, 1e-12f) << i;
+      }
+      EXPECT_NEAR(f.normal[3 * i], 0.0f, 1e-6f) << i;
+      EXPECT_NEAR(f.normal[3 * i + 1], -std::sin(0.4f), 1e-5f) << i;
+      EXPECT_NEAR(f.normal[3 * i + 2], std::cos(0.4f), 1e-5f) << i;
+      // y in [-1, 1] over the view: the plane's height there is y tan 0.4.
+      EXPECT_GT(f.depth[i], 7.0f - 0.43f) << i;
+      EXPECT_LT(f.depth[i], 7.0f + 0.43f) << i;
+      EXPECT_GT(f.var_depth[i], 0.0f) << i;  // jittered samples see different heights
+    }
+    EXPECT_LT(f.depth[8 * 7], f.depth[0]);  // top row (y = +1) is higher up: closer
+  }
+}
+
+// A mirror (Glossy, roughness 0, colour m) tilted 45 degrees under an orthographic top camera
+// sends every camera ray sideways onto a diffuse wall out of the view: the albedo is m x the
+// wall's colour (Cycles multiplies the specular weights crossed), the normal the wall's turned
+// towards the ray (0, 1, 0), the depth the path's length to the wall (its second segment weighted
+// by m). A rough glossy (alpha 0.25 > 0.075) in its place is the feature hit itself: its colour,
+// normal and distance.
+TEST(Render, FeaturePassesThroughAMirror) {
+  const Spectrum wall(0.25f, 0.5f, 0.75f);
+  for (const float m : {1.0f, 0.8f})
+    for (const float roughness : {0.0f, 0.5f}) {
+      Scene scene;
+      scene.meshes.push_back(quad(1.5f));
+      scene.meshes.push_back(quad(10.0f));
+      scene.materials.push_back(glossy(Spectrum(m), roughness));
+      scene.materials.push_back(diffuse(wall));
+      scene.instances.push_back(place(0, 0, rotation_x(kPi / 4.0f)));
+      scene.instances.push_back(place(1, 1, rotation_x(kPi / 2.0f, {0, -3, 0})));
+      scene.world.color = Spectrum(1.0f);
+      scene.camera = top_camera(4, 2.0f, 7.0f);
+      for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+        RenderSettings s = pt(4);
+        s.mode = mode;
+        const FeatureImage f = render_features(scene, s);
+        const bool mirror = roughness == 0.0f;
+        const Vec3f n = mirror ? Vec3f(0, 1, 0) : Vec3f(0, -std::sqrt(0.5f), std::sqrt(0.5f));
+        for (size_t i = 0; i < 16; ++i) {
+          for (int c = 0; c < 3; ++c) {
+            EXPECT_NEAR(f.albedo[3 * i + c], mirror ? m * wall[c] : m, 1e-6f)
+                << i << " m " << m << " rough " << roughness << " mode " << int(mode);
+            EXPECT_NEAR(f.normal[3 * i + c], n[c], 1e-5f) << i << " rough " << roughness;
+          }
+          // Down 7 - y to the mirror (z = y), then y + 3 to the wall weighted by m: 10 for m = 1.
+          // The rough glossy: its own distance.
+          const float lo = !mirror ? 5.9f : m == 1.0f ? 10.0f - 1e-4f : 9.2f - 1e-4f;
+          const float hi = !mirror ? 8.1f : m == 1.0f ? 10.0f + 1e-4f : 9.6f + 1e-4f;
+          EXPECT_GE(f.depth[i], lo) << i << " m " << m << " rough " << roughness;
+          EXPECT_LE(f.depth[i], hi) << i << " m " << m << " rough " << roughness;
+        }
+      }
+    }
+}
+
+// A Principled plane (base (0.3, 0.5, 0.7), specular 0.5, roughness 0.5) seen head-on: every
+// lobe is rough, and the albedo is the base colour plus the specular lobe's weight times its
+// Fresnel colour at normal incidence, F0 = 0.08 x 0.5 = 0.04 (Cycles scales it so: the weight
+// alone is 1 and would give base + 1).
+TEST(Render, FeatureAlbedoOfPrincipledCountsTheSpecularFresnel) {
+  Scene scene;
+  scene.meshes.push_back(quad(10.0f));
+  MaterialDesc m = test::single_node(ShaderNodeKind::Principled, Spectrum(0.3f, 0.5f, 0.7f), 0.5f);
+  m.nodes[0].specular = FloatInput(0.5f);
+  scene.materials.push_back(m);
+  scene.instances.push_back(place(0, 0));
+  scene.world.color = Spectrum(1.0f);
+  scene.camera = top_camera(4, 2.0f, 7.0f);
+  for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+    RenderSettings s = pt(2);
+    s.mode = mode;
+    const FeatureImage f = render_features(scene, s);
+    for (size_t i = 0; i < 16; ++i)
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(f.albedo[3 * i + c], 0.3f + 0.2f * float(c) + 0.04f, 1e-4f)
+            << i << " mode " << int(mode);
+  }
+}
+
+// The halves: A the even sample indices, B the odd ones, each the mean of its half, so that with
+// an even count their average is the primal exactly (up to float rounding); independent noise
+// (A != B), each half's variance of its mean positive. The image itself does not change when the
+// passes are on (bit for bit), and a film without them holds none.
+TEST(Render, FeaturePassesPrimalHalves) {
+  Scene scene;
+  scene.meshes.push_back(quad(10.0f));
+  scene.meshes.push_back(sphere(0.5f, 12, 8, {0, 0, 0.5f}));
+  scene.materials.push_back(diffuse(Spectrum(0.6f)));
+  scene.instances.push_back(place(0, 0));
+  scene.instances.push_back(place(1, 0));
+  scene.world.color = Spectrum(1.0f);
+  scene.camera = top_camera(8, 2.5f, 7.0f);
+  for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+    RenderSettings s = pt(8);
+    s.mode = mode;
+    s.samples_per_pass = 3;  // halves by the global sample index, across passes
+    const FeatureImage f = render_features(scene, s);
+    const Image plain = render(scene, s);
+    double differ = 0.0;
+    for (size_t k = 0; k < f.primal.size(); ++k) {
+      EXPECT_NEAR(0.5f * (f.a[k] + f.b[k]), f.primal[k], 1e-6f * (1.0f + f.primal[k])) << k;
+      EXPECT_EQ(f.primal[k], plain.primal[k]) << k << " mode " << int(mode);
+      EXPECT_GE(f.var_a[k], 0.0f) << k;
+      differ += std::fabs(f.a[k] - f.b[k]);
+    }
+    EXPECT_GT(differ / double(f.primal.size()), 1e-3) << "halves identical, mode " << int(mode);
+    double var = 0.0;
+    for (float v : f.var_a) var += v;
+    EXPECT_GT(var, 0.0);
+  }
+  RenderSession off(scene, pt(1));
+  EXPECT_FALSE(off.film().has_features());
+}
+
 // Renders a sheet_over_floor scene under an 8 x 8 top view with direct light only and checks
 // its primal: `inside` on the sheet's square (pixels 2..5), `outside` around it.
 void expect_square(const Scene& scene, RenderSettings::Mode mode, float inside, float outside,
