@@ -36,6 +36,9 @@ if method.startswith("cycles"):
     if method == "cycles_unbiased":
         c.blur_glossy = 0.0
         c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
+        # Adaptive sampling stops at its noise threshold, before small frames' budgets end: this
+        # curve samples every pixel for the whole budget (the defaults' curve keeps it on).
+        c.use_adaptive_sampling = False
     elif method != "cycles_default":
         sys.exit(f"render_one.py: unknown method {method}")
 elif method in ("pt", "gpt"):

@@ -252,8 +252,10 @@ def write_doc(results, meta, path, figures):
         "relMSE is measured against each method's own converged reference (two independent "
         "halves, whose noise is subtracted); times are whole Blender render calls (export, "
         "render, write) plus, for G-PT, the `gdpt-reconstruct` solve. Cycles' defaults include "
-        "Filter Glossy 1.0 and indirect clamping at 10 (biased, less noise); \"unbiased\" sets "
-        "both to 0. Denoising is off: Debian's Blender has no OpenImageDenoise.",
+        "Filter Glossy 1.0 and indirect clamping at 10 (biased, less noise) and adaptive sampling "
+        "(which may stop before the budget); \"unbiased\" sets the first two to 0 and samples "
+        "every pixel for the whole budget. Denoising is off: Debian's Blender has no "
+        "OpenImageDenoise.",
         "",
         "## Summary: relMSE improvement over Cycles (defaults) at equal time",
         "",
