@@ -13,6 +13,10 @@ import time
 
 import bpy
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tests",
+                                "blender"))
+import scenes as S  # noqa: E402
+
 argv = sys.argv[sys.argv.index("--") + 1:]
 blend, method, out = argv[0], argv[1], os.path.abspath(argv[2])
 opts = dict(zip(argv[3::2], argv[4::2]))
@@ -52,18 +56,8 @@ elif method in ("pt", "gpt"):
 else:
     sys.exit(f"render_one.py: unknown method {method}")
 scene.render.use_persistent_data = False
-s = scene.render.image_settings
-s.file_format = 'OPEN_EXR_MULTILAYER'
-s.color_depth = '32'
-s.exr_codec = 'ZIP'
-scene.render.use_file_extension = False
-scene.render.filepath = out
-if os.path.exists(out):
-    os.remove(out)
 t0 = time.perf_counter()
-bpy.ops.render.render(write_still=True)
+S.render(scene, out, multilayer=True)  # raises when nothing was written
 elapsed = time.perf_counter() - t0
-if not os.path.exists(out):
-    sys.exit(f"render_one.py: the render wrote no {out}")
 print("BENCH " + json.dumps({"method": method, "seconds": elapsed, "engine": scene.render.engine}),
       flush=True)
