@@ -146,6 +146,13 @@ PYBIND11_MODULE(_gdpt, m) {
            }),
            py::arg("builder"), py::arg("settings"), py::arg("display"))
       .def("set_camera", &ViewportJob::set_camera, py::arg("camera"))
+      .def(
+          "update",
+          [](ViewportJob& job, SceneBuilder& builder, const py::dict& settings,
+             const py::dict& display) {
+            job.update(builder, settings_from_dict(settings), display_from_dict(display));
+          },
+          py::arg("builder"), py::arg("settings"), py::arg("display"))
       .def("latest", &ViewportJob::latest, py::arg("seen") = -1)
       .def("status", &ViewportJob::status)
       .def("cancel", &ViewportJob::cancel)
