@@ -4,8 +4,10 @@
 // one Integrator. For each pass it calls render_tile() on disjoint tiles from several threads;
 // an integrator must therefore be const/thread-safe and write only the pixels of its tile.
 //
-// Sample indices: pass `p` covers samples [p * spp, (p + 1) * spp) of every pixel, so the value a
-// pixel receives depends only on (seed, pixel, sample index), never on threads or tile order.
+// Sample indices: pass `p` covers samples [K + p * spp, K + (p + 1) * spp) of every pixel (K =
+// RenderSettings::sample_offset), so the value a pixel receives depends only on (seed, pixel,
+// sample index), never on threads or tile order. The depth and index passes come from the
+// render's first sample K (sample 0 unless the render is one part of a farm's split).
 #pragma once
 
 #include <atomic>

@@ -47,6 +47,8 @@ void check_settings(RenderSettings& settings) {
   if (settings.rr_depth < 0)
     throw std::invalid_argument("render settings: the Russian roulette depth must be >= 0");
   if (settings.threads < 0) throw std::invalid_argument("render settings: threads must be >= 0");
+  if (uint64_t(settings.sample_offset) + uint64_t(settings.samples) > uint64_t(UINT32_MAX))
+    throw std::invalid_argument("render settings: sample_offset + samples must be < 2^32");
   if (settings.samples_per_pass < 1) settings.samples_per_pass = 1;
 }
 }  // namespace
@@ -146,6 +148,7 @@ void RenderSession::Impl::setup_for_camera() {
       f->enable_feature_passes(settings.feature_passes);
     }
   }
+  for (Film* f : {&film, &pass_film}) f->set_sample_offset(settings.sample_offset);
   tiles.clear();
   const int th = tile_height(w, h, arena->max_concurrency());
   for (int y = 0; y < h; y += th)
@@ -176,7 +179,7 @@ void RenderSession::render(const std::function<void(const RenderProgress&)>& on_
   while (done < total) {
     if (cancel.load(std::memory_order_relaxed)) break;
     if (d.settings.time_limit > 0.0 && elapsed() >= d.settings.time_limit) break;
-    const uint32_t first = uint32_t(done);
+    const uint32_t first = d.settings.sample_offset + uint32_t(done);
     const uint32_t count = uint32_t(std::min(d.settings.samples_per_pass, total - done));
 
     // --- One pass over every tile; a pass interrupted by cancel is discarded, so every pixel

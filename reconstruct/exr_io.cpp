@@ -14,6 +14,8 @@ struct RawExr {
   int width = 0, height = 0;
   std::vector<std::string> names;
   std::vector<std::vector<float>> channels;  // one top-down plane per name
+  std::map<std::string, std::string> attributes;
+  bool half = false;
 };
 
 std::string one_line(std::string s) {
@@ -33,6 +35,8 @@ RawExr read_raw(const std::string& path) {
     if (sub == 0) {
       raw.width = spec.width;
       raw.height = spec.height;
+      for (const OIIO::ParamValue& p : spec.extra_attribs)
+        if (p.type() == OIIO::TypeDesc::STRING) raw.attributes[p.name().string()] = p.get_string();
     } else if (spec.width != raw.width || spec.height != raw.height) {
       throw ExrError("'" + path + "': parts have different sizes (" + std::to_string(raw.width) +
                      "x" + std::to_string(raw.height) + " and " + std::to_string(spec.width) + "x" +
@@ -44,6 +48,7 @@ RawExr read_raw(const std::string& path) {
     if (!in->read_image(sub, 0, 0, nc, OIIO::TypeDesc::FLOAT, data.data()))
       throw ExrError("cannot read '" + path + "': " + one_line(in->geterror()));
     for (int c = 0; c < nc; ++c) {
+      if (spec.channelformat(c) == OIIO::TypeDesc::HALF) raw.half = true;
       raw.names.push_back(spec.channel_name(c));
       std::vector<float> plane(pixels);
       for (size_t i = 0; i < pixels; ++i) plane[i] = data[i * nc + c];
@@ -236,6 +241,44 @@ void write_multilayer_exr(const std::string& path, int width, int height, const 
     first += n;
   }
   spec.attribute("compression", "zip");
+  write_image(path, spec, data.data());
+}
+
+ExrChannels read_exr_channels(const std::string& path) {
+  RawExr raw = read_raw(path);
+  ExrChannels image;
+  image.width = raw.width;
+  image.height = raw.height;
+  image.names = std::move(raw.names);
+  image.attributes = std::move(raw.attributes);
+  image.half = raw.half;
+  const size_t W = size_t(raw.width), H = size_t(raw.height);
+  for (std::vector<float>& plane : raw.channels) {
+    std::vector<float> flipped(plane.size());
+    for (size_t y = 0; y < H; ++y)  // EXR top-down -> bottom-up
+      std::copy_n(&plane[(H - 1 - y) * W], W, &flipped[y * W]);
+    image.planes.push_back(std::move(flipped));
+  }
+  return image;
+}
+
+void write_exr_channels(const std::string& path, const ExrChannels& image) {
+  const size_t W = size_t(image.width), H = size_t(image.height), nc = image.names.size();
+  if (nc == 0 || image.planes.size() != nc)
+    throw ExrError("write_exr_channels: " + std::to_string(nc) + " names for " +
+                   std::to_string(image.planes.size()) + " planes");
+  OIIO::ImageSpec spec(image.width, image.height, int(nc), OIIO::TypeDesc::FLOAT);
+  spec.channelnames = image.names;
+  for (const auto& [name, value] : image.attributes) spec.attribute(name, value);
+  spec.attribute("compression", "zip");
+  std::vector<float> data(W * H * nc);
+  for (size_t c = 0; c < nc; ++c) {
+    if (image.planes[c].size() != W * H)
+      throw ExrError("write_exr_channels: channel '" + image.names[c] + "' has the wrong size");
+    for (size_t y = 0; y < H; ++y)  // bottom-up -> EXR top-down
+      for (size_t x = 0; x < W; ++x)
+        data[(y * W + x) * nc + c] = image.planes[c][(H - 1 - y) * W + x];
+  }
   write_image(path, spec, data.data());
 }
 

@@ -50,4 +50,17 @@ void write_multilayer_exr(const std::string& path, int width, int height, const 
                           const std::map<std::string, std::vector<float>>& passes,
                           const std::vector<std::string>& xyz_passes = {});
 
+// Every channel of a file as stored, with the header's string attributes: what gdpt-merge reads
+// and writes back (channel names and attributes kept).
+struct ExrChannels {
+  int width = 0, height = 0;
+  std::vector<std::string> names;                 // channel names, in file order
+  std::vector<std::vector<float>> planes;         // one bottom-up plane per name
+  std::map<std::string, std::string> attributes;  // string attributes of the (first) header
+  bool half = false;                              // some channel is stored as half float
+};
+ExrChannels read_exr_channels(const std::string& path);
+// One part, every channel as 32-bit float, zip compression, the string attributes in the header.
+void write_exr_channels(const std::string& path, const ExrChannels& image);
+
 }  // namespace gdpt

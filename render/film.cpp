@@ -244,10 +244,10 @@ void Film::feature_sums(FeaturePass pass, size_t i, const double*& sum, const do
   n = samples_[i];
   switch (pass) {
     case FeaturePass::PrimalA:
-      sum = f.half_a, sum2 = f.half_a2, n = (n + 1) / 2;  // even indices 0, 2, ...
+      sum = f.half_a, sum2 = f.half_a2, n = even_sample_count(sample_offset_, n);
       break;
     case FeaturePass::PrimalB:
-      sum = f.half_b, sum2 = f.half_b2, n = n / 2;
+      sum = f.half_b, sum2 = f.half_b2, n = n - even_sample_count(sample_offset_, n);
       break;
     case FeaturePass::Albedo:
       sum = f.albedo, sum2 = f.albedo2;
@@ -279,6 +279,32 @@ void Film::feature_variance(FeaturePass pass, float* out) const {
     if (!features_.empty()) feature_sums(pass, i, sum, sum2, n);
     for (int c = 0; c < channels; ++c)
       out[size_t(channels) * i + c] = n ? float(variance_of_mean(sum[c], sum2[c], n)) : 0.0f;
+  }
+}
+
+void Film::sample_count(float* out) const {
+  for (size_t i = 0; i < samples_.size(); ++i) out[i] = float(samples_[i]);
+}
+
+void Film::shift_attempts(float* out) const {
+  for (size_t i = 0; i < grad_.size(); ++i)
+    out[i] = samples_[i] ? float(grad_[i].shift_attempts / samples_[i]) : 0.0f;
+  if (grad_.empty()) std::fill(out, out + pixel_count(), 0.0f);
+}
+
+void Film::gradient_halves(float* out) const {
+  if (grad_.empty()) {
+    std::fill(out, out + 4 * pixel_count(), 0.0f);
+    return;
+  }
+  for (size_t i = 0; i < grad_.size(); ++i) {
+    const GradientAccumulator& a = grad_[i];
+    const uint32_t n = samples_[i];
+    const double inv = n ? 1.0 / n : 0.0;
+    out[4 * i + 0] = float(lum(a.dx) * inv);
+    out[4 * i + 1] = float(lum(a.dy) * inv);
+    out[4 * i + 2] = float(variance_of_mean(lum(a.dx), a.dx2, n));
+    out[4 * i + 3] = float(variance_of_mean(lum(a.dy), a.dy2, n));
   }
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/huge_pages.h"
+#include "core/sample_halves.h"
 #include "core/vec.h"
 
 namespace gdpt {
@@ -41,6 +42,15 @@ class Film {
   // 3 per pixel: variance of the pixel mean of luminance(primal), luminance(dx), luminance(dy).
   void variance3(float* out) const;
   void shift_failures(float* out) const;  // 1 per pixel: fraction of failed shifts
+  // What merging renders of disjoint sample ranges needs besides (reconstruct/pass_merge.h), 1
+  // per pixel: the samples taken; the shift attempts per sample (Shift Failures' weight; 0 in PT
+  // mode).
+  void sample_count(float* out) const;
+  void shift_attempts(float* out) const;
+  // 4 per pixel (0 in PT mode): the luminance means of this pixel's forward gradient halves
+  // G_right and G_up and the variances of those means, which Variance's dx and dy entries sum
+  // with the neighbours' backward halves: the merge needs the halves apart to pool them exactly.
+  void gradient_halves(float* out) const;
   // 1 per pixel: coverage, the mean of the samples' alphas (1 unless the background is
   // transparent: then 0 for a camera ray that reaches the world, 1 - the transparency crossed on
   // the way for one that reaches it through Transparent surfaces).
@@ -167,6 +177,10 @@ class Film {
   void enable_data_passes(bool normal, bool mist);
   // Allocates the feature passes' sums (none by default).
   void enable_feature_passes(bool on);
+  // The index of the render's first sample (RenderSettings::sample_offset): the feature passes'
+  // halves are the even and odd global sample indices.
+  void set_sample_offset(uint32_t offset) { sample_offset_ = offset; }
+  uint32_t sample_offset() const { return sample_offset_; }
   // Adds rows [y0, y1) of `pass` (same size) into this film and zeroes them in `pass`: how a
   // completed pass is committed.
   void take_rows(Film& pass, int y0, int y1);
@@ -199,6 +213,7 @@ class Film {
                     uint32_t& n) const;
   HugePageVector<FeatureAccumulator> features_;  // empty when the feature passes are off
   bool gradients_from_primal_ = false;
+  uint32_t sample_offset_ = 0;
 };
 
 }  // namespace gdpt

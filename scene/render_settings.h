@@ -15,6 +15,10 @@ struct RenderSettings {
   int max_diffuse_bounces = 1 << 20, max_glossy_bounces = 1 << 20,
       max_transmission_bounces = 1 << 20;
   uint32_t seed = 0;
+  // First sample index (Cycles' Sample Offset): the render takes samples sample_offset ..
+  // sample_offset + samples - 1 of the seed's sequence, so renders of disjoint ranges are
+  // independent parts of one render and merge exactly (reconstruct/pass_merge.h).
+  uint32_t sample_offset = 0;
   int threads = 0;                           // 0 = all cores
   float clamp = 0.0f;                        // max sample value, 0 = off
   int rr_depth = 3;                          // Russian roulette from this vertex on

@@ -84,7 +84,8 @@ class GradientPathTracer final : public Integrator {
             sampler.start(g_.settings.seed, x + rx, y + ry, s);
             offset_mask(W, H, x, y, mask);
             const CameraSample cs = grid_sample(grid, x, y, mask);
-            if (s == 0 && cs.found)  // Depth and index passes: sample 0's camera hit, as Cycles
+            // Depth and index passes: the first sample's camera hit (sample 0, as Cycles).
+            if (s == g_.settings.sample_offset && cs.found)
               g_.ctx.record_first_hit(film, x, y, *cs.hit);
             rays += run_path(sampler, cs, x, y, s, *scratch, r, film);
           }
@@ -97,7 +98,7 @@ class GradientPathTracer final : public Integrator {
             const int n = std::min(kRow, tile.x1 - x0);
             rays += trace_camera_row(g_, W, H, x0, y, n, s, row);
             for (int i = 0; i < n; ++i) {
-              if (s == 0 && row.found[i])  // Depth and index passes: sample 0's camera hit
+              if (s == g_.settings.sample_offset && row.found[i])  // the first sample's hit
                 g_.ctx.record_first_hit(film, x0 + i, y, row.hit[i]);
               rays += run_path(row.sampler[i], row_sample(row, i), x0 + i, y, s, *scratch, r, film);
             }

@@ -79,7 +79,7 @@ class PathTracer final : public Integrator {
           for (int j = 0; j < n; ++j)
             camera_rays[j] = camera_ray(numbers.sampler(j), numbers.camera(j), x0 + j + rx, y + ry);
           ctx_.bvh().intersect_stream(camera_rays, valid, n, found, hits);
-          if (s == 0)  // Depth and index passes: sample 0's camera hit, as Cycles
+          if (s == settings_.sample_offset)  // Depth and index passes: the first sample's hit
             for (int j = 0; j < n; ++j)
               if (found[j]) ctx_.record_first_hit(film, x0 + j, y, hits[j]);
           // --- The paths ---

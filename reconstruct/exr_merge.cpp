@@ -1,0 +1,167 @@
+#include "reconstruct/exr_merge.h"
+
+#include <algorithm>
+#include <charconv>
+
+#include "reconstruct/exr_io.h"
+
+namespace gdpt {
+
+namespace {
+
+struct ChannelName {
+  std::string layer, pass, channel;
+};
+
+// Blender's multilayer naming, `<view layer>.<pass>.<channel>`, split from the right (view layer
+// names may hold dots, pass names do not).
+bool split_channel(const std::string& name, ChannelName& out) {
+  const size_t last = name.rfind('.');
+  if (last == std::string::npos || last == 0) return false;
+  const size_t middle = name.rfind('.', last - 1);
+  if (middle == std::string::npos) return false;
+  out = {name.substr(0, middle), name.substr(middle + 1, last - middle - 1), name.substr(last + 1)};
+  return !out.layer.empty() && !out.pass.empty() && !out.channel.empty();
+}
+
+const std::string& attribute(const ExrChannels& image, const std::string& name,
+                             const std::string& key) {
+  const auto it = image.attributes.find(key);
+  if (it == image.attributes.end())
+    throw MergeError("'" + name + "' has no '" + key +
+                     "' header attribute: it was not rendered by a Gradient PT that records its "
+                     "settings for gdpt-merge");
+  return it->second;
+}
+
+template <typename T>
+T parse_number(const std::string& text, const std::string& what) {
+  T value{};
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc() || end != text.data() + text.size())
+    throw MergeError(what + " is '" + text + "', not a number");
+  return value;
+}
+
+}  // namespace
+
+std::string record_key(const std::string& layer, const std::string& key) {
+  return "gdpt." + layer + "." + key;
+}
+
+std::map<std::string, RenderPart> parts_from_exr(const ExrChannels& image,
+                                                 const std::string& name) {
+  const size_t pixels = size_t(image.width) * size_t(image.height);
+  // Each pass's channels in file order, by (layer, pass).
+  std::map<std::pair<std::string, std::string>, std::vector<size_t>> channels;
+  for (size_t c = 0; c < image.names.size(); ++c) {
+    ChannelName n;
+    if (!split_channel(image.names[c], n))
+      throw MergeError("'" + name + "': channel '" + image.names[c] +
+                       "' is not named <view layer>.<pass>.<channel>: not a multilayer EXR of a "
+                       "Blender render");
+    channels[{n.layer, n.pass}].push_back(c);
+  }
+  std::map<std::string, RenderPart> parts;
+  for (const auto& [key, list] : channels) {
+    RenderPart& part = parts[key.first];
+    part.width = image.width;
+    part.height = image.height;
+    PassImage& out = part.passes[key.second];
+    out.channels = int(list.size());
+    out.data.resize(pixels * list.size());
+    for (size_t c = 0; c < list.size(); ++c)
+      for (size_t i = 0; i < pixels; ++i) out.data[i * list.size() + c] = image.planes[list[c]][i];
+  }
+  for (auto& [layer, part] : parts) {
+    part.name = name + "' view layer '" + layer;
+    if (!part.passes.count("Sample Count")) continue;  // not rendered by GDPT
+    RenderRecord& r = part.record;
+    r.mode = attribute(image, name, record_key(layer, "mode"));
+    r.seed = parse_number<uint32_t>(attribute(image, name, record_key(layer, "seed")),
+                                    "'" + name + "': the seed");
+    r.sample_offset =
+        parse_number<uint32_t>(attribute(image, name, record_key(layer, "sample_offset")),
+                               "'" + name + "': the sample offset");
+    r.reconstruction = attribute(image, name, record_key(layer, "reconstruction"));
+    r.alpha = parse_number<float>(attribute(image, name, record_key(layer, "alpha")),
+                                  "'" + name + "': alpha");
+  }
+  return parts;
+}
+
+ExrMergeSummary merge_exr_files(const std::vector<std::string>& inputs, const std::string& output,
+                                const MergeSettings& settings) {
+  if (inputs.empty()) throw MergeError("no input files");
+  std::vector<ExrChannels> images;
+  std::vector<std::map<std::string, RenderPart>> parts;  // [file][view layer]
+  for (const std::string& path : inputs) {
+    images.push_back(read_exr_channels(path));
+    if (images.back().half)
+      throw MergeError("'" + path +
+                       "' stores half floats: render with Color Depth Float (Full) for an exact "
+                       "merge");
+    parts.push_back(parts_from_exr(images.back(), path));
+    const ExrChannels& a = images.front();
+    const ExrChannels& b = images.back();
+    for (const std::string& n : b.names)
+      if (std::find(a.names.begin(), a.names.end(), n) == a.names.end())
+        throw MergeError("'" + path + "' has a channel '" + n + "' that '" + inputs.front() +
+                         "' lacks: merged files need the same passes");
+    for (const std::string& n : a.names)
+      if (std::find(b.names.begin(), b.names.end(), n) == b.names.end())
+        throw MergeError("'" + path + "' has no channel '" + n + "', which '" + inputs.front() +
+                         "' has: merged files need the same passes");
+  }
+  ExrMergeSummary summary;
+  size_t lowest_file = 0;
+  std::vector<RenderPart> merged_layers;
+  for (const auto& [layer, first] : parts.front()) {
+    if (!first.passes.count("Sample Count")) continue;  // not a GDPT layer
+    std::vector<RenderPart> layer_parts;
+    for (auto& file_parts : parts) layer_parts.push_back(std::move(file_parts.at(layer)));
+    RenderPart merged = merge_render_parts(layer_parts, settings);
+    if (summary.layers.empty()) {
+      for (size_t f = 0; f < layer_parts.size(); ++f)
+        if (layer_parts[f].record.sample_offset == merged.record.sample_offset) lowest_file = f;
+      summary.first_sample = merged.record.sample_offset;
+      const auto& counts = merged.passes.at("Sample Count").data;
+      summary.min_samples = uint32_t(*std::min_element(counts.begin(), counts.end()));
+      summary.max_samples = uint32_t(*std::max_element(counts.begin(), counts.end()));
+      summary.norm =
+          settings.norm ? *settings.norm : norm_from_name(merged.record.reconstruction).value();
+      summary.alpha = settings.alpha ? *settings.alpha : merged.record.alpha;
+    }
+    summary.layers.push_back(layer);
+    merged.name = layer;
+    merged_layers.push_back(std::move(merged));
+  }
+  if (summary.layers.empty())
+    throw MergeError("'" + inputs.front() +
+                     "' has no view layer with a 'Sample Count' pass: not a Gradient PT render");
+
+  // The output: the lowest part's channels and header, with the merged values and record.
+  ExrChannels out = std::move(images[lowest_file]);
+  for (const RenderPart& merged : merged_layers) {
+    std::map<std::string, size_t> used;  // channels taken per pass, in file order
+    for (size_t c = 0; c < out.names.size(); ++c) {
+      ChannelName n;
+      split_channel(out.names[c], n);
+      if (n.layer != merged.name) continue;
+      const PassImage& pass = merged.passes.at(n.pass);
+      const size_t k = used[n.pass]++;
+      for (size_t i = 0; i < out.planes[c].size(); ++i)
+        out.planes[c][i] = pass.data[i * size_t(pass.channels) + k];
+    }
+    const auto& counts = merged.passes.at("Sample Count").data;
+    out.attributes[record_key(merged.name, "sample_offset")] =
+        std::to_string(merged.record.sample_offset);
+    out.attributes[record_key(merged.name, "samples")] =
+        std::to_string(uint32_t(*std::max_element(counts.begin(), counts.end())));
+    out.attributes[record_key(merged.name, "merged_parts")] = std::to_string(inputs.size());
+  }
+  write_exr_channels(output, out);
+  return summary;
+}
+
+}  // namespace gdpt
