@@ -138,7 +138,7 @@ struct Pair {
   // Base vertex seen from the eye towards `x`, offset vertex towards `y` (offset 0 only).
   void place(Vec3f x, Vec3f y) {
     const SurfaceHit hx = hit_from_eye(x), hy = hit_from_eye(y);
-    setup_vertex(*ctx, g->sides, hx, normalize(hx.position - eye), base());
+    setup_vertex(*ctx, g->sides, hx, normalize(hx.position - eye), PathView{}, base());
     for (Offset& o : scratch->off) o.active = o.alive = false;
     Offset& o = offset();
     o.active = o.alive = true;
@@ -147,7 +147,7 @@ struct Pair {
     o.f = Vec3d(1.0, 1.0, 1.0);
     o.p = 1.0;
     o.grad = Vec3d();
-    setup_vertex(*ctx, g->sides, hy, normalize(hy.position - eye), o.v);
+    setup_vertex(*ctx, g->sides, hy, normalize(hy.position - eye), PathView{}, o.v);
     o.nee_on = g->classify(base().roughness) == VertexType::Diffuse &&
                g->classify(o.v.roughness) == VertexType::Diffuse;
   }
@@ -452,7 +452,7 @@ TEST(GradientPairTerms, InvertibilityKill) {
     } else {
       EXPECT_NE(o.grad.x, -pb / (pl * pl + pb * pb) * cb.x) << "a living offset adds its C'";
     }
-    advance(*p.g, o, false);
+    advance(*p.g, o, false, PathView{});
     EXPECT_EQ(o.alive, !right_diffuse);
     EXPECT_EQ(o.failed, right_diffuse);
   }
