@@ -362,8 +362,7 @@ class GradientPathTracer final : public Integrator {
       g_.features.at_surface(hit, *base.closures, length(hit.position - cam_ray.origin),
                              std::fabs(base.wi.z), out.feature);
     // Seen from the near clip (the ray length of a camera ray, as Cycles starts it there).
-    out.emission +=
-        g_.triangle_le(hit, cam_ray.origin + cam_ray.direction * cam_ray.t_min, camera);
+    out.emission += g_.triangle_le(hit, cam_ray.origin + cam_ray.direction * cam_ray.t_min, camera);
     return true;
   }
 
