@@ -483,10 +483,11 @@ struct AverageInputs {
   Vec3f geometry_output(GeometryOutput which) const {
     return which == GeometryOutput::Backfacing ? Vec3f(0.0f) : Vec3f(0.0f, 0.0f, 1.0f);
   }
-  // As a light sample sees it (emitter power estimates).
+  // As a light sample from a unit distance sees it (emitter power estimates).
   float light_path(LightPathOutput which) const {
     PathView p;
     p.light_sample = true;
+    p.ray_length = 1.0f;
     return light_path_output(p, which);
   }
 

@@ -300,8 +300,10 @@ class _Translator:
         """A colour input fed by output `out`; d holds the input's own value."""
         node = out.node
         self.current = node
-        if node.type == 'LIGHT_FALLOFF' and self._falloff_is_strength(node, out):
-            return self.color(node.inputs["Strength"])
+        if node.type == 'LIGHT_FALLOFF':
+            f = self._falloff(node, out)
+            return {"value": (f["value"],) * 3, "node": f["node"]} if "node" in f else \
+                self.color(node.inputs["Strength"])
         if self._unsupported_geometry(node, out):
             d["value"] = (0.5, 0.5, 0.5)
             return d
@@ -339,8 +341,8 @@ class _Translator:
         """A float input fed by output `out`; d holds the input's own value."""
         node = out.node
         self.current = node
-        if node.type == 'LIGHT_FALLOFF' and self._falloff_is_strength(node, out):
-            return self.value(node.inputs["Strength"])
+        if node.type == 'LIGHT_FALLOFF':
+            return self._falloff(node, out)
         if self._unsupported_geometry(node, out):
             d["value"] = 0.5
             return d
@@ -371,15 +373,36 @@ class _Translator:
         self.warn(node, f"output {out.name} (0.5 stands in) of")
         return True
 
-    def _falloff_is_strength(self, node, out):
-        """Light Falloff: its Quadratic output without smoothing is its Strength whatever the
-        ray length; the others scale by the ray length, which the shading context lacks
-        (reported; the Strength stands in)."""
+    def _push_input(self, d):
+        """Appends input node d (not keyed to a Blender node); returns a float input reading it."""
+        self.inputs.append(d)
+        return {"value": 0.0, "node": len(self.inputs) - 1}
+
+    def _falloff(self, node, out):
+        """Light Falloff (Cycles' svm_node_light_falloff) as a float input: Strength, times the ray
+        length L (Linear) or L^2 (Constant), times L^2 / (Smooth + L^2) for Smooth > 0; built from
+        Light Path's Ray Length and Math nodes (evaluated per path, as the ray length is)."""
         smooth = node.inputs["Smooth"]
-        if out.name != "Quadratic" or smooth.is_linked or smooth.default_value != 0.0:
-            self.warn(node, f"output {out.name} (needs the ray length; its Strength is used) "
-                      f"with Smooth {smooth.default_value:g} of")
-        return True
+        if smooth.is_linked:
+            self.warn(node, "linked Smooth (its default value is used) of")
+        s = float(smooth.default_value)
+        strength = self.value(node.inputs["Strength"])
+        if out.name == "Quadratic" and s <= 0.0:
+            return strength
+        length = self._push_input({"kind": "LIGHT_PATH", "output": "Ray Length"})
+
+        def math(op, a, b):
+            return self._push_input({"kind": "MATH", "op": op, "value_a": a, "value_b": b})
+
+        if out.name == "Linear":
+            strength = math("MULTIPLY", strength, length)
+        elif out.name == "Constant":
+            strength = math("MULTIPLY", math("MULTIPLY", strength, length), length)
+        if s > 0.0:
+            squared = math("MULTIPLY", length, length)
+            ratio = math("DIVIDE", squared, math("ADD", squared, {"value": s}))
+            strength = math("MULTIPLY", strength, ratio)
+        return strength
 
     def _curve_table(self, node, channels, combined=False):
         """Cycles' baked table of a curve mapping: RAMP_TABLE_SIZE entries over the curves'

@@ -350,19 +350,20 @@ class GradientPathTracer final : public Integrator {
       o.alive = cs.off_found[k] && !holdout_ends_path(g_.ctx, true, *cs.off_hit[k]);
       if (o.alive) {
         PathView camera;
-        camera.ray_length = cs.off_hit[k]->t;
+        camera.ray_length = cs.off_hit[k]->t - cs.off_ray[k]->t_min;  // from the near clip
         setup_vertex(g_.ctx, g_.sides, *cs.off_hit[k], cs.off_ray[k]->direction, camera, o.v);
       }
     }
     Vertex& base = scratch.verts[0];
     PathView camera;
-    camera.ray_length = hit.t;
+    camera.ray_length = hit.t - cam_ray.t_min;
     setup_vertex(g_.ctx, g_.sides, hit, cam_ray.direction, camera, base);
     if (g_.data.active()) g_.data.at_surface(hit, *base.closures, Spectrum(1.0f), out.data);
     if (g_.features.active())
       g_.features.at_surface(hit, *base.closures, length(hit.position - cam_ray.origin),
                              std::fabs(base.wi.z), out.feature);
-    out.emission += g_.triangle_le(hit, cam_ray.origin, camera);
+    // Seen from the near clip (the ray length of a camera ray, as Cycles starts it there).
+    out.emission += g_.triangle_le(hit, cam_ray.origin + cam_ray.direction * cam_ray.t_min, camera);
     return true;
   }
 

@@ -180,7 +180,8 @@ class PathTracer final : public Integrator {
         sc.geometry = &view;
       }
       if (material.reads_path()) [[unlikely]] {
-        path_view = path.state.view(hit.t);
+        // Measured from the ray's start: camera rays start at the near clip, as in Cycles.
+        path_view = path.state.view(hit.t - ray.t_min);
         sc.path = &path_view;
       }
       if constexpr (kEmissive)

@@ -288,7 +288,7 @@ def case_path_nodes(scene):
     nt.links.new(path.outputs["Is Camera Ray"], scale.inputs[0])
     nt.links.new(scale.outputs[0], hide.inputs[1])
     nt.links.new(hide.outputs[0], glow.inputs["Strength"])
-    S.plane("panel", 1.0, (1.2, 0.8, 3.9), (math.pi, 0, 0), panel)
+    S.plane("panel", 1.0, (1.2, 0.8, 3.4), (math.pi, 0, 0), panel)
     normal = S.diffuse("normal", (0.5, 0.5, 0.5))
     nt, bsdf = _out_shader(normal)
     geometry = nt.nodes.new("ShaderNodeNewGeometry")
@@ -331,6 +331,26 @@ def case_path_nodes(scene):
     glossy.inputs["Roughness"].default_value = 0.25
     _mix_by(facing, dot, "Value", glossy)
     S.uv_sphere("incoming", 0.5, (1.3, 0.0, 0.5), facing)
+    return 4
+
+
+def case_light_falloff(scene):
+    # Emissive balls whose strength comes from a Light Falloff output (Cycles' ray-length
+    # formulas, on camera rays, indirect hits and light samples alike): Linear, Constant with
+    # Smooth 0.5, Quadratic with Smooth 2.
+    lit_room(scene)
+    area_ceiling(size=1.0, energy=40.0)
+    for name, output, strength, smooth, color, location in (
+            ("linear", "Linear", 1.5, 0.0, (1.0, 0.6, 0.3), (-1.2, 0.5, 0.5)),
+            ("constant", "Constant", 0.3, 0.5, (0.3, 0.6, 1.0), (0.2, 0.9, 1.2)),
+            ("quadratic", "Quadratic", 4.0, 2.0, (0.5, 1.0, 0.4), (1.3, 0.0, 0.5))):
+        m = S.emission(name, color, 1.0)
+        nt, glow = _out_shader(m)
+        falloff = nt.nodes.new("ShaderNodeLightFalloff")
+        falloff.inputs["Strength"].default_value = strength
+        falloff.inputs["Smooth"].default_value = smooth
+        nt.links.new(falloff.outputs[output], glow.inputs["Strength"])
+        S.uv_sphere(name, 0.4, location, m)
     return 4
 
 
