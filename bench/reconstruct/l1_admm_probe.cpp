@@ -40,7 +40,7 @@ enum class Mode { kStart, kIterate };
 // sum, gradient term count, primal residual sum.
 template <Mode kMode>
 void update_term(const float* e, const float* b, float* t, float* u, const Term& term,
-                 float relaxation, bool gradient, std::array<double, 4>& s) {
+                 float relaxation, float u_scale, bool gradient, std::array<double, 4>& s) {
   const float ne = norm3f(e);
   s[0] += double(term.weight) * ne;
   if (gradient) {
@@ -58,7 +58,7 @@ void update_term(const float* e, const float* b, float* t, float* u, const Term&
   float v[3], r[3];
   for (int c = 0; c < 3; ++c) {
     const float z_old = t[c] - b[c] + u[c];
-    v[c] = relaxation * e[c] + (1.f - relaxation) * z_old + u[c];
+    v[c] = relaxation * e[c] + (1.f - relaxation) * z_old + u_scale * u[c];
   }
   const float nv = norm3f(v);
   const float shrink = nv > term.threshold ? 1.f - term.threshold / nv : 0.f;
@@ -73,7 +73,7 @@ void update_term(const float* e, const float* b, float* t, float* u, const Term&
 
 template <Mode kMode>
 std::array<double, 4> update_pass(const AdmmProblem& p, const float* x, State& st,
-                                  const Term (&terms)[3], float relaxation) {
+                                  const Term (&terms)[3], float relaxation, float u_scale) {
   const int W = p.width, H = p.height;
   return detail::parallel_rows_sum<4>(H, [&](int y0, int y1, std::array<double, 4>& s) {
     for (int y = y0; y < y1; ++y)
@@ -82,18 +82,19 @@ std::array<double, 4> update_pass(const AdmmProblem& p, const float* x, State& s
         const float* xi = x + k;
         float e[3];
         for (int c = 0; c < 3; ++c) e[c] = xi[c] - p.primal[k + c];
-        update_term<kMode>(e, p.primal + k, &st.t0[k], &st.u0[k], terms[0], relaxation, false, s);
+        update_term<kMode>(e, p.primal + k, &st.t0[k], &st.u0[k], terms[0], relaxation, u_scale,
+                           false, s);
         if (xx < W - 1) {
           for (int c = 0; c < 3; ++c) e[c] = xi[3 + c] - xi[c] - p.gradient_x[k + c];
-          update_term<kMode>(e, p.gradient_x + k, &st.tx[k], &st.ux[k], terms[1], relaxation, true,
-                             s);
+          update_term<kMode>(e, p.gradient_x + k, &st.tx[k], &st.ux[k], terms[1], relaxation,
+                             u_scale, true, s);
         } else {  // Neumann: not part of the problem (the L2 solve ignores it)
           for (int c = 0; c < 3; ++c) st.tx[k + c] = st.ux[k + c] = 0.f;
         }
         if (y < H - 1) {
           for (int c = 0; c < 3; ++c) e[c] = xi[3 * W + c] - xi[c] - p.gradient_y[k + c];
-          update_term<kMode>(e, p.gradient_y + k, &st.ty[k], &st.uy[k], terms[2], relaxation, true,
-                             s);
+          update_term<kMode>(e, p.gradient_y + k, &st.ty[k], &st.uy[k], terms[2], relaxation,
+                             u_scale, true, s);
         } else {
           for (int c = 0; c < 3; ++c) st.ty[k + c] = st.uy[k + c] = 0.f;
         }
@@ -115,15 +116,18 @@ AdmmResult solve_l1_admm(const AdmmProblem& p, float* x, const AdmmOptions& o) {
 
   // The start's residuals set the scale of the shrinkage (a first pass with zero thresholds).
   Term terms[3] = {{alpha, 0.f}, {1.f, 0.f}, {1.f, 0.f}};
-  auto s = update_pass<Mode::kStart>(p, x, st, terms, relax);
+  auto s = update_pass<Mode::kStart>(p, x, st, terms, relax, 1.f);
   result.objectives.push_back(s[0]);
   result.seconds.push_back(elapsed());
   const double mean_residual = s[2] > 0 ? s[1] / s[2] : 0.0;
   if (!(mean_residual > 0.0)) return result;  // exact already
-  const double rho = 1.0 / (o.threshold_per_residual * mean_residual);
-  terms[0].threshold = float(1.0 / (rho * alpha));
-  terms[1].threshold = terms[2].threshold = float(1.0 / rho);
-  update_pass<Mode::kStart>(p, x, st, terms, relax);
+  double rho = 1.0 / (o.threshold_per_residual * mean_residual);
+  auto set_thresholds = [&] {
+    terms[0].threshold = float(1.0 / (rho * alpha));
+    terms[1].threshold = terms[2].threshold = float(1.0 / rho);
+  };
+  set_thresholds();
+  update_pass<Mode::kStart>(p, x, st, terms, relax, 1.f);
 
   const detail::CachedDctBuffer planes(values);
   const int W = p.width;
@@ -135,7 +139,17 @@ AdmmResult solve_l1_admm(const AdmmProblem& p, float* x, const AdmmOptions& o) {
                                   for (int i = 0; i < W; ++i) dst[3 * i + c] = float(rows[c][i]);
                               });
     ++result.iterations;
-    s = update_pass<Mode::kIterate>(p, x, st, terms, relax);
+    // Continuation: the threshold shrinks by threshold_decay per iteration down to
+    // final_threshold_per_residual (the scaled duals follow rho).
+    float u_scale = 1.f;
+    const double rho_final = 1.0 / (o.final_threshold_per_residual * mean_residual);
+    if (o.threshold_decay < 1.0 && rho < rho_final) {
+      const double next = std::min(rho_final, rho / o.threshold_decay);
+      u_scale = float(rho / next);
+      rho = next;
+      set_thresholds();
+    }
+    s = update_pass<Mode::kIterate>(p, x, st, terms, relax, u_scale);
     const double previous = result.objectives.back();
     result.objectives.push_back(s[0]);
     result.seconds.push_back(elapsed());

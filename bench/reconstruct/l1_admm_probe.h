@@ -13,7 +13,9 @@
 //      by 1 / (rho s_k) (s_0 = alpha, s_x = s_y = 1), u_k += h_k - z_k, next t_k = b_k + z_k - u_k;
 //      one pass over memory, which also sums the objective of the current I.
 // Finite inputs only (the benchmark's): missing data is not handled.
-// rho = 1 / (threshold_per_residual x the mean gradient residual of the start): scale-free.
+// rho = 1 / (threshold_per_residual x the mean gradient residual of the start): scale-free. With
+// threshold_decay < 1 the threshold shrinks by that factor per iteration down to
+// final_threshold_per_residual (continuation; the scaled duals are rescaled with rho).
 // Start: z = A I - b and u = (threshold) e / |e|, the dual that makes the start a fixed point of
 // the shrinkage. Stop: the objective changed by less than `tolerance` (relative) over the last
 // iteration and the primal residual sum |A I - b - z| is below 10 x tolerance x the objective, or
@@ -38,6 +40,8 @@ struct AdmmOptions {
   double tolerance = 0.0;  // 0: exactly max_iterations solves
   double relaxation = 1.7;
   double threshold_per_residual = 1.0;
+  double threshold_decay = 1.0;  // < 1: continuation down to final_threshold_per_residual
+  double final_threshold_per_residual = 1.0;
 };
 
 struct AdmmResult {
