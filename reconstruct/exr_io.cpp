@@ -5,6 +5,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "reconstruct/exr_header_check.h"
+
 namespace gdpt {
 
 namespace {
@@ -25,6 +27,7 @@ std::string one_line(std::string s) {
 }
 
 RawExr read_raw(const std::string& path) {
+  check_exr_header(path);  // before OpenEXR allocates what a corrupt header claims
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw ExrError("cannot read '" + path + "': " + one_line(OIIO::geterror()));
   RawExr raw;

@@ -11,6 +11,9 @@
 // The statistical tests cannot see a symmetric 3% error in a Jacobian or in a pair term (the two
 // MIS halves' errors cancel to first order, docs/gradient.md); these tests compare one pair to
 // 2e-5 and check that the oracle itself moves by more than 20 times that under such an error.
+// What each guards (docs/gradient.md, "Power"): the reconnection Jacobian (offset_path.cpp, and
+// reconnect_to_light for lamps), the half-vector Jacobian, the BSDF-hit pair terms of
+// end_events and lamp_events, the next-event Jacobian and pair term, the invertibility kill.
 #include <gtest/gtest.h>
 
 #include <cmath>
