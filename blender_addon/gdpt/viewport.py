@@ -21,7 +21,7 @@ from . import export_mesh, export_scene, native, properties, viewport_camera
 
 MARKER = "GDPT:"
 # Seconds between the redraw timer's looks at the jobs.
-REDRAW_INTERVAL = 0.05
+REDRAW_INTERVAL = 0.02
 # Viewport Samples 0: until stopped (the largest sample count the settings allow).
 UNLIMITED_SAMPLES = 1 << 24
 

@@ -72,6 +72,9 @@ struct ViewportJob::State {
   Clock::time_point requested = Clock::now();  // of the newest restart
   int bvh_builds = 0, in_place_updates = 0;
   double scene_seconds = 0.0, first_image_seconds = -1.0;
+  // Of the published restart: seconds in publish (read-out and solves) and since its start, and
+  // the mean fraction of failed shifts at the last solve (-1: none yet).
+  double publish_seconds = 0.0, restart_seconds = 0.0, shift_failures = -1.0;
   bool stopping = false;
   bool rendering = true;
   bool finished = false;  // run() returned
@@ -87,7 +90,7 @@ struct ViewportJob::State {
   std::vector<float> image;  // RGBA
 
   // The worker's scratch film copies, reused by every publish.
-  std::vector<float> primal, gradient_x, gradient_y, emission, alpha, rgb, rgba;
+  std::vector<float> primal, gradient_x, gradient_y, emission, alpha, rgb, rgba, failures;
 
   void run();
   void work();
@@ -171,10 +174,12 @@ void ViewportJob::State::render_view(const Camera& camera) {
   const auto start = Clock::now();
   if (display.start_divider > 1) {
     session->set_camera(reduced(camera, display.start_divider));
-    // One pass, then the full resolution: on_pass cancels the rest of this render.
+    // One pass, then the full resolution: on_pass cancels the rest of this render. Its image is
+    // the primal: a solve at a second size would plan FFTs and map solver buffers for it on every
+    // restart, for a 1-sample preview that a reconstruction barely improves.
     session->render(
         [&](const RenderProgress& p) {
-          publish(p.samples_done, true, start);
+          publish(p.samples_done, false, start);
           cancel.store(true);
         },
         cancel);
@@ -203,6 +208,7 @@ void ViewportJob::State::render_view(const Camera& camera) {
 }
 
 void ViewportJob::State::publish(int samples_done, bool solve, Clock::time_point start) {
+  const auto t = Clock::now();
   const Film& film = session->film();
   const size_t n = film.pixel_count();
   primal.resize(3 * n);
@@ -212,6 +218,7 @@ void ViewportJob::State::publish(int samples_done, bool solve, Clock::time_point
   film.emission_rgb(emission.data());
   film.alpha(alpha.data());
   const bool solved_now = solve && norm.has_value();
+  double failure_rate = -1.0;
   if (solved_now) {
     gradient_x.resize(3 * n);
     gradient_y.resize(3 * n);
@@ -229,6 +236,11 @@ void ViewportJob::State::publish(int samples_done, bool solve, Clock::time_point
     rs.alpha = display.alpha;
     rs.threads = settings.threads;
     rgb = reconstruct(input, rs);
+    failures.resize(n);
+    film.shift_failures(failures.data());
+    double sum = 0.0;
+    for (float f : failures) sum += f;
+    failure_rate = n ? sum / double(n) : 0.0;
   } else {
     rgb.resize(3 * n);
     for (size_t i = 0; i < 3 * n; ++i) rgb[i] = primal[i] + emission[i];
@@ -243,7 +255,14 @@ void ViewportJob::State::publish(int samples_done, bool solve, Clock::time_point
   width = film.width();
   height = film.height();
   samples = samples_done;
-  if (image_restart != restart) first_image_seconds = seconds_since(requested);
+  if (image_restart != restart) {
+    first_image_seconds = seconds_since(requested);
+    publish_seconds = 0.0;
+    shift_failures = -1.0;
+  }
+  publish_seconds += seconds_since(t);
+  restart_seconds = seconds_since(start);
+  if (failure_rate >= 0.0) shift_failures = failure_rate;
   image_restart = restart;
   solved = solved_now;
   seconds = seconds_since(start);
@@ -322,6 +341,9 @@ py::dict ViewportJob::status() {
   d["in_place_updates"] = st.in_place_updates;
   d["scene_seconds"] = st.scene_seconds;
   d["first_image_seconds"] = st.first_image_seconds;
+  d["publish_seconds"] = st.publish_seconds;
+  d["restart_seconds"] = st.restart_seconds;
+  d["shift_failures"] = st.shift_failures;
   return d;
 }
 

@@ -8,7 +8,7 @@
 // restarts on the same BVH; stop() (and the destructor) cancel and join.
 //
 // Start resolution: with a divider d > 1 each restart first renders one pass at 1/d of the
-// resolution, so an image appears after a fraction of a full pass.
+// resolution, so an image appears after a fraction of a full pass (its primal, not solved).
 //
 // A changed scene (update) goes to the same worker and session: RenderSession::update keeps the
 // BVH when only lamps, materials, the world, the camera or settings changed, and builds it again
@@ -59,7 +59,9 @@ class ViewportJob {
   // error ("" or the message), bvh_builds (sessions built: the first, and updates that changed
   // the geometry), in_place_updates (updates that kept the BVH), scene_seconds (the last build or
   // update of the scene), first_image_seconds (from the last update or set_camera call to its
-  // first published image; -1 before it)}.
+  // first published image; -1 before it), and of the restart of the newest image: publish_seconds
+  // (read-outs and solves), restart_seconds (from its start to that image), shift_failures (mean
+  // fraction of failed shifts at its last solve, -1 before one)}.
   py::dict status();
   // Asks the worker to end and returns at once (a solve in flight is not interrupted): the viewport
   // retires a job this way and drops it once finished, so Blender's thread never waits on it.
