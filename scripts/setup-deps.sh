@@ -15,6 +15,8 @@ PACKAGES=(
   blender
   # The viewport test: Blender with a window on Xvfb and Mesa's software OpenGL.
   xvfb xauth libgl1-mesa-dri libglx-mesa0
+  # The render farm's localhost test (tests/farm): a private single-node Slurm, MUNGE auth.
+  slurm-wlm munge
 )
 
 missing=()
