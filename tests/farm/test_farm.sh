@@ -3,7 +3,8 @@
 # (local_slurm.sh), `gdpt-farm submit` of a small scene split into 3 sample ranges (an array job
 # and a dependent gdpt-merge job), `gdpt-farm status --wait`, and the merged EXR compared with a
 # single-machine render of all its samples (compare_exr.py: every channel within float
-# rounding). Also the refusals: no sbatch on PATH, a .blend that does not render with GDPT.
+# rounding). Also the refusals: no sbatch on PATH, a .blend that does not render with GDPT, and a
+# task whose Blender did not render with Gradient PT (the merge job is then cancelled).
 # The daemons are stopped on every exit path.
 #   test_farm.sh <blender> <source dir> <build dir> <out dir>
 set -euo pipefail
@@ -57,6 +58,33 @@ for i in 0 1 2; do
     || { cat "$out/farm/logs/task_$i.out"; fail "task $i did not render 4 samples with GDPT"; }
 done
 merged=$out/farm/scene_GDPT_0001.exr
+report=$("$farm" status "$out/farm")
+for line in "task 0 (samples 0..3): COMPLETED" "task 2 (samples 8..11): COMPLETED" \
+            "merge (job [0-9]*): COMPLETED"; do
+  grep -q "$line" <<<"$report" || fail "gdpt-farm status lacks '$line':"$'\n'"$report"
+done
+
+# --- a task whose Blender exits 0 without rendering (as one without the add-on falls back to
+# EEVEE) fails, and the merge never runs ---
+cat >"$out/fake_blender" <<FAKE
+#!/bin/bash
+case "\$*" in *GDPT-FARM-PROBE*) exec "$blender" "\$@" ;; esac
+echo "Fra:1 Mem:1M | Rendering with another engine"
+FAKE
+chmod +x "$out/fake_blender"
+"$farm" submit "$scene" --frame 1 --jobs 2 --out "$out/fallback" --threads 1 \
+  --blender "$out/fake_blender" --merge "$merge" >/dev/null || fail "submit with a fake Blender"
+set +e
+report=$("$farm" status "$out/fallback" --wait --timeout 120 --interval 1 2>&1)
+status=$?
+set -e
+[ $status = 1 ] && grep -q "task 0 (samples 0..5): FAILED" <<<"$report" \
+  && grep -q "merge (job [0-9]*): CANCELLED" <<<"$report" \
+  && grep -q "the job ended without" <<<"$report" \
+  || fail "a task that did not render with GDPT: exit $status:"$'\n'"$report"
+grep -q "Gradient PT did not render" "$out"/fallback/logs/task_0.out \
+  || fail "the failed task does not say why"
+echo "ok: a task without Gradient PT fails and cancels the merge"
 
 # --- the oracle: one machine, all 12 samples ---
 "$blender" -b "$scene" --addons gdpt -E GDPT --python-expr "import bpy
