@@ -2,6 +2,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
@@ -37,24 +38,8 @@ int tile_height(int w, int h, int workers) {
     height /= 2;
   return height;
 }
-}  // namespace
 
-struct RenderSession::Impl {
-  Scene scene;
-  RenderSettings settings;
-  std::unique_ptr<SceneContext> context;
-  std::unique_ptr<Integrator> integrator;
-  Film film, pass_film;
-  std::vector<Tile> tiles;
-  std::vector<std::string> warnings;
-  // settings.threads worker slots (0 = all cores): used for the BVH build and every pass.
-  std::unique_ptr<tbb::task_arena> arena;
-  // The integrator, films and tiles for scene.camera (at construction and on set_camera).
-  void setup_for_camera();
-};
-
-RenderSession::RenderSession(Scene scene, RenderSettings settings)
-    : impl_(std::make_unique<Impl>()) {
+void check_settings(RenderSettings& settings) {
   if (settings.samples < 0) throw std::invalid_argument("render settings: samples must be >= 0");
   if (settings.max_bounces < 0 || settings.max_diffuse_bounces < 0 ||
       settings.max_glossy_bounces < 0 || settings.max_transmission_bounces < 0)
@@ -65,16 +50,70 @@ RenderSession::RenderSession(Scene scene, RenderSettings settings)
   if (uint64_t(settings.sample_offset) + uint64_t(settings.samples) > uint64_t(UINT32_MAX))
     throw std::invalid_argument("render settings: sample_offset + samples must be < 2^32");
   if (settings.samples_per_pass < 1) settings.samples_per_pass = 1;
+}
+}  // namespace
+
+struct RenderSession::Impl {
+  Scene scene;
+  RenderSettings settings;
+  std::unique_ptr<SceneContext> context;
+  std::unique_ptr<Integrator> integrator;
+  Film film, pass_film;
+  Film spare_film, spare_pass_film;  // the films of the camera before (another size)
+  std::vector<Tile> tiles;
+  std::vector<std::string> warnings;
+  // settings.threads worker slots (0 = all cores): used for the BVH build and every pass.
+  std::unique_ptr<tbb::task_arena> arena;
+  // The integrator, films and tiles for scene.camera (at construction and on set_camera).
+  void setup_for_camera();
+  // The arena, the context (BVH included), then setup_for_camera(), for scene and settings.
+  void build();
+};
+
+RenderSession::RenderSession(Scene scene, RenderSettings settings)
+    : impl_(std::make_unique<Impl>()) {
+  check_settings(settings);
   Impl& d = *impl_;
   d.scene = std::move(scene);  // owned: the context and the BVH refer to it
   d.settings = settings;
+  d.build();
+}
+
+void RenderSession::Impl::build() {
+  integrator.reset();
+  context.reset();  // it refers to the scene, which the caller may have replaced
   const int arena_threads =
-      d.settings.threads > 0 ? d.settings.threads : int(tbb::task_arena::automatic);
-  d.arena = std::make_unique<tbb::task_arena>(arena_threads);
+      settings.threads > 0 ? settings.threads : int(tbb::task_arena::automatic);
+  arena = std::make_unique<tbb::task_arena>(arena_threads);
   // Embree builds with TBB: inside the arena it uses no more threads than the user allowed.
-  d.arena->execute([&] { d.context = std::make_unique<SceneContext>(d.scene, d.settings); });
+  arena->execute([&] { context = std::make_unique<SceneContext>(scene, settings); });
+  warnings = context->warnings();
+  setup_for_camera();
+}
+
+bool RenderSession::update(Scene scene, RenderSettings settings) {
+  check_settings(settings);
+  Impl& d = *impl_;
+  std::vector<std::string> warnings;
+  validate_scene(scene, warnings);  // before anything changes
+  if (settings.threads != d.settings.threads || !same_geometry(d.scene, scene)) {
+    d.integrator.reset();
+    d.context.reset();  // before the meshes its BVH points into go
+    d.scene = std::move(scene);
+    d.settings = settings;
+    d.build();
+    return false;
+  }
+  // The BVH points into the kept meshes; the new scene's equal copies are dropped.
+  scene.meshes = std::move(d.scene.meshes);
+  d.integrator.reset();
+  d.scene = std::move(scene);
+  d.settings = settings;
+  d.context->update_shading(d.settings);
   d.warnings = d.context->warnings();
+  d.context->set_camera(d.scene.camera);
   d.setup_for_camera();
+  return true;
 }
 
 void RenderSession::Impl::setup_for_camera() {
@@ -84,13 +123,32 @@ void RenderSession::Impl::setup_for_camera() {
                    : make_path_tracer(*context, settings);
   const int w = scene.camera.image_width(), h = scene.camera.image_height();
   const bool gradients_from_primal = !integrator->estimates_gradients();
-  film = Film(w, h, gradients_from_primal);
-  pass_film = Film(w, h, gradients_from_primal);  // the output film's layout (take_rows)
-  for (Film* f : {&film, &pass_film}) {
-    f->enable_data_passes(settings.normal_pass, settings.mist_pass);
-    f->enable_feature_passes(settings.feature_passes);
-    f->set_sample_offset(settings.sample_offset);
+  auto fits = [&](const Film& f) {
+    return f.width() == w && f.height() == h &&
+           f.gradients_from_primal() == gradients_from_primal &&
+           f.has_normal() == settings.normal_pass && f.has_mist() == settings.mist_pass &&
+           f.has_features() == settings.feature_passes;
+  };
+  // The viewport alternates a small first pass and the full view: both film pairs are kept, so
+  // a restart clears films instead of allocating (and faulting in) new ones.
+  if (!fits(film) && fits(spare_film)) {
+    std::swap(film, spare_film);
+    std::swap(pass_film, spare_pass_film);
   }
+  if (fits(film)) {
+    arena->execute(
+        [&] { tbb::parallel_invoke([&] { film.clear(); }, [&] { pass_film.clear(); }); });
+  } else {
+    spare_film = std::move(film);
+    spare_pass_film = std::move(pass_film);
+    film = Film(w, h, gradients_from_primal);
+    pass_film = Film(w, h, gradients_from_primal);  // the output film's layout (take_rows)
+    for (Film* f : {&film, &pass_film}) {
+      f->enable_data_passes(settings.normal_pass, settings.mist_pass);
+      f->enable_feature_passes(settings.feature_passes);
+    }
+  }
+  for (Film* f : {&film, &pass_film}) f->set_sample_offset(settings.sample_offset);
   tiles.clear();
   const int th = tile_height(w, h, arena->max_concurrency());
   for (int y = 0; y < h; y += th)

@@ -35,6 +35,13 @@ class RenderSession {
   // Replaces the camera (its resolution may differ) and clears the film, keeping the BVH, lights
   // and materials: the viewport restarts this way when only the view moved. Not during render().
   void set_camera(const Camera& camera);
+  // Replaces the scene and the settings and clears the film. When the new scene's geometry is the
+  // old one's (same_geometry: a lamp, a material, the world, the camera or a setting changed)
+  // the BVH is kept and only textures, materials and lights are rebuilt; otherwise (or with
+  // another thread count) everything is built again. Returns true when the BVH was kept. The scene
+  // and settings are checked first: std::invalid_argument for unusable ones leaves the session as
+  // it was. Not during render().
+  bool update(Scene scene, RenderSettings settings);
 
   const Film& film() const;
   const RenderSettings& settings() const;

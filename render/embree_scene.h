@@ -48,6 +48,18 @@ inline ShadingContext shading_context_of(const SurfaceHit& hit) {
   return {hit.uv, hit.front_facing, &hit.color, &hit.coords};
 }
 
+// The view of `hit` from `wi_world` (unit, from the hit back along the incoming ray), for
+// materials that read it (Material::reads_view).
+// `front_facing`: the side it is seen from (the hit's own by default).
+inline ShadingGeometry shading_geometry(const SurfaceHit& hit, Vec3f wi_world, bool front_facing) {
+  const float side = front_facing ? 1.0f : -1.0f;
+  const Vec3f interpolated = hit.perturbed ? hit.unperturbed_normal : hit.shading_normal;
+  return {wi_world, interpolated * side, hit.shading_normal * side, hit.geometric_normal * side};
+}
+inline ShadingGeometry shading_geometry(const SurfaceHit& hit, Vec3f wi_world) {
+  return shading_geometry(hit, wi_world, hit.front_facing);
+}
+
 // Moves p off the surface along n (the side the new ray leaves to) by an amount proportional to
 // the floating-point spacing at p, in the spirit of Wächter & Binder (Ray Tracing Gems, ch. 6):
 // integer ULP steps away from the origin, a small absolute step near it. `scale`

@@ -1,7 +1,9 @@
 #include "render/scene_context.h"
 
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
+#include <type_traits>
 
 #include "render/features.h"
 #include "shaders/shading_context.h"
@@ -28,7 +30,9 @@ uint32_t camera_features(const Camera& cam) {
   return f;
 }
 
-void validate(const Scene& scene, std::vector<std::string>& warnings) {
+}  // namespace
+
+void validate_scene(const Scene& scene, std::vector<std::string>& warnings) {
   validate_camera(scene.camera);
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
@@ -67,20 +71,77 @@ void validate(const Scene& scene, std::vector<std::string>& warnings) {
     throw std::invalid_argument("scene: camera-view world image index out of range");
 }
 
+namespace {
+
+template <typename T>
+bool same_data(const std::vector<T>& a, const std::vector<T>& b) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+bool same_mesh(const Mesh& a, const Mesh& b) {
+  return same_data(a.positions, b.positions) && same_data(a.indices, b.indices) &&
+         same_data(a.corner_normals, b.corner_normals) && same_data(a.corner_uvs, b.corner_uvs) &&
+         same_data(a.corner_tangents, b.corner_tangents) &&
+         same_data(a.corner_tangent_signs, b.corner_tangent_signs) &&
+         same_data(a.corner_colors, b.corner_colors) &&
+         same_data(a.material_slot, b.material_slot) &&
+         same_data(a.vertex_normals, b.vertex_normals) &&
+         std::memcmp(&a.texspace_location, &b.texspace_location, sizeof(Vec3f)) == 0 &&
+         std::memcmp(&a.texspace_size, &b.texspace_size, sizeof(Vec3f)) == 0;
+}
+
+bool same_placement(const Instance& a, const Instance& b) {
+  return a.mesh == b.mesh &&
+         std::memcmp(&a.object_to_world, &b.object_to_world, sizeof(Transform)) == 0 &&
+         a.slot_material == b.slot_material && a.visibility == b.visibility &&
+         a.holdout == b.holdout;
+}
+
 }  // namespace
 
+bool same_geometry(const Scene& a, const Scene& b) {
+  if (a.meshes.size() != b.meshes.size() || a.instances.size() != b.instances.size() ||
+      a.materials.size() != b.materials.size())
+    return false;
+  for (size_t i = 0; i < a.meshes.size(); ++i)
+    if (!same_mesh(a.meshes[i], b.meshes[i])) return false;
+  for (size_t i = 0; i < a.instances.size(); ++i)
+    if (!same_placement(a.instances[i], b.instances[i])) return false;
+  return true;
+}
+
 SceneContext::SceneContext(const Scene& scene, const RenderSettings& settings) : scene_(scene) {
-  validate(scene, warnings_);
-
-  // Textures first: materials keep a span over them.
-  textures_.reserve(scene.images.size());
-  for (const ImageDesc& img : scene.images) textures_.emplace_back(img);
-  materials_.reserve(scene.materials.size() + 1);
-  for (const MaterialDesc& desc : scene.materials) materials_.emplace_back(desc, textures_);
-  materials_.emplace_back();  // Blender's default grey diffuse
-
+  validate_scene(scene, warnings_);
+  build_materials();
   bvh_ = std::make_unique<EmbreeScene>(scene, default_material());
+  finish_shading(settings);
+}
+
+void SceneContext::update_shading(const RenderSettings& settings) {
+  warnings_.clear();
+  validate_scene(scene_, warnings_);
+  lights_.reset();  // it refers to the materials and textures rebuilt next
+  build_materials();
+  finish_shading(settings);
+}
+
+void SceneContext::build_materials() {
+  // Textures first: materials keep a span over them.
+  materials_.clear();
+  textures_.clear();
+  textures_.reserve(scene_.images.size());
+  for (const ImageDesc& img : scene_.images) textures_.emplace_back(img);
+  materials_.reserve(scene_.materials.size() + 1);
+  for (const MaterialDesc& desc : scene_.materials) materials_.emplace_back(desc, textures_);
+  materials_.emplace_back();  // Blender's default grey diffuse
+}
+
+void SceneContext::finish_shading(const RenderSettings& settings) {
+  const Scene& scene = scene_;
   bvh_->set_materials(materials_);
+  has_holdout_ = false;
   for (const Instance& inst : scene.instances) has_holdout_ = has_holdout_ || inst.holdout;
   lights_ = std::make_unique<LightSampler>(scene, materials_, textures_);
   camera_ = CameraModel(scene.camera);

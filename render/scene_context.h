@@ -28,6 +28,13 @@ inline uint32_t ray_kind_of_lobe(uint32_t lobe) {
   return (lobe & kLobeDiffuse) ? kRayDiffuse : kRayGlossy;
 }
 
+// Throws std::invalid_argument with a clear message for an unusable scene; appends non-fatal
+// problems to `warnings`.
+void validate_scene(const Scene& scene, std::vector<std::string>& warnings);
+// Whether the BVH of `a` serves `b`: equal meshes (their data), instances placing them alike
+// (mesh, transform, slot materials, ray visibility, holdout) and the same material count.
+bool same_geometry(const Scene& a, const Scene& b);
+
 class SceneContext {
  public:
   // Validates and prepares `scene` (which must outlive the context). Throws std::invalid_argument
@@ -37,6 +44,11 @@ class SceneContext {
   // Replaces the camera (the viewport's view moved), keeping the BVH, lights and materials.
   // Throws std::invalid_argument for an unusable camera. Not while an integrator renders.
   void set_camera(const Camera& camera);
+  // Rebuilds textures, materials, lights and the feature mask from the scene (whose lights,
+  // materials, images, world or camera the owner changed), keeping the BVH: the scene's meshes,
+  // instance placements and slot tables and its material count must be those the BVH was built
+  // from (same_geometry). Not while an integrator renders.
+  void update_shading(const RenderSettings& settings);
 
   const Scene& scene() const { return scene_; }
   // The data passes of pixel (x, y) from the camera hit of its sample 0 (Film::set_first_hit):
@@ -72,6 +84,8 @@ class SceneContext {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
+  void build_materials();                               // textures_ and materials_ from the scene
+  void finish_shading(const RenderSettings& settings);  // lights, camera and features
   const Scene& scene_;
   std::vector<Texture> textures_;
   std::vector<Material> materials_;

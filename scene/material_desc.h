@@ -108,7 +108,32 @@ enum class InputNodeKind : uint8_t {
   SeparateHsv,  // one channel (`channel`: hue, saturation, value) of a, as grey (Cycles'
                 // rgb_to_hsv)
   CombineHsv,   // the colour of hue value_a, saturation value_b, value value_c (hsv_to_rgb)
+  // Nodes that read the view of the hit (ShadingContext::geometry), at the interpolated normal
+  // or, with normal_linked, the material's normal map / bump:
+  Fresnel,      // the dielectric reflectance of IOR value_a (Cycles' svm_node_fresnel)
+  LayerWeight,  // blend value_a; `channel` 0: the Fresnel output, 1: Facing (svm_node_layer_weight)
+  Geometry,     // the Geometry node's `geometry_output` (Position is a Coordinates node)
+  LightPath,    // the Light Path node's `light_path_output` (ShadingContext::path)
 };
+// The Light Path node's outputs (Cycles' svm_node_light_path for surface shading).
+enum class LightPathOutput : uint8_t {
+  IsCameraRay,
+  IsShadowRay,
+  IsDiffuseRay,
+  IsGlossyRay,
+  IsSingularRay,
+  IsReflectionRay,
+  IsTransmissionRay,
+  RayLength,
+  RayDepth,
+  DiffuseDepth,
+  GlossyDepth,
+  TransparentDepth,
+  TransmissionDepth,
+};
+// The Geometry node's outputs read from ShadingContext::geometry (world space, flipped to the
+// incoming side as Cycles' sd->N / sd->Ng), and Backfacing (1 on a back face, else 0).
+enum class GeometryOutput : uint8_t { Normal, TrueNormal, Incoming, Backfacing };
 enum class MixBlend : uint8_t {
   Mix,
   Add,
@@ -135,6 +160,9 @@ struct InputNode {
   FloatInput value_c;           // Combine
   FloatInput value_d, value_e, value_f;  // Wave, Musgrave
   uint8_t channel = 0;                   // Separate: 0 red, 1 green, 2 blue
+  bool normal_linked = false;  // Fresnel, Layer Weight: Normal takes the normal map / bump
+  GeometryOutput geometry_output = GeometryOutput::Normal;
+  LightPathOutput light_path_output = LightPathOutput::IsCameraRay;
   // Ramp: RGBA at fac = i / (n - 1), i < n (Blender's ColorRamp.evaluate, as Cycles bakes it),
   // interpolated linearly between entries unless the ramp is Constant; the result is the colour,
   // or the alpha as grey for the node's Alpha output.

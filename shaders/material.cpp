@@ -19,6 +19,7 @@
 #include "shaders/principled.h"
 #include "shaders/procedural_texture.h"
 #include "shaders/vector_math_node.h"
+#include "shaders/view_nodes.h"
 
 namespace gdpt {
 
@@ -109,6 +110,43 @@ Spectrum hsv_to_rgb(Vec3f hsv) {
   if (i == 3.0f) return {p, q, v};
   if (i == 4.0f) return {t, p, v};
   return {v, p, q};
+}
+
+// The Light Path node's outputs for a surface shaded at the end of path `p` (Cycles'
+// svm_node_light_path with the path flags of path_state_next: a delta event is singular and
+// glossy, a transparent crossing keeps the flags of the event before it; no shadow rays shade).
+float light_path_output(const PathView& p, LightPathOutput which) {
+  const bool event = !p.light_sample;
+  const uint8_t l = p.lobe;
+  switch (which) {
+    case LightPathOutput::IsCameraRay:
+      return event && l == 0 ? 1.0f : 0.0f;
+    case LightPathOutput::IsShadowRay:
+      return 0.0f;
+    case LightPathOutput::IsDiffuseRay:
+      return event && (l & kLobeDiffuse) ? 1.0f : 0.0f;
+    case LightPathOutput::IsGlossyRay:
+      return event && (l & (kLobeGlossy | kLobeDelta)) ? 1.0f : 0.0f;
+    case LightPathOutput::IsSingularRay:
+      return event && (l & kLobeDelta) ? 1.0f : 0.0f;
+    case LightPathOutput::IsReflectionRay:
+      return event && (l & kLobeReflection) ? 1.0f : 0.0f;
+    case LightPathOutput::IsTransmissionRay:
+      return event && (l & kLobeTransmission) ? 1.0f : 0.0f;
+    case LightPathOutput::RayLength:
+      return p.ray_length;
+    case LightPathOutput::RayDepth:
+      return float(p.depth);
+    case LightPathOutput::DiffuseDepth:
+      return float(p.diffuse_depth);
+    case LightPathOutput::GlossyDepth:
+      return float(p.glossy_depth);
+    case LightPathOutput::TransparentDepth:
+      return float(p.transparent_depth);
+    case LightPathOutput::TransmissionDepth:
+      return float(p.transmission_depth);
+  }
+  return 0.0f;
 }
 
 // Input nodes that read InputNode::vector: procedural textures and coordinates.
@@ -322,6 +360,22 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
     case InputNodeKind::CombineHsv:
       r = hsv_to_rgb(Vec3f(in.scalar(n.value_a), in.scalar(n.value_b), in.scalar(n.value_c)));
       break;
+    case InputNodeKind::Fresnel:
+    case InputNodeKind::LayerWeight: {
+      const float v = in.scalar(n.value_a);
+      const float cos_in = in.view_cosine(n.normal_linked);
+      const bool back = !in.front_facing();
+      r = Spectrum(n.kind == InputNodeKind::Fresnel ? fresnel_node(v, cos_in, back)
+                   : n.channel == 0                 ? layer_weight_fresnel(v, cos_in, back)
+                                                    : layer_weight_facing(v, cos_in));
+      break;
+    }
+    case InputNodeKind::Geometry:
+      r = in.geometry_output(n.geometry_output);
+      break;
+    case InputNodeKind::LightPath:
+      r = Spectrum(in.light_path(n.light_path_output));
+      break;
     case InputNodeKind::BrightContrast: {
       const float contrast = in.scalar(n.value_b);
       const float a = 1.0f + contrast, b = in.scalar(n.value_a) - contrast * 0.5f;
@@ -339,13 +393,16 @@ template <class Inputs>
 float input_node_scalar(const InputNode& n, const Inputs& in) {
   const Spectrum r = input_node_result(n, in);
   if ((n.kind == InputNodeKind::Coordinates || n.kind == InputNodeKind::VectorMath ||
-       n.kind == InputNodeKind::CombineXyz || n.kind == InputNodeKind::VectorCurves) &&
+       n.kind == InputNodeKind::CombineXyz || n.kind == InputNodeKind::VectorCurves ||
+       (n.kind == InputNodeKind::Geometry && n.geometry_output != GeometryOutput::Backfacing)) &&
       !n.fac_output)
     return (r.x + r.y + r.z) * (1.0f / 3.0f);
   const bool grey = n.kind == InputNodeKind::Math || n.kind == InputNodeKind::Separate ||
                     n.kind == InputNodeKind::MapRange || n.kind == InputNodeKind::Clamp ||
                     n.kind == InputNodeKind::ToBw || n.kind == InputNodeKind::FloatCurve ||
-                    n.kind == InputNodeKind::SeparateHsv ||
+                    n.kind == InputNodeKind::SeparateHsv || n.kind == InputNodeKind::Fresnel ||
+                    n.kind == InputNodeKind::LayerWeight || n.kind == InputNodeKind::Geometry ||
+                    n.kind == InputNodeKind::LightPath ||
                     (n.kind == InputNodeKind::Ramp && n.ramp_alpha) ||
                     n.fac_output;  // a texture's Fac / Distance
   return grey ? r.x : luminance(r);
@@ -360,6 +417,25 @@ struct PointInputs {
   bool front_facing() const { return at.front_facing; }
 
   Spectrum attribute_color() const { return at.color ? *at.color : Spectrum(0.0f); }
+  // Cosine between the incoming direction and the interpolated (or perturbed) normal; normal
+  // incidence without a view.
+  float view_cosine(bool perturbed) const {
+    if (!at.geometry) return 1.0f;
+    const ShadingGeometry& g = *at.geometry;
+    return dot(g.incoming, perturbed ? g.perturbed_normal : g.normal);
+  }
+  float light_path(LightPathOutput which) const {
+    return light_path_output(at.path ? *at.path : PathView{}, which);
+  }
+  // A Geometry output; without a view, the front of a surface facing +z seen head-on.
+  Vec3f geometry_output(GeometryOutput which) const {
+    if (which == GeometryOutput::Backfacing) return Vec3f(at.front_facing ? 0.0f : 1.0f);
+    if (!at.geometry) return Vec3f(0.0f, 0.0f, 1.0f);
+    const ShadingGeometry& g = *at.geometry;
+    return which == GeometryOutput::Normal       ? g.normal
+           : which == GeometryOutput::TrueNormal ? g.true_normal
+                                                 : g.incoming;
+  }
 
   // A texture's coordinates: the source (zero without object-space coordinates), then its
   // mapping.
@@ -402,6 +478,17 @@ struct AverageInputs {
 
   // Unknown without the mesh: white, an upper bound for power estimates (emitter selection).
   Spectrum attribute_color() const { return Spectrum(1.0f); }
+  // The view is unknown: a mid-range cosine, a surface facing +z seen from the front.
+  float view_cosine(bool) const { return 0.5f; }
+  Vec3f geometry_output(GeometryOutput which) const {
+    return which == GeometryOutput::Backfacing ? Vec3f(0.0f) : Vec3f(0.0f, 0.0f, 1.0f);
+  }
+  // As a light sample sees it (emitter power estimates).
+  float light_path(LightPathOutput which) const {
+    PathView p;
+    p.light_sample = true;
+    return light_path_output(p, which);
+  }
 
   Spectrum color(const ColorInput& in) const {
     if (in.node >= 0) return input_node_result(nodes[size_t(in.node)], *this);
@@ -632,6 +719,11 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         features_ |= kFeatureTextures;
         reads_color_attribute_ = true;
       }
+      // Backfacing alone is a function of the side, which the per-side cache keys on.
+      if (n.kind == InputNodeKind::Fresnel || n.kind == InputNodeKind::LayerWeight ||
+          (n.kind == InputNodeKind::Geometry && n.geometry_output != GeometryOutput::Backfacing))
+        reads_view_ = true;
+      if (n.kind == InputNodeKind::LightPath) reads_path_ = true;
       if (reads_vector(n.kind)) {
         features_ |= kFeatureTextures;
         note_vector(self, n.vector, depth);
@@ -761,7 +853,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
 
 void Material::cache_if_constant() {
   constant_ = false;
-  if (features_ & kFeatureTextures) return;
+  if ((features_ & kFeatureTextures) || reads_view_ || reads_path_) return;
   for (int side = 0; side < 2; ++side) {
     ClosureSet& set = constant_closures_[side];
     set.clear();

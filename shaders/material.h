@@ -53,12 +53,19 @@ class Material {
   bool reads_color_attribute() const { return reads_color_attribute_; }
   // Some texture reads Generated or Object coordinates (ShadingContext::coords).
   bool reads_coordinates() const { return reads_coordinates_; }
+  // Some input reads the view of the hit (ShadingContext::geometry: Fresnel, Layer Weight): its
+  // closures depend on the incoming direction, so they are never cached per side, and a G-PT
+  // offset evaluates them with its own direction.
+  bool reads_view() const { return reads_view_; }
+  // Some input reads the path (ShadingContext::path: Light Path): closures per hit, never cached.
+  bool reads_path() const { return reads_path_; }
 
  private:
   void cache_if_constant();
 
-  // Materials without textures give the same closures at every hit of a side: evaluated once
-  // at load, indexed by front_facing, and copied per hit instead of walking the tree.
+  // Materials without textures or view nodes give the same closures at every hit of a side:
+  // evaluated once at load, indexed by front_facing, and copied per hit instead of walking the
+  // tree.
   bool constant_ = false;
   ClosureSet constant_closures_[2];
   std::vector<ShaderNode> nodes_;
@@ -70,6 +77,8 @@ class Material {
   BumpDesc bump_;
   bool reads_color_attribute_ = false;
   bool reads_coordinates_ = false;
+  bool reads_view_ = false;
+  bool reads_path_ = false;
   Spectrum average_emission_{0.0f, 0.0f, 0.0f};
 };
 

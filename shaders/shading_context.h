@@ -1,6 +1,8 @@
 // What a material needs to know about a hit point.
 #pragma once
 
+#include <cstdint>
+
 #include "core/vec.h"
 
 namespace gdpt {
@@ -12,6 +14,29 @@ struct TexCoords {
   Vec3f position;   // TexCoordSource::Position (world space)
 };
 
+// The hit as seen along the incoming ray, for nodes that read the view (Fresnel, Layer Weight,
+// Geometry): world space, unit, every normal flipped to the incoming ray's side for back faces
+// as Cycles flips sd->N and sd->Ng.
+struct ShadingGeometry {
+  Vec3f incoming;          // from the hit back along the incoming ray (Cycles' sd->wi, "I")
+  Vec3f normal;            // interpolated normal, no normal map / bump (Cycles' sd->N)
+  Vec3f perturbed_normal;  // the material's normal map / bump applied (= normal without one)
+  Vec3f true_normal;       // the triangle's normal (Cycles' sd->Ng)
+};
+
+// The path that reached the hit, for the Light Path node (Cycles' path flags and bounce counts
+// when the surface is shaded).
+struct PathView {
+  uint8_t lobe = 0;  // LobeFlags (closure.h) of the event that spawned the incoming ray; 0: the
+                     // camera path (nothing but transparent crossings since the camera)
+  // Emission evaluated for a light sample (Cycles' PATH_RAY_EMISSION alone): every Is ... Ray
+  // output reads 0.
+  bool light_sample = false;
+  float ray_length = 0.0f;  // length of the incoming ray segment
+  int16_t depth = 0, diffuse_depth = 0, glossy_depth = 0, transmission_depth = 0,
+          transparent_depth = 0;
+};
+
 struct ShadingContext {
   Vec2f uv;                  // mesh UV (0 when the mesh has none)
   bool front_facing = true;  // the ray hit the side the geometric normal points to
@@ -21,6 +46,13 @@ struct ShadingContext {
   // The hit's object-space coordinates when its instance's materials read them, else null
   // (zero coordinates).
   const TexCoords* coords = nullptr;
+  // The view of the hit when the caller knows the incoming ray, else null (view nodes then read
+  // normal incidence). A material that reads it (Material::reads_view) is evaluated per hit, and
+  // each G-PT path (base or offset) evaluates it with its own incoming direction.
+  const ShadingGeometry* geometry = nullptr;
+  // The path when the caller knows it, else null (a camera ray of length 0). A material that
+  // reads it (Material::reads_path) is evaluated per hit; a G-PT offset passes its own length.
+  const PathView* path = nullptr;
 };
 
 }  // namespace gdpt

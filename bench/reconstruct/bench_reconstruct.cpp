@@ -1,7 +1,7 @@
 // bench_reconstruct: cost of the reconstruction solvers at 1920x1080 RGB on 1 and 2 threads.
 //
 //   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] [--l2-only] [--feature-only]
-//                     [--memory]
+//                     [--memory] [--admm]
 //
 // Reports, per thread count:
 //   - one bare FFTW forward + inverse 2-D DCT of the 3 planes (double, the same cached plans the
@@ -18,6 +18,7 @@
 //     guide solve, preparation, the cross-filtered candidates and the choice, on the synthetic
 //     room of testing/feature_scene.h (half noise 0.2, gradient noise 0.1), relMSE against L1;
 //     --feature-only runs just this case.
+// --admm compares an ADMM L1 probe (l1_admm_probe.h) with the library's IRLS (see bench_admm).
 // --memory only measures the peak resident memory (getrusage) after one solve of each norm, in the
 // order L2, Weighted, L1: each figure is the process's peak so far, inputs included.
 // Synthetic data: a smooth image with edges; primal noise sigma 0.2 (0.05 in the right half),
@@ -37,6 +38,7 @@
 #include <fftw3.h>
 #include <tbb/task_arena.h>
 
+#include "bench/reconstruct/l1_admm_probe.h"
 #include "reconstruct/dct_solver.h"
 #include "reconstruct/feature_reconstruct.h"
 #include "reconstruct/parallel.h"
@@ -211,9 +213,82 @@ void bench_feature(int width, int height, int threads) {
   }
 }
 
+// --admm: the ADMM probe (l1_admm_probe.h) against the library's IRLS L1, in one run: a tight
+// IRLS reference (twice the default schedule), then the default IRLS and ADMM interleaved, ADMM's
+// objective and time after every iteration, and a warm start (alpha 0.2 -> 0.25) against a cold
+// one.
+int bench_admm(const Data& d, int threads) {
+  using gdpt::ReconstructionNorm;
+  gdpt::ReconstructionInput in{d.w,         d.h,     d.primal.data(), d.gx.data(),
+                               d.gy.data(), nullptr, nullptr};
+  tbb::task_arena arena(threads);
+  auto objective = [&](const std::vector<float>& x, float alpha) {
+    return gdpt::reconstruction_objective(in, ReconstructionNorm::L1, alpha, x.data());
+  };
+  auto solve = [&](ReconstructionNorm norm, float alpha, int k = 36, int first = 12, int last = 3) {
+    gdpt::ReconstructionSettings s;
+    s.threads = threads;
+    s.fft_measure = true;
+    s.norm = norm;
+    s.alpha = alpha;
+    s.l1_reweightings = k;
+    s.l1_cg_steps_first = first;
+    s.l1_cg_steps_last = last;
+    return gdpt::reconstruct(in, s);
+  };
+  auto admm = [&](std::vector<float>& x, float alpha, int iterations, double tolerance) {
+    gdpt::bench::AdmmOptions o;
+    o.max_iterations = iterations;
+    o.tolerance = tolerance;
+    gdpt::bench::AdmmResult r;
+    arena.execute([&] {
+      r = gdpt::bench::solve_l1_admm({d.w, d.h, d.primal.data(), d.gx.data(), d.gy.data(), alpha},
+                                     x.data(), o);
+    });
+    return r;
+  };
+  const float alpha = 0.2f;
+  std::printf("bench_reconstruct --admm: %dx%d RGB, alpha %.2f, %d threads\n", d.w, d.h,
+              double(alpha), threads);
+  const auto tight = solve(ReconstructionNorm::L1, alpha, 72, 24, 6);
+  const double f_tight = objective(tight, alpha);
+  std::printf("tight IRLS reference (72 reweightings x 24->6 PCG steps): objective %.8g\n",
+              f_tight);
+  auto l2 = solve(ReconstructionNorm::L2, alpha);  // warm-up (plans), and the ADMM start
+  for (int round = 0; round < 2; ++round) {
+    auto t0 = Clock::now();
+    const auto irls = solve(ReconstructionNorm::L1, alpha);
+    const double t_irls = seconds_since(t0);
+    t0 = Clock::now();
+    std::vector<float> x = solve(ReconstructionNorm::L2, alpha);
+    const double t_l2 = seconds_since(t0);
+    const auto r = admm(x, alpha, 30, 0.0);
+    std::printf("round %d: IRLS (default) %.2f s, objective / tight %.6f, rms to truth %.5f\n",
+                round, t_irls, objective(irls, alpha) / f_tight,
+                gdpt::test::rms_error(irls, d.truth));
+    std::printf("round %d: ADMM from L2 (L2 %.2f s), rms to truth after 30 %.5f\n", round, t_l2,
+                gdpt::test::rms_error(x, d.truth));
+    for (size_t k = 0; k < r.objectives.size(); ++k)
+      std::printf("  ADMM iteration %2zu: %6.2f s (+ L2), objective / tight %.6f\n", k,
+                  r.seconds[k], r.objectives[k] / f_tight);
+  }
+  // Warm start: from the L1 solution at alpha 0.2 to alpha 0.25, against a cold start from L2.
+  const float alpha2 = 0.25f;
+  std::vector<float> warm = solve(ReconstructionNorm::L1, alpha);
+  std::vector<float> cold = solve(ReconstructionNorm::L2, alpha2);
+  const auto rw = admm(warm, alpha2, 40, 1e-4);
+  const auto rc = admm(cold, alpha2, 40, 1e-4);
+  std::printf(
+      "alpha 0.2 -> 0.25, stop rule tolerance 1e-4: warm start %d iterations (%.2f s, objective "
+      "%.8g), cold start from L2 %d iterations (%.2f s, objective %.8g)\n",
+      rw.iterations, rw.seconds.back(), rw.objectives.back(), rc.iterations, rc.seconds.back(),
+      rc.objectives.back());
+  return 0;
+}
+
 int main(int argc, char** argv) {
   int width = 1920, height = 1080, only_threads = 0;
-  bool sweep = false, l2_only = false, feature_only = false, memory = false;
+  bool sweep = false, l2_only = false, feature_only = false, memory = false, admm = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--width" && i + 1 < argc)
@@ -230,16 +305,19 @@ int main(int argc, char** argv) {
       l2_only = true;
     else if (a == "--memory")
       memory = true;
+    else if (a == "--admm")
+      admm = true;
     else {
       std::fprintf(stderr,
                    "usage: bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] "
-                   "[--l2-only] [--feature-only] [--memory]\n");
+                   "[--l2-only] [--feature-only] [--memory] [--admm]\n");
       return 2;
     }
   }
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress is visible when piped to a file
   const Data d = make_data(width, height);
   if (memory) return measure_memory(d, only_threads);
+  if (admm) return bench_admm(d, only_threads > 0 ? only_threads : 2);
   const size_t px = size_t(width) * height;
   gdpt::ReconstructionInput input{
       width, height, d.primal.data(), d.gx.data(), d.gy.data(), d.variance.data(), nullptr};

@@ -24,6 +24,8 @@
 import os
 import sys
 import textwrap
+import threading
+import time
 
 import bpy
 import nodeitems_utils
@@ -68,10 +70,11 @@ def _module():
     return module
 
 
-def _say(node, level, message):
+def _say(node, level, message, console=True):
     _STATUS[node.as_pointer()] = (level, message)
-    print(f"{MARKER} {'compositor' if level == 'INFO' else 'warning'}: "
-          f"Gradient Reconstruct '{node.name}': {message}", flush=True)
+    if console:
+        print(f"{MARKER} {'compositor' if level == 'INFO' else 'warning'}: "
+              f"Gradient Reconstruct '{node.name}': {message}", flush=True)
 
 
 # --- the node's internal group and image --------------------------------------------------------
@@ -229,16 +232,16 @@ def sources(scene, node):
     return found
 
 
-def reconstruct_node(scene, node, threads=0):
-    """Solves the node from its inputs and writes its image; returns the RGB result. Raises
-    InputError when an input cannot be read (the image is then left untouched)."""
+def _request(scene, node, threads):
+    """Everything one solve of the node needs, read from Blender on the main thread: the input
+    arrays (copies, safe to use from another thread) and the node's settings. Raises InputError
+    when an input cannot be read."""
     srcs = sources(scene, node)
     arrays = {name: _array(src) for name, src in srcs.items()}
     shapes = {a.shape for a in arrays.values()}
     if len(shapes) != 1:
         raise InputError("the inputs differ in resolution: "
                          + ", ".join(f"{n} {a.shape[1]}x{a.shape[0]}" for n, a in arrays.items()))
-    emission = arrays.get("Emission")
     layers = {(src[1], src[2]) for src in srcs.values() if src[0] == 'LAYER'}
     cached = _CACHE.get(layers.pop(), {}) if len(layers) == 1 else {}
     features = None
@@ -248,20 +251,163 @@ def reconstruct_node(scene, node, threads=0):
             raise InputError("the Feature norm needs Render Layers inputs from a Gradient PT "
                              "render with Reconstruction set to Feature (its feature passes)")
         features = {k: cached[k] for k in FEATURE_KEYS}
-    rgb = _module().reconstruct(
-        np.ascontiguousarray(arrays["Primal"], dtype=np.float32),
-        np.ascontiguousarray(arrays["Gradient X"], dtype=np.float32),
-        np.ascontiguousarray(arrays["Gradient Y"], dtype=np.float32), None,
-        None if emission is None else np.ascontiguousarray(emission, dtype=np.float32),
-        node.norm, float(node.alpha), int(threads), features=features)
-    alpha = cached.get("alpha")
-    if alpha is not None and alpha.shape[:2] != rgb.shape[:2]:
-        alpha = None
-    _write_image(node, rgb, cached.get("placement"), alpha)
+    emission = arrays.get("Emission")
+    return {
+        "passes": [np.ascontiguousarray(arrays[n], dtype=np.float32) for n in REQUIRED],
+        "emission": None if emission is None else np.ascontiguousarray(emission, dtype=np.float32),
+        "norm": node.norm, "alpha": float(node.alpha), "threads": int(threads),
+        "features": features, "placement": cached.get("placement"), "mask": cached.get("alpha")}
+
+
+def _solve(request, progress=None):
+    """The C++ solve of a request: safe off the main thread (the call releases the GIL)."""
+    r = request
+    return _module().reconstruct(*r["passes"], None, r["emission"], r["norm"], r["alpha"],
+                                 r["threads"], features=r["features"], progress=progress)
+
+
+def _show(node, request, rgb, seconds=None):
+    """Writes a solve's result into the node's image and its status line (main thread)."""
+    mask = request["mask"]
+    if mask is not None and mask.shape[:2] != rgb.shape[:2]:
+        mask = None
+    _write_image(node, rgb, request["placement"], mask)
     height, width = rgb.shape[:2]
-    _say(node, 'INFO', f"{node.norm}, alpha {node.alpha:g}, {width}x{height}"
-                       + ("" if emission is not None else ", no Emission input"))
+    _say(node, 'INFO', f"{request['norm']}, alpha {request['alpha']:g}, {width}x{height}"
+                       + ("" if request["emission"] is not None else ", no Emission input")
+                       + ("" if seconds is None else f", solved in {seconds:.1f} s"))
+
+
+def reconstruct_node(scene, node, threads=0):
+    """Solves the node from its inputs now and writes its image; returns the RGB result. Raises
+    InputError when an input cannot be read (the image is then left untouched). A background
+    re-solve of the node still running is superseded: its result is dropped."""
+    request = _request(scene, node, threads)
+    _supersede(node)
+    rgb = _solve(request)
+    _show(node, request, rgb)
     return rgb
+
+
+# --- re-solves off the main thread -----------------------------------------------------------------
+# A change of alpha or norm in the UI must not freeze Blender for the length of a solve (seconds
+# for L1 at 1080p): the update callback reads the inputs, starts the solve in a thread (the C++
+# call releases the GIL) and returns. A timer (bpy.app.timers) shows the progress on the node and,
+# once the solve is done, writes the image and makes the compositor run again. One solve per node
+# at a time: changes made meanwhile are coalesced into one more solve with the latest settings.
+
+# node.as_pointer() -> _Job running for that node.
+_JOBS = {}
+# node.as_pointer() -> count of solves started for it: a finished job whose number is no longer
+# the latest (a render or another change solved the node since) is dropped.
+_GENERATION = {}
+_POLL_SECONDS = 0.1
+
+
+class _Job:
+    def __init__(self, node, request):
+        key = node.as_pointer()
+        _GENERATION[key] = _GENERATION.get(key, 0) + 1
+        self.key, self.generation, self.request = key, _GENERATION[key], request
+        self.progress = np.zeros(1, dtype=np.float32)
+        self.result = self.error = self.seconds = None
+        self.again = False  # the settings changed while solving: solve once more when done
+        self.started = time.monotonic()
+        self.thread = threading.Thread(target=self._run, name="GDPT node solve", daemon=True)
+        self.thread.start()
+
+    def _run(self):
+        try:
+            self.result = _solve(self.request, self.progress)
+        except Exception as e:  # reported on the node by the timer
+            self.error = e
+        self.seconds = time.monotonic() - self.started
+
+    def line(self):
+        r = self.request
+        return (f"Solving {r['norm']}, alpha {r['alpha']:g}: {100 * float(self.progress[0]):.0f}%"
+                f" ({time.monotonic() - self.started:.1f} s)")
+
+
+def _supersede(node):
+    key = node.as_pointer()
+    _GENERATION[key] = _GENERATION.get(key, 0) + 1
+    job = _JOBS.get(key)
+    if job is not None:
+        job.again = False
+
+
+def _start(node, request):
+    job = _JOBS.get(node.as_pointer())
+    if job is not None and job.thread.is_alive():
+        job.again = True
+        return
+    job = _JOBS[node.as_pointer()] = _Job(node, request)
+    _say(node, 'INFO', job.line())
+    if not bpy.app.timers.is_registered(_poll_jobs):
+        bpy.app.timers.register(_poll_jobs, first_interval=_POLL_SECONDS, persistent=True)
+
+
+def _node_by_pointer(key):
+    for scene in bpy.data.scenes:
+        for node in nodes_in(scene, all_trees=True):
+            if node.as_pointer() == key:
+                return scene, node
+    return None, None
+
+
+def _redraw_node_editors():
+    wm = bpy.context.window_manager
+    for window in wm.windows if wm is not None else ():
+        for area in window.screen.areas:
+            if area.type == 'NODE_EDITOR':
+                area.tag_redraw()
+
+
+def _finish(job):
+    """A job's thread has ended: show its result, or start the coalesced next solve."""
+    del _JOBS[job.key]
+    scene, node = _node_by_pointer(job.key)
+    if node is None:  # removed meanwhile
+        return
+    if job.again:
+        _current()._on_setting(node, bpy.context)
+    elif job.generation != _GENERATION.get(job.key):
+        return
+    elif job.error is not None:
+        _say(node, 'ERROR', f"{job.error} (the image was not updated)")
+    else:
+        _show(node, job.request, job.result, job.seconds)
+        # See _on_setting: makes the compositor run again with the new image.
+        node.node_tree.interface_update(bpy.context)
+
+
+def _poll_jobs():
+    """Timer: progress lines of running solves, results of finished ones."""
+    for job in list(_JOBS.values()):
+        if job.thread.is_alive():
+            _, node = _node_by_pointer(job.key)
+            if node is not None:
+                _say(node, 'INFO', job.line(), console=False)
+        else:
+            _finish(job)
+    _redraw_node_editors()
+    return _POLL_SECONDS if _JOBS else None
+
+
+def wait_for_solves():
+    """Blocks until every background solve (and any coalesced follow-up) is done and shown: for
+    scripts and tests (a background-mode Blender runs no timers)."""
+    while _JOBS:
+        for job in list(_JOBS.values()):
+            job.thread.join()
+        _poll_jobs()
+
+
+def solving(node):
+    """True while a background solve of the node runs."""
+    job = _JOBS.get(node.as_pointer())
+    return job is not None and job.thread.is_alive()
 
 
 # --- the engine's hook and the update callback --------------------------------------------------
@@ -353,16 +499,14 @@ def _on_setting(node, context):
         return
     _unshare()  # a copy must not overwrite its original's image
     try:
-        reconstruct_node(scene, node, _threads(scene))
-        # A Python property's update sends no node-tree notifier, and the image's own "edited"
-        # notifier is only matched against top-level nodes: an interface update of the internal
-        # group propagates a change to the scene's tree, whose NC_SCENE | ND_NODES notifier makes
-        # the Compositor re-run with the new image.
-        node.node_tree.interface_update(context)
+        request = _request(scene, node, _threads(scene))
     except NoCache as e:
         _say(node, 'WARNING', f"{e} (the image was not updated)")
+        return
     except InputError as e:
         _say(node, 'ERROR', f"{e} (the image was not updated)")
+        return
+    _start(node, request)
 
 
 @persistent
@@ -480,6 +624,9 @@ def unregister():
     # Blender frees them: at quit (exit status 139 after a successful `blender -b ... -f 1`) or
     # at the next file load after disabling the add-on (both reproduced). So the type lives until
     # Blender exits; while the add-on is disabled, existing nodes keep their last image.
+    if bpy.app.timers.is_registered(_poll_jobs):
+        bpy.app.timers.unregister(_poll_jobs)
+    _JOBS.clear()  # running threads end on their own; their results are dropped
     _CACHE.clear()
     _EXR_CACHE.clear()
     _STATUS.clear()

@@ -5,7 +5,9 @@
 # Glass, Emission (and, reported, Background: Cycles shows it as one on a surface), Transparent,
 # Mix Shader, Add Shader; a colour or float output on a shader
 # socket becomes an Emission, and an unlinked shader input is no closure (black), as in Cycles.
-# Inputs may be constants, RGB / Value nodes, colour / math / curve nodes, Blackbody, image and
+# Inputs may be constants, RGB / Value nodes, colour / math / curve nodes, Blackbody, Fresnel,
+# Layer Weight, Geometry (Normal, True Normal, Incoming, Backfacing; Pointiness and the others
+# reported, 0.5 standing in) and Light Path (read per path: its own direction and state), image and
 # procedural textures read at UV, Generated or Object coordinates, optionally through a Mapping
 # node. Reroutes and muted nodes are followed. Anything else is reported once per material
 # (naming the node) and followed through its mute pass-through link when it has one; otherwise a
@@ -36,7 +38,14 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
                 'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH', 'COMBXYZ',
                 'TEX_BRICK', 'CURVE_RGB', 'CURVE_VEC', 'CURVE_FLOAT', 'BLACKBODY', 'SEPHSV',
-                'COMBHSV'}
+                'COMBHSV', 'FRESNEL', 'LAYER_WEIGHT', 'NEW_GEOMETRY', 'LIGHT_PATH'}
+# The Geometry node's outputs the core reads from the view of the hit (Position: coordinates).
+_GEOMETRY_OUTPUTS = {'Normal', 'True Normal', 'Incoming', 'Backfacing'}
+# The Light Path node's outputs in object materials (Is Volume Scatter Ray: no volumes, 0).
+_LIGHT_PATH_OUTPUTS = {'Is Camera Ray', 'Is Shadow Ray', 'Is Diffuse Ray', 'Is Glossy Ray',
+                       'Is Singular Ray', 'Is Reflection Ray', 'Is Transmission Ray',
+                       'Ray Length', 'Ray Depth', 'Diffuse Depth', 'Glossy Depth',
+                       'Transparent Depth', 'Transmission Depth'}
 _RAMP_TABLE_SIZE = 256  # Cycles' RAMP_TABLE_SIZE
 _VORONOI_FEATURES = {'F1', 'F2', 'SMOOTH_F1', 'DISTANCE_TO_EDGE'}  # 3D
 _MAPPING_TYPES = {'POINT', 'TEXTURE', 'VECTOR'}  # Normal normalises: not a fixed transform
@@ -251,6 +260,15 @@ class _Translator:
                                   "strength": float(node.inputs["Strength"].default_value)})
         return True
 
+    def _view_normal(self, socket):
+        """A Fresnel / Layer Weight Normal input: unlinked or the Geometry node's Normal is the
+        interpolated normal; a Normal Map / Bump node the material's perturbation (normal()).
+        Returns whether it reads the perturbation."""
+        out = self._source(socket)
+        if out is None or (out.node.type == 'NEW_GEOMETRY' and out.name == "Normal"):
+            return False
+        return self.normal(socket)
+
     def _bump(self, node):
         """A Bump node on a BSDF's Normal input: the material's bump (one per material, not
         with a normal map; its own Normal input is not followed). Returns whether it is the
@@ -284,6 +302,9 @@ class _Translator:
         self.current = node
         if node.type == 'LIGHT_FALLOFF' and self._falloff_is_strength(node, out):
             return self.color(node.inputs["Strength"])
+        if self._unsupported_geometry(node, out):
+            d["value"] = (0.5, 0.5, 0.5)
+            return d
         if node.type == 'RGB':
             d["value"] = tuple(out.default_value)[:3]
         elif node.type == 'VALUE':
@@ -320,6 +341,9 @@ class _Translator:
         self.current = node
         if node.type == 'LIGHT_FALLOFF' and self._falloff_is_strength(node, out):
             return self.value(node.inputs["Strength"])
+        if self._unsupported_geometry(node, out):
+            d["value"] = 0.5
+            return d
         if node.type == 'VALUE':
             d["value"] = float(out.default_value)
         elif node.type == 'RGB':
@@ -337,6 +361,15 @@ class _Translator:
             if passthrough is not None and passthrough.type in {'RGBA', 'VALUE'}:
                 return self.value(passthrough)
         return d
+
+    def _unsupported_geometry(self, node, out):
+        """A Geometry output Gradient PT does not compute (Pointiness, Tangent, Parametric,
+        Random Per Island): reported by name; 0.5 stands in, as Cycles' Pointiness of a flat
+        surface."""
+        if node.type != 'NEW_GEOMETRY' or out.name in _GEOMETRY_OUTPUTS or out.name == "Position":
+            return False
+        self.warn(node, f"output {out.name} (0.5 stands in) of")
+        return True
 
     def _falloff_is_strength(self, node, out):
         """Light Falloff: its Quadratic output without smoothing is its Strength whatever the
@@ -374,7 +407,8 @@ class _Translator:
                                    'TEX_NOISE', 'TEX_COORD', 'SEPXYZ', 'TEX_VORONOI',
                                    'TEX_GRADIENT', 'TEX_WAVE', 'TEX_MUSGRAVE',
                                    'TEX_WHITE_NOISE', 'NEW_GEOMETRY', 'TEX_MAGIC',
-                                   'VECT_MATH', 'TEX_BRICK', 'SEPHSV'}
+                                   'VECT_MATH', 'TEX_BRICK', 'SEPHSV', 'LAYER_WEIGHT',
+                                   'LIGHT_PATH'}
         key = (node.name, out.name if per_output else "")
         if key in self.input_index:
             return self.input_index[key]
@@ -557,6 +591,17 @@ class _Translator:
                 d["value_a"] = self.value(node.inputs["Value"])
             else:
                 d["a"] = self.color(node.inputs[1])
+        elif node.type == 'LIGHT_PATH' and out.name in _LIGHT_PATH_OUTPUTS:
+            d = {"kind": "LIGHT_PATH", "output": out.name}
+        elif node.type == 'NEW_GEOMETRY' and out.name in _GEOMETRY_OUTPUTS:
+            d = {"kind": "GEOMETRY", "output": out.name}
+        elif node.type == 'FRESNEL':
+            d = {"kind": "FRESNEL", "value_a": self.value(node.inputs["IOR"]),
+                 "normal_linked": self._view_normal(node.inputs["Normal"])}
+        elif node.type == 'LAYER_WEIGHT':
+            d = {"kind": "LAYER_WEIGHT", "value_a": self.value(node.inputs["Blend"]),
+                 "channel": 0 if out.name == "Fresnel" else 1,
+                 "normal_linked": self._view_normal(node.inputs["Normal"])}
         elif node.type == 'BLACKBODY':
             d = {"kind": "BLACKBODY", "value_a": self.value(node.inputs["Temperature"])}
         elif node.type == 'RGBTOBW':

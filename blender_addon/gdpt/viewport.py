@@ -33,14 +33,11 @@ _retiring = []
 # test and benchmark.
 LAST_DRAW = {}
 _jobs_started = [0]  # jobs started in this process (LAST_DRAW["job"])
-# The last viewport export: meshes read from Blender and meshes kept from the export before.
+# The last viewport export: meshes read from Blender and meshes kept from the export before, the
+# kinds of change (classify_updates) and the export's seconds.
 LAST_EXPORT = {}
-# Datablock types whose geometry updates leave every kept mesh valid (objects, and the data of
-# objects, drop their objects' meshes; any other type, e.g. a geometry node tree or a collection,
-# drops them all).
+# Object data whose geometry updates drop the kept meshes of the objects using it.
 _OBJECT_DATA_TYPES = (bpy.types.Mesh, bpy.types.Curve, bpy.types.MetaBall)
-_MESH_NEUTRAL_TYPES = (bpy.types.Scene, bpy.types.World, bpy.types.Material, bpy.types.Light,
-                       bpy.types.Camera, bpy.types.Image)
 
 
 def render_settings(scene):
@@ -68,33 +65,52 @@ def _restart_key(scene):
             tuple(sorted(display_settings(scene).items())))
 
 
-def _forget_changed_meshes(store, depsgraph):
-    """Drops the kept meshes whose geometry the depsgraph updates changed."""
+def classify_updates(depsgraph):
+    """What the depsgraph updates change, as Cycles' sync reads them: a set of 'geometry' (an
+    object's or object data's geometry), 'transform' (an object other than a lamp or the camera
+    moved), 'light' (a lamp's data or placement), 'material', 'world', 'image', 'other' (another
+    datablock, e.g. a collection or a geometry node tree), and the names of the objects whose
+    meshes changed (their kept meshes are dropped; None in it: all of them). Scene updates
+    (settings) are left to the restart key; the camera object to view_draw."""
+    kinds, changed_objects = set(), set()
     for update in depsgraph.updates:
-        if not update.is_updated_geometry:
+        data = update.id
+        if isinstance(data, bpy.types.Object):
+            if data.type == 'CAMERA':
+                continue
+            if data.type == 'LIGHT':
+                if update.is_updated_geometry or update.is_updated_transform or \
+                        update.is_updated_shading:
+                    kinds.add('light')
+                continue
+            if update.is_updated_geometry:
+                kinds.add('geometry')
+                changed_objects.add(data.original.name_full)
+            if update.is_updated_transform:
+                kinds.add('transform')
+            if update.is_updated_shading:
+                kinds.add('material')  # e.g. a material slot changed
+        elif isinstance(data, _OBJECT_DATA_TYPES):
+            if update.is_updated_geometry:
+                kinds.add('geometry')
+                original = data.original
+                changed_objects.update(o.name_full for o in bpy.data.objects
+                                       if o.data is not None and o.data.original == original)
+        elif isinstance(data, bpy.types.Light):
+            kinds.add('light')
+        elif isinstance(data, (bpy.types.Material, bpy.types.ShaderNodeTree)):
+            kinds.add('material')
+        elif isinstance(data, bpy.types.World):
+            kinds.add('world')
+        elif isinstance(data, bpy.types.Image):
+            kinds.add('image')
+        elif isinstance(data, (bpy.types.Scene, bpy.types.Camera)):
             continue
-        if isinstance(update.id, bpy.types.Object):
-            store.forget(update.id.original.name_full)
-        elif isinstance(update.id, _OBJECT_DATA_TYPES):
-            data = update.id.original
-            for obj in bpy.data.objects:
-                if obj.data is not None and obj.data.original == data:
-                    store.forget(obj.name_full)
-        elif not isinstance(update.id, _MESH_NEUTRAL_TYPES):
-            store.meshes.clear()
-            return
-
-
-def _needs_export(depsgraph):
-    """Whether the depsgraph updates change what the job renders (the scene camera moving only
-    changes the view, which view_draw handles)."""
-    for update in depsgraph.updates:
-        if isinstance(update.id, bpy.types.Object) and update.id.type == 'CAMERA':
-            continue
-        if update.is_updated_geometry or update.is_updated_transform or \
-                update.is_updated_shading:
-            return True
-    return False
+        else:
+            kinds.add('other')
+            if update.is_updated_geometry:
+                changed_objects.add(None)
+    return kinds, changed_objects
 
 
 class ViewportSession:
@@ -114,8 +130,9 @@ class ViewportSession:
 
     def update(self, engine, context, depsgraph):
         scene = depsgraph.scene
-        restart = self.restart_key != _restart_key(scene)
-        if self.job is not None and not restart and not _needs_export(depsgraph):
+        kinds, changed_objects = classify_updates(depsgraph)
+        settings_changed = self.restart_key != _restart_key(scene)
+        if self.job is not None and not settings_changed and not kinds:
             return
         module, _build, error = native.load()
         if module is None:
@@ -124,34 +141,44 @@ class ViewportSession:
         camera, _rect = viewport_camera.view_camera(scene, depsgraph, context.space_data,
                                                     context.region, context.region_data,
                                                     lambda m: None)
-        self.retire()
         if camera is None:
+            self.retire()
             return
+        store = self.mesh_store
+        if None in changed_objects:
+            store.meshes.clear()
+        for name in changed_objects - {None}:
+            store.forget(name)
+        store.reused = store.exported = 0
         warnings = set()
-        _forget_changed_meshes(self.mesh_store, depsgraph)
-        self.mesh_store.reused = self.mesh_store.exported = 0
         try:
             builder, stats = export_scene.export_scene(module, depsgraph, None, warnings.add,
-                                                       camera=camera, mesh_store=self.mesh_store)
-            self.job = module.ViewportJob(builder, render_settings(scene),
-                                          display_settings(scene))
+                                                       camera=camera, mesh_store=store)
+            if self.job is not None:
+                # Same worker: the session keeps its BVH unless the geometry changed.
+                self.job.update(builder, render_settings(scene), display_settings(scene))
+            else:
+                self.job = module.ViewportJob(builder, render_settings(scene),
+                                              display_settings(scene))
+                _jobs_started[0] += 1
+                self.job_number = _jobs_started[0]
+                self.seen = -1
         except Exception as e:  # a broken datablock must not take Blender down
+            store.meshes.clear()  # the store may hold meshes the job never received
             self._fail(engine, f"viewport export failed: {e}")
             return
         for w in sorted(warnings):
             print(f"{MARKER} viewport warning: {w}", flush=True)
-        store = self.mesh_store
-        LAST_EXPORT.update(exported=store.exported, reused=store.reused, seconds=stats.seconds)
+        changes = sorted(kinds) + (['settings'] if settings_changed else [])
+        LAST_EXPORT.update(exported=store.exported, reused=store.reused, seconds=stats.seconds,
+                           changes=changes)
         print(f"{MARKER} viewport: exported {stats.instances} instances ({store.exported} meshes "
-              f"read, {store.reused} kept), {stats.lights} lights in {stats.seconds:.3f} s",
-              flush=True)
+              f"read, {store.reused} kept), {stats.lights} lights in {stats.seconds:.3f} s "
+              f"(changed: {', '.join(changes) or 'nothing, the first export'})", flush=True)
         self.error = None
         self.camera_key = viewport_camera.camera_key(camera)
         self.restart_key = _restart_key(scene)
         self.samples_total = int(scene.gdpt.preview_samples)
-        self.seen = -1
-        _jobs_started[0] += 1
-        self.job_number = _jobs_started[0]
         _live.add(self)
         _start_timer()
 
@@ -193,8 +220,9 @@ class ViewportSession:
         total = self.samples_total or "∞"
         kind = "reconstructed" if self.image["solved"] else "primal"
         engine.update_stats("", f"Sample {self.image['samples']}/{total} ({kind})")
-        if LAST_DRAW.get("job") != self.job_number:
-            LAST_DRAW["job_first_draw"] = time.perf_counter()  # for the benchmark
+        if (LAST_DRAW.get("job"), LAST_DRAW.get("restart")) != (self.job_number,
+                                                                 self.image["restart"]):
+            LAST_DRAW["first_draw"] = time.perf_counter()  # of this restart, for the benchmark
         LAST_DRAW.update(job=self.job_number, restart=self.image["restart"], version=self.seen,
                          samples=self.image["samples"], solved=self.image["solved"],
                          rect=tuple(rect),

@@ -147,6 +147,13 @@ PYBIND11_MODULE(_gdpt, m) {
            }),
            py::arg("builder"), py::arg("settings"), py::arg("display"))
       .def("set_camera", &ViewportJob::set_camera, py::arg("camera"))
+      .def(
+          "update",
+          [](ViewportJob& job, SceneBuilder& builder, const py::dict& settings,
+             const py::dict& display) {
+            job.update(builder, settings_from_dict(settings), display_from_dict(display));
+          },
+          py::arg("builder"), py::arg("settings"), py::arg("display"))
       .def("latest", &ViewportJob::latest, py::arg("seen") = -1)
       .def("status", &ViewportJob::status)
       .def("cancel", &ViewportJob::cancel)
@@ -158,7 +165,9 @@ PYBIND11_MODULE(_gdpt, m) {
         py::arg("gradient_x").noconvert(), py::arg("gradient_y").noconvert(),
         py::arg("variance").noconvert() = py::none(), py::arg("emission").noconvert() = py::none(),
         py::arg("norm") = "L1", py::arg("alpha") = 0.2f, py::arg("threads") = 0,
-        py::arg("features") = py::none());
+        py::arg("features") = py::none(), py::arg("progress").noconvert() = py::none(),
+        "progress: optional float32 array; its first value is set to the solved fraction "
+        "(0 to 1) while the solve runs without the GIL, for a caller polling from Python");
   m.def("read_exr_passes", &read_exr_passes_dict, py::arg("path"), py::arg("layer"),
         py::arg("required"), py::arg("optional") = std::vector<std::string>{});
 }

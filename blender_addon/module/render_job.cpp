@@ -287,7 +287,8 @@ py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray
                                       const std::optional<FloatArray>& variance,
                                       const std::optional<FloatArray>& emission,
                                       const std::string& norm, float alpha, int threads,
-                                      const std::optional<py::dict>& features) {
+                                      const std::optional<py::dict>& features,
+                                      const std::optional<FloatArray>& progress) {
   if (primal.ndim() < 2) throw std::invalid_argument("primal: expected a (height, width, 3) array");
   const int height = int(primal.shape(0)), width = int(primal.shape(1));
   const size_t rgb = size_t(width) * size_t(height) * 3;
@@ -302,6 +303,12 @@ py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray
   settings.norm = parse_norm(norm);
   settings.alpha = alpha;
   settings.threads = threads;
+  if (progress) {
+    if (progress->size() < 1) throw std::invalid_argument("progress: expected at least 1 value");
+    // Written from the solving thread without the GIL: one float that the caller polls.
+    float* slot = const_cast<float*>(progress->data());
+    settings.progress = [slot](float f) { *static_cast<volatile float*>(slot) = f; };
+  }
 
   ReconstructionInput input;
   input.width = width;

@@ -78,12 +78,15 @@ ReconstructionNorm parse_norm(const std::string& norm);
 
 // Reconstruction of numpy passes (the same code as the CLI and the engine). FEATURE reads the
 // feature passes from `features`, a dict with the film keys of FilmPasses (primal_a, primal_b,
-// denoising_albedo, ... and their *_variance).
+// denoising_albedo, ... and their *_variance). `progress` (optional, float32): its first value
+// follows the solved fraction, written without the GIL, for Python code polling a solve that runs
+// in another thread.
 py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray& gradient_x,
                                       const FloatArray& gradient_y,
                                       const std::optional<FloatArray>& variance,
                                       const std::optional<FloatArray>& emission,
                                       const std::string& norm, float alpha, int threads,
-                                      const std::optional<py::dict>& features);
+                                      const std::optional<py::dict>& features,
+                                      const std::optional<FloatArray>& progress);
 
 }  // namespace gdpt::python

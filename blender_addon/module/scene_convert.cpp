@@ -158,7 +158,11 @@ InputNode read_input_node(const py::dict& d) {
       {"FLOAT_CURVE", InputNodeKind::FloatCurve},
       {"BLACKBODY", InputNodeKind::Blackbody},
       {"SEPARATE_HSV", InputNodeKind::SeparateHsv},
-      {"COMBINE_HSV", InputNodeKind::CombineHsv}};
+      {"COMBINE_HSV", InputNodeKind::CombineHsv},
+      {"FRESNEL", InputNodeKind::Fresnel},
+      {"LAYER_WEIGHT", InputNodeKind::LayerWeight},
+      {"GEOMETRY", InputNodeKind::Geometry},
+      {"LIGHT_PATH", InputNodeKind::LightPath}};
   n.kind = get_enum(d, "kind", "MIX", kKinds, "input node kind");
   static const std::pair<const char*, MixBlend> kBlends[] = {{"MIX", MixBlend::Mix},
                                                              {"ADD", MixBlend::Add},
@@ -271,6 +275,31 @@ InputNode read_input_node(const py::dict& d) {
   get(d, "clamp_range", n.clamp_range);
   if (d.contains("vector")) read_vector(d["vector"].cast<py::dict>(), n.vector);
   get(d, "fac_output", n.fac_output);
+  get(d, "normal_linked", n.normal_linked);
+  // Geometry: Blender's output names.
+  static const std::pair<const char*, GeometryOutput> kGeometry[] = {
+      {"Normal", GeometryOutput::Normal},
+      {"True Normal", GeometryOutput::TrueNormal},
+      {"Incoming", GeometryOutput::Incoming},
+      {"Backfacing", GeometryOutput::Backfacing}};
+  static const std::pair<const char*, LightPathOutput> kLightPath[] = {
+      {"Is Camera Ray", LightPathOutput::IsCameraRay},
+      {"Is Shadow Ray", LightPathOutput::IsShadowRay},
+      {"Is Diffuse Ray", LightPathOutput::IsDiffuseRay},
+      {"Is Glossy Ray", LightPathOutput::IsGlossyRay},
+      {"Is Singular Ray", LightPathOutput::IsSingularRay},
+      {"Is Reflection Ray", LightPathOutput::IsReflectionRay},
+      {"Is Transmission Ray", LightPathOutput::IsTransmissionRay},
+      {"Ray Length", LightPathOutput::RayLength},
+      {"Ray Depth", LightPathOutput::RayDepth},
+      {"Diffuse Depth", LightPathOutput::DiffuseDepth},
+      {"Glossy Depth", LightPathOutput::GlossyDepth},
+      {"Transparent Depth", LightPathOutput::TransparentDepth},
+      {"Transmission Depth", LightPathOutput::TransmissionDepth}};
+  if (n.kind == InputNodeKind::Geometry)
+    n.geometry_output = get_enum(d, "output", "Normal", kGeometry, "geometry output");
+  if (n.kind == InputNodeKind::LightPath)
+    n.light_path_output = get_enum(d, "output", "Is Camera Ray", kLightPath, "light path output");
   // Brick: {"offset", "offset_frequency", "squash", "squash_frequency"} (the node's properties).
   if (d.contains("brick")) {
     const auto b = d["brick"].cast<py::dict>();

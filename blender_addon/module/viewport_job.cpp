@@ -40,7 +40,22 @@ Camera reduced(const Camera& camera, int divider) {
   return c;
 }
 
+// The reconstruction the display asks for, if the mode estimates gradients.
+std::optional<ReconstructionNorm> display_norm(const ViewportDisplay& display,
+                                               const RenderSettings& settings) {
+  const ReconstructionNorm norm = parse_norm(display.norm);
+  if (norm != ReconstructionNorm::None && settings.mode == RenderSettings::Mode::GPT) return norm;
+  return std::nullopt;
+}
+
 }  // namespace
+
+// A scene for the worker to take up (ViewportJob::update).
+struct PendingScene {
+  Scene scene;
+  RenderSettings settings;
+  ViewportDisplay display;
+};
 
 struct ViewportJob::State {
   RenderSettings settings;
@@ -53,6 +68,10 @@ struct ViewportJob::State {
   std::mutex mutex;
   std::condition_variable wake;
   std::optional<Camera> pending;  // a restart asked for by set_camera (or the first start)
+  std::optional<PendingScene> pending_scene;   // a scene asked for by update
+  Clock::time_point requested = Clock::now();  // of the newest restart
+  int bvh_builds = 0, in_place_updates = 0;
+  double scene_seconds = 0.0, first_image_seconds = -1.0;
   bool stopping = false;
   bool rendering = true;
   bool finished = false;  // run() returned
@@ -73,6 +92,8 @@ struct ViewportJob::State {
   void run();
   void work();
   void render_view(const Camera& camera);
+  void take_scene(PendingScene next, const Camera& camera);
+  void set_display(const ViewportDisplay& d);
   void publish(int samples_done, bool solve, Clock::time_point start);
   bool restart_pending() {
     std::lock_guard lock(mutex);
@@ -87,9 +108,33 @@ void ViewportJob::State::run() {
   rendering = false;
 }
 
+void ViewportJob::State::set_display(const ViewportDisplay& d) {
+  display = d;
+  display.start_divider = std::max(1, d.start_divider);
+  norm = display_norm(display, settings);
+}
+
+void ViewportJob::State::take_scene(PendingScene next, const Camera& camera) {
+  const auto t = Clock::now();
+  // The session's films are set up for the first pass's camera, not the full view.
+  next.scene.camera = reduced(camera, std::max(1, next.display.start_divider));
+  next.settings.time_limit = 0.0;
+  const bool kept = session->update(std::move(next.scene), next.settings);
+  settings = next.settings;
+  set_display(next.display);
+  std::lock_guard lock(mutex);
+  ++(kept ? in_place_updates : bvh_builds);
+  scene_seconds = seconds_since(t);
+}
+
 void ViewportJob::State::work() {
   try {
+    const auto t = Clock::now();
+    scene.camera = reduced(scene.camera, display.start_divider);  // the first pass's films
     session = std::make_unique<RenderSession>(std::move(scene), settings);
+    std::lock_guard lock(mutex);
+    ++bvh_builds;
+    scene_seconds = seconds_since(t);
   } catch (const std::exception& e) {
     std::lock_guard lock(mutex);
     error = e.what();
@@ -98,17 +143,20 @@ void ViewportJob::State::work() {
   }
   for (;;) {
     Camera camera;
+    std::optional<PendingScene> next;
     {
       std::unique_lock lock(mutex);
       wake.wait(lock, [&] { return stopping || pending.has_value(); });
       if (stopping) return;
       camera = *pending;
       pending.reset();
+      next.swap(pending_scene);
       ++restart;
       cancel.store(false);
       rendering = true;
     }
     try {
+      if (next) take_scene(std::move(*next), camera);
       render_view(camera);
     } catch (const std::exception& e) {
       std::lock_guard lock(mutex);
@@ -195,6 +243,7 @@ void ViewportJob::State::publish(int samples_done, bool solve, Clock::time_point
   width = film.width();
   height = film.height();
   samples = samples_done;
+  if (image_restart != restart) first_image_seconds = seconds_since(requested);
   image_restart = restart;
   solved = solved_now;
   seconds = seconds_since(start);
@@ -207,11 +256,7 @@ ViewportJob::ViewportJob(SceneBuilder& builder, const RenderSettings& settings,
   State& st = *state_;
   st.settings = settings;
   st.settings.time_limit = 0.0;
-  st.display = display;
-  st.display.start_divider = std::max(1, display.start_divider);
-  const ReconstructionNorm norm = parse_norm(display.norm);
-  if (norm != ReconstructionNorm::None && settings.mode == RenderSettings::Mode::GPT)
-    st.norm = norm;
+  st.set_display(display);
   st.scene = builder.take();
   st.pending = st.scene.camera;
   st.worker = std::thread([&st] { st.run(); });
@@ -226,9 +271,24 @@ void ViewportJob::set_camera(const py::dict& camera) {
   b.set_camera(camera);  // validates the dict's layout
   std::lock_guard lock(state_->mutex);
   state_->pending = b.scene().camera;
+  state_->requested = Clock::now();
   state_->rendering = true;
   state_->cancel.store(true);
   state_->wake.notify_all();
+}
+
+void ViewportJob::update(SceneBuilder& builder, const RenderSettings& settings,
+                         const ViewportDisplay& display) {
+  parse_norm(display.norm);  // a bad name fails here, not on the worker
+  PendingScene next{builder.take(), settings, display};
+  State& st = *state_;
+  std::lock_guard lock(st.mutex);
+  st.pending = next.scene.camera;
+  st.pending_scene = std::move(next);
+  st.requested = Clock::now();
+  st.rendering = true;
+  st.cancel.store(true);
+  st.wake.notify_all();
 }
 
 py::object ViewportJob::latest(int64_t seen) {
@@ -258,6 +318,10 @@ py::dict ViewportJob::status() {
   d["rendering"] = st.rendering && st.error.empty();
   d["finished"] = st.finished;
   d["error"] = st.error;
+  d["bvh_builds"] = st.bvh_builds;
+  d["in_place_updates"] = st.in_place_updates;
+  d["scene_seconds"] = st.scene_seconds;
+  d["first_image_seconds"] = st.first_image_seconds;
   return d;
 }
 

@@ -9,6 +9,10 @@
 //
 // Start resolution: with a divider d > 1 each restart first renders one pass at 1/d of the
 // resolution, so an image appears after a fraction of a full pass.
+//
+// A changed scene (update) goes to the same worker and session: RenderSession::update keeps the
+// BVH when only lamps, materials, the world, the camera or settings changed, and builds it again
+// otherwise; status() counts both, so tests can tell what a change cost.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -42,13 +46,20 @@ class ViewportJob {
 
   // Restarts the render for this camera dict (scene_convert.h's layout). Returns at once.
   void set_camera(const py::dict& camera);
+  // Restarts the render with the builder's scene (its camera included), these settings and this
+  // display. Returns at once; the worker updates the session in place or rebuilds it.
+  void update(SceneBuilder& builder, const RenderSettings& settings,
+              const ViewportDisplay& display);
   // The newest image if its version is above `seen`, else None: {version, width, height,
   // samples, solved (a reconstruction, not the primal), seconds (from the restart), image
   // float32 (height, width, 4), rows bottom-up, alpha from the film, restart (1 for the first
   // camera, +1 for each set_camera the worker took up)}.
   py::object latest(int64_t seen);
   // {version, samples, rendering (passes still to come), finished (the worker has returned),
-  // error ("" or the message)}.
+  // error ("" or the message), bvh_builds (sessions built: the first, and updates that changed
+  // the geometry), in_place_updates (updates that kept the BVH), scene_seconds (the last build or
+  // update of the scene), first_image_seconds (from the last update or set_camera call to its
+  // first published image; -1 before it)}.
   py::dict status();
   // Asks the worker to end and returns at once (a solve in flight is not interrupted): the viewport
   // retires a job this way and drops it once finished, so Blender's thread never waits on it.

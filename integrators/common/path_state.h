@@ -21,6 +21,7 @@ struct PathState {
   int transparent = 0;      // straight transparent crossings (Cycles' transparent bounces)
   BounceCounts kinds;       // scattering events by kind, for the per-kind limits
   bool camera_path = true;  // nothing but transparent crossings since the camera
+  uint8_t lobe = 0;         // LobeFlags of the last scattering event (0 on the camera path)
   // A roulette that takes effect past the next hit (roulette_past_next_hit): stopped, that hit
   // is the path's last; survived, what follows the hit's emission is divided by rr_divide.
   bool rr_stop = false;
@@ -35,7 +36,7 @@ struct PathState {
 
   // Counts the event that spawned the next ray: a straight transparent crossing is no bounce,
   // counts for no per-kind limit and keeps the camera-path status.
-  void count_event(bool crossing, uint32_t ray_kind) {
+  void count_event(bool crossing, uint32_t ray_kind, uint8_t event_lobe) {
     if (crossing) {
       ++transparent;
       return;
@@ -43,6 +44,20 @@ struct PathState {
     ++bounce;
     kinds.add(ray_kind);
     camera_path = false;
+    lobe = event_lobe;
+  }
+
+  // What the Light Path node sees at the next surface, reached by a segment of `ray_length`.
+  PathView view(float ray_length) const {
+    PathView v;
+    v.lobe = lobe;
+    v.ray_length = ray_length;
+    v.depth = int16_t(bounce);
+    v.diffuse_depth = int16_t(kinds.diffuse);
+    v.glossy_depth = int16_t(kinds.glossy);
+    v.transmission_depth = int16_t(kinds.transmission);
+    v.transparent_depth = int16_t(transparent);
+    return v;
   }
 
   // The roulette after a real bounce (count_event() already called) of throughput `beta` that

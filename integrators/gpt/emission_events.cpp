@@ -67,9 +67,10 @@ void reconnect_to_light(const GptContext& g, Offset& o, const Vertex& base, Vec3
 // sampling here, so the offset's own light density counts.
 // `world_seen`: the world emits into this segment (not with a transparent background on the
 // camera path); `camera_path`: the segment is still a camera ray's (it sees the camera view).
+// `path`: the path state at the end point (Light Path in an emitter's material).
 void end_event(const GptContext& g, const Offset& o, bool found, bool world_seen, bool camera_path,
-               const SurfaceHit& next, Spectrum le, float pl_pair, bool nee_on, Vec3d& co,
-               PathDensities& d_off) {
+               const SurfaceHit& next, Spectrum le, float pl_pair, bool nee_on,
+               const PathView& path, Vec3d& co, PathDensities& d_off) {
   const LightSampler& lights = g.ctx.lights();
   switch (o.shift) {
     case Shift::Follow:
@@ -81,7 +82,7 @@ void end_event(const GptContext& g, const Offset& o, bool found, bool world_seen
     case Shift::Reconnect: {
       // Same end point, reached from y_d. Occlusion zeroes the contribution and the BSDF
       // density, but light sampling from y_d could still have produced the path.
-      const Spectrum le_o = g.triangle_le(next, o.v.hit.position);
+      const Spectrum le_o = g.triangle_le(next, o.v.hit.position, path);
       const float pl_o = pl_pair > 0.0f
                              ? lights.pdf_triangle(next.instance, next.primitive, o.v.hit.position,
                                                    next.position, next.geometric_normal)
@@ -105,7 +106,7 @@ void end_event(const GptContext& g, const Offset& o, bool found, bool world_seen
                              : lights.environment(o.ray.direction);
         if (nee_on && !is_black(le_o)) pl_o = lights.pdf_environment(o.ray.direction);
       } else {
-        le_o = g.triangle_le(o.next_hit, o.v.hit.position);
+        le_o = g.triangle_le(o.next_hit, o.v.hit.position, path);
         if (nee_on && !is_black(le_o))
           pl_o = lights.pdf_triangle(o.next_hit.instance, o.next_hit.primitive, o.v.hit.position,
                                      o.next_hit.position, o.next_hit.geometric_normal);
@@ -197,6 +198,7 @@ void end_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, un
   const double pb = bp.pb;
   Spectrum le(0.0f);
   float pl = 0.0f;
+  const PathView path = bp.state.view(0.0f);  // the state at the end point (counted already)
   if (!found) {
     bp.state.set_alpha(g.settings, beta, out.alpha);
     if (world_seen && !base_holdout) {
@@ -205,7 +207,7 @@ void end_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, un
       if (!delta && !camera_path && !is_black(le)) pl = lights.pdf_environment(ray.direction);
     }
   } else {
-    le = g.triangle_le(next, base.hit.position);
+    le = g.triangle_le(next, base.hit.position, path);
     if (!delta && !is_black(le))
       pl = lights.pdf_triangle(next.instance, next.primitive, base.hit.position, next.position,
                                next.geometric_normal);
@@ -223,8 +225,8 @@ void end_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, un
     PathDensities d_off{0.0, 0.0, 0.0};
     const float pl_pair = o.nee_on ? pl : 0.0f;
     if (o.alive)
-      end_event(g, o, found, world_seen, camera_path, next, le, pl_pair, !delta && o.nee_on, co,
-                d_off);
+      end_event(g, o, found, world_seen, camera_path, next, le, pl_pair, !delta && o.nee_on, path,
+                co, d_off);
     if (is_zero(cb) && is_zero(co)) continue;
     const double w = shift::mis_weight_over_pdf(PathDensities{pb, pl_pair, pdf_b}, d_off, pdf_b);
     o.grad = o.grad + (co - cb) * w;

@@ -43,9 +43,10 @@ struct GptContext {
   shift::VertexType classify(float roughness) const {
     return shift::classify_vertex(roughness, settings.shift_roughness_threshold);
   }
-  // Emission of an emissive triangle at `hit` towards `from`; none without emissive triangles.
-  Spectrum triangle_le(const SurfaceHit& hit, Vec3f from) const {
-    return has_emissive ? triangle_emission(ctx, hit, from) : Spectrum(0.0f);
+  // Emission of an emissive triangle at `hit` towards `from`, reached by `path` (its ray length
+  // is the distance to `from`); none without emissive triangles.
+  Spectrum triangle_le(const SurfaceHit& hit, Vec3f from, const PathView& path) const {
+    return has_emissive ? triangle_emission(ctx, hit, from, path) : Spectrum(0.0f);
   }
   // The classification of a path's end point that is not set up as a vertex.
   shift::VertexType classify_hit(const SurfaceHit& h) const {

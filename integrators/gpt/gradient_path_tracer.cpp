@@ -168,7 +168,7 @@ class GradientPathTracer final : public Integrator {
       if (!base.closures->has_bsdf()) break;
       const VertexType base_type = g_.classify(base.roughness);
       const ClosureSet& bc = *base.closures;
-      const unsigned open_mask = open_offsets(base, base_type, off);
+      const unsigned open_mask = open_offsets(base, base_type, bp.state, off);
 
       // --- Next-event estimation: base and offsets (nee_pairs.h) ---
       if (has_lights) {
@@ -199,7 +199,7 @@ class GradientPathTracer final : public Integrator {
       bp.beta *= bs.value / bs.pdf;
       const bool crossing = bs.is_straight_crossing();
       ray.kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
-      bp.state.count_event(crossing, ray.kind);
+      bp.state.count_event(crossing, ray.kind, bs.lobe);
 
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
       if (!crossing) {
@@ -232,7 +232,7 @@ class GradientPathTracer final : public Integrator {
       // The end point of the last segment is no vertex: the shifts need its classification only.
       VertexType next_type = VertexType::Diffuse;
       if (found && !last) {
-        finish_vertex(g_.ctx, g_.sides, ray.direction, next_base);
+        finish_vertex(g_.ctx, g_.sides, ray.direction, bp.state.view(next.t), next_base);
         next_type = g_.classify(next_base.roughness);
       } else if (found && open_mask != 0) {
         next_type = g_.classify_hit(next);
@@ -281,13 +281,14 @@ class GradientPathTracer final : public Integrator {
       // --- Advance base and offsets to the segment's end ---
       bp.fb = mul(bp.fb, seg_b);
       bp.pb *= bs.pdf;
+      const PathView next_view = bp.state.view(0.0f);
       for (Offset& o : scratch.off) {
         if (!o.active || !o.alive) continue;
         if (o.link == Link::Connected) {  // the base's segment (shift_segment skipped them)
           o.f = mul(o.f, seg_b);
           o.p *= bs.pdf;
         } else {
-          advance(g_, o, last);
+          advance(g_, o, last, next_view);
         }
       }
       if (!found || last) break;  // last: the end point was not set up as a vertex
@@ -347,15 +348,21 @@ class GradientPathTracer final : public Integrator {
       o.grad = Vec3d();
       // Base hits a surface, the offset the world: no shift.
       o.alive = cs.off_found[k] && !holdout_ends_path(g_.ctx, true, *cs.off_hit[k]);
-      if (o.alive) setup_vertex(g_.ctx, g_.sides, *cs.off_hit[k], cs.off_ray[k]->direction, o.v);
+      if (o.alive) {
+        PathView camera;
+        camera.ray_length = cs.off_hit[k]->t;
+        setup_vertex(g_.ctx, g_.sides, *cs.off_hit[k], cs.off_ray[k]->direction, camera, o.v);
+      }
     }
     Vertex& base = scratch.verts[0];
-    setup_vertex(g_.ctx, g_.sides, hit, cam_ray.direction, base);
+    PathView camera;
+    camera.ray_length = hit.t;
+    setup_vertex(g_.ctx, g_.sides, hit, cam_ray.direction, camera, base);
     if (g_.data.active()) g_.data.at_surface(hit, *base.closures, Spectrum(1.0f), out.data);
     if (g_.features.active())
       g_.features.at_surface(hit, *base.closures, length(hit.position - cam_ray.origin),
                              std::fabs(base.wi.z), out.feature);
-    out.emission += g_.triangle_le(hit, cam_ray.origin);
+    out.emission += g_.triangle_le(hit, cam_ray.origin, camera);
     return true;
   }
 
@@ -365,7 +372,8 @@ class GradientPathTracer final : public Integrator {
   // BSDF-sampled light hits at the next vertex: a not-connected pair shifts light samples only
   // when both vertices are diffuse. A dead offset leaves the base alone with both of its
   // techniques: light sampling stays on (nee_on, as for connected offsets).
-  unsigned open_offsets(const Vertex& base, VertexType base_type, Offset* off) const {
+  unsigned open_offsets(const Vertex& base, VertexType base_type, const PathState& state,
+                        Offset* off) const {
     unsigned open_mask = 0;
     for (int k = 0; k < kOffsets; ++k) {
       Offset& o = off[k];
@@ -373,6 +381,10 @@ class GradientPathTracer final : public Integrator {
       if (!o.active || !o.alive || o.link == Link::Connected) continue;
       if (o.link == Link::Recent) {
         o.wi_shared = base.frame.to_local(o.wi_world);
+        // Its own segment from y_d (still in o.v) to the shared vertex.
+        o.shared =
+            &shared_closures(g_.ctx, base, o.wi_world,
+                             state.view(length(base.hit.position - o.v.hit.position)), o.v.own);
       } else if (!o.v.closures->has_bsdf()) {
         o.alive = false;  // the offset ends on a surface without BSDF: it cannot follow
         continue;

@@ -173,11 +173,11 @@ void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, cons
         Spectrum f_r(0.0f);
         float pdf_o = 0.0f;
         if (wo.z != 0.0f && visible) {
-          if (same_side(base, o.wi_shared, base.wi, wo)) {
+          if (o.shared == &bc && same_side(base, o.wi_shared, base.wi, wo)) {
             f_r = fs;
             pdf_o = pdf_fs;
           } else {
-            f_r = bc.eval_pdf(o.wi_shared, wo, pdf_o);
+            f_r = o.shared->eval_pdf(o.wi_shared, wo, pdf_o);
           }
           if (ls.is_delta) pdf_o = 0.0f;
         }

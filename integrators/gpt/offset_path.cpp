@@ -31,13 +31,13 @@ void shift_merged(Offset& o, const BaseStep& st) {
         o.shift = Shift::Failed;  // a delta lobe cannot map another wi onto the same wo
         return;
       }
-      if (same_side(base, o.wi_shared, base.wi, bs.wo)) {
+      if (o.shared == base.closures && same_side(base, o.wi_shared, base.wi, bs.wo)) {
         // A Lambert sample's value and pdf are eval() and pdf() of wo (bit-identical).
         o.seg_value = Vec3d(bs.value);
         o.seg_pdf = bs.pdf;
       } else {
         float pdf = 0.0f;
-        o.seg_value = Vec3d(base.closures->eval_pdf(o.wi_shared, bs.wo, pdf));
+        o.seg_value = Vec3d(o.shared->eval_pdf(o.wi_shared, bs.wo, pdf));
         o.seg_pdf = pdf;
       }
       if (!(o.seg_pdf > 0.0)) o.shift = Shift::Failed;
@@ -189,7 +189,7 @@ void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t&
   half_vector_copy(g, o, st, yd_type, rays);
 }
 
-void advance(const GptContext& g, Offset& o, bool last) {
+void advance(const GptContext& g, Offset& o, bool last, const PathView& path) {
   auto kill = [&] {
     o.alive = false;
     o.failed = true;
@@ -211,7 +211,11 @@ void advance(const GptContext& g, Offset& o, bool last) {
       break;
     case Shift::HalfVector:
       if (o.killed) return kill();
-      if (o.next_found && !last) setup_vertex(g.ctx, g.sides, o.next_hit, o.ray.direction, o.v);
+      if (o.next_found && !last) {
+        PathView own = path;
+        own.ray_length = o.next_hit.t;
+        setup_vertex(g.ctx, g.sides, o.next_hit, o.ray.direction, own, o.v);
+      }
       break;
     case Shift::Failed:
       return kill();

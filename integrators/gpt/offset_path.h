@@ -24,9 +24,12 @@ struct Offset {
   bool alive = false;
   bool failed = false;  // died at some point (statistics)
   Link link = Link::NotConnected;
-  Vertex v;            // own vertex while NotConnected
-  Vec3f wi_world;      // Recent: direction towards the previous offset vertex, world
-  Vec3f wi_shared;     // Recent: the same in the base vertex's local frame
+  Vertex v;         // own vertex while NotConnected
+  Vec3f wi_world;   // Recent: direction towards the previous offset vertex, world
+  Vec3f wi_shared;  // Recent: the same in the base vertex's local frame
+  // Recent: the shared vertex's closures as the offset sees them (shared_closures()): the base's,
+  // or for a material that reads the view its own evaluation (in v.own, free while merged).
+  const ClosureSet* shared = nullptr;
   shift::Vec3d f;      // throughput up to the current vertex, Jacobians included
   double p = 0.0;      // density up to the current vertex, Jacobians included
   shift::Vec3d grad;   // sum of w (C' - C)
@@ -66,8 +69,9 @@ struct BaseStep {
 // segment, its Jacobian, and the visibility or own hit it needs.
 void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t& rays);
 
-// Moves the offset to the end of the segment (`last`: the path ends there, no vertex needed).
-void advance(const GptContext& g, Offset& o, bool last);
+// Moves the offset to the end of the segment (`last`: the path ends there, no vertex needed);
+// `path`: the base's path state there (the offset's own vertex gets its own ray length).
+void advance(const GptContext& g, Offset& o, bool last, const PathView& path);
 
 // Merged offsets: a connected offset shares the rest of the base path, so for an emission event
 // with base contribution C = fb Y its contribution is C' = f' Y with the same technique

@@ -40,7 +40,7 @@ float hit_roughness(const SceneContext& ctx, std::span<const MaterialSide> sides
 }
 
 void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides, const Vec3f& dir,
-                   Vertex& v) {
+                   const PathView& path, Vertex& v) {
   const SurfaceHit& hit = v.hit;
   const MaterialSide& side = sides[2 * size_t(hit.material) + (hit.front_facing ? 1 : 0)];
   if (side.set) {
@@ -48,11 +48,23 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
     v.roughness = side.roughness;
     v.lambert = side.lambert;
   } else {
-    v.own.clear();
-    ctx.materials()[size_t(hit.material)].evaluate(shading_context_of(hit), v.own);
+    const Material& m = ctx.materials()[size_t(hit.material)];
+    ShadingContext sc = shading_context_of(hit);
+    ShadingGeometry view;
+    // The vertex's class (hit_roughness) must not depend on the direction or path it is
+    // reached by: base and offsets arriving at a shared vertex classify it alike.
+    const bool per_path = m.reads_view() || m.reads_path();
+    if (per_path) v.roughness = hit_roughness(ctx, sides, hit);
+    if (m.reads_view()) {
+      view = shading_geometry(hit, -dir);
+      sc.geometry = &view;
+    }
+    if (m.reads_path()) sc.path = &path;
+    m.evaluate(sc, v.own);
     v.closures = &v.own;
-    v.roughness = vertex_roughness(v.own);
-    v.lambert = single_lambert(v.own);
+    if (!per_path) v.roughness = vertex_roughness(v.own);
+    // Such a set is another set from another path (no same_side() sharing).
+    v.lambert = !per_path && single_lambert(v.own);
   }
   const Vec3f wi_world = -dir;
   // The frame PT uses: a shading normal facing away from wi stays (the BSDFs see wi below it).
@@ -68,11 +80,36 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   v.offset_scale = ctx.bvh().offset_scale();
 }
 
-Spectrum triangle_emission(const SceneContext& ctx, const SurfaceHit& hit, Vec3f from) {
+const ClosureSet& shared_closures(const SceneContext& ctx, const Vertex& base, Vec3f wi_world,
+                                  const PathView& path, ClosureSet& scratch) {
+  const Material& m = ctx.materials()[size_t(base.hit.material)];
+  if (!m.reads_view() && !m.reads_path()) return *base.closures;
+  ShadingContext sc = shading_context_of(base.hit);
+  const ShadingGeometry view = shading_geometry(base.hit, wi_world);
+  sc.geometry = &view;
+  sc.path = &path;
+  m.evaluate(sc, scratch);
+  // Bump shadowing as at the base (`rotated`: let shading_closures compare the normals).
+  return shading_closures(scratch, scratch, base.hit, base.frame, base.ng, wi_world, true);
+}
+
+Spectrum triangle_emission(const SceneContext& ctx, const SurfaceHit& hit, Vec3f from,
+                           const PathView& path) {
   const Material& m = ctx.materials()[size_t(hit.material)];
   if (!m.is_emissive()) return Spectrum(0.0f);
   ShadingContext sc = shading_context_of(hit);
   sc.front_facing = dot(from - hit.position, hit.geometric_normal) > 0.0f;
+  ShadingGeometry view;
+  if (m.reads_view()) {
+    view = shading_geometry(hit, normalize(from - hit.position), sc.front_facing);
+    sc.geometry = &view;
+  }
+  PathView own;
+  if (m.reads_path()) {
+    own = path;
+    own.ray_length = length(from - hit.position);
+    sc.path = &own;
+  }
   return m.emission(sc);
 }
 

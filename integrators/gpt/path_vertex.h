@@ -76,19 +76,29 @@ float vertex_roughness(const ClosureSet& cs);
 float hit_roughness(const SceneContext& ctx, std::span<const MaterialSide> sides,
                     const SurfaceHit& h);
 
-// Sets up `v` at its hit v.hit reached along `dir` (world, unit). (The base's next hit is traced
-// into v.hit directly: no copy.)
+// Sets up `v` at its hit v.hit reached along `dir` (world, unit) by the path `path` (for
+// materials that read it, Material::reads_path). (The base's next hit is traced into v.hit
+// directly: no copy.)
 void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides, const Vec3f& dir,
-                   Vertex& v);
+                   const PathView& path, Vertex& v);
 
 // The same at a copy of `hit`.
 inline void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
-                         const SurfaceHit& hit, const Vec3f& dir, Vertex& v) {
+                         const SurfaceHit& hit, const Vec3f& dir, const PathView& path, Vertex& v) {
   v.hit = hit;
-  finish_vertex(ctx, sides, dir, v);
+  finish_vertex(ctx, sides, dir, path, v);
 }
 
-// Emitted radiance of an emissive triangle at `hit` towards the point `from`.
-Spectrum triangle_emission(const SceneContext& ctx, const SurfaceHit& hit, Vec3f from);
+// The closures of the base vertex `base` as an offset that reached it by reconnection sees them
+// from `wi_world` (unit, towards the offset's previous vertex) at the end of `path` (its own ray
+// length): the base's own, unless its material reads the view or the path
+// (Material::reads_view, reads_path); then evaluated into `scratch`, in the base's frame.
+const ClosureSet& shared_closures(const SceneContext& ctx, const Vertex& base, Vec3f wi_world,
+                                  const PathView& path, ClosureSet& scratch);
+
+// Emitted radiance of an emissive triangle at `hit` towards the point `from`, reached by `path`
+// (for materials that read it; the ray length is the distance to `from`).
+Spectrum triangle_emission(const SceneContext& ctx, const SurfaceHit& hit, Vec3f from,
+                           const PathView& path);
 
 }  // namespace gdpt

@@ -147,6 +147,9 @@ class PathTracer final : public Integrator {
     PathResult out;
     Path path;
     path.prev_position = ray.origin;
+    // The view and the path state of a vertex, for materials that read them.
+    ShadingGeometry view;
+    PathView path_view;
     // `vertex` numbers every surface interaction (sampler dimensions); state.bounce follows Cycles.
     for (int vertex = 0;; ++vertex) {
       const bool last = path.state.last(settings_);
@@ -170,8 +173,16 @@ class PathTracer final : public Integrator {
       }
 
       // --- Shading point ---
-      const ShadingContext sc = shading_context_of(hit);
+      ShadingContext sc = shading_context_of(hit);
       const Material& material = ctx_.materials()[size_t(hit.material)];
+      if (material.reads_view()) [[unlikely]] {
+        view = shading_geometry(hit, -ray.direction);
+        sc.geometry = &view;
+      }
+      if (material.reads_path()) [[unlikely]] {
+        path_view = path.state.view(hit.t);
+        sc.path = &path_view;
+      }
       if constexpr (kEmissive)
         if (material.is_emissive()) emitter_hit(path, hit, material.emission(sc), out);
       if (last) break;
@@ -310,7 +321,7 @@ class PathTracer final : public Integrator {
     // vertex is still the competing technique.
     const bool crossing = bs.is_straight_crossing();
     const uint32_t kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
-    path.state.count_event(crossing, kind);
+    path.state.count_event(crossing, kind, bs.lobe);
     path.crossed_since_vertex = crossing;
     bool continues = true;
     if (!crossing) {

@@ -100,6 +100,17 @@ struct TriangleLight {
     const Vec3f color = color0 * (1.0f - b.x - b.y) + color1 * b.x + color2 * b.y;
     ctx.color = &color;
     ctx.front_facing = dot(dir, normal) < 0.0f;  // the receiver is on the normal's side
+    ShadingGeometry view;
+    if (m.reads_view()) {
+      // Seen from the receiver; the triangle keeps no corner normals: the flat one stands in.
+      const Vec3f n = ctx.front_facing ? normal : -normal;
+      view = {-dir, n, n, n};
+      ctx.geometry = &view;
+    }
+    PathView light_sample;  // Cycles evaluates a light sample's emission outside any path
+    light_sample.light_sample = true;
+    light_sample.ray_length = d;
+    if (m.reads_path()) ctx.path = &light_sample;
     s.radiance = m.emission(ctx);
     s.position = p;
     s.normal = normal;

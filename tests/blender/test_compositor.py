@@ -12,6 +12,10 @@
 #  - tweaking alpha / norm after the render re-solves from the cached passes (the node's image
 #    equals the reconstruction with the new settings); without cached passes the node says so
 #    and leaves its image alone;
+#  - that re-solve runs in a background thread: on passes enlarged to 512x384 (L1), setting alpha
+#    returns in a small fraction of the solve's time with the image not yet changed and a
+#    "Solving" progress line on the node; once done, the image equals the synchronous solve of
+#    the same passes; two quick changes are coalesced into the last one;
 #  - a copied node owns its image (tweaking the copy leaves the original alone);
 #  - two view layers: each node solves the layer its Render Layers node names;
 #  - a multilayer EXR Image node as the source (read through the module's OpenImageIO reader),
@@ -22,6 +26,7 @@ import math
 import os
 import subprocess
 import sys
+import time
 
 import bpy
 import numpy as np
@@ -180,11 +185,13 @@ def test_update_from_cache(scene, node, ch):
     from gdpt import compositor_node
     before = node_pixels(node)
     node.alpha = 0.3  # the update callback re-solves from the cached passes
+    compositor_node.wait_for_solves()
     px = node_pixels(node)
     err = max_rel_diff(px[..., :3], solve(ch, 'L1', 0.3))
     check(err < 1e-4, f"alpha 1 -> 0.3 re-solves from the cache (L1; max rel diff {err:.2e})")
     check(float(np.abs(px - before).mean()) > 1e-3, "the node's image changed")
     node.norm = 'L2'
+    compositor_node.wait_for_solves()
     px = node_pixels(node)
     err = max_rel_diff(px[..., :3], solve(ch, 'L2', 0.3))
     check(err < 1e-4, f"norm L1 -> L2 re-solves from the cache (max rel diff {err:.2e})")
@@ -211,6 +218,57 @@ def test_update_from_cache(scene, node, ch):
     fresh.use_nodes = False
 
 
+def test_background_resolve(scene, node):
+    """A change of alpha returns at once; the solve runs in a thread and its image, once shown,
+    equals the synchronous solve. Run on the cached passes enlarged 8x (512x384) so that the L1
+    solve takes long enough to be seen running."""
+    from gdpt import _gdpt, compositor_node
+    key = (scene.name, "ViewLayer")
+    saved = dict(compositor_node._CACHE[key])
+    big = {k: np.ascontiguousarray(np.tile(v, (8, 8, 1))) for k, v in saved.items()
+           if isinstance(v, np.ndarray) and v.ndim == 3 and v.shape[2] == 3}
+    compositor_node._CACHE[key].update(big)
+    compositor_node._CACHE[key]["alpha"] = None
+    compositor_node._CACHE[key]["placement"] = None
+    try:
+        node.norm, node.alpha = 'L1', 0.5
+        compositor_node.wait_for_solves()
+        before = node_pixels(node).copy()
+        start = time.monotonic()
+        node.alpha = 0.25
+        returned = time.monotonic() - start
+        job = compositor_node._JOBS[node.as_pointer()]
+        running = compositor_node.solving(node)
+        unchanged = np.array_equal(node_pixels(node), before)
+        line = compositor_node._STATUS[node.as_pointer()][1]
+        compositor_node.wait_for_solves()
+        check(running and unchanged, f"setting alpha returned in {returned * 1e3:.0f} ms with the "
+                                     f"solve still running and the image unchanged")
+        check(returned < 0.2 * job.seconds, f"the setter took {returned * 1e3:.0f} ms, the "
+                                            f"background solve {job.seconds * 1e3:.0f} ms")
+        check(line.startswith("Solving L1, alpha 0.25"), f"progress line while solving: '{line}'")
+        check(float(job.progress[0]) == 1.0, "the progress slot reached 1")
+        ref = _gdpt.reconstruct(big["primal"], big["gradient_x"], big["gradient_y"], None,
+                                big["emission"], 'L1', 0.25)
+        px = node_pixels(node)
+        check(px.shape[:2] == ref.shape[:2] and np.array_equal(px[..., :3], ref),
+              "the image shown after the background solve equals the synchronous solve")
+        level, message = compositor_node._STATUS[node.as_pointer()]
+        check(level == 'INFO' and "L1, alpha 0.25" in message and "solved in" in message,
+              f"status after the solve: '{message}'")
+        # Two changes while solving: one follow-up solve with the last settings.
+        node.alpha = 0.6
+        node.alpha = 0.7
+        compositor_node.wait_for_solves()
+        ref = _gdpt.reconstruct(big["primal"], big["gradient_x"], big["gradient_y"], None,
+                                big["emission"], 'L1', 0.7)
+        check(np.array_equal(node_pixels(node)[..., :3], ref), "quick changes end on the last one")
+    finally:
+        compositor_node._CACHE[key] = saved
+        node.norm, node.alpha = 'L2', 0.3  # as test_update_from_cache left it
+        compositor_node.wait_for_solves()
+
+
 def test_copy_owns_its_image(scene, node, ch):
     """A copied node (a scene copy here; Shift+D alike) gets its own image: tweaking the
     copy leaves the original's result alone."""
@@ -222,6 +280,7 @@ def test_copy_owns_its_image(scene, node, ch):
     copy = next(n for n in copy_scene.node_tree.nodes if n.bl_idname == NODE)
     copy_scene.node_tree.nodes["Render Layers"].scene = scene  # read the rendered passes
     copy.alpha = 0.9
+    compositor_node.wait_for_solves()
     check(compositor_node.node_image(copy) != compositor_node.node_image(node),
           "the copy has its own image")
     err = max_rel_diff(node_pixels(copy)[..., :3], solve(ch, copy.norm, 0.9))
@@ -300,6 +359,7 @@ def test_unlinked_inputs(out):
 
 def test_exr_image_node(out, exr_path):
     """A multilayer EXR loaded in an Image node feeds the node (no render needed to tweak it)."""
+    from gdpt import compositor_node
     scene = S.clear()
     build(scene)
     scene.use_nodes = True
@@ -317,6 +377,7 @@ def test_exr_image_node(out, exr_path):
     tree.links.new(node.outputs["Image"], comp.inputs["Image"])
     node.norm = 'L2'
     node.alpha = 0.4  # update: reads the file
+    compositor_node.wait_for_solves()
     ch = exr.read_exr(exr_path)
     err = max_rel_diff(node_pixels(node)[..., :3], solve(ch, 'L2', 0.4))
     check(err < 1e-4, f"EXR Image node: the node's image = L2 solve of the file (max rel diff "
@@ -353,6 +414,7 @@ def main():
     exr_path = test_command_line(out, a["build"])
     scene, node, ch = test_render_layers(out)
     test_update_from_cache(scene, node, ch)
+    test_background_resolve(scene, node)
     test_copy_owns_its_image(scene, node, ch)
     test_two_view_layers(out)
     test_unlinked_inputs(out)

@@ -210,6 +210,130 @@ def case_velvet(scene):
     return 4
 
 
+def _mix_by(m, factor_node, output, second):
+    """Material m's shader mixed with `second` (a shader node in m) by `output` of factor_node."""
+    nt = m.node_tree
+    out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    nt.links.new(out.inputs["Surface"].links[0].from_socket, mix.inputs[1])
+    nt.links.new(second.outputs[0], mix.inputs[2])
+    nt.links.new(factor_node.outputs[output], mix.inputs[0])
+    nt.links.new(mix.outputs[0], out.inputs["Surface"])
+    return mix
+
+
+def case_view_nodes(scene):
+    # Nodes that read the incoming direction: a ball mixing Diffuse and a rough Glossy by Fresnel
+    # (IOR 1.45), one mixing a dark and a light Diffuse by Layer Weight's Facing (blend 0.3), and a
+    # dim one whose rim glows by Layer Weight's Fresnel (blend 0.4) driving an Emission.
+    lit_room(scene)
+    area_ceiling(size=1.5, energy=250.0)
+    a = S.diffuse("fresnel", (0.2, 0.3, 0.7))
+    nt = a.node_tree
+    fresnel = nt.nodes.new("ShaderNodeFresnel")
+    fresnel.inputs["IOR"].default_value = 1.45
+    glossy = nt.nodes.new("ShaderNodeBsdfGlossy")
+    glossy.distribution = 'GGX'
+    glossy.inputs["Roughness"].default_value = 0.3
+    _mix_by(a, fresnel, "Fac", glossy)
+    S.uv_sphere("fresnel", 0.7, (-1.2, 0.4, 0.7), a)
+    b = S.diffuse("facing", (0.05, 0.05, 0.05))
+    nt = b.node_tree
+    weight = nt.nodes.new("ShaderNodeLayerWeight")
+    weight.inputs["Blend"].default_value = 0.3
+    light = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    light.inputs["Color"].default_value = (0.9, 0.7, 0.3, 1)
+    _mix_by(b, weight, "Facing", light)
+    S.uv_sphere("facing", 0.7, (0.3, 0.6, 0.7), b)
+    c = S.diffuse("rim", (0.1, 0.1, 0.1))
+    nt = c.node_tree
+    weight = nt.nodes.new("ShaderNodeLayerWeight")
+    weight.inputs["Blend"].default_value = 0.4
+    glow = nt.nodes.new("ShaderNodeEmission")
+    glow.inputs["Color"].default_value = (0.3, 0.9, 0.5, 1)
+    nt.links.new(weight.outputs["Fresnel"], glow.inputs["Strength"])
+    add = nt.nodes.new("ShaderNodeAddShader")
+    out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
+    nt.links.new(out.inputs["Surface"].links[0].from_socket, add.inputs[0])
+    nt.links.new(glow.outputs[0], add.inputs[1])
+    nt.links.new(add.outputs[0], out.inputs["Surface"])
+    S.uv_sphere("rim", 0.5, (1.5, 0.0, 0.5), c)
+    return 4
+
+
+def _out_shader(m):
+    nt = m.node_tree
+    out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
+    return nt, out.inputs["Surface"].links[0].from_node
+
+
+def case_path_nodes(scene):
+    # Geometry and Light Path in object materials: a ceiling panel that lights the room but hides
+    # from the camera (Emission times 1 - Is Camera Ray); a ball coloured by its normal
+    # (|Normal| through Vector Math); one mixing two Diffuse colours by Is Diffuse Ray (the camera
+    # sees one, diffuse bounces the other); a floor rug whose colour fades with Ray Length; a ball
+    # mixing Diffuse and Glossy by Incoming . True Normal.
+    lit_room(scene)
+    area_ceiling(size=1.0, energy=80.0)
+    panel = S.emission("panel", (1.0, 0.9, 0.8), 6.0)
+    nt, glow = _out_shader(panel)
+    path = nt.nodes.new("ShaderNodeLightPath")
+    hide = nt.nodes.new("ShaderNodeMath")
+    hide.operation = 'SUBTRACT'
+    hide.inputs[0].default_value = 6.0
+    hide.inputs[1].default_value = 6.0
+    scale = nt.nodes.new("ShaderNodeMath")
+    scale.operation = 'MULTIPLY'
+    scale.inputs[1].default_value = 6.0
+    nt.links.new(path.outputs["Is Camera Ray"], scale.inputs[0])
+    nt.links.new(scale.outputs[0], hide.inputs[1])
+    nt.links.new(hide.outputs[0], glow.inputs["Strength"])
+    S.plane("panel", 1.0, (1.2, 0.8, 3.9), (math.pi, 0, 0), panel)
+    normal = S.diffuse("normal", (0.5, 0.5, 0.5))
+    nt, bsdf = _out_shader(normal)
+    geometry = nt.nodes.new("ShaderNodeNewGeometry")
+    absolute = nt.nodes.new("ShaderNodeVectorMath")
+    absolute.operation = 'ABSOLUTE'
+    nt.links.new(geometry.outputs["Normal"], absolute.inputs[0])
+    nt.links.new(absolute.outputs[0], bsdf.inputs["Color"])
+    S.uv_sphere("normal", 0.6, (-1.2, 0.5, 0.6), normal)
+    bleed = S.diffuse("bleed", (0.1, 0.2, 0.8))
+    nt = bleed.node_tree
+    path = nt.nodes.new("ShaderNodeLightPath")
+    yellow = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    yellow.inputs["Color"].default_value = (0.9, 0.8, 0.1, 1)
+    _mix_by(bleed, path, "Is Diffuse Ray", yellow)
+    S.uv_sphere("bleed", 0.6, (0.2, 0.9, 0.6), bleed)
+    rug = S.diffuse("rug", (0.8, 0.3, 0.1))
+    nt, bsdf = _out_shader(rug)
+    path = nt.nodes.new("ShaderNodeLightPath")
+    fade = nt.nodes.new("ShaderNodeMixRGB")
+    fade.use_clamp = True
+    fade.inputs["Color1"].default_value = (0.9, 0.9, 0.9, 1)
+    fade.inputs["Color2"].default_value = (0.1, 0.3, 0.8, 1)
+    length = nt.nodes.new("ShaderNodeMath")
+    length.operation = 'MULTIPLY_ADD'
+    length.inputs[1].default_value = 0.5
+    length.inputs[2].default_value = -2.0
+    nt.links.new(path.outputs["Ray Length"], length.inputs[0])
+    nt.links.new(length.outputs[0], fade.inputs["Fac"])
+    nt.links.new(fade.outputs[0], bsdf.inputs["Color"])
+    S.plane("rug", 3.0, (0, 0, 0.01), material=rug)
+    facing = S.diffuse("incoming", (0.8, 0.2, 0.2))
+    nt = facing.node_tree
+    geometry = nt.nodes.new("ShaderNodeNewGeometry")
+    dot = nt.nodes.new("ShaderNodeVectorMath")
+    dot.operation = 'DOT_PRODUCT'
+    nt.links.new(geometry.outputs["Incoming"], dot.inputs[0])
+    nt.links.new(geometry.outputs["True Normal"], dot.inputs[1])
+    glossy = nt.nodes.new("ShaderNodeBsdfGlossy")
+    glossy.distribution = 'GGX'
+    glossy.inputs["Roughness"].default_value = 0.25
+    _mix_by(facing, dot, "Value", glossy)
+    S.uv_sphere("incoming", 0.5, (1.3, 0.0, 0.5), facing)
+    return 4
+
+
 def case_world_color(scene):
     S.plane("floor", 6.0, (0, 0, 0), material=S.diffuse("floor", (0.6, 0.6, 0.6)))
     S.uv_sphere("ball", 0.8, (0, 0, 0.8), S.diffuse("ball", (0.8, 0.5, 0.3)))

@@ -4,8 +4,10 @@
 # has all its samples the area is saved with screenshot_area. Both are display-transformed 8-bit
 # (Standard view transform): block means of the camera frame in the screenshot must match block
 # means of the F12 image; after the lamp moves, the next screenshot must match the second F12
-# render and differ from the first where the light moved; leaving Rendered mode must stop the
-# job, and Blender must quit with 0.
+# render and differ from the first where the light moved; after the sphere's material changes
+# colour, the next must match a third F12 render. The lamp move and the material change must
+# update the job's session in place (no mesh read, no BVH build), a mesh edit must rebuild it;
+# leaving Rendered mode must stop the job, and Blender must quit with 0.
 #   blender -b --factory-startup --addons gdpt --python test_viewport.py -- --make SCENE.blend
 #   blender --factory-startup --addons gdpt SCENE.blend --python test_viewport.py -- --out DIR
 # (a .blend on the command line: no splash screen over the viewport)
@@ -29,6 +31,7 @@ LAMP_CHANGE = 20.0
 TIMEOUT = 420.0
 FRAME_ZOOM = -12.0
 LAMP_LEFT, LAMP_RIGHT = (-2.0, -1.0, 3.0), (2.0, -1.0, 3.0)
+RED, BLUE = (0.8, 0.1, 0.1, 1.0), (0.1, 0.2, 0.8, 1.0)
 
 
 def fail(message):
@@ -50,7 +53,7 @@ def build_scene(path):
     bpy.ops.mesh.primitive_cube_add(size=1.0, location=(-1.0, 0.5, 0.5))
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.7, location=(1.0, 0.0, 0.7))
     red = bpy.data.materials.new("Red")
-    red.diffuse_color = (0.8, 0.1, 0.1, 1.0)  # no nodes: Blender's diffuse colour
+    red.diffuse_color = RED  # no nodes: Blender's diffuse colour
     bpy.context.active_object.data.materials.append(red)
     light = bpy.data.lights.new("Lamp", 'POINT')
     light.energy = 800.0
@@ -109,6 +112,14 @@ def block_means(rgb):
     return out
 
 
+def job_status():
+    """The status of the viewport's job (one Rendered viewport)."""
+    from gdpt import viewport
+    sessions = [s for s in viewport._live if s.job is not None]
+    check(len(sessions) == 1, f"one viewport session has a job ({len(sessions)})")
+    return sessions[0].job.status()
+
+
 def view3d():
     window = bpy.context.window_manager.windows[0]
     area = max((a for a in window.screen.areas if a.type == 'VIEW_3D'),
@@ -153,6 +164,10 @@ class Steps:
         f12(self.scene, os.path.join(OUT, "f12_left.png"))
         self.lamp.location = LAMP_RIGHT
         f12(self.scene, os.path.join(OUT, "f12_right.png"))
+        self.material = bpy.data.materials["Red"]
+        self.material.diffuse_color = BLUE
+        f12(self.scene, os.path.join(OUT, "f12_blue.png"))
+        self.material.diffuse_color = RED
         self.lamp.location = LAMP_LEFT
         window, area, region = view3d()
         space = area.spaces.active
@@ -167,13 +182,14 @@ class Steps:
         space.shading.type = 'RENDERED'
         self.stage = "wait_image"
         self.wait_from = time.perf_counter()
-        self.job = 0
+        self.shown = (0, 0)  # (job, restart) of the image before the change
         return 0.2
 
     def wait_image(self):
         from gdpt import viewport
         d = viewport.LAST_DRAW
-        if d.get("job", 0) <= self.job or d.get("samples") != SAMPLES or d.get("rendering"):
+        if (d.get("job", 0), d.get("restart", 0)) <= self.shown or d.get("samples") != SAMPLES \
+                or d.get("rendering"):
             return 0.2
         if not hasattr(self, "first_seconds"):
             self.first_seconds = time.perf_counter() - self.wait_from
@@ -190,29 +206,50 @@ class Steps:
             check(viewport.LAST_EXPORT["exported"] == 3 and viewport.LAST_EXPORT["reused"] == 0,
                   f"the first export reads the 3 meshes: {viewport.LAST_EXPORT}")
             self.compare(self.shots[0], "f12_left.png")
-            self.job = d["job"]  # the lamp move must start a new job
+            self.status = job_status()
+            self.shown = (d["job"], d["restart"])  # the lamp move must restart the render
             self.lamp.location = LAMP_RIGHT
             self.wait_from = time.perf_counter()
             return 0.2
-        check(viewport.LAST_EXPORT["exported"] == 0 and viewport.LAST_EXPORT["reused"] == 3,
-              f"the lamp move keeps the 3 meshes: {viewport.LAST_EXPORT}")
-        self.compare(self.shots[1], "f12_right.png")
-        before, after = block_means(self.shots[0]), block_means(self.shots[1])
-        change = (after - before).mean(axis=2)
-        half = BLOCKS[0] // 2
-        check(change[:, :half].mean() < -LAMP_CHANGE / 4 and change[:, half:].mean() > LAMP_CHANGE / 4,
-              f"the lamp moved right: the left half darkened ({change[:, :half].mean():.1f}), "
-              f"the right half brightened ({change[:, half:].mean():.1f})")
-        check(np.abs(change).max() > LAMP_CHANGE,
-              f"the largest block change {np.abs(change).max():.1f} > {LAMP_CHANGE}")
+        self.check_in_place(d, "light" if len(self.shots) == 2 else "material")
+        if len(self.shots) == 2:
+            self.compare(self.shots[1], "f12_right.png")
+            before, after = block_means(self.shots[0]), block_means(self.shots[1])
+            change = (after - before).mean(axis=2)
+            half = BLOCKS[0] // 2
+            check(change[:, :half].mean() < -LAMP_CHANGE / 4 and
+                  change[:, half:].mean() > LAMP_CHANGE / 4,
+                  f"the lamp moved right: the left half darkened ({change[:, :half].mean():.1f}),"
+                  f" the right half brightened ({change[:, half:].mean():.1f})")
+            check(np.abs(change).max() > LAMP_CHANGE,
+                  f"the largest block change {np.abs(change).max():.1f} > {LAMP_CHANGE}")
+            self.shown = (d["job"], d["restart"])
+            self.material.diffuse_color = BLUE
+            self.wait_from = time.perf_counter()
+            return 0.2
+        self.compare(self.shots[2], "f12_blue.png")
         self.full_rect = d["rect"]
         self.free_views = ['PERSP', 'ORTHO']
         self.stage = "free_view"
         return 0.0
 
+    def check_in_place(self, d, kind):
+        """The change of `kind` restarted the same job with its session updated in place: no
+        mesh read from Blender, no BVH built."""
+        from gdpt import viewport
+        status = job_status()
+        check(d["job"] == self.shown[0], f"the {kind} change kept the job")
+        check(viewport.LAST_EXPORT["exported"] == 0 and viewport.LAST_EXPORT["reused"] == 3 and
+              viewport.LAST_EXPORT["changes"] == [kind],
+              f"the {kind} change read no mesh: {viewport.LAST_EXPORT}")
+        check(status["bvh_builds"] == self.status["bvh_builds"] and
+              status["in_place_updates"] == self.status["in_place_updates"] + 1,
+              f"the {kind} change updated the session in place, no BVH build: {status}")
+        self.status = status
+
     def border(self):
         """Back in camera view with a Render Region: the right half of the frame only renders
-        and draws, and matches the right half of the F12 image."""
+        and draws, and matches the right half of the F12 image (lamp right, blue sphere)."""
         from gdpt import viewport
         self.restart = viewport.LAST_DRAW["restart"]
         r = self.scene.render
@@ -235,12 +272,12 @@ class Steps:
         path = os.path.join(OUT, "viewport_border.png")
         with bpy.context.temp_override(window=window, area=area, region=region):
             bpy.ops.screen.screenshot_area(filepath=path)
-        f12_right = load_rgb(os.path.join(OUT, "f12_right.png"))
-        f12_right = f12_right[:, f12_right.shape[1] // 2:]
-        self.compare_to(frame_of_screenshot(path, area, region), f12_right,
-                        "the right half of f12_right.png")
-        # An edit of the cube's mesh: only that mesh is read again.
-        self.job = viewport.LAST_DRAW["job"]
+        f12_blue = load_rgb(os.path.join(OUT, "f12_blue.png"))
+        f12_blue = f12_blue[:, f12_blue.shape[1] // 2:]
+        self.compare_to(frame_of_screenshot(path, area, region), f12_blue,
+                        "the right half of f12_blue.png")
+        # An edit of the cube's mesh: only that mesh is read again, and the BVH built again.
+        self.status = job_status()
         cube = next(o for o in self.scene.objects if o.name.startswith("Cube"))
         cube.data.vertices[0].co.z += 0.1
         cube.data.update()
@@ -249,10 +286,14 @@ class Steps:
 
     def wait_geometry_edit(self):
         from gdpt import viewport
-        if viewport.LAST_DRAW["job"] <= self.job:
+        status = job_status()
+        if status["bvh_builds"] + status["in_place_updates"] <= \
+                self.status["bvh_builds"] + self.status["in_place_updates"]:
             return 0.2
         check(viewport.LAST_EXPORT["exported"] == 1 and viewport.LAST_EXPORT["reused"] == 2,
               f"a mesh edit reads that mesh again and keeps the others: {viewport.LAST_EXPORT}")
+        check(status["bvh_builds"] == self.status["bvh_builds"] + 1,
+              f"a mesh edit builds the BVH again: {status}")
         view3d()[1].spaces.active.shading.type = 'SOLID'
         self.stage = "left_mode"
         self.wait_from = time.perf_counter()

@@ -457,6 +457,50 @@ TEST(GradientUnbiased, MultiLobeMaterialsWithADeltaLobe) {
   expect_unbiased("principled-transmission", principled, 4096, 1024, 0.26f);
 }
 
+// Materials whose closures depend on the incoming direction (Layer Weight, Fresnel) or on the
+// path (Light Path's Ray Length): an offset that reconnects to the base's vertex sees it from its
+// own direction at its own distance, so it must evaluate the material there itself
+// (shared_closures) rather than reuse the base's closures; a half-vector offset's own vertex
+// likewise. White walls mix a dark and a light diffuse by Layer Weight's Facing (every vertex
+// reconnects), the red wall white into red by the ray length, the ball a diffuse and a rough
+// glossy by Fresnel.
+MaterialDesc view_mix(MaterialDesc a, MaterialDesc b, InputNode factor) {
+  MaterialDesc m = mix_of(std::move(a), std::move(b), 0.0f);
+  m.inputs = {factor};
+  m.nodes[2].fac.node = 0;
+  return m;
+}
+
+TEST(GradientUnbiased, ViewDependentMaterials) {
+  InputNode facing;  // 1 - |cos|^5: steep, so a few degrees between base and offset matter
+  facing.kind = InputNodeKind::LayerWeight;
+  facing.value_a = FloatInput(0.9f);
+  facing.channel = 1;
+  InputNode fresnel;
+  fresnel.kind = InputNodeKind::Fresnel;
+  fresnel.value_a = FloatInput(1.45f);
+  Scene scene = make_scene(SceneKind::CornellDiffuse, 32);
+  scene.materials[0] =
+      view_mix(diffuse({0.05f, 0.05f, 0.05f}), diffuse({0.95f, 0.9f, 0.85f}), facing);
+  scene.materials[3] =
+      view_mix(diffuse({0.5f, 0.5f, 0.8f}), glossy({0.9f, 0.9f, 0.9f}, 0.3f), fresnel);
+  InputNode length;
+  length.kind = InputNodeKind::LightPath;
+  length.light_path_output = LightPathOutput::RayLength;
+  InputNode ramp;  // 5 (ray length - 1), clamped to [0, 1]
+  ramp.kind = InputNodeKind::Math;
+  ramp.math = MathOp::MultiplyAdd;
+  ramp.value_a.node = 1;
+  ramp.value_b = FloatInput(5.0f);
+  ramp.value_c = FloatInput(-5.0f);
+  ramp.clamp_result = true;
+  scene.materials[1] = view_mix(diffuse({0.95f, 0.9f, 0.9f}), diffuse({0.6f, 0.05f, 0.05f}), ramp);
+  scene.materials[1].inputs.push_back(length);
+  scene.materials[2] = view_mix(diffuse({0.95f, 0.9f, 0.9f}), diffuse({0.05f, 0.4f, 0.05f}), ramp);
+  scene.materials[2].inputs.push_back(length);
+  expect_unbiased("view-dependent", scene, 4096, 1024, 0.1f);
+}
+
 TEST(GradientIntegrator, DeterministicAcrossThreadCounts) {
   const Scene scene = make_scene(SceneKind::CornellGlossy, 24, 0.02f);
   const Passes a = render(scene, settings(RenderSettings::Mode::GPT, 8, 3, 1));

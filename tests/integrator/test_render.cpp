@@ -1703,6 +1703,56 @@ TEST(Render, SetCameraRendersAsANewSession) {
   }
 }
 
+// The viewport's in-place update: after update() with moved and brighter lamps, another material
+// colour, another world and other settings, a session keeps its BVH and renders bit for bit what
+// a new session of the changed scene renders, in PT and G-PT; a moved instance rebuilds it (same
+// image as a new session again); an unusable scene is refused and the session keeps its own.
+TEST(Render, UpdateRendersAsANewSession) {
+  for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+    const Scene scene = cornell_like();
+    RenderSettings s = pt(2, 5);
+    s.mode = mode;
+    auto film_of = [](const RenderSession& session) {
+      std::vector<float> v(session.film().pixel_count() * 3);
+      session.film().primal_rgb(v.data());
+      return v;
+    };
+    auto expect_as_new = [&](RenderSession& session, const Scene& changed, const RenderSettings& st,
+                             const char* what) {
+      std::atomic<bool> cancel{false};
+      ASSERT_EQ(session.film().min_samples(), 0u) << what;  // the film starts over
+      session.render(nullptr, cancel);
+      EXPECT_EQ(film_of(session), render(changed, st).primal) << what << " mode " << int(mode);
+      EXPECT_NE(film_of(session), render(scene, s).primal) << what << ": nothing changed";
+    };
+    RenderSession session(scene, s);
+    std::atomic<bool> cancel{false};
+    session.render(nullptr, cancel);
+
+    Scene shaded = scene;
+    shaded.lights[0].light_to_world.m[0][3] -= 0.5f;
+    shaded.lights[0].power *= 2.0f;
+    shaded.materials[1] = diffuse(Spectrum(0.1f, 0.1f, 0.8f));
+    shaded.world.color = Spectrum(0.3f, 0.2f, 0.1f);
+    RenderSettings s2 = s;
+    s2.max_bounces = 2;
+    s2.samples = 3;
+    EXPECT_TRUE(session.update(shaded, s2));
+    expect_as_new(session, shaded, s2, "lamp, material, world and settings");
+
+    Scene bad = shaded;
+    bad.world.image = 3;  // no such image
+    EXPECT_THROW(session.update(bad, s2), std::invalid_argument);
+    session.set_camera(shaded.camera);
+    expect_as_new(session, shaded, s2, "after a refused update");
+
+    Scene moved = shaded;
+    moved.instances[1].object_to_world.m[2][3] += 0.2f;
+    EXPECT_FALSE(session.update(moved, s2));
+    expect_as_new(session, moved, s2, "a moved instance");
+  }
+}
+
 TEST(Render, NeverNaNOrInf) {
   Scene scene = cornell_like();
   // Degenerate triangles, zero-length and inverted shading normals, zero-roughness glossy,
