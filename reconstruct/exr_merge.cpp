@@ -43,6 +43,78 @@ T parse_number(const std::string& text, const std::string& what) {
   return value;
 }
 
+// Blender's channel order within a pass (R, G, B, A or X, Y, Z, W), whatever order the file
+// lists them in; other names keep the file's order.
+int channel_rank(const std::string& channel) {
+  static const std::string kOrders[2] = {"RGBA", "XYZW"};
+  for (const std::string& order : kOrders)
+    if (channel.size() == 1 && order.find(channel[0]) != std::string::npos)
+      return int(order.find(channel[0]));
+  return 4;
+}
+
+// Each pass's channel indices, by (view layer, pass), in Blender's channel order.
+using PassChannels = std::map<std::pair<std::string, std::string>, std::vector<size_t>>;
+PassChannels pass_channels(const ExrChannels& image, const std::string& name) {
+  PassChannels channels;
+  std::vector<int> rank(image.names.size());
+  for (size_t c = 0; c < image.names.size(); ++c) {
+    ChannelName n;
+    if (!split_channel(image.names[c], n))
+      throw MergeError("'" + name + "': channel '" + image.names[c] +
+                       "' is not named <view layer>.<pass>.<channel>: not a multilayer EXR of a "
+                       "Blender render");
+    channels[{n.layer, n.pass}].push_back(c);
+    rank[c] = channel_rank(n.channel);
+  }
+  for (auto& [key, list] : channels)
+    std::stable_sort(list.begin(), list.end(),
+                     [&](size_t a, size_t b) { return rank[a] < rank[b]; });
+  return channels;
+}
+
+// Reads every input; the files must hold the same channels.
+void read_inputs(const std::vector<std::string>& inputs, std::vector<ExrChannels>& images,
+                 std::vector<std::map<std::string, RenderPart>>& parts) {
+  for (const std::string& path : inputs) {
+    images.push_back(read_exr_channels(path));
+    if (images.back().half)
+      throw MergeError("'" + path +
+                       "' stores half floats: render with Color Depth Float (Full) for an exact "
+                       "merge");
+    parts.push_back(parts_from_exr(images.back(), path));
+    const ExrChannels& a = images.front();
+    const ExrChannels& b = images.back();
+    for (const std::string& n : b.names)
+      if (std::find(a.names.begin(), a.names.end(), n) == a.names.end())
+        throw MergeError("'" + path + "' has a channel '" + n + "' that '" + inputs.front() +
+                         "' lacks: merged files need the same passes");
+    for (const std::string& n : a.names)
+      if (std::find(b.names.begin(), b.names.end(), n) == b.names.end())
+        throw MergeError("'" + path + "' has no channel '" + n + "', which '" + inputs.front() +
+                         "' has: merged files need the same passes");
+  }
+}
+
+// `out` (the lowest part's file) with the merged layers' values and records.
+void store_merged(ExrChannels& out, const std::vector<RenderPart>& merged_layers, size_t files) {
+  const PassChannels channels = pass_channels(out, "merged");
+  for (const RenderPart& merged : merged_layers) {
+    for (const auto& [name, pass] : merged.passes) {
+      const std::vector<size_t>& list = channels.at({merged.name, name});
+      for (size_t k = 0; k < list.size(); ++k)
+        for (size_t i = 0; i < out.planes[list[k]].size(); ++i)
+          out.planes[list[k]][i] = pass.data[i * size_t(pass.channels) + k];
+    }
+    const auto& counts = merged.passes.at("Sample Count").data;
+    out.attributes[record_key(merged.name, "sample_offset")] =
+        std::to_string(merged.record.sample_offset);
+    out.attributes[record_key(merged.name, "samples")] =
+        std::to_string(uint32_t(*std::max_element(counts.begin(), counts.end())));
+    out.attributes[record_key(merged.name, "merged_parts")] = std::to_string(files);
+  }
+}
+
 }  // namespace
 
 std::string record_key(const std::string& layer, const std::string& key) {
@@ -52,16 +124,7 @@ std::string record_key(const std::string& layer, const std::string& key) {
 std::map<std::string, RenderPart> parts_from_exr(const ExrChannels& image,
                                                  const std::string& name) {
   const size_t pixels = size_t(image.width) * size_t(image.height);
-  // Each pass's channels in file order, by (layer, pass).
-  std::map<std::pair<std::string, std::string>, std::vector<size_t>> channels;
-  for (size_t c = 0; c < image.names.size(); ++c) {
-    ChannelName n;
-    if (!split_channel(image.names[c], n))
-      throw MergeError("'" + name + "': channel '" + image.names[c] +
-                       "' is not named <view layer>.<pass>.<channel>: not a multilayer EXR of a "
-                       "Blender render");
-    channels[{n.layer, n.pass}].push_back(c);
-  }
+  const auto channels = pass_channels(image, name);
   std::map<std::string, RenderPart> parts;
   for (const auto& [key, list] : channels) {
     RenderPart& part = parts[key.first];
@@ -95,24 +158,7 @@ ExrMergeSummary merge_exr_files(const std::vector<std::string>& inputs, const st
   if (inputs.empty()) throw MergeError("no input files");
   std::vector<ExrChannels> images;
   std::vector<std::map<std::string, RenderPart>> parts;  // [file][view layer]
-  for (const std::string& path : inputs) {
-    images.push_back(read_exr_channels(path));
-    if (images.back().half)
-      throw MergeError("'" + path +
-                       "' stores half floats: render with Color Depth Float (Full) for an exact "
-                       "merge");
-    parts.push_back(parts_from_exr(images.back(), path));
-    const ExrChannels& a = images.front();
-    const ExrChannels& b = images.back();
-    for (const std::string& n : b.names)
-      if (std::find(a.names.begin(), a.names.end(), n) == a.names.end())
-        throw MergeError("'" + path + "' has a channel '" + n + "' that '" + inputs.front() +
-                         "' lacks: merged files need the same passes");
-    for (const std::string& n : a.names)
-      if (std::find(b.names.begin(), b.names.end(), n) == b.names.end())
-        throw MergeError("'" + path + "' has no channel '" + n + "', which '" + inputs.front() +
-                         "' has: merged files need the same passes");
-  }
+  read_inputs(inputs, images, parts);
   ExrMergeSummary summary;
   size_t lowest_file = 0;
   std::vector<RenderPart> merged_layers;
@@ -142,24 +188,7 @@ ExrMergeSummary merge_exr_files(const std::vector<std::string>& inputs, const st
 
   // The output: the lowest part's channels and header, with the merged values and record.
   ExrChannels out = std::move(images[lowest_file]);
-  for (const RenderPart& merged : merged_layers) {
-    std::map<std::string, size_t> used;  // channels taken per pass, in file order
-    for (size_t c = 0; c < out.names.size(); ++c) {
-      ChannelName n;
-      split_channel(out.names[c], n);
-      if (n.layer != merged.name) continue;
-      const PassImage& pass = merged.passes.at(n.pass);
-      const size_t k = used[n.pass]++;
-      for (size_t i = 0; i < out.planes[c].size(); ++i)
-        out.planes[c][i] = pass.data[i * size_t(pass.channels) + k];
-    }
-    const auto& counts = merged.passes.at("Sample Count").data;
-    out.attributes[record_key(merged.name, "sample_offset")] =
-        std::to_string(merged.record.sample_offset);
-    out.attributes[record_key(merged.name, "samples")] =
-        std::to_string(uint32_t(*std::max_element(counts.begin(), counts.end())));
-    out.attributes[record_key(merged.name, "merged_parts")] = std::to_string(inputs.size());
-  }
+  store_merged(out, merged_layers, inputs.size());
   write_exr_channels(output, out);
   return summary;
 }

@@ -15,6 +15,9 @@ PACKAGES=(
   blender
   # The viewport test: Blender with a window on Xvfb and Mesa's software OpenGL.
   xvfb xauth libgl1-mesa-dri libglx-mesa0
+  # The render farm's localhost test (tests/farm): a private single-node Slurm (auth/none, so
+  # the MUNGE daemon the package brings is not started).
+  slurm-wlm
 )
 
 missing=()

@@ -24,6 +24,9 @@ _FILM_KEYS = {
     "Emission": "emission",
     "Variance": "variance",
     "Shift Failures": "shift_failures",
+    "Sample Count": "sample_count",
+    "Shift Attempts": "shift_attempts",
+    "Gradient Halves": "gradient_halves",
     "Depth": "depth",
     "IndexOB": "object_index",
     "IndexMA": "material_index",
@@ -59,6 +62,18 @@ FEATURE_PASSES = (
 )
 
 
+# What gdpt-merge needs to combine renders of disjoint sample ranges exactly (reconstruct/
+# pass_merge.h), always registered: the samples per pixel; the shift attempts per sample
+# (Shift Failures' weight); the luminance means of each pixel's forward gradient halves and
+# their variances (X, Y, Z, W: dx's and dy's means, then their variances), which the Variance
+# pass sums with the neighbours' backward halves.
+MERGE_PASSES = (
+    ("Sample Count", 1, "X", 'VALUE'),
+    ("Shift Attempts", 1, "X", 'VALUE'),
+    ("Gradient Halves", 4, "XYZW", 'VECTOR'),
+)
+
+
 def feature_passes_on(scene):
     """Whether the render computes the feature passes: the Feature reconstruction needs them."""
     settings = getattr(scene, "gdpt", None)
@@ -86,6 +101,8 @@ def register_passes(engine, scene, view_layer):
     if feature_passes_on(scene):
         for name, channels, chan_id, kind in FEATURE_PASSES:
             engine.register_pass(scene, view_layer, name, channels, chan_id, kind)
+    for name, channels, chan_id, kind in MERGE_PASSES:
+        engine.register_pass(scene, view_layer, name, channels, chan_id, kind)
 
 
 # World > Mist Pass falloff -> Cycles' exponent.

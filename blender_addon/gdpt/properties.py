@@ -68,6 +68,13 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
         default=0.001, min=0.0, max=1.0, precision=4)
     seed: IntProperty(name="Seed", description="Random seed (the image does not depend on the "
                       "thread count)", default=0, min=0)
+    # Cycles' Sample Offset: a render farm splits one frame's samples over machines, each
+    # rendering its own range; gdpt-merge combines their EXRs exactly (docs/farm.md).
+    sample_offset: IntProperty(
+        name="Sample Offset", description="Index of the first sample to render: this render "
+        "takes samples Sample Offset .. Sample Offset + Samples - 1 of the seed's sequence, so "
+        "renders of disjoint ranges merge exactly (gdpt-merge)", default=0, min=0,
+        max=(1 << 31) - 1)
     threads: IntProperty(name="Threads", description="Render threads (0 = all cores)", default=0,
                          min=0, max=1024)
     clamp: FloatProperty(name="Clamp", description="Maximum sample value (0 = off)", default=0.0,
@@ -141,6 +148,7 @@ def settings_dict(scene):
         "max_transmission_bounces": int(s.transmission_bounces),
         "rr_depth": int(s.min_light_bounces) + 1,
         "seed": int(s.seed),
+        "sample_offset": int(s.sample_offset),
         "threads": int(s.threads),
         "clamp": float(s.clamp),
         "shift_threshold": float(s.shift_threshold),

@@ -39,6 +39,7 @@ class GDPT_PT_sampling(_RenderPanel, Panel):
         col.prop(s, "time_limit")
         col = layout.column()
         col.prop(s, "seed")
+        col.prop(s, "sample_offset")
         col.prop(s, "clamp")
         col.prop(s, "min_light_bounces")
 

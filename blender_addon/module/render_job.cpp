@@ -56,6 +56,9 @@ void for_each_pass(Passes& p, Add&& add) {
   add("emission", p.emission, 3);
   add("variance", p.variance, 3);
   add("shift_failures", p.shift_failures, 1);
+  add("sample_count", p.sample_count, 1);
+  add("shift_attempts", p.shift_attempts, 1);
+  add("gradient_halves", p.gradient_halves, 4);
   add("alpha", p.alpha, 1);
   add("depth", p.depth, 1);
   add("object_index", p.object_index, 1);
@@ -91,6 +94,12 @@ void FilmPasses::read(const Film& film, int samples) {
   emission.resize(n * 3);
   variance.resize(n * 3);
   shift_failures.resize(n);
+  sample_count.resize(n);
+  film.sample_count(sample_count.data());
+  shift_attempts.resize(n);
+  film.shift_attempts(shift_attempts.data());
+  gradient_halves.resize(4 * n);
+  film.gradient_halves(gradient_halves.data());
   alpha.resize(n);
   film.alpha(alpha.data());
   depth.resize(n);

@@ -31,6 +31,9 @@ struct FilmPasses {
   int width = 0, height = 0, samples_done = 0;
   HugePageVector<float> primal, gradient_x, gradient_y, emission, variance, shift_failures, alpha,
       depth, object_index, material_index;
+  // What merging renders of disjoint sample ranges needs (Film::sample_count, shift_attempts,
+  // gradient_halves: 1, 1 and 4 per pixel).
+  HugePageVector<float> sample_count, shift_attempts, gradient_halves;
   HugePageVector<float> normal, mist;  // empty unless the render computes them
   // The feature passes (RenderSettings::feature_passes), empty without them: the primal halves,
   // Denoising Albedo / Normal / Depth, and each one's variance of its pixel mean.
