@@ -199,6 +199,7 @@ class GradientPathTracer final : public Integrator {
       const bool crossing = bs.is_straight_crossing();
       ray.kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
       bp.state.count_event(crossing, ray.kind);
+      if (!crossing) bp.state.scattered(bs);
 
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
       if (!crossing) {
@@ -231,10 +232,10 @@ class GradientPathTracer final : public Integrator {
       // The end point of the last segment is no vertex: the shifts need its classification only.
       VertexType next_type = VertexType::Diffuse;
       if (found && !last) {
-        finish_vertex(g_.ctx, g_.sides, ray.direction, next_base);
+        finish_vertex(g_.ctx, g_.sides, g_.rules(bp.state), ray.direction, next_base);
         next_type = g_.classify(next_base.roughness);
       } else if (found && open_mask != 0) {
-        next_type = g_.classify_hit(next);
+        next_type = g_.classify_hit(next, bp.state);
       }
 
       // --- Shift every open offset over this segment (offset_path.h) ---
@@ -243,7 +244,7 @@ class GradientPathTracer final : public Integrator {
       if (open_mask != 0) {
         BaseStep& st = scratch.step;
         prepare_step(base, bs, xd_type, next_type, wo_world, found, next, u_lobe, u_dir, ray.kind,
-                     holdout_ends, st);
+                     holdout_ends, bp.state, st);
         for (unsigned m = open_mask; m != 0; m &= m - 1) {
           Offset& o = off[std::countr_zero(m)];
           if (!lobe_drawn && delta && o.link == Link::NotConnected &&
@@ -286,7 +287,7 @@ class GradientPathTracer final : public Integrator {
           o.f = mul(o.f, seg_b);
           o.p *= bs.pdf;
         } else {
-          advance(g_, o, last);
+          advance(g_, o, last, bp.state);
         }
       }
       if (!found || last) break;  // last: the end point was not set up as a vertex
@@ -304,6 +305,7 @@ class GradientPathTracer final : public Integrator {
   // False when the camera ray escaped or met a holdout (the sample is complete).
   bool start(const CameraSample& cs, PathScratch& scratch, SampleResult& out) const {
     const LightSampler& lights = g_.ctx.lights();
+    const PathState camera_state;  // the camera hits: no light-path rule applies yet
     out.primal = Spectrum(0.0f);
     out.emission = Spectrum(0.0f);
     out.alpha = 1.0f;
@@ -346,10 +348,12 @@ class GradientPathTracer final : public Integrator {
       o.grad = Vec3d();
       // Base hits a surface, the offset the world: no shift.
       o.alive = cs.off_found[k] && !holdout_ends_path(g_.ctx, true, *cs.off_hit[k]);
-      if (o.alive) setup_vertex(g_.ctx, g_.sides, *cs.off_hit[k], cs.off_ray[k]->direction, o.v);
+      if (o.alive)
+        setup_vertex(g_.ctx, g_.sides, g_.rules(camera_state), *cs.off_hit[k],
+                     cs.off_ray[k]->direction, o.v);
     }
     Vertex& base = scratch.verts[0];
-    setup_vertex(g_.ctx, g_.sides, hit, cam_ray.direction, base);
+    setup_vertex(g_.ctx, g_.sides, g_.rules(camera_state), hit, cam_ray.direction, base);
     if (g_.data.active()) g_.data.at_surface(hit, *base.closures, Spectrum(1.0f), out.data);
     if (g_.features.active())
       g_.features.at_surface(hit, *base.closures, length(hit.position - cam_ray.origin),
@@ -390,7 +394,7 @@ class GradientPathTracer final : public Integrator {
   static void prepare_step(const Vertex& base, const BsdfSample& bs, VertexType xd_type,
                            VertexType next_type, Vec3f wo_world, bool found, const SurfaceHit& next,
                            float u_lobe, Vec2f u_dir, uint32_t kind, bool holdout_ends,
-                           BaseStep& st) {
+                           const PathState& state, BaseStep& st) {
     st.base = &base;
     st.bs = &bs;
     st.xd_type = xd_type;
@@ -402,6 +406,7 @@ class GradientPathTracer final : public Integrator {
     st.u_dir = u_dir;
     st.kind = kind;
     st.holdout_ends = holdout_ends;
+    st.state = &state;
     st.base_front = false;
     // The reconnection target (a double square root and division) only where shift_segment()
     // may reconnect: x_d and x_{d+1} diffuse.

@@ -167,7 +167,8 @@ void half_vector_copy(const GptContext& g, Offset& o, const BaseStep& st, Vertex
   // Kill: the reverse shift (from the offset as base) would reconnect: x_d, y_d, y_{d+1} all
   // diffuse. Without this the shift is not invertible and the estimator is biased.
   if (xd_type == VertexType::Diffuse && yd_type == VertexType::Diffuse) {
-    const VertexType yn_type = o.next_found ? g.classify_hit(o.next_hit) : VertexType::Diffuse;
+    const VertexType yn_type =
+        o.next_found ? g.classify_hit(o.next_hit, *st.state) : VertexType::Diffuse;
     if (yn_type == VertexType::Diffuse) o.killed = true;
   }
 }
@@ -189,7 +190,7 @@ void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t&
   half_vector_copy(g, o, st, yd_type, rays);
 }
 
-void advance(const GptContext& g, Offset& o, bool last) {
+void advance(const GptContext& g, Offset& o, bool last, const PathState& state) {
   auto kill = [&] {
     o.alive = false;
     o.failed = true;
@@ -211,7 +212,8 @@ void advance(const GptContext& g, Offset& o, bool last) {
       break;
     case Shift::HalfVector:
       if (o.killed) return kill();
-      if (o.next_found && !last) setup_vertex(g.ctx, g.sides, o.next_hit, o.ray.direction, o.v);
+      if (o.next_found && !last)
+        setup_vertex(g.ctx, g.sides, g.rules(state), o.next_hit, o.ray.direction, o.v);
       break;
     case Shift::Failed:
       return kill();

@@ -31,25 +31,36 @@ std::vector<MaterialSide> material_sides(const SceneContext& ctx) {
 }
 
 float hit_roughness(const SceneContext& ctx, std::span<const MaterialSide> sides,
-                    const SurfaceHit& h) {
+                    const VertexRules& rules, const SurfaceHit& h) {
   const MaterialSide& side = sides[2 * size_t(h.material) + (h.front_facing ? 1 : 0)];
-  if (side.set) return side.roughness;
+  const bool filtered = rules.filters.enabled() && rules.filters.active(rules.state);
+  if (side.set && !filtered) return side.roughness;
   ClosureSet cs;
-  ctx.materials()[size_t(h.material)].evaluate(shading_context_of(h), cs);
+  if (side.set)
+    cs.assign(*side.set);
+  else
+    ctx.materials()[size_t(h.material)].evaluate(shading_context_of(h), cs);
+  if (filtered) rules.filters.apply(rules.state, cs);
   return vertex_roughness(cs);
 }
 
-void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides, const Vec3f& dir,
-                   Vertex& v) {
+void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
+                   const VertexRules& rules, const Vec3f& dir, Vertex& v) {
   const SurfaceHit& hit = v.hit;
   const MaterialSide& side = sides[2 * size_t(hit.material) + (hit.front_facing ? 1 : 0)];
-  if (side.set) {
+  const bool filtered = rules.filters.enabled() && rules.filters.active(rules.state);
+  if (side.set && !filtered) {
     v.closures = side.set;
     v.roughness = side.roughness;
     v.lambert = side.lambert;
   } else {
-    v.own.clear();
-    ctx.materials()[size_t(hit.material)].evaluate(shading_context_of(hit), v.own);
+    if (side.set) {
+      v.own.assign(*side.set);
+    } else {
+      v.own.clear();
+      ctx.materials()[size_t(hit.material)].evaluate(shading_context_of(hit), v.own);
+    }
+    if (filtered) rules.filters.apply(rules.state, v.own);
     v.closures = &v.own;
     v.roughness = vertex_roughness(v.own);
     v.lambert = single_lambert(v.own);

@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "core/frame.h"
+#include "integrators/common/light_path_filters.h"
+#include "integrators/common/path_state.h"
 #include "render/embree_scene.h"
 #include "render/scene_context.h"
 #include "shaders/bsdf.h"
@@ -72,20 +74,28 @@ std::vector<MaterialSide> material_sides(const SceneContext& ctx);
 // ClosureSet::roughness(), 1 for a set without BSDF.
 float vertex_roughness(const ClosureSet& cs);
 
+// The light-path rules (light_path_filters.h) for a vertex reached with a path state: base and
+// offsets pass the base's state.
+struct VertexRules {
+  const LightPathFilters& filters;
+  const PathState& state;
+};
+
 // The roughness of the material at `h` without setting up a vertex there.
 float hit_roughness(const SceneContext& ctx, std::span<const MaterialSide> sides,
-                    const SurfaceHit& h);
+                    const VertexRules& rules, const SurfaceHit& h);
 
 // Sets up `v` at its hit v.hit reached along `dir` (world, unit). (The base's next hit is traced
 // into v.hit directly: no copy.)
-void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides, const Vec3f& dir,
-                   Vertex& v);
+void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
+                   const VertexRules& rules, const Vec3f& dir, Vertex& v);
 
 // The same at a copy of `hit`.
 inline void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
-                         const SurfaceHit& hit, const Vec3f& dir, Vertex& v) {
+                         const VertexRules& rules, const SurfaceHit& hit, const Vec3f& dir,
+                         Vertex& v) {
   v.hit = hit;
-  finish_vertex(ctx, sides, dir, v);
+  finish_vertex(ctx, sides, rules, dir, v);
 }
 
 // Emitted radiance of an emissive triangle at `hit` towards the point `from`.
