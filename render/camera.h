@@ -7,9 +7,8 @@
 // Raster coordinates: (0, 0) is the bottom-left corner of the image, (width, height) the top
 // right; pixel (x, y) covers [x, x+1) x [y, y+1). y = 0 is the BOTTOM row (Blender's convention).
 //
-// Pixel filter: Cycles importance-samples a Blackman-Harris filter of width 1.5 px; we use a box
-// filter over the pixel (jitter uniform in [0,1)^2), which G-PT needs for its +-1 pixel shifts.
-// Cross-engine comparisons therefore set Cycles' filter_width small (e.g. 0.01).
+// Pixel filter: the raster position of a camera sample comes from PixelFilter (pixel_filter.h),
+// Cycles' importance-sampled filters; G-PT's offsets move that position by +-1 pixel.
 #pragma once
 
 #include <cmath>

@@ -145,6 +145,7 @@ void SceneContext::finish_shading(const RenderSettings& settings) {
   for (const Instance& inst : scene.instances) has_holdout_ = has_holdout_ || inst.holdout;
   lights_ = std::make_unique<LightSampler>(scene, materials_, textures_);
   camera_ = CameraModel(scene.camera);
+  pixel_filter_ = PixelFilter(settings.pixel_filter, settings.filter_width);
 
   // --- Feature mask: what the instanced geometry, lights, world and camera really use ---
   uint32_t f = 0;

@@ -11,6 +11,7 @@
 #include "render/embree_scene.h"
 #include "render/film.h"
 #include "render/light_sampler.h"
+#include "render/pixel_filter.h"
 #include "scene/render_settings.h"
 #include "scene/scene.h"
 #include "shaders/material.h"
@@ -73,6 +74,8 @@ class SceneContext {
   }
   const EmbreeScene& bvh() const { return *bvh_; }
   const CameraModel& camera() const { return camera_; }
+  // RenderSettings::pixel_filter / filter_width: where each camera sample lies in its pixel.
+  const PixelFilter& pixel_filter() const { return pixel_filter_; }
   const LightSampler& lights() const { return *lights_; }
   // Scene::materials followed by Blender's default grey material (index default_material()).
   const std::vector<Material>& materials() const { return materials_; }
@@ -93,6 +96,7 @@ class SceneContext {
   std::unique_ptr<LightSampler> lights_;
   bool has_holdout_ = false;
   CameraModel camera_;
+  PixelFilter pixel_filter_;
   uint32_t features_ = 0, scene_features_ = 0;
   std::vector<std::string> warnings_;
 };

@@ -5,6 +5,9 @@
 
 namespace gdpt {
 
+// Cycles' pixel filters (Film > Pixel Filter), importance-sampled (render/pixel_filter.h).
+enum class PixelFilterType : uint8_t { Box, Gaussian, BlackmanHarris };
+
 struct RenderSettings {
   enum class Mode : uint8_t { PT, GPT } mode = Mode::GPT;
   int samples = 64;         // samples per pixel
@@ -19,6 +22,15 @@ struct RenderSettings {
   // sample_offset + samples - 1 of the seed's sequence, so renders of disjoint ranges are
   // independent parts of one render and merge exactly (reconstruct/pass_merge.h).
   uint32_t sample_offset = 0;
+  // Film > Pixel Filter, Cycles' meaning of the width (pixel_filter.h). The core's default is the
+  // box over the pixel; the add-on passes scene.gdpt's (Cycles' default: Blackman-Harris 1.5).
+  PixelFilterType pixel_filter = PixelFilterType::Box;
+  float filter_width = 1.0f;
+  // Light Paths > Caustics (integrators/common/light_path_filters.h): Filter Glossy (Cycles'
+  // blur_glossy; 0 = off, the core's default; Cycles' and the add-on's is 1) and the reflective /
+  // refractive caustics toggles.
+  float blur_glossy = 0.0f;
+  bool caustics_reflective = true, caustics_refractive = true;
   int threads = 0;                           // 0 = all cores
   float clamp = 0.0f;                        // max sample value, 0 = off
   int rr_depth = 3;                          // Russian roulette from this vertex on

@@ -77,6 +77,13 @@ class ClosureSet {
 
   int count() const { return count_; }
   const Closure& operator[](int i) const { return closures_[i]; }
+  // For the integrators' light-path rules (integrators/common/light_path_filters.h), which
+  // roughen or drop lobes of a copy: lobe i, and its removal (the others keep their order).
+  Closure& lobe(int i) { return closures_[i]; }
+  void remove(int i) {
+    for (int k = i + 1; k < count_; ++k) closures_[k - 1] = closures_[k];
+    --count_;
+  }
   Spectrum emission() const { return emission_; }
   bool has_bsdf() const { return count_ > 0; }
   // Sum of the Transparent closures' weights: what passes straight through the surface (Cycles'

@@ -53,6 +53,7 @@ elif method in ("pt", "gpt"):
     g.seed = seed
     g.samples = samples or many
     g.time_limit = seconds
+    g.blur_glossy = 0.0  # unbiased, as the cycles_unbiased reference
 else:
     sys.exit(f"render_one.py: unknown method {method}")
 scene.render.use_persistent_data = False

@@ -45,7 +45,8 @@ def setup(scene):
     scene.view_settings.look = 'None'
     c = scene.cycles
     c.device = 'CPU'
-    c.blur_glossy = 0.0  # Cycles' Filter Glossy would blur what Gradient PT renders sharp
+    c.blur_glossy = 0.0  # both engines unblurred: the reference is Cycles'
+    scene.gdpt.blur_glossy = 0.0
     c.use_preview_denoising = False
     c.use_denoising = False
     c.samples = REF_SAMPLES

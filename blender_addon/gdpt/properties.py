@@ -32,6 +32,17 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
     transmission_bounces: IntProperty(
         name="Transmission", description="Maximum number of transmission bounces, bounded by the "
         "total maximum", default=12, min=0, max=1024)
+    # Light Paths > Caustics, Cycles' names, ranges and defaults.
+    blur_glossy: FloatProperty(
+        name="Filter Glossy", description="Adaptively blur glossy shaders after blurry bounces, "
+        "to reduce noise at the cost of accuracy (as Cycles'; 0 = off)", default=1.0, min=0.0,
+        max=10.0)
+    caustics_reflective: BoolProperty(
+        name="Reflective Caustics", description="Use reflective caustics, resulting in a "
+        "brighter image (more noise but added realism)", default=True)
+    caustics_refractive: BoolProperty(
+        name="Refractive Caustics", description="Use refractive caustics, resulting in a "
+        "brighter image (more noise but added realism)", default=True)
     # Cycles' Min Light Bounces (Sampling > Advanced) with Cycles' meaning: Russian roulette may
     # end a path only after this many bounces past the first indirect hit (Cycles' kernel counts
     # min_light_bounces + 1), i.e. the core's rr_depth = min_light_bounces + 1. GDPT's default 2
@@ -66,6 +77,18 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
         name="Shift Roughness Threshold", description="GGX alpha below which a vertex is treated "
         "as specular by the shift mapping (half-vector copy instead of reconnection)",
         default=0.001, min=0.0, max=1.0, precision=4)
+    # Film > Pixel Filter, Cycles' names, ranges and defaults (GDPT's own settings: an artist
+    # switching engines keeps them; Cycles' are not read).
+    pixel_filter_type: EnumProperty(
+        name="Pixel Filter", description="Pixel filter type, as Cycles' (each camera sample is "
+        "placed by it: primal and gradients alike)",
+        items=[('BOX', "Box", "Box filter"),
+               ('GAUSSIAN', "Gaussian", "Gaussian filter"),
+               ('BLACKMAN_HARRIS', "Blackman-Harris", "Blackman-Harris filter")],
+        default='BLACKMAN_HARRIS')
+    filter_width: FloatProperty(
+        name="Width", description="Pixel filter width, as Cycles'", default=1.5, min=0.01,
+        max=10.0, subtype='PIXEL')
     seed: IntProperty(name="Seed", description="Random seed (the image does not depend on the "
                       "thread count)", default=0, min=0)
     # Cycles' Sample Offset: a render farm splits one frame's samples over machines, each
@@ -152,6 +175,11 @@ def settings_dict(scene):
         "threads": int(s.threads),
         "clamp": float(s.clamp),
         "shift_threshold": float(s.shift_threshold),
+        "pixel_filter": s.pixel_filter_type,
+        "filter_width": float(s.filter_width),
+        "blur_glossy": float(s.blur_glossy),
+        "caustics_reflective": bool(s.caustics_reflective),
+        "caustics_refractive": bool(s.caustics_refractive),
         # Blender's Render Properties > Film > Transparent.
         "transparent_background": bool(scene.render.film_transparent),
     }

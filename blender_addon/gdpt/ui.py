@@ -77,12 +77,30 @@ class GDPT_PT_light_paths(_RenderPanel, Panel):
         col.prop(s, "transmission_bounces")
 
 
+class GDPT_PT_light_paths_caustics(_RenderPanel, Panel):
+    """Light Paths > Caustics, as Cycles' panel of that name."""
+    bl_label = "Caustics"
+    bl_parent_id = "GDPT_PT_light_paths"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        s = context.scene.gdpt
+        layout.prop(s, "blur_glossy")
+        col = layout.column(heading="Caustics", align=True)
+        col.prop(s, "caustics_reflective", text="Reflective")
+        col.prop(s, "caustics_refractive", text="Refractive")
+
+
 class GDPT_PT_film(_RenderPanel, Panel):
     bl_label = "Film"
     bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
         layout = _split(self.layout)
+        col = layout.column()
+        col.prop(context.scene.gdpt, "pixel_filter_type")
+        col.prop(context.scene.gdpt, "filter_width")
         # Blender's own setting (Cycles and EEVEE show it in their Film panels).
         layout.prop(context.scene.render, "film_transparent", text="Transparent")
 
@@ -183,7 +201,8 @@ class GDPT_PT_light_shadow(_Panel, Panel):
         layout.prop(context.light.cycles, "cast_shadow")
 
 
-_classes = (GDPT_PT_sampling, GDPT_PT_sampling_viewport, GDPT_PT_light_paths, GDPT_PT_film, GDPT_PT_gradient_domain,
+_classes = (GDPT_PT_sampling, GDPT_PT_sampling_viewport, GDPT_PT_light_paths,
+            GDPT_PT_light_paths_caustics, GDPT_PT_film, GDPT_PT_gradient_domain,
             GDPT_PT_reconstruction, GDPT_PT_performance, GDPT_PT_passes, GDPT_PT_ray_visibility,
             GDPT_PT_light_shadow)
 

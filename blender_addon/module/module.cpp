@@ -27,6 +27,17 @@ RenderSettings settings_from_dict(const py::dict& d) {
     else
       throw std::invalid_argument("unknown mode '" + mode + "'");
   }
+  if (d.contains("pixel_filter")) {
+    const auto filter = d["pixel_filter"].cast<std::string>();
+    if (filter == "BOX")
+      s.pixel_filter = PixelFilterType::Box;
+    else if (filter == "GAUSSIAN")
+      s.pixel_filter = PixelFilterType::Gaussian;
+    else if (filter == "BLACKMAN_HARRIS")
+      s.pixel_filter = PixelFilterType::BlackmanHarris;
+    else
+      throw std::invalid_argument("unknown pixel filter '" + filter + "'");
+  }
   auto get = [&](const char* key, auto& out) {
     if (d.contains(key)) out = d[key].cast<std::decay_t<decltype(out)>>();
   };
@@ -42,6 +53,11 @@ RenderSettings settings_from_dict(const py::dict& d) {
   get("clamp", s.clamp);
   get("rr_depth", s.rr_depth);
   get("shift_threshold", s.shift_roughness_threshold);
+  get("filter_width", s.filter_width);
+  get("blur_glossy", s.blur_glossy);
+  get("caustics_reflective", s.caustics_reflective);
+  get("caustics_refractive", s.caustics_refractive);
+  if (!(s.blur_glossy >= 0.0f)) throw std::invalid_argument("blur_glossy must be >= 0");
   get("samples_per_pass", s.samples_per_pass);
   get("transparent_background", s.transparent_background);
   get("normal_pass", s.normal_pass);

@@ -4,7 +4,9 @@
 // path keep one each.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 
 #include "core/vec.h"
 #include "integrators/common/bounce_limits.h"
@@ -26,6 +28,11 @@ struct PathState {
   // is the path's last; survived, what follows the hit's emission is divided by rr_divide.
   bool rr_stop = false;
   float rr_divide = 1.0f;
+  // For Cycles' Filter Glossy and caustics rules (light_path_filters.h): the lowest BSDF
+  // sampling density of the path's scattering events (delta ones aside), and whether the last
+  // scattering event was diffuse (Cycles' PATH_RAY_DIFFUSE; transparent crossings keep both).
+  float min_ray_pdf = std::numeric_limits<float>::infinity();
+  bool diffuse_ray = false;
 
   // Past the limits the next surface only ends the path: emission and MIS there, no light
   // sample, no scattering.
@@ -58,6 +65,12 @@ struct PathState {
     v.transmission_depth = int16_t(kinds.transmission);
     v.transparent_depth = int16_t(transparent);
     return v;
+  }
+
+  // The BSDF sample of a scattering event (not a transparent crossing), after count_event().
+  void scattered(const BsdfSample& bs) {
+    diffuse_ray = (bs.lobe & kLobeDiffuse) != 0;
+    if (!bs.is_delta()) min_ray_pdf = std::min(min_ray_pdf, bs.pdf);
   }
 
   // The roulette after a real bounce (count_event() already called) of throughput `beta` that

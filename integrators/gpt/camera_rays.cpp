@@ -13,10 +13,12 @@ static_assert(kRight == 0 && kUp == 1 && kLeft == 2 && kDown == 3);
 
 uint64_t trace_camera_grid(const GptContext& g, const Tile& tile, int W, int H, uint32_t s,
                            CameraGrid& grid) {
-  // The image-wide jitter: a sampler keyed to no pixel, (-1, -1).
+  // The image-wide jitter: a sampler keyed to no pixel, (-1, -1). Every pixel takes the same
+  // filter sample, so a neighbour's base ray is this pixel's offset ray.
   Sampler image_wide;
   image_wide.start(g.settings.seed, -1, -1, s);
   const Vec2f jitter = image_wide.get2d(Sampler::kDimCamera);
+  const PixelFilter& filter = g.ctx.pixel_filter();
   grid.x0 = std::max(tile.x0 - 1, 0);
   grid.y0 = std::max(tile.y0 - 1, 0);
   const int x1 = std::min(tile.x1 + 1, W), y1 = std::min(tile.y1 + 1, H);
@@ -33,8 +35,7 @@ uint64_t trace_camera_grid(const GptContext& g, const Tile& tile, int W, int H, 
       // The halo's corners are no tile pixel's neighbour.
       grid.valid[c] = row_inside || (x >= tile.x0 && x < tile.x1);
       if (!grid.valid[c]) continue;
-      grid.ray[c] = camera.generate_ray(Vec2f(float(x + rx) + jitter.x, float(y + ry) + jitter.y),
-                                        Vec2f(0.5f, 0.5f));
+      grid.ray[c] = camera.generate_ray(filter.raster(x + rx, y + ry, jitter), Vec2f(0.5f, 0.5f));
       ++n;
     }
   }
@@ -71,7 +72,7 @@ uint64_t trace_camera_row(const GptContext& g, int W, int H, int x0, int y, int 
     row.sampler[i].start(g.settings.seed, x + rx, y + ry, s);
     const Vec2f jitter = row.sampler[i].get2d(Sampler::kDimCamera);
     row.lens[i] = row.sampler[i].get2d(Sampler::kDimLens);
-    row.raster[i] = Vec2f(float(x + rx) + jitter.x, float(y + ry) + jitter.y);
+    row.raster[i] = g.ctx.pixel_filter().raster(x + rx, y + ry, jitter);
     row.ray[i] = camera.generate_ray(row.raster[i], row.lens[i]);
   }
   g.ctx.bvh().intersect_stream(row.ray, row.valid, kRow, row.found, row.hit);

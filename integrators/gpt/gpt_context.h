@@ -29,7 +29,8 @@ struct GptContext {
         transparent_shadows((c.features() & kFeatureTransparent) != 0),
         sides(material_sides(c)),
         data(s, c.camera()),
-        features(s) {}
+        features(s),
+        filters(s) {}
 
   const SceneContext& ctx;
   RenderSettings settings;
@@ -38,6 +39,7 @@ struct GptContext {
   std::vector<MaterialSide> sides;
   DataPasses data;
   FeaturePasses features;
+  LightPathFilters filters;  // Filter Glossy and caustics (light_path_filters.h)
 
   // Kettunen et al.'s vertex classification: specular (half-vector copy) or diffuse (reconnect).
   shift::VertexType classify(float roughness) const {
@@ -48,10 +50,12 @@ struct GptContext {
   Spectrum triangle_le(const SurfaceHit& hit, Vec3f from, const PathView& path) const {
     return has_emissive ? triangle_emission(ctx, hit, from, path) : Spectrum(0.0f);
   }
-  // The classification of a path's end point that is not set up as a vertex.
-  shift::VertexType classify_hit(const SurfaceHit& h) const {
-    return classify(hit_roughness(ctx, sides, h));
+  // The classification of a path's end point that is not set up as a vertex, reached with the
+  // base's path state `state`.
+  shift::VertexType classify_hit(const SurfaceHit& h, const PathState& state) const {
+    return classify(hit_roughness(ctx, sides, rules(state), h));
   }
+  VertexRules rules(const PathState& state) const { return {filters, state}; }
 };
 
 }  // namespace gdpt

@@ -200,6 +200,7 @@ class GradientPathTracer final : public Integrator {
       const bool crossing = bs.is_straight_crossing();
       ray.kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
       bp.state.count_event(crossing, ray.kind, bs.lobe);
+      if (!crossing) bp.state.scattered(bs);
 
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
       if (!crossing) {
@@ -232,10 +233,11 @@ class GradientPathTracer final : public Integrator {
       // The end point of the last segment is no vertex: the shifts need its classification only.
       VertexType next_type = VertexType::Diffuse;
       if (found && !last) {
-        finish_vertex(g_.ctx, g_.sides, ray.direction, bp.state.view(next.t), next_base);
+        finish_vertex(g_.ctx, g_.sides, g_.rules(bp.state), ray.direction, bp.state.view(next.t),
+                      next_base);
         next_type = g_.classify(next_base.roughness);
       } else if (found && open_mask != 0) {
-        next_type = g_.classify_hit(next);
+        next_type = g_.classify_hit(next, bp.state);
       }
 
       // --- Shift every open offset over this segment (offset_path.h) ---
@@ -244,7 +246,7 @@ class GradientPathTracer final : public Integrator {
       if (open_mask != 0) {
         BaseStep& st = scratch.step;
         prepare_step(base, bs, xd_type, next_type, wo_world, found, next, u_lobe, u_dir, ray.kind,
-                     holdout_ends, st);
+                     holdout_ends, bp.state, st);
         for (unsigned m = open_mask; m != 0; m &= m - 1) {
           Offset& o = off[std::countr_zero(m)];
           if (!lobe_drawn && delta && o.link == Link::NotConnected &&
@@ -288,7 +290,7 @@ class GradientPathTracer final : public Integrator {
           o.f = mul(o.f, seg_b);
           o.p *= bs.pdf;
         } else {
-          advance(g_, o, last, next_view);
+          advance(g_, o, last, bp.state, next_view);
         }
       }
       if (!found || last) break;  // last: the end point was not set up as a vertex
@@ -306,6 +308,7 @@ class GradientPathTracer final : public Integrator {
   // False when the camera ray escaped or met a holdout (the sample is complete).
   bool start(const CameraSample& cs, PathScratch& scratch, SampleResult& out) const {
     const LightSampler& lights = g_.ctx.lights();
+    const PathState camera_state;  // the camera hits: no light-path rule applies yet
     out.primal = Spectrum(0.0f);
     out.emission = Spectrum(0.0f);
     out.alpha = 1.0f;
@@ -351,13 +354,14 @@ class GradientPathTracer final : public Integrator {
       if (o.alive) {
         PathView camera;
         camera.ray_length = cs.off_hit[k]->t - cs.off_ray[k]->t_min;  // from the near clip
-        setup_vertex(g_.ctx, g_.sides, *cs.off_hit[k], cs.off_ray[k]->direction, camera, o.v);
+        setup_vertex(g_.ctx, g_.sides, g_.rules(camera_state), *cs.off_hit[k],
+                     cs.off_ray[k]->direction, camera, o.v);
       }
     }
     Vertex& base = scratch.verts[0];
     PathView camera;
     camera.ray_length = hit.t - cam_ray.t_min;
-    setup_vertex(g_.ctx, g_.sides, hit, cam_ray.direction, camera, base);
+    setup_vertex(g_.ctx, g_.sides, g_.rules(camera_state), hit, cam_ray.direction, camera, base);
     if (g_.data.active()) g_.data.at_surface(hit, *base.closures, Spectrum(1.0f), out.data);
     if (g_.features.active())
       g_.features.at_surface(hit, *base.closures, length(hit.position - cam_ray.origin),
@@ -384,7 +388,7 @@ class GradientPathTracer final : public Integrator {
         o.wi_shared = base.frame.to_local(o.wi_world);
         // Its own segment from y_d (still in o.v) to the shared vertex.
         o.shared =
-            &shared_closures(g_.ctx, base, o.wi_world,
+            &shared_closures(g_.ctx, g_.rules(state), base, o.wi_world,
                              state.view(length(base.hit.position - o.v.hit.position)), o.v.own);
       } else if (!o.v.closures->has_bsdf()) {
         o.alive = false;  // the offset ends on a surface without BSDF: it cannot follow
@@ -404,7 +408,7 @@ class GradientPathTracer final : public Integrator {
   static void prepare_step(const Vertex& base, const BsdfSample& bs, VertexType xd_type,
                            VertexType next_type, Vec3f wo_world, bool found, const SurfaceHit& next,
                            float u_lobe, Vec2f u_dir, uint32_t kind, bool holdout_ends,
-                           BaseStep& st) {
+                           const PathState& state, BaseStep& st) {
     st.base = &base;
     st.bs = &bs;
     st.xd_type = xd_type;
@@ -416,6 +420,7 @@ class GradientPathTracer final : public Integrator {
     st.u_dir = u_dir;
     st.kind = kind;
     st.holdout_ends = holdout_ends;
+    st.state = &state;
     st.base_front = false;
     // The reconnection target (a double square root and division) only where shift_segment()
     // may reconnect: x_d and x_{d+1} diffuse.

@@ -167,7 +167,8 @@ void half_vector_copy(const GptContext& g, Offset& o, const BaseStep& st, Vertex
   // Kill: the reverse shift (from the offset as base) would reconnect: x_d, y_d, y_{d+1} all
   // diffuse. Without this the shift is not invertible and the estimator is biased.
   if (xd_type == VertexType::Diffuse && yd_type == VertexType::Diffuse) {
-    const VertexType yn_type = o.next_found ? g.classify_hit(o.next_hit) : VertexType::Diffuse;
+    const VertexType yn_type =
+        o.next_found ? g.classify_hit(o.next_hit, *st.state) : VertexType::Diffuse;
     if (yn_type == VertexType::Diffuse) o.killed = true;
   }
 }
@@ -189,7 +190,8 @@ void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t&
   half_vector_copy(g, o, st, yd_type, rays);
 }
 
-void advance(const GptContext& g, Offset& o, bool last, const PathView& path) {
+void advance(const GptContext& g, Offset& o, bool last, const PathState& state,
+             const PathView& path) {
   auto kill = [&] {
     o.alive = false;
     o.failed = true;
@@ -214,7 +216,7 @@ void advance(const GptContext& g, Offset& o, bool last, const PathView& path) {
       if (o.next_found && !last) {
         PathView own = path;
         own.ray_length = o.next_hit.t;
-        setup_vertex(g.ctx, g.sides, o.next_hit, o.ray.direction, own, o.v);
+        setup_vertex(g.ctx, g.sides, g.rules(state), o.next_hit, o.ray.direction, own, o.v);
       }
       break;
     case Shift::Failed:

@@ -60,6 +60,9 @@ struct BaseStep {
   Vec2f u_dir;
   uint32_t kind;      // RayKind of the base's segment: the offsets' segments see what it sees
   bool holdout_ends;  // a holdout at the segment's end ends the path (the camera path's)
+  // The base's path state past this step: the offsets shade their next vertices by its
+  // light-path rules (light_path_filters.h).
+  const PathState* state;
   // Reconnection target x_{d+1} (when found): its base side, and the side the base arrives on.
   shift::ReconnectionBase target;
   bool base_front;
@@ -70,8 +73,10 @@ struct BaseStep {
 void shift_segment(const GptContext& g, Offset& o, const BaseStep& st, uint32_t& rays);
 
 // Moves the offset to the end of the segment (`last`: the path ends there, no vertex needed);
-// `path`: the base's path state there (the offset's own vertex gets its own ray length).
-void advance(const GptContext& g, Offset& o, bool last, const PathView& path);
+// `state`: the base's path state there; `path`: its view (the offset's own vertex gets its own
+// ray length).
+void advance(const GptContext& g, Offset& o, bool last, const PathState& state,
+             const PathView& path);
 
 // Merged offsets: a connected offset shares the rest of the base path, so for an emission event
 // with base contribution C = fb Y its contribution is C' = f' Y with the same technique

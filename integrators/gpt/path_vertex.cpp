@@ -31,36 +31,47 @@ std::vector<MaterialSide> material_sides(const SceneContext& ctx) {
 }
 
 float hit_roughness(const SceneContext& ctx, std::span<const MaterialSide> sides,
-                    const SurfaceHit& h) {
+                    const VertexRules& rules, const SurfaceHit& h) {
   const MaterialSide& side = sides[2 * size_t(h.material) + (h.front_facing ? 1 : 0)];
-  if (side.set) return side.roughness;
+  const bool filtered = rules.filters.enabled() && rules.filters.active(rules.state);
+  if (side.set && !filtered) return side.roughness;
   ClosureSet cs;
-  ctx.materials()[size_t(h.material)].evaluate(shading_context_of(h), cs);
+  if (side.set)
+    cs.assign(*side.set);
+  else
+    ctx.materials()[size_t(h.material)].evaluate(shading_context_of(h), cs);
+  if (filtered) rules.filters.apply(rules.state, cs);
   return vertex_roughness(cs);
 }
 
-void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides, const Vec3f& dir,
-                   const PathView& path, Vertex& v) {
+void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
+                   const VertexRules& rules, const Vec3f& dir, const PathView& path, Vertex& v) {
   const SurfaceHit& hit = v.hit;
   const MaterialSide& side = sides[2 * size_t(hit.material) + (hit.front_facing ? 1 : 0)];
-  if (side.set) {
+  const bool filtered = rules.filters.enabled() && rules.filters.active(rules.state);
+  if (side.set && !filtered) {
     v.closures = side.set;
     v.roughness = side.roughness;
     v.lambert = side.lambert;
   } else {
     const Material& m = ctx.materials()[size_t(hit.material)];
-    ShadingContext sc = shading_context_of(hit);
-    ShadingGeometry view;
     // The vertex's class (hit_roughness) must not depend on the direction or path it is
     // reached by: base and offsets arriving at a shared vertex classify it alike.
     const bool per_path = m.reads_view() || m.reads_path();
-    if (per_path) v.roughness = hit_roughness(ctx, sides, hit);
-    if (m.reads_view()) {
-      view = shading_geometry(hit, -dir);
-      sc.geometry = &view;
+    if (side.set) {
+      v.own.assign(*side.set);
+    } else {
+      ShadingContext sc = shading_context_of(hit);
+      ShadingGeometry view;
+      if (per_path) v.roughness = hit_roughness(ctx, sides, rules, hit);
+      if (m.reads_view()) {
+        view = shading_geometry(hit, -dir);
+        sc.geometry = &view;
+      }
+      if (m.reads_path()) sc.path = &path;
+      m.evaluate(sc, v.own);
     }
-    if (m.reads_path()) sc.path = &path;
-    m.evaluate(sc, v.own);
+    if (filtered) rules.filters.apply(rules.state, v.own);
     v.closures = &v.own;
     if (!per_path) v.roughness = vertex_roughness(v.own);
     // Such a set is another set from another path (no same_side() sharing).
@@ -80,8 +91,9 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   v.offset_scale = ctx.bvh().offset_scale();
 }
 
-const ClosureSet& shared_closures(const SceneContext& ctx, const Vertex& base, Vec3f wi_world,
-                                  const PathView& path, ClosureSet& scratch) {
+const ClosureSet& shared_closures(const SceneContext& ctx, const VertexRules& rules,
+                                  const Vertex& base, Vec3f wi_world, const PathView& path,
+                                  ClosureSet& scratch) {
   const Material& m = ctx.materials()[size_t(base.hit.material)];
   if (!m.reads_view() && !m.reads_path()) return *base.closures;
   ShadingContext sc = shading_context_of(base.hit);
@@ -89,6 +101,9 @@ const ClosureSet& shared_closures(const SceneContext& ctx, const Vertex& base, V
   sc.geometry = &view;
   sc.path = &path;
   m.evaluate(sc, scratch);
+  // The light-path rules as at the base, which shares its path state with the offset.
+  if (rules.filters.enabled() && rules.filters.active(rules.state))
+    rules.filters.apply(rules.state, scratch);
   // Bump shadowing as at the base (`rotated`: let shading_closures compare the normals).
   return shading_closures(scratch, scratch, base.hit, base.frame, base.ng, wi_world, true);
 }

@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "core/frame.h"
+#include "integrators/common/light_path_filters.h"
+#include "integrators/common/path_state.h"
 #include "render/embree_scene.h"
 #include "render/scene_context.h"
 #include "shaders/bsdf.h"
@@ -72,29 +74,38 @@ std::vector<MaterialSide> material_sides(const SceneContext& ctx);
 // ClosureSet::roughness(), 1 for a set without BSDF.
 float vertex_roughness(const ClosureSet& cs);
 
+// The light-path rules (light_path_filters.h) for a vertex reached with a path state: base and
+// offsets pass the base's state.
+struct VertexRules {
+  const LightPathFilters& filters;
+  const PathState& state;
+};
+
 // The roughness of the material at `h` without setting up a vertex there.
 float hit_roughness(const SceneContext& ctx, std::span<const MaterialSide> sides,
-                    const SurfaceHit& h);
+                    const VertexRules& rules, const SurfaceHit& h);
 
 // Sets up `v` at its hit v.hit reached along `dir` (world, unit) by the path `path` (for
 // materials that read it, Material::reads_path). (The base's next hit is traced into v.hit
 // directly: no copy.)
-void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides, const Vec3f& dir,
-                   const PathView& path, Vertex& v);
+void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
+                   const VertexRules& rules, const Vec3f& dir, const PathView& path, Vertex& v);
 
 // The same at a copy of `hit`.
 inline void setup_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
-                         const SurfaceHit& hit, const Vec3f& dir, const PathView& path, Vertex& v) {
+                         const VertexRules& rules, const SurfaceHit& hit, const Vec3f& dir,
+                         const PathView& path, Vertex& v) {
   v.hit = hit;
-  finish_vertex(ctx, sides, dir, path, v);
+  finish_vertex(ctx, sides, rules, dir, path, v);
 }
 
 // The closures of the base vertex `base` as an offset that reached it by reconnection sees them
 // from `wi_world` (unit, towards the offset's previous vertex) at the end of `path` (its own ray
 // length): the base's own, unless its material reads the view or the path
 // (Material::reads_view, reads_path); then evaluated into `scratch`, in the base's frame.
-const ClosureSet& shared_closures(const SceneContext& ctx, const Vertex& base, Vec3f wi_world,
-                                  const PathView& path, ClosureSet& scratch);
+const ClosureSet& shared_closures(const SceneContext& ctx, const VertexRules& rules,
+                                  const Vertex& base, Vec3f wi_world, const PathView& path,
+                                  ClosureSet& scratch);
 
 // Emitted radiance of an emissive triangle at `hit` towards the point `from`, reached by `path`
 // (for materials that read it; the ray length is the distance to `from`).

@@ -10,6 +10,7 @@
 #include "integrators/common/bump_shadowing.h"
 #include "integrators/common/data_passes.h"
 #include "integrators/common/feature_passes.h"
+#include "integrators/common/light_path_filters.h"
 #include "integrators/common/mis.h"
 #include "integrators/common/path_state.h"
 #include "integrators/common/shadow_ray.h"
@@ -48,7 +49,11 @@ class PathTracer final : public Integrator {
 
  public:
   PathTracer(const SceneContext& ctx, const RenderSettings& settings)
-      : ctx_(ctx), settings_(settings), data_(settings, ctx.camera()), features_(settings) {}
+      : ctx_(ctx),
+        settings_(settings),
+        data_(settings, ctx.camera()),
+        features_(settings),
+        filters_(settings) {}
 
   // Camera rays go to Embree a row segment at a time (kStream pixels of one sample index) as one
   // coherent stream, which traverses neighbouring rays together; each path then continues from
@@ -62,8 +67,9 @@ class PathTracer final : public Integrator {
     static_assert(VertexNumberBatch::kMaxPixels >= kStream);
     Ray camera_rays[kStream];
     bool valid[kStream], found[kStream];
-    SurfaceHit hits[kStream];      // each path's working hit record, starting as its camera hit
-    ClosureSet closures, scratch;  // ~0.5 KB each: initialised once per tile, not per sample
+    SurfaceHit hits[kStream];  // each path's working hit record, starting as its camera hit
+    // ~0.5 KB each: initialised once per tile, not per sample.
+    ClosureSet closures, scratch, filtered;
     const float clamp = settings_.clamp;
     // Raster positions and sampler keys are the frame's (a render region samples as the frame).
     const int rx = ctx_.camera().region_x(), ry = ctx_.camera().region_y();
@@ -85,7 +91,7 @@ class PathTracer final : public Integrator {
           // --- The paths ---
           for (int j = 0; j < n; ++j) {
             const PathResult r =
-                trace(numbers, j, camera_rays[j], found[j], closures, scratch, hits[j]);
+                trace(numbers, j, camera_rays[j], found[j], closures, scratch, filtered, hits[j]);
             rays += r.rays;
             const Spectrum added =
                 film.pixel(x0 + j, y).add_path(r.primal, r.emission, clamp, r.alpha);
@@ -112,10 +118,10 @@ class PathTracer final : public Integrator {
     return ctx_.transmittance(ray, scratch, rays);
   }
 
-  // The camera ray of pixel (px, py) of the frame.
+  // The camera ray of pixel (px, py) of the frame, through the filter's sample for `jitter`.
   Ray camera_ray(const Sampler& sampler, Vec2f jitter, int px, int py) const {
     const Vec2f lens = kDoF ? sampler.get2d(Sampler::kDimLens) : Vec2f(0.5f, 0.5f);
-    return ctx_.camera().generate_ray({float(px) + jitter.x, float(py) + jitter.y}, lens);
+    return ctx_.camera().generate_ray(ctx_.pixel_filter().raster(px, py, jitter), lens);
   }
 
   // The path's state between vertices.
@@ -139,9 +145,11 @@ class PathTracer final : public Integrator {
 
   // The path of one camera sample, from its camera ray already traced (`camera_found`, and `hit`
   // holding the hit when found); `hit` is the path's working hit record from there on.
-  // `numbers` holds the pixel's Sampler and first vertices' numbers in lane `lane`.
+  // `numbers` holds the pixel's Sampler and first vertices' numbers in lane `lane`. `filtered`
+  // holds the closures the light-path rules rewrote (light_path_filters.h).
   PathResult trace(const VertexNumberBatch& numbers, int lane, Ray ray, bool camera_found,
-                   ClosureSet& closure_scratch, ClosureSet& scratch, SurfaceHit& hit) const {
+                   ClosureSet& closure_scratch, ClosureSet& scratch, ClosureSet& filtered,
+                   SurfaceHit& hit) const {
     const Sampler& sampler = numbers.sampler(lane);
     const EmbreeScene& bvh = ctx_.bvh();
     PathResult out;
@@ -189,7 +197,13 @@ class PathTracer final : public Integrator {
       if (last) break;
       if (const float q = path.state.take_deferred_division(); q != 1.0f) [[unlikely]]
         path.beta /= q;
-      const ClosureSet& material_closures = material.closures(sc, closure_scratch);
+      const ClosureSet* evaluated = &material.closures(sc, closure_scratch);
+      if (filters_.enabled() && filters_.active(path.state)) {
+        filtered.assign(*evaluated);
+        filters_.apply(path.state, filtered);
+        evaluated = &filtered;
+      }
+      const ClosureSet& material_closures = *evaluated;
       if (path.state.camera_path && data_.active())
         data_.at_surface(hit, material_closures, path.beta, out.data);
       if (features_.active())
@@ -323,6 +337,7 @@ class PathTracer final : public Integrator {
     const bool crossing = bs.is_straight_crossing();
     const uint32_t kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
     path.state.count_event(crossing, kind, bs.lobe);
+    if (!crossing) path.state.scattered(bs);
     path.crossed_since_vertex = crossing;
     bool continues = true;
     if (!crossing) {
@@ -349,6 +364,7 @@ class PathTracer final : public Integrator {
   RenderSettings settings_;
   DataPasses data_;
   FeaturePasses features_;
+  LightPathFilters filters_;
 };
 
 // --- Dispatch: one instantiation per subset of kSpecialised, picked once per session ---

@@ -256,6 +256,10 @@ def setup_gdpt(scene, samples, mode='GPT', reconstruction='L2', bounces=4, seed=
     g.seed = seed
     g.time_limit = 0.0
     g.alpha = 0.2
+    g.pixel_filter_type = 'BOX'  # as setup_cycles()
+    g.filter_width = 1.0
+    g.blur_glossy = 0.0
+    g.caustics_reflective = g.caustics_refractive = True
 
 
 def setup_cycles(scene, samples, bounces=4, seed=1):

@@ -151,6 +151,51 @@ def case_area_camera_visible(scene):
     return 3
 
 
+def case_thin_edges(scene):
+    # Window bars against a bright sky: thin lit bars (under a pixel wide, slightly rotated, so
+    # their edges cross the pixels at every offset) in front of an emissive plane, orthographic.
+    # Both engines filter with Cycles' default Blackman-Harris 1.5 (PIXEL_FILTER); the box-
+    # filtered Gradient PT image must fail the bound (BOX_MUST_FAIL).
+    S.plane("sky", 6.0, (0, 2.0, 0), (math.pi / 2, 0, 0), S.emission("sky", (1.0, 0.95, 0.9), 8.0))
+    bar = S.diffuse("bar", (0.2, 0.2, 0.2))
+    w, h = 0.01, 1.2  # bars 0.64 px wide, about 4 px apart
+    for k in range(-8, 9):
+        S.mesh_object(f"vbar{k}", [(-w, 0, -h), (w, 0, -h), (w, 0, h), (-w, 0, h)],
+                      [(0, 1, 2, 3)], bar).location = (0.13 * k, 1.0, 0)
+    for k in range(-5, 6):
+        S.mesh_object(f"hbar{k}", [(-h, 0, -w), (h, 0, -w), (h, 0, w), (-h, 0, w)],
+                      [(0, 1, 2, 3)], bar).location = (0, 0.9, 0.135 * k)
+    for obj in bpy.data.objects:
+        if obj.name.startswith(("vbar", "hbar")):
+            obj.rotation_euler = (0, 0.07, 0)
+    S.camera((0, -5.0, 0), (0, 0, 0), ortho_scale=2.0)
+    S.light('SUN', (0, -10.0, 3.0), 3.0, target=(0, 0, 0))
+    return 2
+
+
+def caustic_room(scene, glass_roughness):
+    # A glossy ball and a glass ball on the floor of the room under a small lamp: their light on
+    # the floor and walls comes through glossy and refractive bounces (caustics), and the floor
+    # seen in them is reached after such bounces.
+    lit_room(scene)
+    area_ceiling(size=0.6, energy=150.0)
+    S.uv_sphere("mirror", 0.6, (-0.8, 0.4, 0.6), S.glossy("mirror", 0.1))
+    glass = S.shader_material("glass", "ShaderNodeBsdfGlass", Color=(1, 1, 1, 1),
+                              Roughness=glass_roughness, IOR=1.5, distribution='GGX')
+    S.uv_sphere("glass", 0.6, (0.8, 0.2, 0.6), glass)
+    return 6
+
+
+def case_filter_glossy(scene):
+    # Filter Glossy 1.0 on both engines (LIGHT_PATHS): the caustics blurred by the same rule.
+    return caustic_room(scene, 0.1)
+
+
+def case_caustics_off(scene):
+    # Reflective and refractive caustics off on both engines (LIGHT_PATHS).
+    return caustic_room(scene, 0.3)
+
+
 def case_mesh_light(scene):
     lit_room(scene)
     S.plane("panel", 1.2, (0, 0, 3.9), (math.pi, 0, 0), S.emission("panel", (1, 0.9, 0.8), 20.0))
@@ -1366,6 +1411,22 @@ REGIONS = {"math_nodes": (math_regions, 1e-4), "vector_math": (vector_regions, 5
            "curve_nodes": (curve_regions, 5e-4)}
 
 
+# Pixel filter (scene.cycles.pixel_filter_type, filter_width) set on both engines; the common
+# set-up uses a 1-pixel box on both. BOX_MUST_FAIL: the case also renders Gradient PT with the box
+# against Cycles' filtered image, which must exceed the bound (the filter is what makes it agree).
+PIXEL_FILTER = {"thin_edges": ('BLACKMAN_HARRIS', 1.5)}
+BOX_MUST_FAIL = {"thin_edges"}
+
+# Light Paths > Caustics settings (the same names on scene.cycles and scene.gdpt) set on both
+# engines; the common set-up has Filter Glossy 0 and caustics on. Each case also renders
+# Gradient PT with the common set-up against Cycles' image, which must exceed the bound (the
+# setting is what makes them agree). Measured: filter_glossy relMSE 0.0060 (0.0015 at 4x: noise),
+# 0.049 without the setting; caustics_off 0.0023 (0.0005 at 4x), 0.095 without; thin_edges
+# 0.0004, 0.015 with the box.
+LIGHT_PATHS = {"filter_glossy": {"blur_glossy": 1.0},
+               "caustics_off": {"caustics_reflective": False, "caustics_refractive": False}}
+
+
 # Per-kind bounce limits (diffuse, glossy, transmission) set on both engines after the common
 # set-up, which makes them all equal to the total.
 KIND_LIMITS = {"bounce_limits": (1, 2, 3)}
@@ -1385,21 +1446,37 @@ def run_case(name, out_dir, mode=None):
     recon = RECON if mode == 'GPT' else 'NONE'
     gdpt_samples = max(1, int(GDPT_SAMPLES * SAMPLE_SCALE.get(name, 1)))
     cycles_samples = max(1, int(CYCLES_SAMPLES * SAMPLE_SCALE.get(name, 1)))
-    S.setup_gdpt(scene, gdpt_samples, mode=mode, reconstruction=recon, bounces=bounces)
     limits = KIND_LIMITS.get(name)
-    if limits:
+    pixel_filter = PIXEL_FILTER.get(name)
+
+    light_paths = LIGHT_PATHS.get(name, {})
+
+    def render_gdpt(filter_type, suffix="", light_path_settings=light_paths):
+        S.setup_gdpt(scene, gdpt_samples, mode=mode, reconstruction=recon, bounces=bounces)
         g = scene.gdpt
-        g.diffuse_bounces, g.glossy_bounces, g.transmission_bounces = limits
-    engine.LAST_RENDER.clear()
+        if limits:
+            g.diffuse_bounces, g.glossy_bounces, g.transmission_bounces = limits
+        if filter_type:
+            g.pixel_filter_type, g.filter_width = filter_type
+        for key, value in light_path_settings.items():
+            setattr(g, key, value)
+        engine.LAST_RENDER.clear()
+        path = S.render(scene, os.path.join(out_dir, f"{name}_gdpt_{mode}{suffix}.exr"))
+        if engine.LAST_RENDER.get("samples") != gdpt_samples:
+            raise RuntimeError(f"{name}: Gradient PT did not render (got {engine.LAST_RENDER})")
+        return path
+
     t0 = time.time()
-    gdpt_path = S.render(scene, os.path.join(out_dir, f"{name}_gdpt_{mode}.exr"))
+    gdpt_path = render_gdpt(pixel_filter)
     t_gdpt = time.time() - t0
-    if engine.LAST_RENDER.get("samples") != gdpt_samples:
-        raise RuntimeError(f"{name}: Gradient PT did not render (got {engine.LAST_RENDER})")
     S.setup_cycles(scene, cycles_samples, bounces=bounces)
+    c = scene.cycles
     if limits:
-        c = scene.cycles
         c.diffuse_bounces, c.glossy_bounces, c.transmission_bounces = limits
+    if pixel_filter:
+        c.pixel_filter_type, c.filter_width = pixel_filter
+    for key, value in light_paths.items():
+        setattr(c, key, value)
     t0 = time.time()
     cycles_path = S.render(scene, os.path.join(out_dir, f"{name}_cycles.exr"))
     t_cycles = time.time() - t0
@@ -1420,6 +1497,20 @@ def run_case(name, out_dir, mode=None):
                 bad_regions.append(f"{label} {e:.2e}")
         print(f"  {len(regions(a))} regions, worst relMSE {worst:.2e}, over {bound:g}: "
               f"{', '.join(bad_regions) or 'none'}", flush=True)
+    if name in BOX_MUST_FAIL:
+        box = S.read_rgb(render_gdpt(('BOX', 1.0), "_box"))
+        err_box = S.rel_mse(box, b)
+        print(f"  with a 1-pixel box on Gradient PT: relMSE {err_box:.5f} (must exceed "
+              f"{THRESHOLD})", flush=True)
+        if not err_box > THRESHOLD:
+            bad_regions.append(f"box filter agrees too (relMSE {err_box:.4f})")
+    if light_paths:
+        plain = S.read_rgb(render_gdpt(pixel_filter, "_common", {}))
+        err_plain = S.rel_mse(plain, b)
+        print(f"  Gradient PT without {light_paths}: relMSE {err_plain:.5f} (must exceed "
+              f"{THRESHOLD})", flush=True)
+        if not err_plain > THRESHOLD:
+            bad_regions.append(f"the common set-up agrees too (relMSE {err_plain:.4f})")
     return err, ratio, bad_regions
 
 

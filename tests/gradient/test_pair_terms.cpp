@@ -141,7 +141,8 @@ struct Pair {
   // Base vertex seen from the eye towards `x`, offset vertex towards `y` (offset 0 only).
   void place(Vec3f x, Vec3f y) {
     const SurfaceHit hx = hit_from_eye(x), hy = hit_from_eye(y);
-    setup_vertex(*ctx, g->sides, hx, normalize(hx.position - eye), PathView{}, base());
+    setup_vertex(*ctx, g->sides, g->rules(PathState{}), hx, normalize(hx.position - eye),
+                 PathView{}, base());
     for (Offset& o : scratch->off) o.active = o.alive = false;
     Offset& o = offset();
     o.active = o.alive = true;
@@ -150,7 +151,8 @@ struct Pair {
     o.f = Vec3d(1.0, 1.0, 1.0);
     o.p = 1.0;
     o.grad = Vec3d();
-    setup_vertex(*ctx, g->sides, hy, normalize(hy.position - eye), PathView{}, o.v);
+    setup_vertex(*ctx, g->sides, g->rules(PathState{}), hy, normalize(hy.position - eye),
+                 PathView{}, o.v);
     o.nee_on = g->classify(base().roughness) == VertexType::Diffuse &&
                g->classify(o.v.roughness) == VertexType::Diffuse;
   }
@@ -194,10 +196,11 @@ void run_segment(Pair& p, Segment& s, bool events = true) {
   s.light_hit =
       g.ctx.lights().intersect(s.ray.origin, s.ray.direction, s.found ? s.next.t : kInf, s.lh);
   const VertexType base_type = g.classify(base.roughness);
-  const VertexType next_type = s.found ? g.classify_hit(s.next) : VertexType::Diffuse;
+  static const PathState kFirstBounce;  // the test's materials follow no light-path rule
+  const VertexType next_type = s.found ? g.classify_hit(s.next, kFirstBounce) : VertexType::Diffuse;
   BaseStep& st = p.scratch->step;
-  st = BaseStep{&base, &s.bs, base_type,  next_type, wo_world, s.found, &s.next,
-                0.0f,  {},    s.ray.kind, false,     {},       false};
+  st = BaseStep{&base, &s.bs, base_type,  next_type, wo_world,      s.found, &s.next,
+                0.0f,  {},    s.ray.kind, false,     &kFirstBounce, {},      false};
   if (s.found && base_type == VertexType::Diffuse && next_type == VertexType::Diffuse) {
     st.target =
         shift::reconnection_base(base.hit.position, s.next.position, s.next.geometric_normal);
@@ -455,7 +458,7 @@ TEST(GradientPairTerms, InvertibilityKill) {
     } else {
       EXPECT_NE(o.grad.x, -pb / (pl * pl + pb * pb) * cb.x) << "a living offset adds its C'";
     }
-    advance(*p.g, o, false, PathView{});
+    advance(*p.g, o, false, PathState{}, PathView{});
     EXPECT_EQ(o.alive, !right_diffuse);
     EXPECT_EQ(o.failed, right_diffuse);
   }
