@@ -1,9 +1,11 @@
 # Cross-engine agreement: each supported feature rendered by Gradient PT (G-PT, L2 reconstruction,
 # which is unbiased) and by Cycles set up to model the same thing (GGX, equal bounces, no clamping,
 # no glossy blur, no light threshold, 1-pixel box filter, no denoising, same resolution) at high
-# sample counts. Pass: relMSE(GDPT, Cycles) < 1% and image means within 2% (an energy error
-# spread over the whole image can hide under the relMSE bound; the mean catches it).
-# Noise floor at the default counts (measured): relMSE 1e-4 .. 4e-3 for the agreeing cases.
+# sample counts. Pass, per case: relMSE(GDPT, Cycles) over the frame and over each ninth of it
+# (a 3x3 grid: a feature covering a few pixels can hide in the frame's relMSE) below 3x the
+# case's noise floor measured at the default counts (FLOORS; the frame bound at most 1%), and
+# image means within 2% (an energy error spread over the whole image can hide under the relMSE
+# bound; the mean catches it).
 #   blender -b --factory-startup --addons gdpt --python-exit-code 1 --python this.py --
 #           --out DIR --cases diffuse,glossy,...
 import math
@@ -1438,6 +1440,82 @@ BOTH_MODES = {"normal_map", "clearcoat", "world_camera_view", "area_visible", "a
               "bounce_limits", "no_shadow", "transparent_shadow"}
 
 
+
+# Noise floors at the default counts: relMSE(GDPT, Cycles) over the frame and the worst ninth of
+# it, measured on the agreeing code (rounded up to two digits). Bounds are 3x these; the frame
+# bound stays at most THRESHOLD. Other sample counts (GDPT_TEST_SAMPLES, ...) use THRESHOLD
+# alone.
+FLOORS = {
+    "area_camera_visible/GPT": (5.9e-4, 1.2e-3), "area_camera_visible/PT": (1.2e-3, 2.4e-3),
+    "area_disk/GPT": (6.1e-4, 1.4e-3), "area_visible/GPT": (5.0e-4, 6.8e-4),
+    "area_visible/PT": (9.9e-4, 1.5e-3), "curve_nodes/GPT": (4.4e-6, 5.9e-6),
+    "empty_mix_input/GPT": (4.5e-3, 9.9e-3), "mesh_light/GPT": (6.2e-3, 1.2e-2),
+    "point/GPT": (1.2e-3, 3.0e-3), "refraction/GPT": (4.9e-3, 2.5e-2),
+    "spot/GPT": (4.3e-3, 6.7e-3), "sun/GPT": (8.7e-5, 7.1e-4),
+    "translucent/GPT": (2.7e-3, 5.6e-3), "velvet/GPT": (1.1e-3, 2.1e-3),
+    "adjust_nodes/GPT": (2.1e-3, 3.2e-3), "bump/GPT": (3.1e-3, 1.1e-2),
+    "channel_nodes/GPT": (9.4e-4, 2.2e-3), "clearcoat/GPT": (3.6e-3, 1.8e-2),
+    "clearcoat/PT": (2.1e-3, 5.4e-3), "color_attribute/GPT": (5.6e-4, 1.4e-3),
+    "diffuse/GPT": (6.0e-4, 1.3e-3), "glass/GPT": (4.6e-3, 2.1e-2),
+    "glossy/GPT": (3.4e-3, 5.0e-3), "image_texture/GPT": (3.6e-4, 1.0e-3),
+    "input_nodes/GPT": (7.4e-4, 1.4e-3), "normal_map/GPT": (1.8e-3, 3.4e-3),
+    "normal_map/PT": (2.2e-3, 3.7e-3), "principled_dielectric/GPT": (1.1e-3, 3.2e-3),
+    "principled_metal/GPT": (2.2e-3, 3.6e-3), "principled_sheen/GPT": (1.3e-5, 8.3e-5),
+    "procedural_textures/GPT": (2.7e-3, 2.0e-2), "smooth_silhouettes/GPT": (1.5e-3, 1.1e-2),
+    "bounce_limits/GPT": (5.6e-3, 2.9e-2), "bounce_limits/PT": (6.8e-3, 3.3e-2),
+    "holdout/GPT": (5.7e-4, 9.7e-4), "holdout/PT": (9.5e-4, 1.7e-3),
+    "no_shadow/GPT": (5.1e-4, 8.1e-4), "no_shadow/PT": (8.4e-4, 1.3e-3),
+    "ray_visibility/GPT": (3.2e-3, 5.3e-3), "ray_visibility/PT": (4.3e-3, 7.4e-3),
+    "transparent_shadow/GPT": (9.5e-4, 1.8e-3), "transparent_shadow/PT": (1.5e-3, 2.3e-3),
+    "brick_texture/GPT": (4.4e-6, 6.5e-6), "dof/GPT": (4.5e-4, 7.1e-4),
+    "instancing/GPT": (5.3e-4, 9.7e-4), "math_nodes/GPT": (8.2e-6, 1.9e-5),
+    "ortho/GPT": (3.6e-4, 5.8e-4), "vector_math/GPT": (8.2e-6, 1.6e-5),
+    "voronoi_features/GPT": (2.6e-5, 1.4e-4), "world_camera_view/GPT": (4.3e-4, 1.3e-3),
+    "world_camera_view/PT": (4.7e-4, 1.4e-3), "world_color/GPT": (4.5e-5, 2.7e-4),
+    "world_hdri/GPT": (1.5e-4, 6.7e-4),
+}
+FLOOR_FACTOR = 3.0
+DEFAULT_COUNTS = (GDPT_SAMPLES, CYCLES_SAMPLES) == (128, 256)
+
+# Cases whose noise in a ninth of the frame (caustics, rough glass, bump and procedural edges at
+# the default counts) is above what a 15% scale of that ninth adds: their ninths' bound cannot
+# see such an error (more samples would, at a CI cost), the frame bound and the mean still hold.
+NOISY_NINTHS = {"refraction/GPT", "spot/GPT", "bump/GPT", "clearcoat/GPT", "glass/GPT",
+                "procedural_textures/GPT", "smooth_silhouettes/GPT", "bounce_limits/GPT",
+                "bounce_limits/PT"}
+
+
+def ninths(image):
+    """The 3x3 grid of an image: (label, pixels) pairs."""
+    h, w = image.shape[:2]
+    return [(f"ninth {i},{j}", image[h * i // 3:h * (i + 1) // 3, w * j // 3:w * (j + 1) // 3])
+            for i in range(3) for j in range(3)]
+
+
+def bounds(key):
+    """(frame bound, ninth bound or None) of a case/mode."""
+    if DEFAULT_COUNTS and key in FLOORS:
+        frame, ninth = FLOORS[key]
+        return min(FLOOR_FACTOR * frame, THRESHOLD), FLOOR_FACTOR * ninth
+    return THRESHOLD, None
+
+
+def ninth_failures(a, b, bound):
+    return [f"{label} {S.rel_mse(ra, rb):.2e}" for (label, ra), (_, rb) in zip(ninths(a), ninths(b))
+            if not S.rel_mse(ra, rb) < bound]
+
+
+def injection_seen(a, b, bound):
+    """Whether the ninths' bound fails a GDPT image whose brightest ninth is scaled by 1.15 (the
+    test's power against a 15% error on a ninth of the frame)."""
+    h, w = a.shape[:2]
+    k = max(range(9), key=lambda k: float(ninths(b)[k][1].mean()))
+    i, j = divmod(k, 3)
+    scaled = a.copy()
+    scaled[h * i // 3:h * (i + 1) // 3, w * j // 3:w * (j + 1) // 3] *= 1.15
+    return bool(ninth_failures(scaled, b, bound))
+
+
 def run_case(name, out_dir, mode=None):
     scene = S.clear()
     bounces = CASES[name](scene)
@@ -1486,7 +1564,17 @@ def run_case(name, out_dir, mode=None):
     ratio = a.mean() / max(b.mean(), 1e-9)
     print(f"CASE {name} ({mode}): relMSE {err:.5f} mean GDPT/Cycles {ratio:.4f} (GDPT {gdpt_samples} spp "
           f"{t_gdpt:.1f} s, Cycles {cycles_samples} spp {t_cycles:.1f} s)", flush=True)
+    key = f"{name}/{mode}"
+    frame_bound, ninth_bound = bounds(key)
     bad_regions = []
+    if ninth_bound is not None:
+        bad_regions += ninth_failures(a, b, ninth_bound)
+        seen = injection_seen(a, b, ninth_bound)
+        worst = max(S.rel_mse(ra, rb) for (_, ra), (_, rb) in zip(ninths(a), ninths(b)))
+        print(f"  frame bound {frame_bound:.2e}; ninths: worst {worst:.2e}, bound {ninth_bound:.2e}; "
+              f"15% on the brightest ninth {'seen' if seen else 'not seen'}", flush=True)
+        if not seen and key not in NOISY_NINTHS:
+            bad_regions.append("a 15% error on its brightest ninth would pass")
     if name in REGIONS:
         regions, bound = REGIONS[name]
         worst = 0.0
@@ -1511,7 +1599,7 @@ def run_case(name, out_dir, mode=None):
               f"{THRESHOLD})", flush=True)
         if not err_plain > THRESHOLD:
             bad_regions.append(f"the common set-up agrees too (relMSE {err_plain:.4f})")
-    return err, ratio, bad_regions
+    return err, ratio, bad_regions, frame_bound
 
 
 def main():
@@ -1522,8 +1610,8 @@ def main():
     failures = []
     for name in names:
         for mode in ((MODE, 'PT') if name in BOTH_MODES and MODE != 'PT' else (MODE,)):
-            err, ratio, bad_regions = run_case(name, out_dir, mode)
-            if not (err < THRESHOLD and abs(ratio - 1.0) < MEAN_TOLERANCE) or bad_regions:
+            err, ratio, bad_regions, frame_bound = run_case(name, out_dir, mode)
+            if not (err < frame_bound and abs(ratio - 1.0) < MEAN_TOLERANCE) or bad_regions:
                 failures.append(f"{name} {mode} (relMSE {err:.4f}, mean ratio {ratio:.3f}"
                                 f"{', regions ' + ', '.join(bad_regions) if bad_regions else ''})")
     if failures:

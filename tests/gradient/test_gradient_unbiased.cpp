@@ -1,6 +1,6 @@
 // Statistical proofs of the G-PT integrator against a converged PT reference on the same scene:
 //  - E[dx], E[dy] equal the finite differences of the PT reference per pixel (rule below),
-//    including the border pixels, and the image-wide sum of the differences is within 4 sigma of
+//    including the border pixels, and the image-wide sum of the differences is within 3.5 sigma of
 //    zero (power against small systematic bias);
 //  - the G-PT primal equals PT within noise (same rule);
 //  - the last column / row hold the Neumann zeros;
@@ -12,8 +12,8 @@
 // statistical tests (calibration only).
 //
 // Per-pixel rule (check()): z = diff / sigma with sigma^2 = max(own variance, mean of the
-// variances of the 3x3 neighbourhood on the same image border); |z| <= 4, except one pixel per
-// buffer in (4, 5]; none beyond 5. Budgets: G-PT 1024 spp against PT 4096 spp (hard cases 512
+// variances of the 3x3 neighbourhood on the same image border); |z| <= 3.5, except one pixel per
+// buffer in (3.5, 4.5]; none beyond 4.5. Budgets: G-PT 1024 spp against PT 4096 spp (hard cases 512
 // against 2048; the heavy-tailed near-threshold and dense-glass cases 2048 / 1024).
 //
 // Why: the per-pixel sample variances of near-specular paths are heavy-tailed. A pixel whose
@@ -97,6 +97,10 @@ struct Buffer {
 
 // The per-pixel rule of the header: the own variance, raised to the mean of its 3x3
 // neighbourhood (same border). The image-wide z uses the sum of the own variances.
+// Thresholds of the rule: the calibration's 800 runs had no false failure at these (nor at 4 / 5 /
+// 4, the earlier ones).
+constexpr double kZ = 3.5, kZSevere = 4.5, kGlobalZ = 3.5;
+
 struct Check {
   int tested = 0, outliers = 0, severe = 0;
   double max_z = 0.0, max_z_own = 0.0;  // pooled sigma, own sigma only (printed for reference)
@@ -122,13 +126,13 @@ Check check(const Buffer& b) {
       c.max_z_own = std::max(c.max_z_own, std::fabs(diff) / std::sqrt(var));
       const double z = std::fabs(diff) / std::sqrt(std::max(var, b.neighbourhood_var(x, y)));
       c.max_z = std::max(c.max_z, z);
-      if (z > 4.0) ++c.outliers;
-      if (z > 5.0) ++c.severe;
+      if (z > kZ) ++c.outliers;
+      if (z > kZSevere) ++c.severe;
     }
   return c;
 }
 
-void expect_within_4_sigma(const Check& c, const char* name, const char* buffer) {
+void expect_within_bounds(const Check& c, const char* name, const char* buffer) {
   EXPECT_LE(c.outliers, 1) << name << " " << buffer;
   EXPECT_EQ(c.severe, 0) << name << " " << buffer;
 }
@@ -161,7 +165,7 @@ Comparison compare(const Passes& ref, const Passes& g) {
   return {check(dx), check(dy), check(primal)};
 }
 
-// Max |z| (with the own variance alone in parentheses), outliers beyond 4 and image-wide z.
+// Max |z| (with the own variance alone in parentheses), outliers beyond kZ and image-wide z.
 void print_comparison(const char* name, const Comparison& c, bool primal) {
   auto one = [](const char* buffer, const Check& k) {
     std::printf(" | %s: max z %.2f (own %.2f), outliers %d/%d, global z %.2f", buffer, k.max_z,
@@ -194,12 +198,12 @@ void expect_unbiased(const char* name, const Scene& scene, int ref_spp, int gpt_
   failures /= double(g.failures.size());
   print_comparison(name, c, true);
   std::printf("[%s] shift failure rate %.3f\n", name, failures);
-  expect_within_4_sigma(c.dx, name, "dx");
-  expect_within_4_sigma(c.dy, name, "dy");
-  expect_within_4_sigma(c.primal, name, "primal");
-  EXPECT_LT(std::fabs(c.dx.global_z()), 4.0) << name;
-  EXPECT_LT(std::fabs(c.dy.global_z()), 4.0) << name;
-  EXPECT_LT(std::fabs(c.primal.global_z()), 4.0) << name;
+  expect_within_bounds(c.dx, name, "dx");
+  expect_within_bounds(c.dy, name, "dy");
+  expect_within_bounds(c.primal, name, "primal");
+  EXPECT_LT(std::fabs(c.dx.global_z()), kGlobalZ) << name;
+  EXPECT_LT(std::fabs(c.dy.global_z()), kGlobalZ) << name;
+  EXPECT_LT(std::fabs(c.primal.global_z()), kGlobalZ) << name;
   EXPECT_LE(failures, max_failure_rate) << name;
   // The gradients carry signal: the test would see a missing or halved gradient.
   double energy = 0.0;
@@ -386,13 +390,13 @@ TEST(GradientUnbiased, EveryVertexHalfVector) {
   const Passes g = render(scene, s);
   const Comparison c = compare(ref, g);
   print_comparison("all-half-vector", c, false);
-  expect_within_4_sigma(c.dx, "all-half-vector", "dx");
-  expect_within_4_sigma(c.dy, "all-half-vector", "dy");
-  EXPECT_LT(std::fabs(c.dx.global_z()), 4.0);
-  EXPECT_LT(std::fabs(c.dy.global_z()), 4.0);
+  expect_within_bounds(c.dx, "all-half-vector", "dx");
+  expect_within_bounds(c.dy, "all-half-vector", "dy");
+  EXPECT_LT(std::fabs(c.dx.global_z()), kGlobalZ);
+  EXPECT_LT(std::fabs(c.dy.global_z()), kGlobalZ);
 }
 
-// Hard cases: no NaN/Inf anywhere, and still unbiased (fewer samples, same 4-sigma rule).
+// Hard cases: no NaN/Inf anywhere, and still unbiased (fewer samples, same rule).
 bool all_finite(const Passes& p) {
   for (const auto* v : {&p.primal, &p.dx, &p.dy, &p.emission, &p.variance, &p.failures})
     for (float f : *v)
@@ -406,10 +410,10 @@ void expect_hard_case(const char* name, const Scene& scene, int gpt_spp = 512) {
   const Passes ref = render(scene, settings(RenderSettings::Mode::PT, 2048, 9 + seed_offset()));
   const Comparison c = compare(ref, g);
   print_comparison(name, c, false);
-  expect_within_4_sigma(c.dx, name, "dx");
-  expect_within_4_sigma(c.dy, name, "dy");
-  EXPECT_LT(std::fabs(c.dx.global_z()), 4.0) << name;
-  EXPECT_LT(std::fabs(c.dy.global_z()), 4.0) << name;
+  expect_within_bounds(c.dx, name, "dx");
+  expect_within_bounds(c.dy, name, "dy");
+  EXPECT_LT(std::fabs(c.dx.global_z()), kGlobalZ) << name;
+  EXPECT_LT(std::fabs(c.dy.global_z()), kGlobalZ) << name;
 }
 
 TEST(GradientHardCases, RoomCornerGrazing) {
