@@ -30,8 +30,8 @@ constexpr int kTileSize = 16;
 constexpr int kTilesPerWorker = 32;
 // Pixel-samples per render_tile call (16 spp of a full tile): a few milliseconds of PT or G-PT.
 constexpr uint32_t kChunkSamples = 16 * kTileSize * kTileSize;
-// Film pairs of other sizes a session keeps: the viewport's start resolutions (divider 8 to 2).
-constexpr size_t kMaxSpareFilms = 3;
+// Film pairs of other sizes a session keeps: the viewport's start resolutions (divider 16 to 2).
+constexpr size_t kMaxSpareFilms = 4;
 
 int tile_height(int w, int h, int workers) {
   const int columns = (w + kTileSize - 1) / kTileSize;
