@@ -30,6 +30,8 @@ constexpr int kTileSize = 16;
 constexpr int kTilesPerWorker = 32;
 // Pixel-samples per render_tile call (16 spp of a full tile): a few milliseconds of PT or G-PT.
 constexpr uint32_t kChunkSamples = 16 * kTileSize * kTileSize;
+// Film pairs of other sizes a session keeps: the viewport's start resolutions (divider 16 to 2).
+constexpr size_t kMaxSpareFilms = 4;
 
 int tile_height(int w, int h, int workers) {
   const int columns = (w + kTileSize - 1) / kTileSize;
@@ -59,7 +61,9 @@ struct RenderSession::Impl {
   std::unique_ptr<SceneContext> context;
   std::unique_ptr<Integrator> integrator;
   Film film, pass_film;
-  Film spare_film, spare_pass_film;  // the films of the camera before (another size)
+  // Films of the cameras before (other sizes), the most recent first: the viewport's restarts
+  // go through a few start resolutions to the full view, each size's films are kept.
+  std::vector<std::pair<Film, Film>> spare_films;
   std::vector<Tile> tiles;
   std::vector<std::string> warnings;
   // settings.threads worker slots (0 = all cores): used for the BVH build and every pass.
@@ -129,18 +133,22 @@ void RenderSession::Impl::setup_for_camera() {
            f.has_normal() == settings.normal_pass && f.has_mist() == settings.mist_pass &&
            f.has_features() == settings.feature_passes;
   };
-  // The viewport alternates a small first pass and the full view: both film pairs are kept, so
-  // a restart clears films instead of allocating (and faulting in) new ones.
-  if (!fits(film) && fits(spare_film)) {
-    std::swap(film, spare_film);
-    std::swap(pass_film, spare_pass_film);
+  // A restart clears kept films of its size instead of allocating (and faulting in) new ones.
+  if (!fits(film)) {
+    auto kept = std::find_if(spare_films.begin(), spare_films.end(),
+                             [&](const auto& f) { return fits(f.first); });
+    if (kept == spare_films.end() && spare_films.size() < kMaxSpareFilms)
+      kept = spare_films.emplace(spare_films.end());
+    else if (kept == spare_films.end())
+      kept = spare_films.end() - 1;  // the least recent goes
+    std::swap(film, kept->first);
+    std::swap(pass_film, kept->second);
+    std::rotate(spare_films.begin(), kept, kept + 1);  // most recent first
   }
   if (fits(film)) {
     arena->execute(
         [&] { tbb::parallel_invoke([&] { film.clear(); }, [&] { pass_film.clear(); }); });
   } else {
-    spare_film = std::move(film);
-    spare_pass_film = std::move(pass_film);
     film = Film(w, h, gradients_from_primal);
     pass_film = Film(w, h, gradients_from_primal);  // the output film's layout (take_rows)
     for (Film* f : {&film, &pass_film}) {

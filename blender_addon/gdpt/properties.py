@@ -116,8 +116,9 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
         "(0 = until stopped)", default=256, min=0, max=1 << 24, soft_max=4096)
     preview_start_divider: IntProperty(
         name="Start Resolution Divider", description="After a change, the viewport first "
-        "renders one pass at the resolution divided by this, for an image at once (1 = off)",
-        default=4, min=1, max=64)
+        "renders one pass at the resolution divided by this, then at twice that resolution and "
+        "so on, for an image at once (1 = off)",
+        default=8, min=1, max=64)
     preview_mode: EnumProperty(
         name="Viewport Integrator",
         items=[('GPT', "Gradient-Domain", "Gradient-domain path tracing, reconstructed"),

@@ -172,22 +172,21 @@ void ViewportJob::State::work() {
 
 void ViewportJob::State::render_view(const Camera& camera) {
   const auto start = Clock::now();
-  if (display.start_divider > 1) {
-    session->set_camera(reduced(camera, display.start_divider));
-    // One pass, then the full resolution: on_pass cancels the rest of this render. Its image is
-    // the primal: a solve at a second size would plan FFTs and map solver buffers for it on every
-    // restart, for a 1-sample preview that a reconstruction barely improves.
+  // One pass at 1/divider of the resolution, then at twice that, ..., then the full view (as
+  // Cycles' start resolution): on_pass cancels the rest of each. Their images are primals: a solve
+  // at other sizes would plan FFTs and map solver buffers for them on every restart, for 1-sample
+  // previews that a reconstruction barely improves.
+  for (int divider = display.start_divider; divider > 1; divider /= 2) {
+    session->set_camera(reduced(camera, divider));
     session->render(
         [&](const RenderProgress& p) {
           publish(p.samples_done, false, start);
           cancel.store(true);
         },
         cancel);
-    {
-      std::lock_guard lock(mutex);
-      if (pending || stopping) return;
-      cancel.store(false);
-    }
+    std::lock_guard lock(mutex);
+    if (pending || stopping) return;
+    cancel.store(false);
   }
   session->set_camera(camera);
   const int total = settings.samples;

@@ -1703,6 +1703,31 @@ TEST(Render, SetCameraRendersAsANewSession) {
   }
 }
 
+// The viewport's restarts through start resolutions: a session keeps the films of a few sizes and
+// clears them on the way back; every restart renders what a new session of its camera renders,
+// including after a size was dropped (more sizes than the session keeps).
+TEST(Render, RestartsAcrossSizesRenderAsNewSessions) {
+  const Scene scene = cornell_like();
+  RenderSettings s = pt(2, 5);
+  s.mode = RenderSettings::Mode::GPT;
+  RenderSession session(scene, s);
+  std::atomic<bool> cancel{false};
+  for (const int divider : {4, 2, 1, 4, 2, 1, 8, 3, 5, 1, 4}) {
+    Scene sized = scene;
+    sized.camera.width = scene.camera.width / divider;
+    sized.camera.height = scene.camera.height / divider;
+    session.set_camera(sized.camera);
+    ASSERT_EQ(session.film().min_samples(), 0u) << divider;
+    session.render(nullptr, cancel);
+    std::vector<float> primal(session.film().pixel_count() * 3), gx(primal.size());
+    session.film().primal_rgb(primal.data());
+    session.film().gradient_x_rgb(gx.data());
+    const Image fresh = render(sized, s);
+    EXPECT_EQ(primal, fresh.primal) << "divider " << divider;
+    EXPECT_EQ(gx, fresh.gradient_x) << "divider " << divider;
+  }
+}
+
 // The viewport's in-place update: after update() with moved and brighter lamps, another material
 // colour, another world and other settings, a session keeps its BVH and renders bit for bit what
 // a new session of the changed scene renders, in PT and G-PT; a moved instance rebuilds it (same
