@@ -290,6 +290,89 @@ std::vector<float> l2_solution(const Prepared& pr, double alpha, bool measure,
   return x;
 }
 
+// The start of a warm L1 solve: input.initial minus the emission, the primal where that is not
+// finite.
+std::vector<float> warm_start(const Prepared& pr, const ReconstructionInput& in) {
+  const int W = pr.width;
+  auto x = huge_vector<float>(3 * size_t(W) * pr.height);
+  parallel_rows(pr.height, [&](int y0, int y1) {
+    for (size_t i = 3 * size_t(y0) * W; i < 3 * size_t(y1) * W; ++i) {
+      float v = in.initial[i];
+      if (in.emission && std::isfinite(in.emission[i])) v -= in.emission[i];
+      x[i] = std::isfinite(v) ? v : pr.primal[i];
+    }
+  });
+  return x;
+}
+
+// The reweighting schedule of an L1 solve: count, regulariser range and steps per reweighting.
+struct L1Schedule {
+  int reweightings = 1;
+  double first_reg = kL1InitialRegulariser, last_reg = kL1FinalRegulariser;
+  int first_steps = 1, last_steps = 1;
+
+  L1Schedule(const ReconstructionSettings& s, bool warm) {
+    if (warm) {
+      reweightings = std::max(1, s.l1_warm_reweightings);
+      first_reg = std::clamp(s.l1_warm_regulariser, kL1FinalRegulariser, kL1InitialRegulariser);
+      first_steps = last_steps = s.l1_warm_cg_steps;
+    } else {
+      reweightings = std::max(1, s.l1_reweightings);
+      first_steps = s.l1_cg_steps_first;
+      last_steps = s.l1_cg_steps_last;
+    }
+    if (reweightings == 1) first_reg = last_reg;
+  }
+  double decay() const {
+    return reweightings > 1 ? std::pow(last_reg / first_reg, 1.0 / (reweightings - 1)) : 1.0;
+  }
+  // Inner steps fall linearly from first to last: the early reweightings move the image far from
+  // the L2 start, the late ones only refine it (bench_reconstruct --sweep).
+  int steps(int k) const {
+    const int K = reweightings;
+    const int n =
+        K > 1 ? int(std::lround(first_steps + double(last_steps - first_steps) * k / (K - 1)))
+              : first_steps;
+    return std::max(1, n);
+  }
+};
+
+// IRLS: each reweighting solves  min sum w e^2  with w = s^2 / (s |e| + reg) from the current
+// iterate (s = alpha for the primal term, 1 for gradients), which majorises the L1 objective.
+// One pass forms the weights, the Jacobi diagonal and the CG's starting residual
+// (irls_reweight.h); the buffers live across the reweightings. `x` holds the start (the L2
+// solution, or a warm start) and receives the result.
+template <class Progress>
+void solve_l1(const Prepared& pr, const ReconstructionSettings& settings, bool warm,
+              std::vector<float>& x, detail::CgWorkspace& ws, ReconstructionReport& rep,
+              const Progress& progress) {
+  const size_t n = size_t(pr.width) * pr.height;
+  Weights w(n);
+  auto inv_diag = huge_vector<float>(n);
+  ws.resize(3 * n);
+  const detail::IrlsData data{pr.width,      pr.height,
+                              pr.primal,     pr.gradient_x,
+                              pr.gradient_y, pr.terms.empty() ? nullptr : pr.terms.data(),
+                              settings.alpha};
+  const detail::IrlsWeights out{w.w0.data(), w.wx.data(), w.wy.data(), inv_diag.data()};
+  auto pb = make_problem(pr, w);
+  pb.inv_diagonal = inv_diag.data();
+  const L1Schedule schedule(settings, warm);
+  const int K = schedule.reweightings;
+  const double decay = schedule.decay();
+  double reg = schedule.first_reg;
+  for (int k = 0; k < K; ++k, reg *= decay) {
+    // |b| only for the last solve, whose exit residual is reported.
+    const detail::CgStart start =
+        detail::irls_reweight(data, float(reg), x.data(), out, ws.r.data(), k == K - 1);
+    const auto cg =
+        detail::solve_weighted_cg_from_residual(pb, x.data(), start, schedule.steps(k), 0.0, ws);
+    rep.iterations += cg.iterations;
+    rep.relative_residual = cg.relative_residual;
+    progress(float(k + 1) / float(K + 1));
+  }
+}
+
 }  // namespace
 
 double reconstruction_objective(const ReconstructionInput& input, ReconstructionNorm norm,
@@ -328,6 +411,7 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
     const bool finish_in_l2 =
         settings.norm == ReconstructionNorm::L2 && !(settings.compute_objective && input.emission);
     bool finished = false;
+    const bool warm = settings.norm == ReconstructionNorm::L1 && input.initial;
     Prepared pr;
     if (!gradients) {
       pr = prepare(input, false);
@@ -335,9 +419,14 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
     } else {
       // Inputs are nearly always finite: the DCT's right-hand side pass checks that, and only
       // when it finds a non-finite value is the data sanitised (prepare) and solved again.
-      pr = unchecked(input);
-      x = l2_solution(pr, alpha, settings.fft_measure, input.emission, finish_in_l2);
-      finished = finish_in_l2 && !x.empty();
+      if (warm) {
+        pr = prepare(input, true);
+        x = warm_start(pr, input);
+      } else {
+        pr = unchecked(input);
+        x = l2_solution(pr, alpha, settings.fft_measure, input.emission, finish_in_l2);
+        finished = finish_in_l2 && !x.empty();
+      }
       if (x.empty()) {
         pr = prepare(input, true);
         x = l2_solution(pr, alpha, settings.fft_measure, nullptr, false);
@@ -355,42 +444,7 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
         rep.iterations = cg.iterations;
         rep.relative_residual = cg.relative_residual;
       } else if (settings.norm == ReconstructionNorm::L1) {
-        // IRLS: each reweighting solves  min sum w e^2  with w = s^2 / (s |e| + reg) from the
-        // current iterate (s = alpha for the primal term, 1 for gradients), which majorises the
-        // L1 objective. One pass forms the weights, the Jacobi diagonal and the CG's starting
-        // residual (irls_reweight.h); the buffers live across the reweightings.
-        Weights w(n);
-        auto inv_diag = huge_vector<float>(n);
-        ws.resize(3 * n);
-        const detail::IrlsData data{W,
-                                    H,
-                                    pr.primal,
-                                    pr.gradient_x,
-                                    pr.gradient_y,
-                                    pr.terms.empty() ? nullptr : pr.terms.data(),
-                                    float(alpha)};
-        const detail::IrlsWeights out{w.w0.data(), w.wx.data(), w.wy.data(), inv_diag.data()};
-        auto pb = make_problem(pr, w);
-        pb.inv_diagonal = inv_diag.data();
-        const int K = std::max(1, settings.l1_reweightings);
-        const double decay =
-            K > 1 ? std::pow(kL1FinalRegulariser / kL1InitialRegulariser, 1.0 / (K - 1)) : 1.0;
-        double reg = K > 1 ? kL1InitialRegulariser : kL1FinalRegulariser;
-        for (int k = 0; k < K; ++k, reg *= decay) {
-          // |b| only for the last solve, whose exit residual is reported.
-          const detail::CgStart start =
-              detail::irls_reweight(data, float(reg), x.data(), out, ws.r.data(), k == K - 1);
-          // Inner steps fall linearly from first to last: the early reweightings move the image
-          // far from the L2 start, the late ones only refine it (bench_reconstruct --sweep).
-          const int first = settings.l1_cg_steps_first, last = settings.l1_cg_steps_last;
-          const int steps =
-              K > 1 ? int(std::lround(first + double(last - first) * k / (K - 1))) : first;
-          const auto cg = detail::solve_weighted_cg_from_residual(pb, x.data(), start,
-                                                                  std::max(1, steps), 0.0, ws);
-          rep.iterations += cg.iterations;
-          rep.relative_residual = cg.relative_residual;
-          progress(float(k + 1) / float(K + 1));
-        }
+        solve_l1(pr, settings, warm, x, ws, rep, progress);
       } else if (settings.norm == ReconstructionNorm::Weighted) {
         const VarianceScale vs = variance_scale(pr, input.variance);
         const Weights w = variance_weights(pr, input.variance, alpha, vs);

@@ -42,6 +42,13 @@ struct ReconstructionSettings {
   int l1_reweightings = 36;
   int l1_cg_steps_first = 12;
   int l1_cg_steps_last = 3;
+  // L1 warm start (ReconstructionInput::initial): reweightings and Jacobi-PCG steps per reweighting
+  // (bench_reconstruct --warm --sweep). The regulariser falls from l1_warm_regulariser to the cold
+  // schedule's last value, so a start near the minimum is not first pulled towards the smoothed
+  // problem's solution.
+  int l1_warm_reweightings = 4;
+  int l1_warm_cg_steps = 4;
+  double l1_warm_regulariser = 0.05 / 512.0;
   // Weighted (and L2 with missing data): stop at |b - A I| <= tolerance |b| per channel.
   double weighted_tolerance = 1e-4;
   int max_cg_iterations = 2000;
@@ -83,6 +90,12 @@ struct ReconstructionInput {
   const float* normal_variance = nullptr;  // XYZ
   const float* depth = nullptr;            // 1 per pixel
   const float* depth_variance = nullptr;   // 1 per pixel
+
+  // L1 only, optional: a previous output of reconstruct() for the same passes (emission included:
+  // it is subtracted), e.g. at another alpha. IRLS then starts from it with the shorter warm
+  // schedule (ReconstructionSettings::l1_warm_*) instead of from the L2 solution. Non-finite
+  // values fall back to the primal's.
+  const float* initial = nullptr;  // RGB
 };
 
 struct ReconstructionReport {

@@ -1,7 +1,7 @@
 // bench_reconstruct: cost of the reconstruction solvers at 1920x1080 RGB on 1 and 2 threads.
 //
 //   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] [--l2-only] [--feature-only]
-//                     [--memory] [--admm]
+//                     [--memory] [--admm] [--pcg] [--warm]
 //
 // Reports, per thread count:
 //   - one bare FFTW forward + inverse 2-D DCT of the 3 planes (double, the same cached plans the
@@ -19,6 +19,9 @@
 //     room of testing/feature_scene.h (half noise 0.2, gradient noise 0.1), relMSE against L1;
 //     --feature-only runs just this case.
 // --admm compares an ADMM L1 probe (l1_admm_probe.h) with the library's IRLS (see bench_admm).
+// --pcg counts PCG steps of the IRLS systems with DCT preconditioners (l1_pcg_probe.h).
+// --warm measures L1 warm-started from another alpha's output (ReconstructionInput::initial);
+// --warm --sweep also a grid of warm schedules.
 // --memory only measures the peak resident memory (getrusage) after one solve of each norm, in the
 // order L2, Weighted, L1: each figure is the process's peak so far, inputs included.
 // Synthetic data: a smooth image with edges; primal noise sigma 0.2 (0.05 in the right half),
@@ -39,6 +42,7 @@
 #include <tbb/task_arena.h>
 
 #include "bench/reconstruct/l1_admm_probe.h"
+#include "bench/reconstruct/l1_pcg_probe.h"
 #include "reconstruct/dct_solver.h"
 #include "reconstruct/feature_reconstruct.h"
 #include "reconstruct/parallel.h"
@@ -301,9 +305,99 @@ int bench_admm(const Data& d, int threads) {
   return 0;
 }
 
+// --pcg: the preconditioner probe (l1_pcg_probe.h) on the library's IRLS trajectory: per probed
+// reweighting, the steps Jacobi, scalar-DCT and scaled-DCT PCG need to reach the residual of the
+// library's fixed steps and a relative residual of 1e-3, and their wall time to the latter.
+int bench_pcg(const Data& d, int threads) {
+  tbb::task_arena arena(threads);
+  const float alpha = 0.2f;
+  const double tolerance = 1e-3;
+  std::vector<gdpt::bench::PcgProbeRow> rows;
+  arena.execute([&] {
+    rows = gdpt::bench::probe_l1_pcg({d.w, d.h, d.primal.data(), d.gx.data(), d.gy.data(), alpha},
+                                     {0, 12, 35}, tolerance, 60);
+  });
+  std::printf("bench_reconstruct --pcg: %dx%d RGB, alpha %.2f, %d threads, tolerance %.0e\n", d.w,
+              d.h, double(alpha), threads, tolerance);
+  std::printf(
+      "reweighting  weight p99/p1  library steps  residual after them  | steps to that residual "
+      "(Jacobi scalar scaled) | steps to tolerance (Jacobi scalar scaled) | seconds to tolerance "
+      "(Jacobi scalar scaled)\n");
+  for (const auto& r : rows)
+    std::printf("%11d  %13.3g  %13d  %19.3e  | %6d %6d %6d | %6d %6d %6d | %7.2f %7.2f %7.2f\n",
+                r.reweighting, r.weight_spread, r.library_steps, r.jacobi_residual,
+                r.steps_to_library[0], r.steps_to_library[1], r.steps_to_library[2],
+                r.steps_to_tolerance[0], r.steps_to_tolerance[1], r.steps_to_tolerance[2],
+                r.seconds_to_tolerance[0], r.seconds_to_tolerance[1], r.seconds_to_tolerance[2]);
+  std::printf("(-1: not reached within 60 steps)\n");
+  return 0;
+}
+
+// --warm: L1 warm-started from the L1 output at alpha 0.2 (ReconstructionInput::initial) at a
+// new alpha, against the cold default at that alpha, interleaved in one process; objectives are
+// divided by a tight cold solve (72 reweightings x 24->6 steps) at the new alpha. With --sweep
+// first a grid of warm schedules (reweightings, first regulariser, steps); then the defaults.
+int bench_warm(const Data& d, int threads, bool sweep) {
+  using gdpt::ReconstructionNorm;
+  gdpt::ReconstructionInput in{d.w,         d.h,     d.primal.data(), d.gx.data(),
+                               d.gy.data(), nullptr, nullptr};
+  auto settings = [&](float alpha) {
+    gdpt::ReconstructionSettings s;
+    s.threads = threads;
+    s.fft_measure = true;
+    s.norm = ReconstructionNorm::L1;
+    s.alpha = alpha;
+    return s;
+  };
+  auto objective = [&](const std::vector<float>& x, float alpha) {
+    return gdpt::reconstruction_objective(in, ReconstructionNorm::L1, alpha, x.data());
+  };
+  std::printf("bench_reconstruct --warm: %dx%d RGB, %d threads\n", d.w, d.h, threads);
+  const auto from = gdpt::reconstruct(in, settings(0.2f));
+  for (const float alpha : {0.25f, 0.15f, 0.05f, 0.8f}) {
+    auto tight_s = settings(alpha);
+    tight_s.l1_reweightings = 72;
+    tight_s.l1_cg_steps_first = 24;
+    tight_s.l1_cg_steps_last = 6;
+    const double f_tight = objective(gdpt::reconstruct(in, tight_s), alpha);
+    auto warm_in = in;
+    warm_in.initial = from.data();
+    std::printf("alpha 0.2 -> %.2f: tight objective %.8g\n", double(alpha), f_tight);
+    for (const int k : sweep ? std::vector<int>{4, 8, 12} : std::vector<int>{})
+      for (const double reg : {0.05 / 512, 0.05 / 4096, 0.05 / 32768})
+        for (const int steps : {3, 4, 6}) {
+          auto s = settings(alpha);
+          s.l1_warm_reweightings = k;
+          s.l1_warm_regulariser = reg;
+          s.l1_warm_cg_steps = steps;
+          gdpt::ReconstructionReport r;
+          const auto x = gdpt::reconstruct(warm_in, s, &r);
+          std::printf(
+              "  warm %2d reweightings, reg 0.05/%-5.0f, %d steps: %3d steps, %5.2f s, objective / "
+              "tight %.6f, rms to truth %.5f\n",
+              k, 0.05 / reg, steps, r.iterations, r.seconds, objective(x, alpha) / f_tight,
+              gdpt::test::rms_error(x, d.truth));
+        }
+    for (int round = 0; round < 2; ++round) {
+      gdpt::ReconstructionReport rc, rw;
+      const auto cold = gdpt::reconstruct(in, settings(alpha), &rc);
+      const auto warm = gdpt::reconstruct(warm_in, settings(alpha), &rw);
+      std::printf(
+          "  round %d: cold default %3d steps %5.2f s objective / tight %.6f rms %.5f | warm "
+          "default %3d steps %5.2f s objective / tight %.6f rms %.5f | time ratio %.2f\n",
+          round, rc.iterations, rc.seconds, objective(cold, alpha) / f_tight,
+          gdpt::test::rms_error(cold, d.truth), rw.iterations, rw.seconds,
+          objective(warm, alpha) / f_tight, gdpt::test::rms_error(warm, d.truth),
+          rc.seconds / rw.seconds);
+    }
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
   int width = 1920, height = 1080, only_threads = 0;
-  bool sweep = false, l2_only = false, feature_only = false, memory = false, admm = false;
+  bool sweep = false, l2_only = false, feature_only = false, memory = false, admm = false,
+       pcg = false, warm = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--width" && i + 1 < argc)
@@ -322,10 +416,14 @@ int main(int argc, char** argv) {
       memory = true;
     else if (a == "--admm")
       admm = true;
+    else if (a == "--pcg")
+      pcg = true;
+    else if (a == "--warm")
+      warm = true;
     else {
       std::fprintf(stderr,
                    "usage: bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] "
-                   "[--l2-only] [--feature-only] [--memory] [--admm]\n");
+                   "[--l2-only] [--feature-only] [--memory] [--admm] [--pcg] [--warm]\n");
       return 2;
     }
   }
@@ -333,6 +431,8 @@ int main(int argc, char** argv) {
   const Data d = make_data(width, height);
   if (memory) return measure_memory(d, only_threads);
   if (admm) return bench_admm(d, only_threads > 0 ? only_threads : 2);
+  if (pcg) return bench_pcg(d, only_threads > 0 ? only_threads : 2);
+  if (warm) return bench_warm(d, only_threads > 0 ? only_threads : 2, sweep);
   const size_t px = size_t(width) * height;
   gdpt::ReconstructionInput input{
       width, height, d.primal.data(), d.gx.data(), d.gy.data(), d.variance.data(), nullptr};

@@ -182,8 +182,11 @@ PYBIND11_MODULE(_gdpt, m) {
         py::arg("variance").noconvert() = py::none(), py::arg("emission").noconvert() = py::none(),
         py::arg("norm") = "L1", py::arg("alpha") = 0.2f, py::arg("threads") = 0,
         py::arg("features") = py::none(), py::arg("progress").noconvert() = py::none(),
+        py::arg("initial").noconvert() = py::none(),
         "progress: optional float32 array; its first value is set to the solved fraction "
-        "(0 to 1) while the solve runs without the GIL, for a caller polling from Python");
+        "(0 to 1) while the solve runs without the GIL, for a caller polling from Python. "
+        "initial: optional float32 array, a previous L1 result for the same passes (e.g. at "
+        "another alpha): L1 starts from it with a much shorter schedule");
   m.def("read_exr_passes", &read_exr_passes_dict, py::arg("path"), py::arg("layer"),
         py::arg("required"), py::arg("optional") = std::vector<std::string>{});
 }

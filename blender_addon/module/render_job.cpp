@@ -282,13 +282,11 @@ ReconstructionNorm parse_norm(const std::string& norm) {
   throw std::invalid_argument("unknown reconstruction norm '" + norm + "'");
 }
 
-py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray& gradient_x,
-                                      const FloatArray& gradient_y,
-                                      const std::optional<FloatArray>& variance,
-                                      const std::optional<FloatArray>& emission,
-                                      const std::string& norm, float alpha, int threads,
-                                      const std::optional<py::dict>& features,
-                                      const std::optional<FloatArray>& progress) {
+py::array_t<float> reconstruct_arrays(
+    const FloatArray& primal, const FloatArray& gradient_x, const FloatArray& gradient_y,
+    const std::optional<FloatArray>& variance, const std::optional<FloatArray>& emission,
+    const std::string& norm, float alpha, int threads, const std::optional<py::dict>& features,
+    const std::optional<FloatArray>& progress, const std::optional<FloatArray>& initial) {
   if (primal.ndim() < 2) throw std::invalid_argument("primal: expected a (height, width, 3) array");
   const int height = int(primal.shape(0)), width = int(primal.shape(1));
   const size_t rgb = size_t(width) * size_t(height) * 3;
@@ -298,6 +296,8 @@ py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray
     throw std::invalid_argument("variance: expected 3 values per pixel");
   if (emission && size_t(emission->size()) != rgb)
     throw std::invalid_argument("emission: expected 3 values per pixel");
+  if (initial && size_t(initial->size()) != rgb)
+    throw std::invalid_argument("initial: expected 3 values per pixel (a previous result)");
 
   ReconstructionSettings settings;
   settings.norm = parse_norm(norm);
@@ -318,6 +318,7 @@ py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray
   input.gradient_y = gradient_y.data();
   input.variance = variance ? variance->data() : nullptr;
   input.emission = emission ? emission->data() : nullptr;
+  input.initial = initial ? initial->data() : nullptr;
   // Feature: the arrays stay alive in `features` (the caller's dict) during the solve.
   std::vector<FloatArray> held;
   if (settings.norm == ReconstructionNorm::Feature) {

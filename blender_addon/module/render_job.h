@@ -80,13 +80,12 @@ ReconstructionNorm parse_norm(const std::string& norm);
 // feature passes from `features`, a dict with the film keys of FilmPasses (primal_a, primal_b,
 // denoising_albedo, ... and their *_variance). `progress` (optional, float32): its first value
 // follows the solved fraction, written without the GIL, for Python code polling a solve that runs
-// in another thread.
-py::array_t<float> reconstruct_arrays(const FloatArray& primal, const FloatArray& gradient_x,
-                                      const FloatArray& gradient_y,
-                                      const std::optional<FloatArray>& variance,
-                                      const std::optional<FloatArray>& emission,
-                                      const std::string& norm, float alpha, int threads,
-                                      const std::optional<py::dict>& features,
-                                      const std::optional<FloatArray>& progress);
+// in another thread. `initial` (optional): a previous L1 result of reconstruct_arrays for the same
+// passes, which L1 warm-starts from (ReconstructionInput::initial).
+py::array_t<float> reconstruct_arrays(
+    const FloatArray& primal, const FloatArray& gradient_x, const FloatArray& gradient_y,
+    const std::optional<FloatArray>& variance, const std::optional<FloatArray>& emission,
+    const std::string& norm, float alpha, int threads, const std::optional<py::dict>& features,
+    const std::optional<FloatArray>& progress, const std::optional<FloatArray>& initial);
 
 }  // namespace gdpt::python

@@ -199,6 +199,42 @@ TEST(Robustness, SameResultOnOneAndTwoThreads) {
   s.threads = 2;
   const auto two = reconstruct(in, s);
   EXPECT_EQ(one, two);
+  // A warm start (from the L2 output, at another alpha) too.
+  s.norm = ReconstructionNorm::L2;
+  const auto start = reconstruct(in, s);
+  in.initial = start.data();
+  s.norm = ReconstructionNorm::L1;
+  s.alpha = 0.3f;
+  const auto warm_two = reconstruct(in, s);
+  s.threads = 1;
+  EXPECT_EQ(reconstruct(in, s), warm_two);
+}
+
+// A warm start with NaN / Inf in the start image (and in the inputs and emission) still gives a
+// finite image near the truth: non-finite start values fall back to the primal's.
+TEST(Robustness, NonFiniteWarmStartValues) {
+  Exact e(33, 21);
+  const auto clean = e.truth;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  e.truth[3 * 40 + 1] = nan;
+  e.gx[3 * 100 + 2] = inf;
+  std::vector<float> emission(clean.size(), 0.f);
+  emission[5] = nan;
+  std::vector<float> start = clean;
+  start[3 * 7] = nan;
+  start[3 * 300 + 2] = -inf;
+  for (size_t i = 3 * 500; i < 3 * 520; ++i) start[i] = nan;
+  ReconstructionInput in = e.input();
+  in.emission = emission.data();
+  in.initial = start.data();
+  ReconstructionSettings s;
+  s.norm = ReconstructionNorm::L1;
+  ReconstructionReport report;
+  const auto out = reconstruct(in, s, &report);
+  expect_finite(out);
+  EXPECT_EQ(report.missing_values, 2);
+  EXPECT_LT(max_relative(out, clean), 2e-4);
 }
 
 }  // namespace
