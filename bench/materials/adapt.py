@@ -20,6 +20,13 @@ INPUTS_4X = {
                              "Randomness"],
 }
 
+# Blender 4.x socket names -> Blender 3.4 names, for scripts that look sockets up by name.
+RENAMED_4X = {
+    "Subsurface Weight": "Subsurface", "Specular IOR Level": "Specular",
+    "Transmission Weight": "Transmission", "Coat Weight": "Clearcoat",
+    "Coat Roughness": "Clearcoat Roughness", "Coat Normal": "Clearcoat Normal",
+    "Sheen Weight": "Sheen", "Emission Color": "Emission"}
+
 
 class Skipped:
     """Stands for a socket Blender 3.4 does not have; assignments and links to it are dropped."""
@@ -41,6 +48,15 @@ def socket(log, node, kind, index):
         log.append(f"{node.name}: {kind}put {index} missing in Blender 3.4")
         return Skipped(f"{node.name}.{kind}puts[{index}]")
     return sockets[index]
+
+
+def named_socket(log, node, kind, name):
+    sockets = node.inputs if kind == "in" else node.outputs
+    name = RENAMED_4X.get(name, name)
+    if name not in sockets:
+        log.append(f"{node.name}: {kind}put '{name}' missing in Blender 3.4")
+        return Skipped(f"{node.name}.{kind}puts['{name}']")
+    return sockets[name]
 
 
 def assign(log, target, attr, value):
@@ -66,6 +82,7 @@ def new_socket(log, group, name, in_out, socket_type, **_):
 
 _SOCKET = re.compile(r"\b(\w+)\.(inputs|outputs)\[(\d+)\]")
 _ASSIGN = re.compile(r"^(\s*)([\w.\[\]\(\), ']+?)\.(\w+)\s*=\s*(.+)$")
+_NAMED = re.compile(r"\b(\w+)\.(inputs|outputs)\[(\"[^\"]+\")\]")
 _LINK = re.compile(r"\b(\w+)\.links\.new\(")
 _IFACE = re.compile(r"\b(\w+)\.interface\.new_socket\(")
 
@@ -77,6 +94,8 @@ def rewrite(source):
     for line in source.splitlines():
         line = _SOCKET.sub(lambda m: f"_socket({m[1]}, '{'in' if m[2] == 'inputs' else 'out'}', "
                            f"{m[3]})", line)
+        line = _NAMED.sub(lambda m: f"_named({m[1]}, '{'in' if m[2] == 'inputs' else 'out'}', "
+                          f"{m[3]})", line)
         line = _LINK.sub(lambda m: f"_link({m[1]}, ", line)
         line = _IFACE.sub(lambda m: f"_new_socket({m[1]}, ", line)
         m = _ASSIGN.match(line)
@@ -94,6 +113,7 @@ def load(bpy, source, label):
         "__name__": "material_script", "bpy": bpy,
         "_socket": lambda n, k, i: socket(log, n, k, i),
         "_assign": lambda t, a, v: assign(log, t, a, v),
+        "_named": lambda n, k, name: named_socket(log, n, k, name),
         "_link": lambda tree, a, b: link(log, tree, a, b),
         "_new_socket": lambda g, *a, **k: new_socket(log, g, *a, **k),
     }

@@ -54,6 +54,8 @@ noise.noise_type = 'FBM'
 math = tree.nodes.new("ShaderNodeMath")
 tree.links.new(noise.outputs[0], math.inputs[1])
 tree.links.new(noise.outputs[1], math.inputs[7])
+noise.inputs["Gain"].default_value = 2.0
+tree.links.new(noise.outputs["Color"], math.inputs["Value"])
 """
 
 
@@ -61,6 +63,7 @@ def main():
     tree, log = Tree(), []
     env = {"tree": tree, "_socket": lambda n, k, i: adapt.socket(log, n, k, i),
            "_assign": lambda t, a, v: adapt.assign(log, t, a, v),
+           "_named": lambda n, k, name: adapt.named_socket(log, n, k, name),
            "_link": lambda t, a, b: adapt.link(log, t, a, b)}
     exec(adapt.rewrite(SCRIPT), env)
     noise = env["noise"]
@@ -68,7 +71,8 @@ def main():
     assert values["Scale"] == 5.0, values
     assert values["Distortion"] == 0.7, values  # input 8 in Blender 4.x, 5 in 3.4
     assert values["Roughness"] == 0.0 and values["Detail"] == 0.0, values  # Offset (6) skipped
-    assert tree.made == [("Fac", "Value_001")], tree.made
+    assert tree.made == [("Fac", "Value_001"), ("Color", "Value")], tree.made
+    assert any("'Gain' missing" in m for m in log), log
     assert any("input 6" in m for m in log), log
     assert any("inputs[7]" in m and "dropped" in m for m in log), log
     print("ok: adapt maps Blender 4.x sockets by name and lists", len(log), "skipped settings")
