@@ -3,6 +3,7 @@
 # Cycles set up as the agreement suite's oracle, and compares them per material.
 #   blender -b --factory-startup --addons gdpt --python-exit-code 1 --python run.py --
 #           --lib DIR --out DIR [--json FILE] [--md FILE] [--only NAME,...] [--reuse 1]
+#           [--source TEXT] (where the library comes from, for the report's header)
 # Verdict: PASS (means within 2% and relMSE < 1%, the agreement suite's bounds, per pixel or over
 # 8x8-pixel blocks: at equal sample counts a caustic-heavy material is noise-limited per pixel, and
 # a biased translation still shows over blocks), REPORTED (outside them and Gradient PT warned
@@ -141,10 +142,10 @@ def main():
         raise SystemExit(f"no material scripts (.txt/.py) in {lib}")
     json_path = a.get("json", os.path.join(out_dir, "materials.json"))
     with open(json_path, "w") as f:
-        json.dump({"library": lib, "samples": SAMPLES, "size": SIZE, "materials": rows}, f,
+        json.dump({"library": a.get("source", lib), "samples": SAMPLES, "size": SIZE, "materials": rows}, f,
                   indent=1)
     with open(a.get("md", os.path.join(out_dir, "materials.md")), "w") as f:
-        f.write(markdown(rows, lib))
+        f.write(markdown(rows, a.get("source", lib)))
     counts = {v: sum(r["verdict"] == v for r in rows) for v in ("PASS", "REPORTED", "FAIL")}
     print(f"MATERIALS {len(rows)}: {counts}", flush=True)
 
