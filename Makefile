@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS  ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: deps build test test-sanitized demo bench fuzz format clean install-addon dev
+.PHONY: deps build test test-sanitized demo bench fuzz format clean install-addon dev materials
 
 deps:
 	bash scripts/setup-deps.sh
@@ -81,6 +81,11 @@ dev: deps
 QUICK ?= 0
 bench: build install-addon
 	QUICK=$(QUICK) bash scripts/bench.sh $(BUILD)
+
+# Per-material agreement with Cycles over a library of material scripts (not in CI):
+#   make materials LIB=/path/to/scripts [ONLY=Name,Name]
+materials: build
+	bash bench/materials/run.sh $(BUILD) "$(LIB)" $(if $(ONLY),--only $(ONLY))
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')

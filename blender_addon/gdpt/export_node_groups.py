@@ -115,7 +115,32 @@ class Sock:
 
     @property
     def default_value(self):
-        return self.follow()[1].socket.default_value
+        return converted(self.follow()[1].socket, self.socket.type)
+
+
+# Cycles' implicit conversions when a group socket's value reaches an input of another type.
+_LUMINANCE = (0.2126, 0.7152, 0.0722)
+
+
+def converted(source, to_type):
+    """`source`'s default_value as an input of type `to_type` reads it (a float group input
+    feeding a Mapping's Scale, a colour feeding a Math node...)."""
+    value = source.default_value
+    kind = source.type
+    if kind == to_type or to_type not in {'VALUE', 'INT', 'VECTOR', 'RGBA'}:
+        return value
+    if kind in {'VALUE', 'INT'}:
+        v = float(value)
+        return (v, v, v) if to_type == 'VECTOR' else (v, v, v, 1.0) if to_type == 'RGBA' else v
+    if kind == 'VECTOR':
+        x, y, z = value
+        return (x, y, z, 1.0) if to_type == 'RGBA' else (x + y + z) / 3.0
+    if kind == 'RGBA':
+        r, g, b = tuple(value)[:3]
+        if to_type == 'VECTOR':
+            return (r, g, b)
+        return sum(w * c for w, c in zip(_LUMINANCE, (r, g, b)))
+    return value
 
 
 def source(socket):

@@ -219,7 +219,33 @@ def world_group(scene, use_group):
     nt.links.new(g_pick.outputs[0], out.inputs["Surface"])
 
 
-MATERIAL_CASES = {"principled": principled, "nested": nested, "shader_through": shader_through}
+def converted_input(use_group):
+    """A float group input, unlinked on the group node, feeding a Mapping's Scale (a vector) in
+    front of a Checker Texture: Cycles reads the float as (f, f, f)."""
+    m, nt, out = S._material("converted")
+    d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    nt.links.new(d.outputs[0], out.inputs["Surface"])
+    tree, gin, gout = (nt, None, None) if not use_group else group(
+        "Tiles", [("NodeSocketFloat", "Scale", 1.0)], [("NodeSocketColor", "Color")])
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    checker = tree.nodes.new("ShaderNodeTexChecker")
+    tree.links.new(coords.outputs["Object"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs[0], checker.inputs["Vector"])
+    if not use_group:
+        mapping.inputs["Scale"].default_value = (3.0, 3.0, 3.0)
+        nt.links.new(checker.outputs["Color"], d.inputs["Color"])
+        return m
+    tree.links.new(gin.outputs["Scale"], mapping.inputs["Scale"])
+    tree.links.new(checker.outputs["Color"], gout.inputs["Color"])
+    g = instance(nt, tree)
+    g.inputs["Scale"].default_value = 3.0
+    nt.links.new(g.outputs["Color"], d.inputs["Color"])
+    return m
+
+
+MATERIAL_CASES = {"principled": principled, "nested": nested, "shader_through": shader_through,
+                  "converted_input": converted_input}
 
 
 def scene_for(case, use_group):
