@@ -251,7 +251,9 @@ struct NormalMapDesc {
 // The Material Output's Displacement rendered as Cycles' "Bump Only" (its default method) is the
 // same tilt, of height (Height - Midlevel) Scale with distance and strength 1, except that it
 // replaces the surface's own normal (replaces_normal: Cycles' set_normal writes sd->N), so no
-// bump shadowing follows and every lobe and Geometry Normal reads it.
+// bump shadowing follows and every lobe and Geometry Normal reads it. The gradient is taken in
+// world units, where Cycles takes an object-space displacement's in object units: the two agree
+// for objects of unit scale only.
 struct BumpDesc {
   bool enabled = false;
   FloatInput height{0.0f};
