@@ -530,6 +530,8 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
   if (!set_unit(n - grad * distance, bumped)) return;
   const float strength = std::max(b.strength, 0.0f);
   set_unit(bumped * strength + n * (1.0f - strength), hit.shading_normal);
+  // Displacement as bump: the tilted normal is the surface's own (not a perturbation of it).
+  if (b.replaces_normal) hit.unperturbed_normal = hit.shading_normal;
 }
 
 }  // namespace gdpt

@@ -248,12 +248,19 @@ struct NormalMapDesc {
 // surface gradient of `height`, N' = normalize(N - distance grad h) (Cycles' svm_node_set_bump to
 // first order in its ray differentials; the gradient here is a forward difference in UV), then
 // mixed with N by strength. Invert negates the distance.
+// The Material Output's Displacement rendered as Cycles' "Bump Only" (its default method) is the
+// same tilt, of height (Height - Midlevel) Scale with distance and strength 1, except that it
+// replaces the surface's own normal (replaces_normal: Cycles' set_normal writes sd->N), so no
+// bump shadowing follows and every lobe and Geometry Normal reads it. The gradient is taken in
+// world units, where Cycles takes an object-space displacement's in object units: the two agree
+// for objects of unit scale only.
 struct BumpDesc {
   bool enabled = false;
   FloatInput height{0.0f};
   float strength = 1.0f;
   float distance = 1.0f;
   bool invert = false;
+  bool replaces_normal = false;
 };
 
 struct MaterialDesc {

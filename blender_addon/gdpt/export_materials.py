@@ -9,8 +9,9 @@
 # Layer Weight, Geometry (Normal, True Normal, Incoming, Backfacing; Pointiness and the others
 # reported, 0.5 standing in) and Light Path (read per path: its own direction and state), image and
 # procedural textures read at UV, Generated or Object coordinates, optionally through a Mapping
-# node. Reroutes and muted nodes are followed. Anything else is reported once per material
-# (naming the node) and followed through its mute pass-through link when it has one; otherwise a
+# node. The Displacement output (a Displacement node) renders as Cycles' Bump Only. Reroutes
+# and muted nodes are followed. Anything else is reported once per material (naming the node)
+# and followed through its mute pass-through link when it has one; otherwise a
 # magenta diffuse (shaders) or the socket's own value (inputs) stands in, so the render still
 # completes. A material whose translation fails (or that the core rejects) renders magenta, with
 # a warning naming it and the node.
@@ -73,6 +74,7 @@ class _Translator:
         self.nodes = []
         self.normal_map = None  # (Normal Map node, its dict) of the BSDFs' Normal inputs
         self.bump = None  # (Bump node, its dict), likewise
+        self.displaced = False  # the Displacement output (as bump) took the perturbation
         self.inputs = []  # colour / math input nodes (MaterialDesc::inputs)
         self.color_attribute = None  # name read by Color Attribute nodes ("": the render one)
         self.input_index = {}  # node name -> index in self.inputs
@@ -234,10 +236,10 @@ class _Translator:
         node becomes the material's normal perturbation (one per material: the first found;
         another one is reported and its input gets the interpolated normal). Returns whether
         the input takes the material's perturbation (an unlinked input keeps the interpolated
-        normal, as in Cycles)."""
+        normal, as in Cycles, which a displacement as bump replaces)."""
         out = self._source(socket)
         if out is None:
-            return False
+            return self.displaced
         node = out.node
         if node.type == 'BUMP':
             return self._bump(node)
@@ -249,8 +251,8 @@ class _Translator:
             return False
         if self.normal_map is not None or self.bump is not None:
             if self.normal_map is None or self.normal_map[0] != node:
-                self.warn(node, _SECOND_PERTURBATION)
-                return False
+                self._second_perturbation(node)
+                return self.displaced
             return True
         if node.uv_map:
             self.warn(node, "UV map other than the active render UV map in")
@@ -275,8 +277,8 @@ class _Translator:
         material's perturbation."""
         if self.normal_map is not None or self.bump is not None:
             if self.bump is None or self.bump[0] != node:
-                self.warn(node, _SECOND_PERTURBATION)
-                return False
+                self._second_perturbation(node)
+                return self.displaced
             return True
         for name in ("Strength", "Distance"):
             if node.inputs[name].is_linked:
@@ -288,6 +290,45 @@ class _Translator:
                             "distance": float(node.inputs["Distance"].default_value),
                             "invert": bool(node.invert)})
         return True
+
+    def _second_perturbation(self, node):
+        if self.displaced:
+            self.warn(node, "normal perturbation on top of the displacement (its input gets the "
+                      "displaced normal) in")
+        else:
+            self.warn(node, _SECOND_PERTURBATION)
+
+    def displacement(self, socket):
+        """The Material Output's Displacement as Cycles' Bump Only method renders it: the
+        displacement's component along the normal, (Height - Midlevel) Scale for a Displacement
+        node, is the height of a bump of distance and strength 1 that replaces the surface's
+        normal (Cycles' bump_from_displacement). It takes the material's perturbation."""
+        out = self._source(socket)
+        if out is None:
+            return
+        node = out.node
+        self.current = node
+        # Cycles' setting (absent when the Cycles add-on is off: its default, Bump Only).
+        cycles = getattr(self.material, "cycles", None)
+        method = getattr(cycles, "displacement_method", 'BUMP')
+        if method != 'BUMP':
+            self.warn(node, f"displacement method {method} (rendered as Bump Only) with")
+        if node.type != 'DISPLACEMENT':
+            self.warn(node, "displacement node (the displacement is ignored)")
+            return
+        if node.inputs["Normal"].is_linked:
+            self.warn(node, "linked Normal (the displacement is ignored) of")
+            return
+
+        def math(op, a, b):
+            return self._push_input({"kind": "MATH", "op": op, "value_a": a, "value_b": b})
+
+        i = node.inputs
+        offset = math("SUBTRACT", self.value(i["Height"]), self.value(i["Midlevel"]))
+        height = math("MULTIPLY", offset, self.value(i["Scale"]))
+        self.bump = (node, {"height": height, "strength": 1.0, "distance": 1.0, "invert": False,
+                            "replaces_normal": True})
+        self.displaced = True
 
     def color(self, socket):
         d = {"value": self._default_rgb(socket)}
@@ -778,8 +819,7 @@ def _translate_tree(material, t, warn):
         return {"name": material.name, "nodes": [], "root": -1}
     if out.inputs["Volume"].is_linked:
         warn(f"material '{material.name}': volumes are not supported by Gradient PT (ignored)")
-    if out.inputs["Displacement"].is_linked:
-        warn(f"material '{material.name}': displacement is not supported by Gradient PT (ignored)")
+    t.displacement(groups.wrap(out.inputs["Displacement"]))
     root = t.shader(groups.wrap(out.inputs["Surface"]))
     if root < 0:
         # Nothing connected: Cycles renders such a surface black. A black diffuse does the same.

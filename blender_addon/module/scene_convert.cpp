@@ -586,7 +586,8 @@ int SceneBuilder::add_material(const py::dict& material) {
   if (material.contains("inputs"))
     for (const auto& item : material["inputs"].cast<py::list>())
       desc.inputs.push_back(read_input_node(item.cast<py::dict>()));
-  // Bump node: {"height": float input, "strength", "distance": float, "invert": bool}.
+  // Bump node: {"height": float input, "strength", "distance": float, "invert": bool,
+  // "replaces_normal": bool (the Displacement output)}.
   if (material.contains("bump")) {
     const auto d = material["bump"].cast<py::dict>();
     desc.bump.enabled = true;
@@ -594,6 +595,7 @@ int SceneBuilder::add_material(const py::dict& material) {
     get(d, "strength", desc.bump.strength);
     get(d, "distance", desc.bump.distance);
     get(d, "invert", desc.bump.invert);
+    get(d, "replaces_normal", desc.bump.replaces_normal);
   }
   // Normal Map node (tangent space): {"color": colour input, "strength": float}.
   if (material.contains("normal_map")) {

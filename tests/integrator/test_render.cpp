@@ -386,6 +386,25 @@ TEST(Render, BumpOnABackFaceKeepsTheSurfacesTilt) {
   }
 }
 
+// The Displacement output as bump (replaces_normal) tilts the surface's own normal, as Cycles'
+// set_normal writes sd->N: the front side of the test above without the bump shadowing factor.
+TEST(Render, DisplacementAsBumpReplacesTheNormalWithoutBumpShadowing) {
+  const ImageDesc ramp = ramp_image(1, 2);
+  constexpr float kTheta = 0.5f;
+  MaterialDesc m = ramp_bumped();
+  m.bump.replaces_normal = true;
+  Scene scene = sunlit_plane(uv_quad(), m, kTheta);
+  scene.images.push_back(ramp);
+  const double cosine = (0.2 * std::sin(kTheta) + std::cos(kTheta)) / std::sqrt(1.04);
+  const double expect = lambert_radiance(cosine);
+  for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+    RenderSettings s = pt(4);
+    s.mode = mode;
+    EXPECT_NEAR(mean_direct(scene, s), expect, 2e-3 * expect)
+        << "G-PT " << (mode == RenderSettings::Mode::GPT);
+  }
+}
+
 // Lobes whose normal input is not linked to the material's bump keep the interpolated normal
 // (Cycles gives an unlinked input sd->N), seen from straight above under a sun from
 // (0, -sin t, cos t):
