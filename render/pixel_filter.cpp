@@ -66,6 +66,13 @@ PixelFilter::PixelFilter(PixelFilterType type, float width) : type_(type), width
         profile_integral(type, width, radius, -radius + 2.0 * radius * i / kTableCells) / total);
   cdf_[0] = 0.0f;
   cdf_[kTableCells] = 1.0f;
+  guide_.resize(kTableCells);
+  int cell = 0;
+  for (int k = 0; k < kTableCells; ++k) {
+    const float u = float(k) / kTableCells;
+    while (cell < kTableCells - 1 && cdf_[size_t(cell) + 1] <= u) ++cell;
+    guide_[size_t(k)] = cell;
+  }
 }
 
 }  // namespace gdpt

@@ -44,11 +44,11 @@ class PixelFilter {
   float position_1d(float u) const {
     // The box exactly (width 1: u itself, bit for bit the unfiltered jitter).
     if (cdf_.empty()) return u * width_ + 0.5f * (1.0f - width_);
-    // The cell of the tabulated CDF holding u, and u's place in it: the sampled density is the
-    // filter's mass of each cell spread evenly over it.
+    // The cell of the tabulated CDF holding u, from the guide table's first candidate, and u's
+    // place in it: the sampled density is the filter's mass of each cell spread evenly over it.
     const int cells = int(cdf_.size()) - 1;
-    const int i = std::clamp(int(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin()) - 1,
-                             0, cells - 1);
+    int i = guide_[size_t(std::clamp(int(u * float(cells)), 0, cells - 1))];
+    while (i < cells - 1 && cdf_[size_t(i) + 1] <= u) ++i;
     const float mass = cdf_[size_t(i) + 1] - cdf_[size_t(i)];
     const float f = mass > 0.0f ? std::clamp((u - cdf_[size_t(i)]) / mass, 0.0f, 1.0f) : 0.5f;
     return 0.5f - radius_ + (float(i) + f) * cell_;
@@ -58,6 +58,8 @@ class PixelFilter {
   float width_ = 1.0f, radius_ = 0.5f;
   float cell_ = 0.0f;       // width of a CDF cell, pixels
   std::vector<float> cdf_;  // normalised CDF at -radius + i * cell_, from 0 to 1
+  // guide_[k]: the cell holding u = k / cells (the first whose upper CDF value exceeds it).
+  std::vector<int> guide_;
 };
 
 }  // namespace gdpt
