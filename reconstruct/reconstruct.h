@@ -92,9 +92,11 @@ struct ReconstructionInput {
   const float* depth_variance = nullptr;   // 1 per pixel
 
   // L1 only, optional: a previous output of reconstruct() for the same passes (emission included:
-  // it is subtracted), e.g. at another alpha. IRLS then starts from it with the shorter warm
+  // it is subtracted), e.g. at a nearby alpha. IRLS then starts from it with the shorter warm
   // schedule (ReconstructionSettings::l1_warm_*) instead of from the L2 solution. Non-finite
-  // values fall back to the primal's.
+  // values fall back to the primal's. The short schedule assumes the start is near the minimum:
+  // alpha x1.25 or x0.75 stays within 0.1% of a tight solve's objective, x4 does not
+  // (docs/reconstruct.md).
   const float* initial = nullptr;  // RGB
 };
 
