@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "reconstruct/cli_options.h"
 #include "reconstruct/exr_io.h"
 #include "reconstruct/exr_merge.h"
 
@@ -36,16 +37,10 @@ constexpr const char* kUsage =
     "\n"
     "exit status: 0 ok, 1 unreadable, invalid or unmergeable input, 2 bad arguments\n";
 
-[[noreturn]] void bad_arguments(const std::string& message) {
-  std::fprintf(stderr, "gdpt-merge: %s (see --help)\n", message.c_str());
-  std::exit(2);
-}
+const gdpt::cli::Parser kCli{"gdpt-merge"};
 
-double parse_number(const std::string& option, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0') bad_arguments(option + " expects a number, got '" + text + "'");
-  return v;
+[[noreturn]] void bad_arguments(const std::string& message) {
+  kCli.bad_arguments(message);
 }
 
 const char* norm_name(gdpt::ReconstructionNorm n) {
@@ -83,19 +78,11 @@ int main(int argc, char** argv) {
     } else if (a == "-o" || a == "--output") {
       output = value();
     } else if (a == "--norm") {
-      std::string n = value();
-      for (char& c : n) c = char(std::toupper(static_cast<unsigned char>(c)));
-      settings.norm = gdpt::norm_from_name(n);
-      if (!settings.norm)
-        bad_arguments("--norm must be l1, l2, weighted, feature or none, got '" + args[i] + "'");
+      settings.norm = kCli.norm(value());
     } else if (a == "--alpha") {
-      const double alpha = parse_number(a, value());
-      if (!(alpha > 0) || alpha > 1e30) bad_arguments("--alpha must be > 0");
-      settings.alpha = float(alpha);
+      settings.alpha = kCli.alpha(a, value());
     } else if (a == "--threads") {
-      const double t = parse_number(a, value());
-      if (t < 0 || t > 4096 || t != int(t)) bad_arguments("--threads must be an integer >= 0");
-      settings.threads = int(t);
+      settings.threads = kCli.threads(a, value());
     } else if (a.size() > 1 && a[0] == '-') {
       bad_arguments("unknown option '" + a + "'");
     } else {

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "reconstruct/cli_options.h"
 #include "reconstruct/display.h"
 #include "reconstruct/exr_io.h"
 #include "reconstruct/reconstruct.h"
@@ -67,9 +68,10 @@ struct Options {
   bool display = false;  // output through OCIO
 };
 
+const gdpt::cli::Parser kCli{"gdpt-reconstruct"};
+
 [[noreturn]] void bad_arguments(const std::string& message) {
-  std::fprintf(stderr, "gdpt-reconstruct: %s (see --help)\n", message.c_str());
-  std::exit(2);
+  kCli.bad_arguments(message);
 }
 
 std::string lower_extension(const std::string& path) {
@@ -78,13 +80,6 @@ std::string lower_extension(const std::string& path) {
   std::string ext = path.substr(dot + 1);
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   return ext;
-}
-
-double parse_number(const std::string& option, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0') bad_arguments(option + " expects a number, got '" + text + "'");
-  return v;
 }
 
 Options parse(int argc, char** argv) {
@@ -104,32 +99,16 @@ Options parse(int argc, char** argv) {
     } else if (a == "-o" || a == "--output") {
       o.output = value();
     } else if (a == "--alpha") {
-      const double alpha = parse_number(a, value());
-      if (!(alpha > 0) || alpha > 1e30) bad_arguments("--alpha must be > 0");
-      o.settings.alpha = float(alpha);
+      o.settings.alpha = kCli.alpha(a, value());
     } else if (a == "--norm") {
-      const std::string n = value();
-      if (n == "l1")
-        o.settings.norm = gdpt::ReconstructionNorm::L1;
-      else if (n == "l2")
-        o.settings.norm = gdpt::ReconstructionNorm::L2;
-      else if (n == "weighted")
-        o.settings.norm = gdpt::ReconstructionNorm::Weighted;
-      else if (n == "none")
-        o.settings.norm = gdpt::ReconstructionNorm::None;
-      else if (n == "feature")
-        o.settings.norm = gdpt::ReconstructionNorm::Feature;
-      else
-        bad_arguments("--norm must be l1, l2, weighted, feature or none, got '" + n + "'");
+      o.settings.norm = kCli.norm(value());
     } else if (a == "--layer") {
       o.layer = value();
       if (o.layer.empty()) bad_arguments("--layer needs a name");
     } else if (a == "--view") {
       o.view = value();
     } else if (a == "--threads") {
-      const double t = parse_number(a, value());
-      if (t < 0 || t > 4096 || t != int(t)) bad_arguments("--threads must be an integer >= 0");
-      o.settings.threads = int(t);
+      o.settings.threads = kCli.threads(a, value());
     } else if (a.size() > 1 && a[0] == '-') {
       bad_arguments("unknown option '" + a + "'");
     } else if (o.input.empty()) {
