@@ -686,12 +686,9 @@ def case_color_attribute(scene):
     return 3
 
 
-def case_bump(scene):
-    # Bump nodes over a smooth height image (sinusoidal ridges, distance 0.2): a diffuse floor
-    # and a glossy back wall (a rotated plane; strength 0.6, inverted).
-    lit_room(scene)
-    area_ceiling(size=2.0, energy=200.0)
-    size = 128
+def ridged_heights(size=128):
+    """A smooth height image (sinusoidal ridges), Non-Color, packed: the bump and displacement
+    cases' height field."""
     img = bpy.data.images.new("heights", size, size, alpha=True, float_buffer=True)
     img.colorspace_settings.name = 'Non-Color'
     c = (np.arange(size) + 0.5) / size
@@ -700,6 +697,15 @@ def case_bump(scene):
     rgba[..., :3] = h[..., None]
     img.pixels.foreach_set(rgba.ravel())
     img.pack()
+    return img
+
+
+def case_bump(scene):
+    # Bump nodes over a smooth height image (sinusoidal ridges, distance 0.2): a diffuse floor
+    # and a glossy back wall (a rotated plane; strength 0.6, inverted).
+    lit_room(scene)
+    area_ceiling(size=2.0, energy=200.0)
+    img = ridged_heights()
 
     def bumped(name, bsdf_type, strength, invert, **inputs):
         m = S.shader_material(name, bsdf_type, **inputs)
@@ -725,7 +731,6 @@ def case_bump(scene):
     return 3
 
 
-
 def case_displacement(scene):
     # The Material Output's Displacement as Cycles' default Bump Only method: a diffuse floor
     # displaced by a height image (Displacement node, object space, midlevel 0.5, scale 0.2), a
@@ -734,15 +739,7 @@ def case_displacement(scene):
     # unlinked Normal takes the displaced normal, as in Cycles.
     lit_room(scene)
     area_ceiling(size=2.0, energy=200.0)
-    size = 128
-    img = bpy.data.images.new("heights", size, size, alpha=True, float_buffer=True)
-    img.colorspace_settings.name = 'Non-Color'
-    c = (np.arange(size) + 0.5) / size
-    h = 0.5 + 0.25 * np.sin(2 * np.pi * 3 * c)[None, :] + 0.25 * np.cos(2 * np.pi * 2 * c)[:, None]
-    rgba = np.ones((size, size, 4), np.float32)
-    rgba[..., :3] = h[..., None]
-    img.pixels.foreach_set(rgba.ravel())
-    img.pack()
+    img = ridged_heights()
 
     def displaced(name, bsdf_type, height_node, midlevel, scale, space, **inputs):
         m = S.shader_material(name, bsdf_type, **inputs)
