@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# `make bench`: runs every benchmark executable (bench_*) of the build, one after the other,
-# and every bench/*/*.sh script (e.g. the Blender-vs-Cycles comparison). Output goes to stdout
+# `make bench`: runs the equal-time report against Cycles first (bench/report/report.sh, which
+# writes docs/benchmarks.md), then every benchmark executable (bench_*) of the build, one after
+# the other, and every other bench/*/*.sh script (e.g. the Blender-vs-Cycles comparison). Output goes to stdout
 # and to out/bench/<name>.txt. QUICK=1 runs only the equal-time report, reduced
 # (bench/report/report.sh: two scenes, short budgets; under ten minutes on 2 cores).
 set -euo pipefail
@@ -11,6 +12,8 @@ if [ "${QUICK:-0}" = 1 ]; then
   exec bash "$root/bench/report/report.sh" "$build"
 fi
 status=0
+echo "=== report"
+bash "$root/bench/report/report.sh" "$build" 2>&1 | tee "$root/out/bench/report.txt" || status=1
 while IFS= read -r exe; do
   name=$(basename "$exe")
   echo "=== $name"
@@ -20,5 +23,5 @@ while IFS= read -r script; do
   name=$(basename "$script" .sh)
   echo "=== $name"
   bash "$script" "$build" 2>&1 | tee "$root/out/bench/$name.txt" || status=1
-done < <(find "$root/bench" -mindepth 2 -name '*.sh' | sort)
+done < <(find "$root/bench" -mindepth 2 -name '*.sh' ! -path '*/report/*' ! -path '*/materials/*' | sort)
 exit $status

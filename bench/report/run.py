@@ -44,9 +44,8 @@ SOLVES = ["l2", "l1", "weighted"]
 # its own converged image; every GDPT curve against GDPT PT's.
 REFERENCE_OF = {"cycles_default": "cycles_default", "cycles_unbiased": "cycles_unbiased",
                 "pt": "pt", "gpt_l2": "pt", "gpt_l1": "pt", "gpt_weighted": "pt"}
-# Cross-engine references are compared on 4x4 block means (pixel filters differ: Cycles'
-# Blackman-Harris against GDPT's box), their noise subtracted; above this relMSE the scene's
-# comparison is void.
+# Cross-engine references are compared on 4x4 block means (the engines' pixel filters need not
+# match sample for sample), their noise subtracted; above this relMSE the scene's comparison is void.
 CROSS_BLOCK, CROSS_VOID = 4, 0.01
 
 
@@ -241,6 +240,40 @@ def fmt(v, spec=".2f", suffix="x"):
     return "-" if v is None else f"{v:{spec}}{suffix}"
 
 
+def verdict(r):
+    """Sentences on what decides the scene at 40 s, from the measured figures only."""
+    e = r["equal_time"]["40"]
+    out = []
+    cd, cu = e.get("cycles_default"), e.get("cycles_unbiased")
+    if cd and cu and cu / cd >= 2:
+        out.append(f"Cycles' defaults reach a {cu / cd:.1f}x lower error than its unbiased "
+                   "setting at 40 s: their bias (Filter Glossy, clamping), measured against "
+                   "their own reference, decides this scene.")
+    gpts = {c: e.get(c) for c in ("gpt_l2", "gpt_l1", "gpt_weighted") if e.get(c)}
+    if not gpts or not cd:
+        return out
+    best = min(gpts, key=gpts.get)
+    name = CURVES[best]
+    if gpts[best] > cd:
+        fails = [p.get("shift_failures") for p in r["curves"]["gpt_l2"]]
+        why = [f"a G-PT sample costs {r['gpt_cost_per_sample_over_pt']:.2f}x a PT sample"]
+        if fails and fails[-1] is not None:
+            why.append(f"{fails[-1]:.1%} of shifts fail")
+        share = r["solve_time_share"].get(best.split("_", 1)[1])
+        if share is not None:
+            why.append(f"the solve takes {share:.1%} of the time")
+        out.append(f"**G-PT loses here**: at 40 s its best curve ({name}) has a "
+                   f"{gpts[best] / cd:.2f}x higher error than Cycles' defaults ("
+                   + "; ".join(why) + ").")
+    else:
+        out.append(f"At 40 s {name} has a {cd / gpts[best]:.2f}x lower error than Cycles' "
+                   "defaults.")
+    if e.get("pt") and gpts[best] > e["pt"]:
+        out.append(f"Gradient sampling does not pay on this scene: GDPT's own PT is "
+                   f"{gpts[best] / e['pt']:.2f}x better than {name} at 40 s.")
+    return out
+
+
 def write_doc(results, meta, path, figures):
     lines = [
         "# Benchmarks: GDPT against Cycles at equal time",
@@ -250,7 +283,8 @@ def write_doc(results, meta, path, figures):
         "run; rerun the command to regenerate this page.",
         "",
         "relMSE is measured against each method's own converged reference (two independent "
-        "halves, whose noise is subtracted); times are whole Blender render calls (export, "
+        f"halves of {results[0]['reference_seconds_per_half']:g} s each, whose noise is "
+        "subtracted); times are whole Blender render calls (export, "
         "render, write) plus, for G-PT, the `gdpt-reconstruct` solve. Cycles' defaults include "
         "Filter Glossy 1.0 and indirect clamping at 10 (biased, less noise) and adaptive sampling "
         "(which may stop before the budget); \"unbiased\" sets the first two to 0 and samples "
@@ -295,6 +329,7 @@ def write_doc(results, meta, path, figures):
                   ", ".join(f"{n.upper()} {v:.1%}" for n, v in r["solve_time_share"].items()) +
                   f". Predicted improvement of gradient sampling (||F||^2 / ||G||^2 of the "
                   f"reference): {r['predicted_improvement']:.1f}x.", ""]
+        lines += [" ".join(verdict(r)), ""] if verdict(r) else []
     with open(path, "w") as f:
         f.write("\n".join(lines))
 
@@ -303,13 +338,29 @@ def git(*args):
     return subprocess.run(["git", "-C", ROOT, *args], capture_output=True, text=True).stdout.strip()
 
 
+def rewrite_doc(args, fig_dir, doc_dir):
+    """The page and plots again from a finished run's JSON (its own commit and date kept)."""
+    results, figures = [], {}
+    for name in args.scenes:
+        with open(os.path.join(args.results, f"{name}.json")) as f:
+            result = json.load(f)
+        plot(result, os.path.join(fig_dir, f"{name}_relmse.png"))
+        rel = os.path.relpath(fig_dir, doc_dir)
+        figures[name] = (f"{rel}/{name}_relmse.png", f"{rel}/{name}_crops.png")
+        results.append(result)
+    write_doc(results, results[0]["meta"], args.out_doc, figures)
+    print(f"rewrote {args.out_doc} from {len(results)} result files in {args.results}")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--build", default=os.path.join(ROOT, "build"))
     p.add_argument("--quick", action="store_true", help="two scenes, short budgets, 160x120")
     p.add_argument("--scenes", help="comma-separated subset of " + ",".join(SCENES))
     p.add_argument("--budgets", help="comma-separated seconds (default 5,10,20,40,80)")
-    p.add_argument("--ref-seconds", type=float, help="seconds per reference half (default 120)")
+    p.add_argument("--ref-seconds", type=float, help="seconds per reference half (default 40)")
+    p.add_argument("--doc-only", action="store_true",
+                   help="rewrite the page and plots from bench/results/<scene>.json, no rendering")
     p.add_argument("--res", help="WIDTHxHEIGHT (default 320x240)")
     p.add_argument("--out-doc", default=os.path.join(ROOT, "docs", "benchmarks.md"))
     p.add_argument("--results", default=os.path.join(ROOT, "bench", "results"))
@@ -321,7 +372,7 @@ def main():
     args.scenes = (args.scenes or ("cornell_panel,interior" if quick else ",".join(SCENES))).split(",")
     args.budgets = [float(b) if "." in b else int(b) for b in
                     (args.budgets or ("2,4,8" if quick else "5,10,20,40,80")).split(",")]
-    args.ref_seconds = args.ref_seconds or (20.0 if quick else 120.0)
+    args.ref_seconds = args.ref_seconds or (20.0 if quick else 40.0)
     args.res = args.res or ("160x120" if quick else "320x240")
     args.crop_budget = 40 if 40 in args.budgets else args.budgets[-1]
     unknown = [s for s in args.scenes if s not in SCENES]
@@ -336,6 +387,8 @@ def main():
             "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
             "machine": f"{platform.machine()}, {os.cpu_count()} cores",
             "command": "make bench" + (" QUICK=1" if quick else ""), "crop_budget": args.crop_budget}
+    if args.doc_only:
+        return rewrite_doc(args, fig_dir, doc_dir)
     blender = Blender(args.build)
     results, figures = [], {}
     try:
