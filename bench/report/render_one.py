@@ -4,7 +4,8 @@
 # METHOD: cycles_default (Cycles as a new scene has it, but denoising off: Debian's Blender has
 # no OpenImageDenoise), cycles_unbiased (the same with Filter Glossy 0 and no clamping), pt
 # (Gradient PT's path tracer), gpt (Gradient PT's G-PT, no reconstruction: the report solves
-# its passes with gdpt-reconstruct). Prints one line `BENCH {json}` with the render call's wall
+# its passes with gdpt-reconstruct), gpt_feature (G-PT with the Feature reconstruction in the
+# render, which computes the feature passes it needs). Prints one line `BENCH {json}` with the render call's wall
 # time; the samples reached are parsed by the caller from the engines' console lines.
 import json
 import os
@@ -45,11 +46,11 @@ if method.startswith("cycles"):
         c.use_adaptive_sampling = False
     elif method != "cycles_default":
         sys.exit(f"render_one.py: unknown method {method}")
-elif method in ("pt", "gpt"):
+elif method in ("pt", "gpt", "gpt_feature"):
     scene.render.engine = 'GDPT'
     g = scene.gdpt
-    g.mode = method.upper()
-    g.reconstruction = 'NONE' if method == "gpt" else 'L2'
+    g.mode = 'PT' if method == "pt" else 'GPT'
+    g.reconstruction = {"pt": 'L2', "gpt": 'NONE', "gpt_feature": 'FEATURE'}[method]
     g.seed = seed
     g.samples = samples or many
     g.time_limit = seconds

@@ -35,15 +35,19 @@ import metrics as M  # noqa: E402
 SCENES = ["cornell_panel", "interior", "glossy", "glass_caustics", "difficult_light", "outdoor",
           "instances"]
 # Rendered methods and the curves they give (G-PT gives one curve per reconstruction).
-RENDERED = ["cycles_default", "cycles_unbiased", "pt", "gpt"]
+# gpt_feature: G-PT with the Feature reconstruction solved in the render (its feature passes
+# cost render time, so it is a render of its own, as an artist picking Feature gets it).
+RENDERED = ["cycles_default", "cycles_unbiased", "pt", "gpt", "gpt_feature"]
 CURVES = {"cycles_default": "Cycles (defaults)", "cycles_unbiased": "Cycles (unbiased)",
           "pt": "GDPT PT", "gpt_l2": "GDPT G-PT + L2", "gpt_l1": "GDPT G-PT + L1",
-          "gpt_weighted": "GDPT G-PT + weighted"}
+          "gpt_weighted": "GDPT G-PT + weighted", "gpt_feature": "GDPT G-PT + feature"}
 SOLVES = ["l2", "l1", "weighted"]
 # Each curve's reference: Cycles' settings are biased differently, so each is measured against
 # its own converged image; every GDPT curve against GDPT PT's.
 REFERENCE_OF = {"cycles_default": "cycles_default", "cycles_unbiased": "cycles_unbiased",
-                "pt": "pt", "gpt_l2": "pt", "gpt_l1": "pt", "gpt_weighted": "pt"}
+                "pt": "pt", "gpt_l2": "pt", "gpt_l1": "pt", "gpt_weighted": "pt",
+                "gpt_feature": "pt"}
+GPT_CURVES = ("gpt_l2", "gpt_l1", "gpt_weighted", "gpt_feature")
 # Cross-engine references are compared on 4x4 block means (the engines' pixel filters need not
 # match sample for sample), their noise subtracted; above this relMSE the scene's comparison is void.
 CROSS_BLOCK, CROSS_VOID = 4, 0.01
@@ -85,7 +89,7 @@ def render(blender, blend, method, out, seconds=0.0, samples=0, seed=1):
     log = blender.run(os.path.join(HERE, "render_one.py"), *args, "--seed", seed)
     line = next(ln for ln in log.splitlines() if ln.startswith("BENCH "))
     info = json.loads(line[6:])
-    expected = "GDPT" if method in ("pt", "gpt") else "CYCLES"
+    expected = "GDPT" if method in ("pt", "gpt", "gpt_feature") else "CYCLES"
     if info["engine"] != expected:
         raise RuntimeError(f"{method} rendered with {info['engine']}, not {expected}")
     info["samples"] = samples_reached(log)
@@ -176,16 +180,25 @@ def measure_scene(name, args, blender, log):
 def summarise(result):
     """Equal-time ratios at 10 s and 40 s, the achieved G-PT improvement over PT, PT costs."""
     def at(curve, t):
-        return M.at_time([(p["seconds"], p["relmse_denoised"]) for p in result["curves"][curve]], t)
+        pts = result["curves"].get(curve, [])
+        e = M.at_time([(p["seconds"], p["relmse_denoised"]) for p in pts], t)
+        # A render that ended well before its budget (Cycles' adaptive sampling at its noise
+        # threshold) gives the same image at any later time.
+        last = max(pts, key=lambda p: p["seconds"], default=None)
+        if e is None and last and t > last["seconds"] and last["seconds"] < 0.9 * last["budget"]:
+            e = last["relmse_denoised"] if last["relmse_denoised"] > 0 else None
+        return e
 
     result["equal_time"] = {}
     for t in (10, 40):
         row = {c: at(c, t) for c in CURVES}
         row["improvement_over_cycles_default"] = {
             c: row["cycles_default"] / row[c] if row["cycles_default"] and row[c] else None
-            for c in ("pt", "gpt_l2", "gpt_l1", "gpt_weighted")}
+            for c in ("pt",) + GPT_CURVES}
         row["achieved_gpt_l2_over_pt"] = (row["pt"] / row["gpt_l2"]
                                           if row["pt"] and row["gpt_l2"] else None)
+        row["feature_over_l1"] = (row["gpt_l1"] / row["gpt_feature"]
+                                  if row["gpt_l1"] and row["gpt_feature"] else None)
         result["equal_time"][str(t)] = row
     pt, gpt = result["curves"]["pt"], result["curves"]["gpt_l2"]
     result["gpt_cost_per_sample_over_pt"] = float(np.median(
@@ -202,7 +215,7 @@ def plot(result, path):
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(5.5, 4))
     for curve, label in CURVES.items():
-        pts = [(p["seconds"], p["relmse_denoised"]) for p in result["curves"][curve]
+        pts = [(p["seconds"], p["relmse_denoised"]) for p in result["curves"].get(curve, [])
                if p["relmse_denoised"] > 0]
         if pts:
             ax.loglog(*zip(*pts), marker="o", label=label)
@@ -249,7 +262,7 @@ def verdict(r):
         out.append(f"Cycles' defaults reach a {cu / cd:.1f}x lower error than its unbiased "
                    "setting at 40 s: their bias (Filter Glossy, clamping), measured against "
                    "their own reference, decides this scene.")
-    gpts = {c: e.get(c) for c in ("gpt_l2", "gpt_l1", "gpt_weighted") if e.get(c)}
+    gpts = {c: e.get(c) for c in GPT_CURVES if e.get(c)}
     if not gpts or not cd:
         return out
     best = min(gpts, key=gpts.get)
@@ -279,7 +292,10 @@ def write_doc(results, meta, path, figures):
         "# Benchmarks: GDPT against Cycles at equal time",
         "",
         f"Generated by `{meta['command']}` at commit {meta['commit']} on {meta['date']}, "
-        f"{meta['machine']}. Every figure below comes from `bench/results/<scene>.json` of that "
+        f"{meta['machine']}"
+        + (f" (page and ratios rewritten from its JSON by `run.py --doc-only` at commit "
+           f"{meta['page_commit']})" if meta.get("page_commit") else "")
+        + ". Every figure below comes from `bench/results/<scene>.json` of that "
         "run; rerun the command to regenerate this page.",
         "",
         "relMSE is measured against each method's own converged reference (two independent "
@@ -287,27 +303,51 @@ def write_doc(results, meta, path, figures):
         "subtracted); times are whole Blender render calls (export, "
         "render, write) plus, for G-PT, the `gdpt-reconstruct` solve. Cycles' defaults include "
         "Filter Glossy 1.0 and indirect clamping at 10 (biased, less noise) and adaptive sampling "
-        "(which may stop before the budget); \"unbiased\" sets the first two to 0 and samples "
+        "(which may stop before the budget: its last image then stands for every later time); "
+        "\"unbiased\" sets the first two to 0 and samples "
         "every pixel for the whole budget. Denoising is off: Debian's Blender has no "
         "OpenImageDenoise.",
         "",
-        "## Summary: relMSE improvement over Cycles (defaults) at equal time",
+        "## Summary: relMSE improvement over Cycles at equal time",
         "",
-        "| scene | refs agree (relMSE PT~Cycles) | PT 10 s | G-PT+L1 10 s | G-PT+L2 40 s "
-        "| G-PT+L1 40 s | predicted / achieved G-PT over PT (40 s) |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
     ]
+    feature = any(r["curves"].get("gpt_feature") for r in results)
+
+    def best_over_unbiased(e):
+        gpts = [e[c] for c in GPT_CURVES if e.get(c)]
+        return e["cycles_unbiased"] / min(gpts) if gpts and e.get("cycles_unbiased") else None
+
+    # (header, cell of a result) per column; ratios over Cycles (defaults) unless named.
+    columns = [
+        ("refs agree (relMSE PT~Cycles)", lambda r: (
+            f"{r['cross_engine_relmse']['pt~cycles_unbiased']:.1e}" + (" (void)" if r["void"] else ""))),
+        ("PT 10 s", lambda r: fmt(r["equal_time"]["10"]["improvement_over_cycles_default"]["pt"])),
+        ("G-PT+L1 10 s", lambda r: fmt(
+            r["equal_time"]["10"]["improvement_over_cycles_default"]["gpt_l1"])),
+        ("G-PT+L2 40 s", lambda r: fmt(
+            r["equal_time"]["40"]["improvement_over_cycles_default"]["gpt_l2"])),
+        ("G-PT+L1 40 s", lambda r: fmt(
+            r["equal_time"]["40"]["improvement_over_cycles_default"]["gpt_l1"])),
+    ]
+    if feature:
+        columns += [
+            ("G-PT+feature 40 s", lambda r: fmt(
+                r["equal_time"]["40"]["improvement_over_cycles_default"].get("gpt_feature"))),
+            ("feature over L1 (40 s)", lambda r: fmt(r["equal_time"]["40"].get("feature_over_l1")))]
+    columns += [
+        ("best G-PT over Cycles unbiased (40 s)", lambda r: fmt(best_over_unbiased(
+            r["equal_time"]["40"]))),
+        ("predicted / achieved G-PT over PT (40 s)", lambda r: (
+            f"{fmt(r['predicted_improvement'], '.1f')} / "
+            f"{fmt(r['equal_time']['40']['achieved_gpt_l2_over_pt'])}")),
+    ]
+    lines += ["| scene | " + " | ".join(h for h, _ in columns) + " |",
+              "| --- |" + " --- |" * len(columns)]
     for r in results:
-        e10, e40 = r["equal_time"]["10"], r["equal_time"]["40"]
-        i10, i40 = e10["improvement_over_cycles_default"], e40["improvement_over_cycles_default"]
-        cross = r["cross_engine_relmse"]["pt~cycles_unbiased"]
-        agree = f"{cross:.1e}" + (" (void)" if r["void"] else "")
-        lines.append(f"| {r['scene']} | {agree} | {fmt(i10['pt'])} | {fmt(i10['gpt_l1'])} | "
-                     f"{fmt(i40['gpt_l2'])} | {fmt(i40['gpt_l1'])} | "
-                     f"{fmt(r['predicted_improvement'], '.1f')} / "
-                     f"{fmt(e40['achieved_gpt_l2_over_pt'])} |")
-    lines += ["", "A ratio above 1x means a lower error than Cycles in the same time; \"-\" means "
-              "the budget range did not reach that time.", ""]
+        lines.append(f"| {r['scene']} | " + " | ".join(cell(r) for _, cell in columns) + " |")
+    lines += ["", "Ratios are Cycles' relMSE over GDPT's at the same time, against Cycles with its "
+              "defaults unless the column names the unbiased setting; above 1x GDPT has the "
+              "lower error; \"-\" means the budget range did not reach that time.", ""]
     for r in results:
         lines += [f"## {r['scene']}", ""]
         if r["void"]:
@@ -320,7 +360,9 @@ def write_doc(results, meta, path, figures):
                   "| --- |" + " --- |" * len(r["budgets"])]
         for curve, label in CURVES.items():
             cells = [f"{p['relmse_denoised']:.2e} ({p['samples']} spp, SSIM {p['ssim']:.3f})"
-                     for p in r["curves"][curve]]
+                     for p in r["curves"].get(curve, [])]
+            if not cells:
+                continue  # a curve this run did not measure
             lines.append(f"| {label} | " + " | ".join(cells) + " |")
         fails = [p.get("shift_failures") for p in r["curves"]["gpt_l2"]]
         lines += ["", f"G-PT cost per sample: {r['gpt_cost_per_sample_over_pt']:.2f}x PT's; "
@@ -344,6 +386,10 @@ def rewrite_doc(args, fig_dir, doc_dir):
     for name in args.scenes:
         with open(os.path.join(args.results, f"{name}.json")) as f:
             result = json.load(f)
+        summarise(result)  # the derived ratios again; the measured points stay as they are
+        result["meta"]["page_commit"] = git("rev-parse", "--short", "HEAD")
+        with open(os.path.join(args.results, f"{name}.json"), "w") as f:
+            json.dump(result, f, indent=1)
         plot(result, os.path.join(fig_dir, f"{name}_relmse.png"))
         rel = os.path.relpath(fig_dir, doc_dir)
         figures[name] = (f"{rel}/{name}_relmse.png", f"{rel}/{name}_crops.png")

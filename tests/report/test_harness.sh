@@ -15,7 +15,8 @@ mkdir -p "$out"
 import json, math, os, sys
 out = sys.argv[1]
 r = json.load(open(os.path.join(out, "results", "cornell_panel.json")))
-curves = ["cycles_default", "cycles_unbiased", "pt", "gpt_l2", "gpt_l1", "gpt_weighted"]
+curves = ["cycles_default", "cycles_unbiased", "pt", "gpt_l2", "gpt_l1", "gpt_weighted",
+          "gpt_feature"]
 for c in curves:
     pts = r["curves"][c]
     assert len(pts) == 2, (c, pts)
