@@ -262,6 +262,15 @@ def verdict(r):
         out.append(f"Cycles' defaults reach a {cu / cd:.1f}x lower error than its unbiased "
                    "setting at 40 s: their bias (Filter Glossy, clamping), measured against "
                    "their own reference, decides this scene.")
+    pt = e.get("pt")
+    if pt and cu and pt > 2 * cu:
+        def samples(curve):
+            return next((p["samples"] for p in r["curves"][curve] if p["budget"] == 40), None)
+        ps, cs = samples("pt"), samples("cycles_unbiased")
+        where = ("per sample, not in speed" if ps and cs and ps >= 0.8 * cs
+                 else "in samples per second")
+        out.append(f"GDPT's own path tracer is {pt / cu:.1f}x behind Cycles' unbiased setting at "
+                   f"40 s ({ps} against {cs} samples at the 40 s budget): it loses {where}.")
     gpts = {c: e.get(c) for c in GPT_CURVES if e.get(c)}
     if not gpts or not cd:
         return out
