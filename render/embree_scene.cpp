@@ -195,7 +195,7 @@ void EmbreeScene::set_materials(std::span<const Material> materials) {
   };
   auto perturbs = [&](int32_t m) {
     return m >= 0 && size_t(m) < materials.size() &&
-           (materials[size_t(m)].has_normal_map() || materials[size_t(m)].has_bump());
+           (materials[size_t(m)].has_normal_map() || !materials[size_t(m)].bumps().empty());
   };
   auto reads_coords = [&](int32_t m) {
     return m >= 0 && size_t(m) < materials.size() && materials[size_t(m)].reads_coordinates();
@@ -441,8 +441,16 @@ void EmbreeScene::perturb_normal(const InstanceData& d, uint32_t primitive, floa
                                  SurfaceHit& hit) const {
   if (size_t(hit.material) >= materials_.size()) return;
   const Material& material = materials_[size_t(hit.material)];
-  if (material.has_bump()) return bump_normal(d, primitive, hit, material);
-  if (!material.has_normal_map() || primitive >= d.corner_tangent_tris) return;
+  const std::vector<BumpDesc>& bumps = material.bumps();
+  size_t k = 0;
+  if (k < bumps.size() && bumps[k].replaces_normal) bump_normal(d, primitive, hit, material, k++);
+  if (material.has_normal_map()) normal_map_normal(d, primitive, u, v, hit, material);
+  for (; k < bumps.size(); ++k) bump_normal(d, primitive, hit, material, k);
+}
+
+void EmbreeScene::normal_map_normal(const InstanceData& d, uint32_t primitive, float u, float v,
+                                    SurfaceHit& hit, const Material& material) const {
+  if (primitive >= d.corner_tangent_tris) return;
   const float w = 1.0f - u - v;
   const Vec3f* T = d.corner_tangents + size_t(primitive) * 3;
   const float* S = d.corner_tangent_signs + size_t(primitive) * 3;
@@ -467,7 +475,7 @@ void EmbreeScene::perturb_normal(const InstanceData& d, uint32_t primitive, floa
 // coordinates along the object-space image of the direction), so image and procedural heights
 // both differentiate.
 void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
-                              const Material& material) const {
+                              const Material& material, size_t bump) const {
   const uint32_t* idx = d.indices + size_t(primitive) * 3;
   const Vec3f* P = d.object_positions;
   Vec3f p[3];
@@ -506,7 +514,7 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
   constexpr float kStep = 1.0f / 1024.0f;
   float h[3];
   ShadingContext at = shading_context(d, hit);
-  h[0] = material.bump_height(at);
+  h[0] = material.bump_height(bump, at);
   const TexCoords base = hit.coords;
   for (int k = 0; k < 2; ++k) {
     at.uv = hit.uv + duv[k] * kStep;
@@ -518,14 +526,18 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
         shifted.generated[c] = base.generated[c] + o[k][c] * kStep * d.generated_scale[c];
     }
     at.coords = d.writes_coords ? &shifted : nullptr;
-    h[k + 1] = material.bump_height(at);
+    h[k + 1] = material.bump_height(bump, at);
   }
-  const Vec3f grad = (g0 * (h[1] - h[0]) + g1 * (h[2] - h[0])) / kStep;
-  const BumpDesc& b = material.bump();
+  Vec3f grad = (g0 * (h[1] - h[0]) + g1 * (h[2] - h[0])) / kStep;
+  const BumpDesc& b = material.bumps()[bump];
   // The tilt belongs to the surface, not to the side it is seen from: a back face shows the
   // same bumped normal, flipped (as Cycles 3.4 renders inside-out meshes).
   const float distance = b.invert ? -b.distance : b.distance;
   const Vec3f n = hit.shading_normal;
+  // The same directional derivatives, in the plane normal to n (Cycles' surface gradient): moves
+  // grad along the face normal; it matters where n is tilted, by smoothing or an earlier bump.
+  const float ng_n = dot(ng, n);
+  if (std::fabs(ng_n) > 1e-3f * length(ng)) grad = grad - ng * (dot(grad, n) / ng_n);
   Vec3f bumped;
   if (!set_unit(n - grad * distance, bumped)) return;
   const float strength = std::max(b.strength, 0.0f);

@@ -250,12 +250,14 @@ class EmbreeScene {
   std::vector<RTCScene> mesh_scenes_;
   std::vector<HugePageVector<UnitNormal>> unit_normals_;  // InstanceData::unit_normals' storage
   std::vector<InstanceData> instances_;                   // indexed by top-level Embree geometry id
-  // Replaces hit.shading_normal by the material's normal map or bump, if it has one (out of
-  // line: rare).
+  // Replaces hit.shading_normal by what the material's normal chain (displacement, normal map,
+  // bumps: MaterialDesc::bumps) makes of it (out of line: rare).
   [[gnu::noinline]] void perturb_normal(const InstanceData& d, uint32_t primitive, float u, float v,
                                         SurfaceHit& hit) const;
+  void normal_map_normal(const InstanceData& d, uint32_t primitive, float u, float v,
+                         SurfaceHit& hit, const Material& material) const;
   void bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
-                   const Material& material) const;
+                   const Material& material, size_t bump) const;
   // The shading context of a completed hit (its colour and coordinates where it has them).
   static ShadingContext shading_context(const InstanceData& d, const SurfaceHit& hit) {
     return {hit.uv, true, d.writes_color ? &hit.color : nullptr,

@@ -254,8 +254,9 @@ struct NormalMapDesc {
 // bump shadowing follows and every lobe and Geometry Normal reads it. The gradient is taken in
 // world units, where Cycles takes an object-space displacement's in object units: the two agree
 // for objects of unit scale only.
+// A Bump node whose Normal input is another Bump (or a Normal Map) tilts that node's normal: the
+// gradient is taken in the plane normal to it (Cycles' surface gradient against its N).
 struct BumpDesc {
-  bool enabled = false;
   FloatInput height{0.0f};
   float strength = 1.0f;
   float distance = 1.0f;
@@ -266,9 +267,11 @@ struct BumpDesc {
 struct MaterialDesc {
   std::string name;
   std::vector<ShaderNode> nodes;
-  int32_t root = -1;              // -1: Blender's default grey diffuse (0.8)
-  NormalMapDesc normal_map;       // needs the meshes' corner tangents (Mesh::corner_tangents)
-  BumpDesc bump;                  // needs UVs; not together with normal_map
+  int32_t root = -1;         // -1: Blender's default grey diffuse (0.8)
+  NormalMapDesc normal_map;  // needs the meshes' corner tangents (Mesh::corner_tangents)
+  // The normal's chain, in Cycles' order: a bump that replaces the normal (the displacement) comes
+  // first, then the normal map, then the other bumps, each tilting the normal the one before gave.
+  std::vector<BumpDesc> bumps;
   std::vector<InputNode> inputs;  // referenced by ColorInput::node / FloatInput::node
   float pass_index = 0.0f;        // Blender's Material > Settings > Pass Index (the IndexMA pass)
 };

@@ -676,7 +676,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
   inputs_ = desc.inputs;
   root_ = desc.root;
   normal_map_ = desc.normal_map;
-  bump_ = desc.bump;
+  bumps_ = desc.bumps;
   const std::string where = "material '" + desc.name + "': ";
   auto check_node = [&](int32_t i) {
     if (i < 0 || size_t(i) >= nodes_.size())
@@ -839,7 +839,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
   };
   visit(visit, root_, 0);
   if (normal_map_.enabled) note(normal_map_.color);
-  if (bump_.enabled) note(bump_.height);
+  for (const BumpDesc& b : bumps_) note(b.height);
 
   // --- Mean of every texture the tree uses, for average_emission().
   std::vector<Rgba> means(textures.size());
@@ -887,8 +887,8 @@ Vec3f Material::normal_map_direction(const ShadingContext& at) const {
           1.0f + (2.0f * (c.z - 0.5f) - 1.0f) * std::clamp(s, 0.0f, 1.0f)};
 }
 
-float Material::bump_height(const ShadingContext& at) const {
-  return PointInputs{textures_, inputs_, at}.scalar(bump_.height);
+float Material::bump_height(size_t bump, const ShadingContext& at) const {
+  return PointInputs{textures_, inputs_, at}.scalar(bumps_[bump].height);
 }
 
 }  // namespace gdpt

@@ -45,10 +45,10 @@ class Material {
   // normalised (x tangent, y bitangent, z normal).
   bool has_normal_map() const { return normal_map_.enabled; }
   Vec3f normal_map_direction(const ShadingContext& at) const;
-  // Bump node (BumpDesc): its height at a point (the caller differentiates).
-  bool has_bump() const { return bump_.enabled; }
-  const BumpDesc& bump() const { return bump_; }
-  float bump_height(const ShadingContext& at) const;
+  // Bump nodes (MaterialDesc::bumps, in their order): the height of one at a point (the caller
+  // differentiates).
+  const std::vector<BumpDesc>& bumps() const { return bumps_; }
+  float bump_height(size_t bump, const ShadingContext& at) const;
   // Some input reads the mesh's colour attribute (ShadingContext::color).
   bool reads_color_attribute() const { return reads_color_attribute_; }
   // Some texture reads Generated or Object coordinates (ShadingContext::coords).
@@ -74,7 +74,7 @@ class Material {
   std::span<const Texture> textures_;
   uint32_t features_ = 0;
   NormalMapDesc normal_map_;
-  BumpDesc bump_;
+  std::vector<BumpDesc> bumps_;
   bool reads_color_attribute_ = false;
   bool reads_coordinates_ = false;
   bool reads_view_ = false;

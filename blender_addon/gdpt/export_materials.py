@@ -21,9 +21,9 @@ from mathutils import Euler, Matrix
 from . import export_node_groups as groups
 
 MAGENTA = (1.0, 0.0, 1.0)
-# A second Normal Map / Bump node in one material: its input keeps the interpolated normal.
-_SECOND_PERTURBATION = "second normal perturbation (only the first is modelled; this input gets " \
-    "the interpolated normal) in"
+# A second chain of Normal Map / Bump nodes in one material: its input keeps the surface's normal.
+_SECOND_PERTURBATION = "second normal perturbation (only the first chain is modelled; this input " \
+    "gets the surface's normal) in"
 IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 
 _SHADERS = {
@@ -72,9 +72,13 @@ class _Translator:
         self.warn_sink = warn
         self.warned = set()
         self.nodes = []
-        self.normal_map = None  # (Normal Map node, its dict) of the BSDFs' Normal inputs
-        self.bump = None  # (Bump node, its dict), likewise
-        self.displaced = False  # the Displacement output (as bump) took the perturbation
+        # The normal chain (MaterialDesc::bumps and normal_map): the displacement as bump, then
+        # the Normal Map and the Bump nodes the BSDFs' Normal inputs lead to.
+        self.displacement_bump = None  # its dict
+        self.normal_map = None  # its dict
+        self.bumps = []  # Bump nodes' dicts, innermost first
+        self.chain_top = None  # the node the BSDFs read the chain's normal from
+        self.chain_nodes = set()
         self.inputs = []  # colour / math input nodes (MaterialDesc::inputs)
         self.color_attribute = None  # name read by Color Attribute nodes ("": the render one)
         self.input_index = {}  # node name -> index in self.inputs
@@ -232,71 +236,78 @@ class _Translator:
     # --- inputs ------------------------------------------------------------------------------
 
     def normal(self, socket):
-        """A BSDF's Normal (or Clearcoat Normal) input: a tangent-space Normal Map node or a Bump
-        node becomes the material's normal perturbation (one per material: the first found;
-        another one is reported and its input gets the interpolated normal). Returns whether
-        the input takes the material's perturbation (an unlinked input keeps the interpolated
-        normal, as in Cycles, which a displacement as bump replaces)."""
+        """A BSDF's Normal (or Clearcoat Normal) input: a tangent-space Normal Map node, or a
+        Bump node with the chain of Bump nodes (and at its base a Normal Map) on its own Normal
+        input, becomes the material's normal chain (one per material: the first found; another
+        one is reported and its input gets the surface's normal). Returns whether the input
+        takes the chain's normal; an unlinked input keeps the surface's normal (interpolated, or
+        the displacement's, which replaces it as in Cycles)."""
         out = self._source(socket)
         if out is None:
-            return self.displaced
+            return False
         node = out.node
-        if node.type == 'BUMP':
-            return self._bump(node)
-        if node.type != 'NORMAL_MAP':
+        if node.type not in ('BUMP', 'NORMAL_MAP'):
             self.warn(node, "normal / tangent input node")
             return False
-        if node.space != 'TANGENT':
-            self.warn(node, f"{node.space.lower()}-space normal map")
-            return False
-        if self.normal_map is not None or self.bump is not None:
-            if self.normal_map is None or self.normal_map[0] != node:
-                self._second_perturbation(node)
-                return self.displaced
+        if self.chain_top is None:
+            self.chain_top = node
+            self._chain(node)
             return True
-        if node.uv_map:
-            self.warn(node, "UV map other than the active render UV map in")
-        if node.inputs["Strength"].is_linked:
-            self.warn(node, "linked Strength (its default value is used) of")
-        self.normal_map = (node, {"color": self.color(node.inputs["Color"]),
-                                  "strength": float(node.inputs["Strength"].default_value)})
-        return True
+        if node == self.chain_top:
+            return True
+        if node in self.chain_nodes:
+            self.warn(node, "normal input reading an inner node of a chain of Bump nodes (it gets "
+                      "the whole chain's normal) in")
+            return True
+        self.warn(node, _SECOND_PERTURBATION)
+        return False
 
     def _view_normal(self, socket):
         """A Fresnel / Layer Weight Normal input: unlinked or the Geometry node's Normal is the
-        interpolated normal; a Normal Map / Bump node the material's perturbation (normal()).
-        Returns whether it reads the perturbation."""
+        interpolated normal; a Normal Map / Bump node the material's normal chain (normal()).
+        Returns whether it reads the chain."""
         out = self._source(socket)
         if out is None or (out.node.type == 'NEW_GEOMETRY' and out.name == "Normal"):
             return False
         return self.normal(socket)
 
-    def _bump(self, node):
-        """A Bump node on a BSDF's Normal input: the material's bump (one per material, not
-        with a normal map; its own Normal input is not followed). Returns whether it is the
-        material's perturbation."""
-        if self.normal_map is not None or self.bump is not None:
-            if self.bump is None or self.bump[0] != node:
-                self._second_perturbation(node)
-                return self.displaced
-            return True
-        for name in ("Strength", "Distance"):
-            if node.inputs[name].is_linked:
-                self.warn(node, f"linked {name} (its default value is used) of")
-        if node.inputs["Normal"].is_linked:
-            self.warn(node, "linked Normal (not followed) of")
-        self.bump = (node, {"height": self.value(node.inputs["Height"]),
-                            "strength": float(node.inputs["Strength"].default_value),
-                            "distance": float(node.inputs["Distance"].default_value),
-                            "invert": bool(node.invert)})
-        return True
+    def _chain(self, top):
+        """The material's normal chain ending at `top`: the Bump nodes down their Normal inputs
+        (innermost first in self.bumps) and a tangent-space Normal Map at the base."""
+        node, stack = top, []
+        while node is not None and node.type == 'BUMP':
+            stack.append(node)
+            out = self._source(node.inputs["Normal"])
+            if out is None or (out.node.type == 'NEW_GEOMETRY' and out.name == "Normal"):
+                node = None
+            elif out.node.type in ('BUMP', 'NORMAL_MAP'):
+                node = out.node
+            else:
+                self.warn(out.node, "node on a Bump's Normal input (not followed)")
+                node = None
+        self.chain_nodes = set(stack)
+        if node is not None:
+            self.chain_nodes.add(node)
+            self._normal_map(node)
+        for bump in reversed(stack):
+            for name in ("Strength", "Distance"):
+                if bump.inputs[name].is_linked:
+                    self.warn(bump, f"linked {name} (its default value is used) of")
+            self.bumps.append({"height": self.value(bump.inputs["Height"]),
+                               "strength": float(bump.inputs["Strength"].default_value),
+                               "distance": float(bump.inputs["Distance"].default_value),
+                               "invert": bool(bump.invert)})
 
-    def _second_perturbation(self, node):
-        if self.displaced:
-            self.warn(node, "normal perturbation on top of the displacement (its input gets the "
-                      "displaced normal) in")
-        else:
-            self.warn(node, _SECOND_PERTURBATION)
+    def _normal_map(self, node):
+        if node.space != 'TANGENT':
+            self.warn(node, f"{node.space.lower()}-space normal map")
+            return
+        if node.uv_map:
+            self.warn(node, "UV map other than the active render UV map in")
+        if node.inputs["Strength"].is_linked:
+            self.warn(node, "linked Strength (its default value is used) of")
+        self.normal_map = {"color": self.color(node.inputs["Color"]),
+                           "strength": float(node.inputs["Strength"].default_value)}
 
     def displacement(self, socket):
         """The Material Output's Displacement as Cycles' Bump Only method renders it: the
@@ -326,9 +337,8 @@ class _Translator:
         i = node.inputs
         offset = math("SUBTRACT", self.value(i["Height"]), self.value(i["Midlevel"]))
         height = math("MULTIPLY", offset, self.value(i["Scale"]))
-        self.bump = (node, {"height": height, "strength": 1.0, "distance": 1.0, "invert": False,
-                            "replaces_normal": True})
-        self.displaced = True
+        self.displacement_bump = {"height": height, "strength": 1.0, "distance": 1.0,
+                                  "invert": False, "replaces_normal": True}
 
     def color(self, socket):
         d = {"value": self._default_rgb(socket)}
@@ -826,9 +836,10 @@ def _translate_tree(material, t, warn):
         root = t._add({"kind": "DIFFUSE", "color": {"value": (0.0, 0.0, 0.0)}})
     d = {"name": material.name, "nodes": t.nodes, "root": root, "inputs": t.inputs}
     if t.normal_map is not None:
-        d["normal_map"] = t.normal_map[1]
-    if t.bump is not None:
-        d["bump"] = t.bump[1]
+        d["normal_map"] = t.normal_map
+    bumps = ([t.displacement_bump] if t.displacement_bump else []) + t.bumps
+    if bumps:
+        d["bumps"] = bumps
     if t.color_attribute is not None:
         d["color_attribute"] = t.color_attribute
     return d

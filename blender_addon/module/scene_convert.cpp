@@ -586,17 +586,23 @@ int SceneBuilder::add_material(const py::dict& material) {
   if (material.contains("inputs"))
     for (const auto& item : material["inputs"].cast<py::list>())
       desc.inputs.push_back(read_input_node(item.cast<py::dict>()));
-  // Bump node: {"height": float input, "strength", "distance": float, "invert": bool,
-  // "replaces_normal": bool (the Displacement output)}.
-  if (material.contains("bump")) {
-    const auto d = material["bump"].cast<py::dict>();
-    desc.bump.enabled = true;
-    read_float(d, "height", desc.bump.height);
-    get(d, "strength", desc.bump.strength);
-    get(d, "distance", desc.bump.distance);
-    get(d, "invert", desc.bump.invert);
-    get(d, "replaces_normal", desc.bump.replaces_normal);
-  }
+  // Bump nodes, in MaterialDesc::bumps' order: [{"height": float input, "strength", "distance":
+  // float, "invert": bool, "replaces_normal": bool (the Displacement output, first only)}].
+  if (material.contains("bumps"))
+    for (const auto& item : material["bumps"].cast<py::list>()) {
+      const auto d = item.cast<py::dict>();
+      BumpDesc& bump = desc.bumps.emplace_back();
+      read_float(d, "height", bump.height);
+      get(d, "strength", bump.strength);
+      get(d, "distance", bump.distance);
+      get(d, "invert", bump.invert);
+      get(d, "replaces_normal", bump.replaces_normal);
+      if (bump.replaces_normal && desc.bumps.size() > 1)
+        throw std::invalid_argument("material '" + desc.name +
+                                    "': only the first bump may replace the normal");
+      if (bump.height.texture.image >= int32_t(scene_.images.size()))
+        throw std::invalid_argument("material '" + desc.name + "': image index out of range");
+    }
   // Normal Map node (tangent space): {"color": colour input, "strength": float}.
   if (material.contains("normal_map")) {
     const auto d = material["normal_map"].cast<py::dict>();
@@ -620,8 +626,7 @@ int SceneBuilder::add_material(const py::dict& material) {
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
     }
   }
-  if (desc.normal_map.color.texture.image >= int32_t(scene_.images.size()) ||
-      desc.bump.height.texture.image >= int32_t(scene_.images.size()))
+  if (desc.normal_map.color.texture.image >= int32_t(scene_.images.size()))
     throw std::invalid_argument("material '" + desc.name + "': image index out of range");
   for (const InputNode& node : desc.inputs)
     for (const TextureLookup* t :

@@ -1428,6 +1428,68 @@ def curve_regions(image):
     return strip_regions(image, [label for label, _ in CURVE_STRIPS], CURVE_ROWS, BRICK_HEIGHT)
 
 
+def case_chained_bump(scene):
+    # Chains of normal perturbations, each tilting the normal the one before gave: a diffuse
+    # floor under Bump(Noise) whose Normal is Bump(ridged image); a diffuse back wall displaced
+    # by the image (Bump Only) under a BSDF Bump(Noise); a Principled ball under Bump(Noise) on a
+    # tangent-space Normal Map of a constant colour. (The same Noise bump on a GGX 0.3 wall, with
+    # or without the displacement, disagrees by relMSE 0.015 / 0.0096: a residual of strong bumps
+    # on glossy lobes, not of the chain.)
+    lit_room(scene)
+    area_ceiling(size=2.0, energy=200.0)
+    img = ridged_heights()
+
+    def noise_bump(nt, distance, strength):
+        noise = nt.nodes.new("ShaderNodeTexNoise")
+        noise.inputs["Scale"].default_value = 6.0
+        bump = nt.nodes.new("ShaderNodeBump")
+        bump.inputs["Distance"].default_value = distance
+        bump.inputs["Strength"].default_value = strength
+        nt.links.new(noise.outputs["Fac"], bump.inputs["Height"])
+        return bump
+
+    def bsdf_of(m):
+        return next(n for n in m.node_tree.nodes if n.type.startswith('BSDF'))
+
+    floor = S.shader_material("ridged", "ShaderNodeBsdfDiffuse", Color=(0.8, 0.8, 0.8, 1.0))
+    nt = floor.node_tree
+    tex = nt.nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    inner = nt.nodes.new("ShaderNodeBump")
+    inner.inputs["Distance"].default_value = 0.5
+    nt.links.new(tex.outputs["Color"], inner.inputs["Height"])
+    outer = noise_bump(nt, 0.03, 0.5)
+    nt.links.new(inner.outputs["Normal"], outer.inputs["Normal"])
+    nt.links.new(outer.outputs["Normal"], bsdf_of(floor).inputs["Normal"])
+
+    wall = S.shader_material("wavy", "ShaderNodeBsdfDiffuse", Color=(0.8, 0.8, 0.8, 1.0))
+    nt = wall.node_tree
+    tex = nt.nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    disp = nt.nodes.new("ShaderNodeDisplacement")
+    disp.inputs["Scale"].default_value = 0.15
+    nt.links.new(tex.outputs["Color"], disp.inputs["Height"])
+    out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
+    nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
+    nt.links.new(noise_bump(nt, 0.1, 1.0).outputs["Normal"], bsdf_of(wall).inputs["Normal"])
+
+    ball = S.shader_material("mapped", "ShaderNodeBsdfPrincipled", **{
+        "Base Color": (0.7, 0.5, 0.3, 1.0), "Roughness": 0.4, "distribution": 'GGX'})
+    nt = ball.node_tree
+    nmap = nt.nodes.new("ShaderNodeNormalMap")
+    nmap.inputs["Color"].default_value = (0.65, 0.5, 0.85, 1.0)
+    bump = noise_bump(nt, 0.02, 1.0)
+    nt.links.new(nmap.outputs["Normal"], bump.inputs["Normal"])
+    nt.links.new(bump.outputs["Normal"], bsdf_of(ball).inputs["Normal"])
+    S.uv_sphere("ball", 0.8, (0.4, 0.3, 0.8), ball)
+
+    for obj_name, m in (("floor", floor), ("back", wall)):
+        obj = bpy.data.objects[obj_name]
+        obj.data.materials.clear()
+        obj.data.materials.append(m)
+    return 3
+
+
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
 
 # Cases whose noise floor at the default counts lies near the threshold render more samples on
@@ -1443,6 +1505,8 @@ CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case
 # 8-bit sRGB textures were linearised before interpolation, unlike Cycles).
 # adjust_nodes: relMSE 0.0042 at the default counts, 0.0011 at 4x (0.16 with the nodes ignored).
 # color_attribute: relMSE 0.0006 (0.51 with both nodes ignored, 0.049 with the Attribute node).
+# chained_bump: relMSE 0.0015 at 4x, worst ninth 0.0070 (0.0064 / 0.028, a ninth's mean 8.3% off,
+# when only the outermost node of each chain is modelled, as before chains were).
 # bump: relMSE 0.0068 at the default counts, 0.0032 at 4x (a residual above the noise, not
 # isolated; the same with the wall's invert off); 0.067 with the bumps ignored.
 # displacement: relMSE 0.0047, mean 0.9985 at 4x (0.0078 / 0.9961 at the default counts); 0.36 /
@@ -1451,7 +1515,7 @@ CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case
 # math_nodes, voronoi_features: directly seen emission only, at half the counts
 # (Smooth F1 hashes 125 cells per lookup: 37 s for GDPT at the default counts).
 SAMPLE_SCALE = {"glass": 2, "refraction": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map": 4,
-                "input_nodes": 2, "adjust_nodes": 2, "bump": 4, "displacement": 4,
+                "input_nodes": 2, "adjust_nodes": 2, "bump": 4, "displacement": 4, "chained_bump": 4,
                 "math_nodes": 0.5, "voronoi_features": 0.5, "curve_nodes": 0.5}
 
 # Cases whose image holds many independent features, each of which must agree on its own (one
@@ -1506,6 +1570,7 @@ FLOORS = {
     "spot/GPT": (4.3e-3, 6.7e-3), "sun/GPT": (8.7e-5, 7.1e-4),
     "translucent/GPT": (2.7e-3, 5.6e-3), "velvet/GPT": (1.1e-3, 2.1e-3),
     "adjust_nodes/GPT": (2.1e-3, 3.2e-3), "bump/GPT": (3.1e-3, 1.1e-2),
+    "chained_bump/GPT": (1.5e-3, 7.1e-3),
     "channel_nodes/GPT": (9.4e-4, 2.2e-3), "clearcoat/GPT": (3.6e-3, 1.8e-2),
     "clearcoat/PT": (2.1e-3, 5.4e-3), "color_attribute/GPT": (5.6e-4, 1.4e-3),
     "diffuse/GPT": (6.0e-4, 1.3e-3), "glass/GPT": (4.6e-3, 2.1e-2),
@@ -1529,14 +1594,6 @@ FLOORS = {
 FLOOR_FACTOR = 3.0
 DEFAULT_COUNTS = (GDPT_SAMPLES, CYCLES_SAMPLES) == (128, 256)
 
-# Cases whose noise in a ninth of the frame (caustics, rough glass, bump and procedural edges at
-# the default counts) is above what a 15% scale of that ninth adds: their ninths' bound cannot
-# see such an error (more samples would, at a CI cost), the frame bound and the mean still hold.
-NOISY_NINTHS = {"refraction/GPT", "spot/GPT", "bump/GPT", "clearcoat/GPT", "glass/GPT",
-                "procedural_textures/GPT", "smooth_silhouettes/GPT", "bounce_limits/GPT",
-                "bounce_limits/PT"}
-
-
 def ninths(image):
     """The 3x3 grid of an image: (label, pixels) pairs."""
     h, w = image.shape[:2]
@@ -1557,15 +1614,34 @@ def ninth_failures(a, b, bound):
             if not S.rel_mse(ra, rb) < bound]
 
 
+# A ninth's mean (GDPT over Cycles) may differ from 1 by at most this, in ninths holding at least
+# NINTH_MEAN_SHARE of the frame's light: a mean over a ninth's thousands of pixels sees a scale
+# error where the ninth's relMSE is dominated by the noise of caustics or edges.
+NINTH_MEAN_BOUND, NINTH_MEAN_SHARE = 0.06, 0.02
+
+
+def ninth_mean_deviations(a, b):
+    """(label, |mean ratio - 1|) of the ninths holding at least NINTH_MEAN_SHARE of the light."""
+    total = max(float(b.sum()), 1e-12)
+    return [(label, abs(float(ra.mean()) / float(rb.mean()) - 1.0))
+            for (label, ra), (_, rb) in zip(ninths(a), ninths(b))
+            if float(rb.sum()) >= NINTH_MEAN_SHARE * total]
+
+
+def ninth_mean_failures(a, b):
+    return [f"{label} mean off by {d:.1%}" for label, d in ninth_mean_deviations(a, b)
+            if not d < NINTH_MEAN_BOUND]
+
+
 def injection_seen(a, b, bound):
-    """Whether the ninths' bound fails a GDPT image whose brightest ninth is scaled by 1.15 (the
-    test's power against a 15% error on a ninth of the frame)."""
+    """Whether the ninths' bounds (relMSE, mean) fail a GDPT image whose brightest ninth is scaled
+    by 1.15 (the test's power against a 15% error on a ninth of the frame)."""
     h, w = a.shape[:2]
     k = max(range(9), key=lambda k: float(ninths(b)[k][1].mean()))
     i, j = divmod(k, 3)
     scaled = a.copy()
     scaled[h * i // 3:h * (i + 1) // 3, w * j // 3:w * (j + 1) // 3] *= 1.15
-    return bool(ninth_failures(scaled, b, bound))
+    return bool(ninth_failures(scaled, b, bound) or ninth_mean_failures(scaled, b))
 
 
 def run_case(name, out_dir, mode=None):
@@ -1620,12 +1696,14 @@ def run_case(name, out_dir, mode=None):
     frame_bound, ninth_bound = bounds(key)
     bad_regions = []
     if ninth_bound is not None:
-        bad_regions += ninth_failures(a, b, ninth_bound)
+        bad_regions += ninth_failures(a, b, ninth_bound) + ninth_mean_failures(a, b)
         seen = injection_seen(a, b, ninth_bound)
         worst = max(S.rel_mse(ra, rb) for (_, ra), (_, rb) in zip(ninths(a), ninths(b)))
+        worst_mean = max((d for _, d in ninth_mean_deviations(a, b)), default=0.0)
         print(f"  frame bound {frame_bound:.2e}; ninths: worst {worst:.2e}, bound {ninth_bound:.2e}; "
-              f"15% on the brightest ninth {'seen' if seen else 'not seen'}", flush=True)
-        if not seen and key not in NOISY_NINTHS:
+              f"worst mean {worst_mean:.2%}, bound {NINTH_MEAN_BOUND:.0%}; 15% on the brightest "
+              f"ninth {'seen' if seen else 'not seen'}", flush=True)
+        if not seen:
             bad_regions.append("a 15% error on its brightest ninth would pass")
     if name in REGIONS:
         regions, bound = REGIONS[name]

@@ -314,11 +314,11 @@ ImageDesc ramp_image(int width, int height) {
 // Albedo 0.5, bumped by the red channel of image 0 (a ramp), distance 10.
 MaterialDesc ramp_bumped() {
   MaterialDesc m = diffuse(Spectrum(0.5f));
-  m.bump.enabled = true;
-  m.bump.height.texture.image = 0;
-  m.bump.height.texture.extension = TextureLookup::Extension::Extend;
-  m.bump.height.channel = FloatInput::Channel::Red;
-  m.bump.distance = 10.0f;
+  m.bumps.emplace_back();
+  m.bumps[0].height.texture.image = 0;
+  m.bumps[0].height.texture.extension = TextureLookup::Extension::Extend;
+  m.bumps[0].height.channel = FloatInput::Channel::Red;
+  m.bumps[0].distance = 10.0f;
   return m;
 }
 
@@ -342,8 +342,8 @@ TEST(Render, BumpTiltsTheNormalAgainstTheHeightGradient) {
        {Case{1.0f, false, tilted}, Case{0.5f, false, half}, Case{1.0f, true, tilted}})
     for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
       MaterialDesc m = ramp_bumped();
-      m.bump.strength = c.strength;
-      m.bump.invert = c.invert;
+      m.bumps[0].strength = c.strength;
+      m.bumps[0].invert = c.invert;
       Scene scene = sunlit_plane(uv_quad(), m, 0.0f);
       scene.images.push_back(ramp);
       RenderSettings s = pt(4);
@@ -352,6 +352,30 @@ TEST(Render, BumpTiltsTheNormalAgainstTheHeightGradient) {
       EXPECT_NEAR(mean_direct(scene, s), expect, 1e-3 * expect)
           << "strength " << c.strength << " invert " << c.invert << " G-PT "
           << (mode == RenderSettings::Mode::GPT);
+    }
+}
+
+// A Bump fed by another Bump tilts the normal the first one gave, against its height's gradient
+// taken in the plane normal to that normal (Cycles' surface gradient against its N). The first
+// bump tilts n to n1 = (-0.2, 0, 1) / sqrt(1.04) as above; a second one rising along v (grad
+// (0, 0.02, 0), normal to n1) adds -0.2 y: cos = 1 / 1.04; a second one along u (grad (0.02, 0,
+// 0)) gains the component 0.02 a / b along z that makes it normal to n1 = (-a, 0, b), so n2 =
+// (-a - 0.2, 0, b - 0.04); leaving it out gives (-a - 0.2, 0, b), 0.6% brighter. PT and G-PT.
+TEST(Render, ChainedBumpsTiltTheNormalTheFirstGave) {
+  const double a = 0.2 / std::sqrt(1.04), b = 1.0 / std::sqrt(1.04);
+  const double along_u = (b - 0.04) / std::hypot(a + 0.2, b - 0.04);
+  for (const bool second_along_v : {true, false})
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      MaterialDesc m = ramp_bumped();
+      m.bumps.push_back(m.bumps[0]);
+      if (second_along_v) m.bumps[1].height.texture.image = 1;
+      Scene scene = sunlit_plane(uv_quad(), m, 0.0f);
+      scene.images = {ramp_image(2, 1), ramp_image(1, 2)};
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      const double expect = lambert_radiance(second_along_v ? 1.0 / 1.04 : along_u);
+      EXPECT_NEAR(mean_direct(scene, s), expect, 1e-3 * expect)
+          << "second along v " << second_along_v << " G-PT " << (mode == RenderSettings::Mode::GPT);
     }
 }
 
@@ -392,7 +416,7 @@ TEST(Render, DisplacementAsBumpReplacesTheNormalWithoutBumpShadowing) {
   const ImageDesc ramp = ramp_image(1, 2);
   constexpr float kTheta = 0.5f;
   MaterialDesc m = ramp_bumped();
-  m.bump.replaces_normal = true;
+  m.bumps[0].replaces_normal = true;
   Scene scene = sunlit_plane(uv_quad(), m, kTheta);
   scene.images.push_back(ramp);
   const double cosine = (0.2 * std::sin(kTheta) + std::cos(kTheta)) / std::sqrt(1.04);
@@ -565,9 +589,9 @@ TEST(Render, BumpDifferentiatesObjectSpaceCoordinates) {
     height.value_a.node = 1;
     height.value_b = FloatInput(c.k);
     m.inputs = {coords, x, height};
-    m.bump.enabled = true;
-    m.bump.height.node = 2;
-    m.bump.distance = 10.0f;
+    m.bumps.emplace_back();
+    m.bumps[0].height.node = 2;
+    m.bumps[0].distance = 10.0f;
     Transform stretch;
     stretch.m[0][0] = c.scale_x;
     const Scene scene = sunlit_plane(plane, m, 0.0f, stretch);
