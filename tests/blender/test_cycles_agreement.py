@@ -1451,10 +1451,14 @@ def case_chained_bump(scene):
     def bsdf_of(m):
         return next(n for n in m.node_tree.nodes if n.type.startswith('BSDF'))
 
-    floor = S.shader_material("ridged", "ShaderNodeBsdfDiffuse", Color=(0.8, 0.8, 0.8, 1.0))
-    nt = floor.node_tree
-    tex = nt.nodes.new("ShaderNodeTexImage")
-    tex.image = img
+    def ridged_diffuse(name):
+        """A diffuse material with the height image's texture node: (material, tree, node)."""
+        m = S.shader_material(name, "ShaderNodeBsdfDiffuse", Color=(0.8, 0.8, 0.8, 1.0))
+        tex = m.node_tree.nodes.new("ShaderNodeTexImage")
+        tex.image = img
+        return m, m.node_tree, tex
+
+    floor, nt, tex = ridged_diffuse("ridged")
     inner = nt.nodes.new("ShaderNodeBump")
     inner.inputs["Distance"].default_value = 0.5
     nt.links.new(tex.outputs["Color"], inner.inputs["Height"])
@@ -1462,10 +1466,7 @@ def case_chained_bump(scene):
     nt.links.new(inner.outputs["Normal"], outer.inputs["Normal"])
     nt.links.new(outer.outputs["Normal"], bsdf_of(floor).inputs["Normal"])
 
-    wall = S.shader_material("wavy", "ShaderNodeBsdfDiffuse", Color=(0.8, 0.8, 0.8, 1.0))
-    nt = wall.node_tree
-    tex = nt.nodes.new("ShaderNodeTexImage")
-    tex.image = img
+    wall, nt, tex = ridged_diffuse("wavy")
     disp = nt.nodes.new("ShaderNodeDisplacement")
     disp.inputs["Scale"].default_value = 0.15
     nt.links.new(tex.outputs["Color"], disp.inputs["Height"])
