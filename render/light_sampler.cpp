@@ -5,6 +5,9 @@
 //   point I*4pi, spot the same times the cone's solid-angle fraction, area pi L A, emissive
 //   triangle 2 pi L_avg A (two-sided), sun E pi R^2 and world 4 pi^2 R^2 L_avg, with R the
 //   radius of the scene's bounding sphere (the power the scene can intercept).
+// A constant-colour world is not a light (as Cycles' automatic world sampling): sampling it
+// uniformly finds nothing cosine-weighted BSDF sampling does not, and would take a share of the
+// light samples from the lamps. Escaping rays still see it (environment()).
 // Lights with zero power, area or radius-related degeneracy never enter the CDF, so sample()
 // cannot pick them and intersect() ignores them.
 #include "render/light_sampler.h"
@@ -15,7 +18,6 @@
 #include <optional>
 #include <vector>
 
-#include "core/warp.h"
 #include "render/environment_map.h"
 #include "render/light_distribution.h"
 #include "render/lights/area_light.h"
@@ -97,7 +99,8 @@ struct LightSampler::Impl {
     Spectrum eval(Vec3f d) const { return environment ? environment->eval(d) : constant; }
   };
 
-  bool world_enabled = false;  // non-black world in the CDF
+  bool world_enabled = false;  // non-black world: escaping rays see it
+  bool world_sampled = false;  // ... and an image, in the CDF (a constant one is not)
   float world_pmf = 0.0f;
   BackgroundRadiance world;
 
@@ -105,8 +108,6 @@ struct LightSampler::Impl {
   bool camera_view = false;
   bool camera_enabled = false;  // non-black
   BackgroundRadiance camera;
-
-  float world_pdf(Vec3f d) const { return world.environment ? world.environment->pdf(d) : kInv4Pi; }
 };
 
 LightSampler::LightSampler(const Scene& scene, std::span<const Material> materials,
@@ -222,8 +223,11 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
     const float p = 4.0f * kPi * kPi * radius * radius * luminance(world_average);
     if (p > 0.0f && std::isfinite(p)) {
       I.world_enabled = true;
-      I.entries.push_back({Kind::World, 0});
-      weights.push_back(p);
+      I.world_sampled = I.world.environment.has_value();
+      if (I.world_sampled) {
+        I.entries.push_back({Kind::World, 0});
+        weights.push_back(p);
+      }
     } else {
       I.world.constant = Spectrum(0.0f);
     }
@@ -299,15 +303,9 @@ LightSample LightSampler::sample_any(Vec3f ref, float u_select, Vec2f u) const {
       ok = t.sample(ref, u, I.materials[t.material], s);
       break;
     }
-    case Kind::World: {
+    case Kind::World: {  // an image world (a constant one is never in the CDF)
       float pdf = 0.0f;
-      Vec3f d;
-      if (I.world.environment) {
-        d = I.world.environment->sample(u, &pdf);
-      } else {
-        d = lights::square_to_sphere(u);
-        pdf = kInv4Pi;
-      }
+      const Vec3f d = I.world.environment->sample(u, &pdf);
       if (pdf > 0.0f) {
         s.direction = d;
         s.radiance = I.world.eval(d);
@@ -417,7 +415,7 @@ bool LightSampler::has_camera_environment() const {
 
 float LightSampler::pdf_environment(Vec3f direction) const {
   const Impl& I = *impl_;
-  return I.world_enabled ? I.world_pdf(direction) * I.world_pmf : 0.0f;
+  return I.world_sampled ? I.world.environment->pdf(direction) * I.world_pmf : 0.0f;
 }
 
 bool LightSampler::has_camera_visible_lights() const {

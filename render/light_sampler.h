@@ -1,5 +1,6 @@
 // All light sources of a scene behind one interface: point (radius: disc), spot, sun, area lights,
-// emissive triangles (sampled by power) and the world (constant or importance-sampled image).
+// emissive triangles (sampled by power) and the world (constant, seen only by escaping rays, or an
+// importance-sampled image).
 // Units and looks as Cycles 3.4: area radiance = P / (4 A), point/spot intensity = P / (4 pi) per
 // steradian, sun = irradiance in W/m^2 (docs/lights.md).
 #pragma once
@@ -52,10 +53,11 @@ class LightSampler {
     }
     return intersect_any(origin, direction, t_max, hit);
   }
-  // Radiance of the world along an escaping ray (sun discs excluded: see intersect) and its pdf.
+  // Radiance of the world along an escaping ray (sun discs excluded: see intersect) and the
+  // density sample() has for it (0 for a constant world, which is not light-sampled).
   Spectrum environment(Vec3f direction) const;
   float pdf_environment(Vec3f direction) const;
-  bool has_environment() const;
+  bool has_environment() const;  // non-black world
   // The world as camera rays see it (World::camera_view, else the lighting world above).
   Spectrum camera_environment(Vec3f direction) const;
   bool has_camera_environment() const;

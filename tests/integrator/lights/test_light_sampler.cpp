@@ -82,7 +82,18 @@ struct MixedScene {
     sun.light_to_world = test::light_frame({0, 0, 0}, normalize(Vec3f(0.2f, -0.3f, -1)));
     scene.lights.push_back(sun);
     scene.lights.push_back(point({9, 9, 9}, 10.0f));  // delta
-    scene.world.color = {0.1f, 0.2f, 0.3f};
+    // An image world: only those are light-sampled (a constant one is not).
+    ImageDesc sky;
+    sky.width = 8;
+    sky.height = 4;
+    sky.rgba.assign(8 * 4 * 4, 1.0f);
+    for (size_t i = 0; i < sky.rgba.size(); i += 4) {
+      sky.rgba[i] = 0.1f + 0.01f * float(i % 7);
+      sky.rgba[i + 1] = 0.2f;
+      sky.rgba[i + 2] = 0.3f + 0.02f * float(i % 5);
+    }
+    scene.images.push_back(sky);
+    scene.world.image = 0;
     scene.materials.push_back(test::emission_material({2, 1, 1}, 4.0f));
     Mesh mesh;
     mesh.positions = {{-1, -3, 1}, {1, -3, 1}, {0, -3, 2.5f}};
