@@ -354,7 +354,7 @@ int bench_warm(const Data& d, int threads, bool sweep) {
   };
   std::printf("bench_reconstruct --warm: %dx%d RGB, %d threads\n", d.w, d.h, threads);
   const auto from = gdpt::reconstruct(in, settings(0.2f));
-  for (const float alpha : {0.25f, 0.15f, 0.05f, 0.8f}) {
+  for (const float alpha : {0.25f, 0.3f, 0.4f, 0.8f, 0.15f, 0.1f, 0.05f}) {
     auto tight_s = settings(alpha);
     tight_s.l1_reweightings = 72;
     tight_s.l1_cg_steps_first = 24;

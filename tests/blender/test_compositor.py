@@ -16,6 +16,8 @@
 #    returns in a small fraction of the solve's time with the image not yet changed and a
 #    "Solving" progress line on the node; once done, the image equals the synchronous solve of
 #    the same passes; two quick changes are coalesced into the last one;
+#  - an L1 alpha tweak of at most 2x starts from the node's last L1 image (its status says so)
+#    and lands within 0.5% of the cold solve in the mean; a 6x jump solves cold;
 #  - a copied node owns its image (tweaking the copy leaves the original alone);
 #  - two view layers: each node solves the layer its Render Layers node names;
 #  - a multilayer EXR Image node as the source (read through the module's OpenImageIO reader),
@@ -39,6 +41,7 @@ check = S.check
 
 SAMPLES = 16
 NODE = "CompositorNodeGDPTReconstruct"
+WARM_MEAN_DIFF = 0.005  # a warm L1 image against the cold solve at the same alpha, in the mean
 
 
 def build(scene):
@@ -235,7 +238,7 @@ def test_background_resolve(scene, node):
         compositor_node.wait_for_solves()
         before = node_pixels(node).copy()
         start = time.monotonic()
-        node.alpha = 0.25
+        node.alpha = 0.15  # more than WARM_ALPHA_RATIO away: a cold solve, long enough to see
         returned = time.monotonic() - start
         job = compositor_node._JOBS[node.as_pointer()]
         running = compositor_node.solving(node)
@@ -246,16 +249,16 @@ def test_background_resolve(scene, node):
                                      f"solve still running and the image unchanged")
         check(returned < 0.2 * job.seconds, f"the setter took {returned * 1e3:.0f} ms, the "
                                             f"background solve {job.seconds * 1e3:.0f} ms")
-        check(line.startswith("Solving L1, alpha 0.25"), f"progress line while solving: '{line}'")
+        check(line.startswith("Solving L1, alpha 0.15"), f"progress line while solving: '{line}'")
         check(float(job.progress[0]) == 1.0, "the progress slot reached 1")
         ref = _gdpt.reconstruct(big["primal"], big["gradient_x"], big["gradient_y"], None,
-                                big["emission"], 'L1', 0.25)
+                                big["emission"], 'L1', 0.15)
         px = node_pixels(node)
         check(px.shape[:2] == ref.shape[:2] and np.array_equal(px[..., :3], ref),
               "the image shown after the background solve equals the synchronous solve")
         level, message = compositor_node._STATUS[node.as_pointer()]
-        check(level == 'INFO' and "L1, alpha 0.25" in message and "solved in" in message,
-              f"status after the solve: '{message}'")
+        check(level == 'INFO' and "L1, alpha 0.15" in message and "solved in" in message
+              and "from the alpha" not in message, f"status after the solve: '{message}'")
         # Two changes while solving: one follow-up solve with the last settings.
         node.alpha = 0.6
         node.alpha = 0.7
@@ -267,6 +270,34 @@ def test_background_resolve(scene, node):
         compositor_node._CACHE[key] = saved
         node.norm, node.alpha = 'L2', 0.3  # as test_update_from_cache left it
         compositor_node.wait_for_solves()
+
+
+def test_warm_start(node, ch):
+    """An L1 alpha tweak within WARM_ALPHA_RATIO starts from the node's last L1 image (the
+    library's short warm schedule) and lands close to the cold solve; a larger jump, or new
+    passes, solves cold."""
+    from gdpt import compositor_node
+    node.norm, node.alpha = 'L1', 0.4
+    compositor_node.wait_for_solves()
+    err = max_rel_diff(node_pixels(node)[..., :3], solve(ch, 'L1', 0.4))
+    check(err < 1e-4, f"L2 -> L1 at alpha 0.4 solves cold ({err:.2e})")
+    node.alpha = 0.3
+    compositor_node.wait_for_solves()
+    message = compositor_node._STATUS[node.as_pointer()][1]
+    check("from the alpha 0.4 image" in message, f"alpha 0.4 -> 0.3 starts warm: '{message}'")
+    cold = solve(ch, 'L1', 0.3)
+    px = node_pixels(node)[..., :3]
+    rel = float(np.abs(px - cold).mean() / np.abs(cold).mean())
+    check(0.0 < rel < WARM_MEAN_DIFF, f"the warm image is within {WARM_MEAN_DIFF:.1%} of the "
+                                      f"cold solve's in the mean ({rel:.3%})")
+    node.alpha = 0.05
+    compositor_node.wait_for_solves()
+    message = compositor_node._STATUS[node.as_pointer()][1]
+    err = max_rel_diff(node_pixels(node)[..., :3], solve(ch, 'L1', 0.05))
+    check(err < 1e-4 and "from the alpha" not in message,
+          f"alpha 0.3 -> 0.05 (6x) solves cold ({err:.2e}, '{message}')")
+    node.norm, node.alpha = 'L2', 0.3  # as test_update_from_cache left it
+    compositor_node.wait_for_solves()
 
 
 def test_copy_owns_its_image(scene, node, ch):
@@ -415,6 +446,7 @@ def main():
     scene, node, ch = test_render_layers(out)
     test_update_from_cache(scene, node, ch)
     test_background_resolve(scene, node)
+    test_warm_start(node, ch)
     test_copy_owns_its_image(scene, node, ch)
     test_two_view_layers(out)
     test_unlinked_inputs(out)
