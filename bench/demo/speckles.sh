@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# `make bench` (via scripts/bench.sh): bright speckles and relMSE of the demo at its default
+# samples, L1 against Feature (bench/demo/speckles.py; writes bench/results/demo_speckles.json).
+#   bash bench/demo/speckles.sh <build-dir>
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+/usr/bin/python3 "$root/bench/demo/speckles.py" --build "${1:-build}"
