@@ -100,8 +100,7 @@ struct LightSampler::Impl {
   };
 
   bool world_enabled = false;  // non-black world: escaping rays see it
-  bool world_sampled = false;  // ... and an image, in the CDF (a constant one is not)
-  float world_pmf = 0.0f;
+  float world_pmf = 0.0f;      // > 0 only for an image world, in the CDF (a constant one is not)
   BackgroundRadiance world;
 
   // World::camera_view, when set (never sampled as a light).
@@ -223,8 +222,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
     const float p = 4.0f * kPi * kPi * radius * radius * luminance(world_average);
     if (p > 0.0f && std::isfinite(p)) {
       I.world_enabled = true;
-      I.world_sampled = I.world.environment.has_value();
-      if (I.world_sampled) {
+      if (I.world.environment) {
         I.entries.push_back({Kind::World, 0});
         weights.push_back(p);
       }
@@ -415,7 +413,7 @@ bool LightSampler::has_camera_environment() const {
 
 float LightSampler::pdf_environment(Vec3f direction) const {
   const Impl& I = *impl_;
-  return I.world_sampled ? I.world.environment->pdf(direction) * I.world_pmf : 0.0f;
+  return I.world_pmf > 0.0f ? I.world.environment->pdf(direction) * I.world_pmf : 0.0f;
 }
 
 bool LightSampler::has_camera_visible_lights() const {

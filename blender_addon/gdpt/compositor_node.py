@@ -282,10 +282,9 @@ def _warm_start(node, request):
     if request["norm"] != 'L1' or last is None:
         return
     inputs, alpha, rgb = last
-    same = len(inputs) == len(_inputs_of(request)) and all(
-        a is b for a, b in zip(inputs, _inputs_of(request)))
+    same = all(a is b for a, b in zip(inputs, _inputs_of(request)))
     ratio = max(alpha, request["alpha"]) / max(min(alpha, request["alpha"]), 1e-12)
-    if same and ratio <= WARM_ALPHA_RATIO and rgb.shape == request["passes"][0].shape:
+    if same and ratio <= WARM_ALPHA_RATIO:
         request["initial"], request["warm_from"] = rgb, alpha
 
 
