@@ -217,8 +217,7 @@ struct ShaderNode {
   bool normal_linked = true;
   bool clearcoat_normal_linked = true;
 
-  // Principled BSDF v1 inputs beyond colour / roughness / ior (subsurface is ignored with a
-  // warning).
+  // Principled BSDF v1 inputs beyond colour / roughness / ior.
   FloatInput metallic{0.0f};
   FloatInput specular{0.5f};
   FloatInput specular_tint{0.0f};
@@ -232,6 +231,10 @@ struct ShaderNode {
   FloatInput alpha{1.0f};
   ColorInput emission{Spectrum(0.0f)};
   FloatInput emission_strength{1.0f};
+  // Subsurface weight and colour: the diffuse Cycles falls back to for a radius below its
+  // minimum (shaders/principled.h); a larger radius renders the same (the add-on reports it).
+  FloatInput subsurface{0.0f};
+  ColorInput subsurface_color{Spectrum(0.8f)};
 };
 
 // Blender's Normal Map node in tangent space, feeding the material's BSDF Normal inputs: the

@@ -25,6 +25,8 @@
 // P_R (Fresnel weighted by colour luminances), value = R F, transmission value = T (1 - F).
 // FresnelMode::RefractionOnly (Refraction BSDF): F = 0 throughout, so no reflection and the
 // transmission is T D G ... without (1 - F); total internal reflection still loses the sample.
+// drop_reflection / drop_refraction (Cycles' caustics toggles, one of the two closures left out):
+// the dropped part evaluates to 0 and is never sampled; the other keeps its F or (1 - F).
 #pragma once
 
 #include "shaders/closure.h"
@@ -55,9 +57,14 @@ inline Setup setup(const Closure& c, float cos_i, bool entering) {
   s.fresnel = c.fresnel == FresnelMode::RefractionOnly ? 0.0f : fresnel_dielectric(cos_i, s.eta);
   s.smooth = is_delta_alpha(c.alpha);
   s.pass_through = std::fabs(s.eta - 1.0f) < 1e-4f;
-  const float r = s.fresnel * selection_luminance(reflection_colour(c, s.eta, cos_i));
-  const float t = (1.0f - s.fresnel) * selection_luminance(c.weight * c.transmission_tint);
-  s.p_reflect = (r + t) > 0.0f ? r / (r + t) : s.fresnel;
+  const float r = c.drop_reflection
+                      ? 0.0f
+                      : s.fresnel * selection_luminance(reflection_colour(c, s.eta, cos_i));
+  const float t = c.drop_refraction
+                      ? 0.0f
+                      : (1.0f - s.fresnel) * selection_luminance(c.weight * c.transmission_tint);
+  const float fallback = c.drop_reflection ? 0.0f : c.drop_refraction ? 1.0f : s.fresnel;
+  s.p_reflect = (r + t) > 0.0f ? r / (r + t) : fallback;
   return s;
 }
 
@@ -69,13 +76,13 @@ inline Spectrum eval_pdf_upper(const Closure& c, const Setup& st, Vec3f wi, Vec3
   if (wo.z > 0.0f) {
     const Vec3f sum = wi + wo;
     const float len2 = length_squared(sum);
-    if (!(len2 > 0.0f) || st.fresnel <= 0.0f) return Spectrum(0.0f);
+    if (!(len2 > 0.0f) || st.fresnel <= 0.0f || c.drop_reflection) return Spectrum(0.0f);
     const Vec3f h = sum / std::sqrt(len2);
     const float common = ggx.D(h) * ggx.G1(wi) / (4.0f * wi.z);
     pdf = st.p_reflect * common;
     return reflection_colour(c, st.eta, dot(wo, h)) * (st.fresnel * common * ggx.G1(wo));
   }
-  if (st.pass_through || st.fresnel >= 1.0f) return Spectrum(0.0f);
+  if (st.pass_through || st.fresnel >= 1.0f || c.drop_refraction) return Spectrum(0.0f);
   // Generalised half vector of the refraction, oriented to the outside (+z).
   Vec3f ht = wi + wo * st.eta;
   const float len2 = length_squared(ht);
@@ -165,8 +172,13 @@ inline float albedo_hint(const Closure& c, Vec3f wi) {
   const Setup st = setup(c, std::fabs(wi.z), wi.z > 0.0f);
   const float lw = selection_luminance(c.weight);
   if (!(lw > 0.0f)) return 1.0f;
-  const float r = st.fresnel * selection_luminance(reflection_colour(c, st.eta, std::fabs(wi.z)));
-  const float t = (1.0f - st.fresnel) * selection_luminance(c.weight * c.transmission_tint);
+  const float r =
+      c.drop_reflection
+          ? 0.0f
+          : st.fresnel * selection_luminance(reflection_colour(c, st.eta, std::fabs(wi.z)));
+  const float t = c.drop_refraction
+                      ? 0.0f
+                      : (1.0f - st.fresnel) * selection_luminance(c.weight * c.transmission_tint);
   return (r + t) / lw;
 }
 

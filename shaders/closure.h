@@ -60,6 +60,9 @@ struct Closure {
   // unlinked: Cycles gives those sd->N). Material data; per hit, the set evaluates such lobes
   // about that normal (ClosureSet::set_interpolated_normal).
   bool interpolated_normal = false;
+  // GGXDielectric: its reflected or its refracted part dropped, the other keeping its Fresnel
+  // weight (Cycles' caustics toggles remove one of the glass BSDF's two closures).
+  bool drop_reflection = false, drop_refraction = false;
 };
 
 enum LobeFlags : uint8_t {

@@ -577,6 +577,11 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       p.clearcoat_roughness = in.scalar(n.clearcoat_roughness);
       p.alpha = in.scalar(n.alpha);
       p.emission = in.color(n.emission) * in.scalar(n.emission_strength);
+      p.subsurface = in.scalar(n.subsurface);
+      if (p.subsurface != 0.0f) {
+        p.subsurface_color = in.color(n.subsurface_color);
+        p.diffuse_ancestor = in.light_path(LightPathOutput::DiffuseDepth) > 0.0f;
+      }
       p.front_facing = in.front_facing();
       p.interpolated_normal = !n.normal_linked;
       p.clearcoat_interpolated_normal = !n.clearcoat_normal_linked;
@@ -819,6 +824,16 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         note(n.alpha);
         note(n.emission);
         note(n.emission_strength);
+        note(n.subsurface);
+        note(n.subsurface_color);
+        // After a diffuse bounce the subsurface mix becomes the base of the other lobes too.
+        const auto may_be_nonzero = [](const FloatInput& f) {
+          return varies(f) || f.value != 0.0f;
+        };
+        if (may_be_nonzero(n.subsurface) &&
+            (may_be_nonzero(n.metallic) || may_be_nonzero(n.specular_tint) ||
+             may_be_nonzero(n.sheen) || may_be_nonzero(n.transmission)))
+          reads_path_ = true;
         const bool specular = varies(n.specular) || varies(n.metallic) || n.specular.value > 0.0f ||
                               n.metallic.value > 0.0f;
         const bool transmission = (varies(n.transmission) || n.transmission.value > 0.0f) &&

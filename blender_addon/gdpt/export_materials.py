@@ -3,8 +3,10 @@
 # Walks from the active Material Output's Surface input over the tree with its node groups
 # flattened (export_node_groups.py). Supported shader nodes: Principled BSDF, Diffuse, Glossy,
 # Glass, Emission (and, reported, Background: Cycles shows it as one on a surface), Transparent,
-# Mix Shader, Add Shader; a colour or float output on a shader
-# socket becomes an Emission, and an unlinked shader input is no closure (black), as in Cycles.
+# Mix Shader, Add Shader, Subsurface Scattering and Principled's subsurface (the diffuse Cycles
+# falls back to at radius 0; a larger radius renders the same, reported); a colour or float
+# output on a shader socket becomes an Emission, and an unlinked shader input is no closure
+# (black), as in Cycles.
 # Inputs may be constants, RGB / Value nodes, colour / math / curve nodes, Blackbody, Fresnel,
 # Layer Weight, Geometry (Normal, True Normal, Incoming, Backfacing; Pointiness and the others
 # reported, 0.5 standing in) and Light Path (read per path: its own direction and state), image and
@@ -29,8 +31,11 @@ IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 _SHADERS = {
     'BSDF_PRINCIPLED', 'BSDF_DIFFUSE', 'BSDF_GLOSSY', 'BSDF_GLASS', 'EMISSION',
     'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSLUCENT', 'BSDF_VELVET',
-    'BSDF_REFRACTION',
+    'BSDF_REFRACTION', 'SUBSURFACE_SCATTERING',
 }
+# Cycles turns a BSSRDF channel of a smaller radius into a diffuse BSDF (BSSRDF_MIN_RADIUS).
+_BSSRDF_MIN_RADIUS = 1e-8
+_NO_TRANSPORT = "subsurface scattering, rendered as diffuse (no subsurface transport), of"
 _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
@@ -146,14 +151,17 @@ class _Translator:
         i = n.inputs
         if n.distribution not in _GGX_LIKE:
             self.warn(n, f"distribution {n.distribution} of")
-        if i["Subsurface"].is_linked or i["Subsurface"].default_value > 0.0:
-            self.warn(n, "subsurface scattering of")
+        subsurface = i["Subsurface"]
+        has_subsurface = subsurface.is_linked or subsurface.default_value != 0.0
+        if has_subsurface:
+            # Cycles' radius is Subsurface Radius x Subsurface.
+            self._warn_transport(n, i["Subsurface Radius"], subsurface)
         normal_linked = self.normal(i["Normal"])
         clearcoat_normal_linked = self.normal(i["Clearcoat Normal"])
         if i["Tangent"].is_linked:
             self.warn(self._source(i["Tangent"]).node if self._source(i["Tangent"]) else n,
                       "normal / tangent input node")
-        return self._add({
+        d = {
             "kind": "PRINCIPLED",
             "color": self.color(i["Base Color"]),
             "metallic": self.value(i["Metallic"]),
@@ -171,7 +179,33 @@ class _Translator:
             "emission": self.color(i["Emission"]),
             "emission_strength": self.value(i["Emission Strength"]),
             "alpha": self.value(i["Alpha"]),
-        })
+        }
+        if has_subsurface:
+            d["subsurface"] = self.value(subsurface)
+            d["subsurface_color"] = self.color(i["Subsurface Color"])
+        return self._add(d)
+
+    def _warn_transport(self, n, radius, scale):
+        """Reports a BSSRDF whose radius (radius x scale, per channel) may reach Cycles' minimum:
+        Cycles carries light under the surface there, Gradient PT renders the diffuse it falls
+        back to below the minimum."""
+        r = tuple(radius.default_value)
+        if radius.is_linked:
+            transport = True
+        elif scale.is_linked:
+            transport = any(c != 0.0 for c in r)  # the scale may take either sign
+        else:
+            transport = max(c * scale.default_value for c in r) >= _BSSRDF_MIN_RADIUS
+        if transport:
+            self.warn(n, _NO_TRANSPORT)
+
+    def _subsurface_scattering(self, n):
+        # Cycles' BSSRDF of radius 0 is a Lambert diffuse of the node's Color (bssrdf_setup).
+        i = n.inputs
+        self._warn_transport(n, i["Radius"], i["Scale"])
+        linked = self.normal(i["Normal"])
+        return self._add({"kind": "DIFFUSE", "color": self.color(i["Color"]),
+                          "roughness": {"value": 0.0}, "normal_linked": linked})
 
     def _bsdf_diffuse(self, n):
         linked = self.normal(n.inputs["Normal"])

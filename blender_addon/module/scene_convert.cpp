@@ -580,6 +580,8 @@ int SceneBuilder::add_material(const py::dict& material) {
       read_float(d, "alpha", node.alpha);
       read_color(d, "emission", node.emission);
       read_float(d, "emission_strength", node.emission_strength);
+      read_float(d, "subsurface", node.subsurface);
+      read_color(d, "subsurface_color", node.subsurface_color);
       desc.nodes.push_back(node);
     }
   }
@@ -621,7 +623,8 @@ int SceneBuilder::add_material(const py::dict& material) {
           &node.fac.texture, &node.metallic.texture, &node.specular.texture,
           &node.specular_tint.texture, &node.transmission.texture, &node.sheen.texture,
           &node.sheen_tint.texture, &node.clearcoat.texture, &node.clearcoat_roughness.texture,
-          &node.alpha.texture, &node.emission.texture, &node.emission_strength.texture}) {
+          &node.alpha.texture, &node.emission.texture, &node.emission_strength.texture,
+          &node.subsurface.texture, &node.subsurface_color.texture}) {
       if (t->image >= int32_t(scene_.images.size()))
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
     }

@@ -15,7 +15,7 @@
 //   material: name, root, nodes: list of dicts {kind: 'DIFFUSE'|'GLOSSY'|'GLASS'|'PRINCIPLED'|
 //             'EMISSION'|'TRANSPARENT'|'MIX'|'ADD', a, b, and inputs color, roughness, ior,
 //             strength, fac, metallic, specular, specular_tint, transmission, alpha, emission,
-//             emission_strength}; a colour input is {value: (3), image, mapping (12), coordinates
+//             emission_strength, subsurface, subsurface_color}; a colour input is {value: (3), image, mapping (12), coordinates
 //             'UV'|'GENERATED'|'OBJECT', interpolation 'Linear'|'Closest', extension
 //             'REPEAT'|'EXTEND'|'CLIP', node}, a float input the same with a scalar value and
 //             channel 'LUMINANCE'|'RED'|'ALPHA'; input nodes (inputs) {kind, ..., vector:

@@ -43,6 +43,12 @@ std::vector<Case> lobe_cases() {
     cases.push_back({"Glass" + s, set_of({glass(a, 1.5f)})});
     cases.push_back({"Clearcoat" + s, set_of({clearcoat(a)})});
   }
+  // Glass with one part dropped (Cycles' caustics toggles): the other part alone.
+  for (const bool reflection : {true, false}) {
+    Closure g = glass(0.2f, 1.5f);
+    (reflection ? g.drop_refraction : g.drop_reflection) = true;
+    cases.push_back({reflection ? "GlassReflectionPart20" : "GlassRefractionPart20", set_of({g})});
+  }
   // Principled-like glass: tinted refraction, Fresnel-coloured reflection.
   {
     Closure g = glass(0.2f, 1.45f);

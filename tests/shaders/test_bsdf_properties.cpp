@@ -197,6 +197,47 @@ TEST(SmoothGlass, TotalInternalReflectionReflectsEverything) {
   }
 }
 
+// Cycles' caustics toggles leave one of the glass BSDF's two closures: dropping a part keeps the
+// other's values (weighted by F or 1 - F at the shading normal) and never samples the dropped one.
+TEST(GlassParts, DroppingOnePartKeepsTheOther) {
+  const float ior = 1.5f;
+  for (const float alpha : {0.0f, 0.3f}) {
+    const Closure whole = glass(alpha, ior);
+    Closure refl = whole, refr = whole;
+    refl.drop_refraction = true;
+    refr.drop_reflection = true;
+    const ClosureSet full = set_of({whole}), reflection = set_of({refl}),
+                     refraction = set_of({refr});
+    Pcg32 rng(11);
+    for (int i = 0; i < 200; ++i) {
+      const Vec3f wi = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+      const float fr = fresnel_dielectric(wi.z, ior);
+      const Vec2f u(rng.uniform(), rng.uniform());
+      const float choice = rng.uniform();
+      const BsdfSample a = reflection.sample(wi, choice, u), b = refraction.sample(wi, choice, u);
+      if (a.valid) {
+        EXPECT_TRUE(a.lobe & kLobeReflection);
+        if (alpha == 0.0f) {
+          EXPECT_NEAR(a.weight().y, fr, 1e-5f);  // F, chosen always
+        }
+      }
+      if (b.valid) {
+        EXPECT_TRUE(b.lobe & kLobeTransmission);
+        if (alpha == 0.0f) {
+          EXPECT_NEAR(b.weight().y, 1.0f - fr, 1e-5f);
+        }
+      }
+      if (alpha == 0.0f) continue;
+      const Vec3f up = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+      const Vec3f down = direction(-0.05 - 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+      EXPECT_EQ(reflection.eval(wi, down).y, 0.0f);
+      EXPECT_EQ(refraction.eval(wi, up).y, 0.0f);
+      EXPECT_NEAR(reflection.eval(wi, up).y, full.eval(wi, up).y, 1e-6f);
+      EXPECT_NEAR(refraction.eval(wi, down).y, full.eval(wi, down).y, 1e-6f);
+    }
+  }
+}
+
 TEST(DiffuseModels, ClosedFormValues) {
   const Vec3f n(0, 0, 1);
   const Vec3f wo = direction(0.5, 0.0);
