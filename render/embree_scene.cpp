@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "scene/generated_mapping.h"
+
 namespace gdpt {
 
 namespace {
@@ -218,27 +220,11 @@ void EmbreeScene::set_materials(std::span<const Material> materials) {
   }
 }
 
-// Generated = (p - location) / (2 size) + 0.5 (Cycles' mesh_texture_space); Blender's auto
-// texture space is the bounding box, with flat axes of size 1.
 void EmbreeScene::set_generated_mapping(InstanceData& d, const Mesh& mesh) {
-  Vec3f location = mesh.texspace_location, size = mesh.texspace_size;
-  if (size == Vec3f(0.0f)) {
-    constexpr float kInf = std::numeric_limits<float>::infinity();
-    Vec3f lo(kInf), hi(-kInf);
-    for (const Vec3f& p : mesh.positions) {
-      lo = min(lo, p);
-      hi = max(hi, p);
-    }
-    if (mesh.positions.empty()) lo = Vec3f(-1.0f), hi = Vec3f(1.0f);
-    location = (lo + hi) * 0.5f;
-    size = (hi - lo) * 0.5f;
-    for (int k = 0; k < 3; ++k)
-      if (size[k] == 0.0f) size[k] = 1.0f;
-  }
+  const GeneratedMapping g = generated_mapping(mesh);
   for (int k = 0; k < 3; ++k) {
-    const float scale = size[k] != 0.0f ? 0.5f / size[k] : 0.0f;
-    d.generated_scale[k] = scale;
-    d.generated_offset[k] = 0.5f - location[k] * scale;
+    d.generated_scale[k] = g.scale[k];
+    d.generated_offset[k] = g.offset[k];
   }
 }
 

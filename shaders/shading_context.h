@@ -45,9 +45,16 @@ struct ShadingInstance {
   Transform object_to_world, world_to_object;
   const Vec3f* positions = nullptr;   // the mesh's object-space vertices
   const uint32_t* indices = nullptr;  // 3 per triangle
+  // Generated = object * generated_scale + generated_offset (coords_at; hits carry their own).
+  Vec3f generated_scale{0.0f}, generated_offset{0.0f};
   // Corner k of triangle `primitive`, in world space.
   Vec3f corner(uint32_t primitive, int k) const {
     return object_to_world.point(positions[indices[3 * size_t(primitive) + size_t(k)]]);
+  }
+  // The texture coordinates of world point p on it (a light sample's point).
+  TexCoords coords_at(Vec3f p) const {
+    const Vec3f object = world_to_object.point(p);
+    return {object * generated_scale + generated_offset, object, p};
   }
 };
 
