@@ -114,6 +114,11 @@ enum class InputNodeKind : uint8_t {
   LayerWeight,  // blend value_a; `channel` 0: the Fresnel output, 1: Facing (svm_node_layer_weight)
   Geometry,     // the Geometry node's `geometry_output` (Position is a Coordinates node)
   LightPath,    // the Light Path node's `light_path_output` (ShadingContext::path)
+  // Nodes that read the hit's instance, triangle or the camera (ShadingContext::instance,
+  // ShadingCamera), as Cycles 3.4's svm_node_vector_transform and svm_node_wireframe:
+  VectorTransform,  // vector a through `vector_transform` (a vector result)
+  Wireframe,        // 1 within value_a / 2 of the hit triangle's edge lines, else 0; in world
+                    // units, or with pixel_size in pixels of the camera's footprint at the hit
 };
 // The Light Path node's outputs (Cycles' svm_node_light_path for surface shading).
 enum class LightPathOutput : uint8_t {
@@ -163,6 +168,8 @@ struct InputNode {
   bool normal_linked = false;  // Fresnel, Layer Weight: Normal takes the normal map / bump
   GeometryOutput geometry_output = GeometryOutput::Normal;
   LightPathOutput light_path_output = LightPathOutput::IsCameraRay;
+  VectorTransformDesc vector_transform;
+  bool pixel_size = false;  // Wireframe: Use Pixel Size
   // Ramp: RGBA at fac = i / (n - 1), i < n (Blender's ColorRamp.evaluate, as Cycles bakes it),
   // interpolated linearly between entries unless the ramp is Constant; the result is the colour,
   // or the alpha as grey for the node's Alpha output.

@@ -106,6 +106,14 @@ enum class MusgraveType : uint8_t {
   RidgedMultifractal
 };
 
+// Blender's Vector Transform node: what the vector is (a point moves with the translation, a
+// normal with the inverse transpose) and the spaces it converts between.
+struct VectorTransformDesc {
+  enum class Type : uint8_t { Point, Vector, Normal } type = Type::Vector;
+  enum class Space : uint8_t { World, Object, Camera };
+  Space from = Space::World, to = Space::Object;
+};
+
 struct BrickDesc {
   float offset = 0.5f;
   int offset_frequency = 2;

@@ -59,6 +59,9 @@ class Material {
   bool reads_view() const { return reads_view_; }
   // Some input reads the path (ShadingContext::path: Light Path): closures per hit, never cached.
   bool reads_path() const { return reads_path_; }
+  // The camera Vector Transform's Camera space and Wireframe's pixel size read (set by the
+  // scene's owner before rendering; default: at the origin, looking down world +z).
+  void set_camera(const ShadingCamera& camera) { camera_ = camera; }
 
  private:
   void cache_if_constant();
@@ -80,6 +83,7 @@ class Material {
   bool reads_view_ = false;
   bool reads_path_ = false;
   Spectrum average_emission_{0.0f, 0.0f, 0.0f};
+  ShadingCamera camera_;
 };
 
 }  // namespace gdpt

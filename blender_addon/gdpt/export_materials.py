@@ -9,10 +9,11 @@
 # (black), as in Cycles.
 # Inputs may be constants, RGB / Value nodes, colour / math / curve nodes, Blackbody, Fresnel,
 # Layer Weight, Geometry (Normal, True Normal, Incoming, Backfacing; Pointiness and the others
-# reported, 0.5 standing in) and Light Path (read per path: its own direction and state), image and
-# procedural textures read at UV, Generated or Object coordinates, optionally through a Mapping
-# node. The Displacement output (a Displacement node) renders as Cycles' Bump Only. Reroutes
-# and muted nodes are followed. Anything else is reported once per material (naming the node)
+# reported, 0.5 standing in), Light Path (read per path: its own direction and state), Vector
+# Transform (World / Object / Camera, Cycles' camera space) and Wireframe (per triangle; Use Pixel
+# Size reported: the camera's pixel), image and procedural textures read at UV, Generated or
+# Object coordinates, optionally through a Mapping node. The Displacement output (a Displacement
+# node) renders as Cycles' Bump Only. Reroutes and muted nodes are followed. Anything else is reported once per material (naming the node)
 # and followed through its mute pass-through link when it has one; otherwise a
 # magenta diffuse (shaders) or the socket's own value (inputs) stands in, so the render still
 # completes. A material whose translation fails (or that the core rejects) renders magenta, with
@@ -44,7 +45,8 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
                 'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH', 'COMBXYZ',
                 'TEX_BRICK', 'CURVE_RGB', 'CURVE_VEC', 'CURVE_FLOAT', 'BLACKBODY', 'SEPHSV',
-                'COMBHSV', 'FRESNEL', 'LAYER_WEIGHT', 'NEW_GEOMETRY', 'LIGHT_PATH'}
+                'COMBHSV', 'FRESNEL', 'LAYER_WEIGHT', 'NEW_GEOMETRY', 'LIGHT_PATH',
+                'VECT_TRANSFORM', 'WIREFRAME'}
 # The Geometry node's outputs the core reads from the view of the hit (Position: coordinates).
 _GEOMETRY_OUTPUTS = {'Normal', 'True Normal', 'Incoming', 'Backfacing'}
 # The Light Path node's outputs in object materials (Is Volume Scatter Ray: no volumes, 0).
@@ -710,6 +712,19 @@ class _Translator:
             d = {"kind": "LAYER_WEIGHT", "value_a": self.value(node.inputs["Blend"]),
                  "channel": 0 if out.name == "Fresnel" else 1,
                  "normal_linked": self._view_normal(node.inputs["Normal"])}
+        elif node.type == 'VECT_TRANSFORM':
+            d = {"kind": "VECTOR_TRANSFORM", "vector_type": node.vector_type,
+                 "from": node.convert_from, "to": node.convert_to,
+                 "a": self.color(node.inputs["Vector"])}
+        elif node.type == 'WIREFRAME':
+            # Use Pixel Size: the camera's pixel at the hit stands in for Cycles' ray
+            # differentials, which it equals only where the camera sees the surface directly.
+            if node.use_pixel_size:
+                self.warn(node, "Use Pixel Size seen other than by the camera (reflections, "
+                          "refractions, indirect light: wires as wide as the camera's pixel at "
+                          "the hit, not Cycles' ray differentials) of")
+            d = {"kind": "WIREFRAME", "value_a": self.value(node.inputs["Size"]),
+                 "pixel_size": bool(node.use_pixel_size)}
         elif node.type == 'BLACKBODY':
             d = {"kind": "BLACKBODY", "value_a": self.value(node.inputs["Temperature"])}
         elif node.type == 'RGBTOBW':

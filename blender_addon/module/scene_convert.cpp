@@ -162,7 +162,9 @@ InputNode read_input_node(const py::dict& d) {
       {"FRESNEL", InputNodeKind::Fresnel},
       {"LAYER_WEIGHT", InputNodeKind::LayerWeight},
       {"GEOMETRY", InputNodeKind::Geometry},
-      {"LIGHT_PATH", InputNodeKind::LightPath}};
+      {"LIGHT_PATH", InputNodeKind::LightPath},
+      {"VECTOR_TRANSFORM", InputNodeKind::VectorTransform},
+      {"WIREFRAME", InputNodeKind::Wireframe}};
   n.kind = get_enum(d, "kind", "MIX", kKinds, "input node kind");
   static const std::pair<const char*, MixBlend> kBlends[] = {{"MIX", MixBlend::Mix},
                                                              {"ADD", MixBlend::Add},
@@ -300,6 +302,18 @@ InputNode read_input_node(const py::dict& d) {
     n.geometry_output = get_enum(d, "output", "Normal", kGeometry, "geometry output");
   if (n.kind == InputNodeKind::LightPath)
     n.light_path_output = get_enum(d, "output", "Is Camera Ray", kLightPath, "light path output");
+  // Vector Transform: Blender's vector_type, convert_from and convert_to.
+  if (n.kind == InputNodeKind::VectorTransform) {
+    using T = VectorTransformDesc;
+    static const std::pair<const char*, T::Type> kTypes[] = {
+        {"POINT", T::Type::Point}, {"VECTOR", T::Type::Vector}, {"NORMAL", T::Type::Normal}};
+    static const std::pair<const char*, T::Space> kSpaces[] = {
+        {"WORLD", T::Space::World}, {"OBJECT", T::Space::Object}, {"CAMERA", T::Space::Camera}};
+    n.vector_transform.type = get_enum(d, "vector_type", "VECTOR", kTypes, "vector transform type");
+    n.vector_transform.from = get_enum(d, "from", "WORLD", kSpaces, "vector transform space");
+    n.vector_transform.to = get_enum(d, "to", "OBJECT", kSpaces, "vector transform space");
+  }
+  get(d, "pixel_size", n.pixel_size);
   // Brick: {"offset", "offset_frequency", "squash", "squash_frequency"} (the node's properties).
   if (d.contains("brick")) {
     const auto b = d["brick"].cast<py::dict>();

@@ -339,6 +339,89 @@ def case_view_nodes(scene):
     return 4
 
 
+def _cube(name, size, location, rotation, scale, material):
+    h = size / 2
+    verts = [(x, y, z) for x in (-h, h) for y in (-h, h) for z in (-h, h)]
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    obj = S.mesh_object(name, verts, faces, material)
+    obj.location, obj.rotation_euler, obj.scale = location, rotation, scale
+    return obj
+
+
+def _colour_from(m, transform, *steps):
+    """Material m's Diffuse colour from `transform` (a node of m) through Vector Math nodes
+    (operation, scale) in turn; the second operand is (0.5, 0.5, 0.5)."""
+    nt = m.node_tree
+    out = transform.outputs[0]
+    for op, scale in steps:
+        vm = nt.nodes.new("ShaderNodeVectorMath")
+        vm.operation = op
+        vm.inputs[1].default_value = (0.5, 0.5, 0.5)
+        vm.inputs[3].default_value = scale
+        nt.links.new(out, vm.inputs[0])
+        out = vm.outputs["Vector"]
+    diffuse = next(n for n in nt.nodes if n.type == 'BSDF_DIFFUSE')
+    nt.links.new(out, diffuse.inputs["Color"])
+
+
+def _vector_transform(m, vector_type, convert_from, convert_to):
+    node = m.node_tree.nodes.new("ShaderNodeVectorTransform")
+    node.vector_type, node.convert_from, node.convert_to = vector_type, convert_from, convert_to
+    return node
+
+
+def _wired(name, size, pixel_size, colour, wire_colour):
+    m = S.diffuse(name, colour)
+    nt = m.node_tree
+    wire = nt.nodes.new("ShaderNodeWireframe")
+    wire.use_pixel_size = pixel_size
+    wire.inputs["Size"].default_value = size
+    second = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    second.inputs["Color"].default_value = (*wire_colour, 1.0)
+    _mix_by(m, wire, "Fac", second)
+    return m
+
+
+def case_object_nodes(scene):
+    # Vector Transform and Wireframe. A turned, stretched cube coloured by |its world normal in
+    # object space| x 0.8 (Normal, World to Object: a primary per face; as a Vector the faces
+    # darken, untransformed they mix); a ball coloured by the fraction of 1.5 x its position in
+    # camera space (Point, World to Camera: Cycles' z is the distance in front of the camera);
+    # a turned cube coloured by 0.5 + 0.45 x (0.3, 0.6, 0.9) of its object space in camera space
+    # (Vector, Object to Camera: blue as Cycles' z points away from the camera); on the back wall
+    # a panel of 4 x 4 quads with wires 0.08 wide (the quads' diagonals show) and a cube with
+    # wires 1.5 pixels wide.
+    lit_room(scene)
+    area_ceiling(size=1.5, energy=250.0)
+    a = S.diffuse("normal_object", (0.8, 0.8, 0.8))
+    t = _vector_transform(a, 'NORMAL', 'WORLD', 'OBJECT')
+    geometry = a.node_tree.nodes.new("ShaderNodeNewGeometry")
+    a.node_tree.links.new(geometry.outputs["Normal"], t.inputs["Vector"])
+    _colour_from(a, t, ('ABSOLUTE', 1.0), ('SCALE', 0.8))
+    _cube("normal_object", 1.0, (-1.1, 0.3, 0.8), (0.5, 0.3, 0.7), (1.0, 0.5, 1.4), a)
+    b = S.diffuse("point_camera", (0.8, 0.8, 0.8))
+    t = _vector_transform(b, 'POINT', 'WORLD', 'CAMERA')
+    geometry = b.node_tree.nodes.new("ShaderNodeNewGeometry")
+    b.node_tree.links.new(geometry.outputs["Position"], t.inputs["Vector"])
+    _colour_from(b, t, ('SCALE', 1.5), ('FRACTION', 1.0), ('SCALE', 0.8))
+    S.uv_sphere("point_camera", 0.6, (0.2, 0.0, 0.6), b)
+    c = S.diffuse("vector_camera", (0.8, 0.8, 0.8))
+    t = _vector_transform(c, 'VECTOR', 'OBJECT', 'CAMERA')
+    t.inputs["Vector"].default_value = (0.3, 0.6, 0.9)
+    _colour_from(c, t, ('SCALE', 0.45), ('ADD', 1.0))
+    _cube("vector_camera", 0.8, (1.3, 0.6, 0.5), (0.0, 0.0, 0.9), (1.0, 1.0, 1.0), c)
+    n = 4
+    verts = [(-1.0 + 0.5 * i, 0.0, 0.5 * j) for j in range(n + 1) for i in range(n + 1)]
+    faces = [(j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1,
+              (j + 1) * (n + 1) + i) for j in range(n) for i in range(n)]
+    panel = S.mesh_object("panel", verts, faces,
+                          _wired("world_wire", 0.08, False, (0.1, 0.15, 0.5), (0.9, 0.9, 0.8)))
+    panel.location = (0.0, 1.9, 1.6)
+    _cube("pixel_wire", 0.9, (0.9, -0.8, 1.9), (0.4, 0.2, 0.6), (1.0, 1.0, 1.0),
+          _wired("pixel_wire", 1.5, True, (0.6, 0.1, 0.1), (0.9, 0.9, 0.2)))
+    return 4
+
+
 def _out_shader(m):
     nt = m.node_tree
     out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
@@ -1625,7 +1708,7 @@ FLOORS = {
     "voronoi_features/GPT": (2.6e-5, 1.4e-4), "world_camera_view/GPT": (4.3e-4, 1.3e-3),
     "world_camera_view/PT": (4.7e-4, 1.4e-3), "world_color/GPT": (4.5e-5, 2.7e-4),
     "world_hdri/GPT": (1.5e-4, 6.7e-4), "subsurface/GPT": (5.4e-4, 1.3e-3),
-    "refractive_caustics_off/GPT": (3.5e-3, 1.1e-2),
+    "refractive_caustics_off/GPT": (3.5e-3, 1.1e-2), "object_nodes/GPT": (2.0e-3, 3.4e-3),
 }
 FLOOR_FACTOR = 3.0
 DEFAULT_COUNTS = (GDPT_SAMPLES, CYCLES_SAMPLES) == (128, 256)
