@@ -114,6 +114,10 @@ struct VectorTransformDesc {
   Space from = Space::World, to = Space::Object;
 };
 
+// The microfacet distribution of Blender's Glossy, Glass and Refraction BSDFs
+// (shaders/microfacet.h).
+enum class MicrofacetDistribution : uint8_t { GGX, Beckmann };
+
 struct BrickDesc {
   float offset = 0.5f;
   int offset_frequency = 2;

@@ -553,6 +553,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       const float r = saturate(in.scalar(n.roughness));
       c.type = ClosureType::GGXReflection;
       c.fresnel = FresnelMode::None;
+      c.distribution = n.distribution;
       c.alpha = r * r;
       c.weight = in.color(n.color) * w;
       out.add(c);
@@ -570,6 +571,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
         c.type = ClosureType::GGXDielectric;
         c.fresnel = n.kind == ShaderNodeKind::Refraction ? FresnelMode::RefractionOnly
                                                          : FresnelMode::Dielectric;
+        c.distribution = n.distribution;
         c.alpha = r * r;
         // The integrators orient the frame towards the incoming ray (as Cycles flips N for back
         // faces), so the closure's IOR is that of the far side: 1 / ior when leaving the object.

@@ -38,6 +38,9 @@ _SHADERS = {
 _BSSRDF_MIN_RADIUS = 1e-8
 _NO_TRANSPORT = "subsurface scattering, rendered as diffuse (no subsurface transport), of"
 _GGX_LIKE = {'GGX', 'SHARP'}
+# The Glossy, Glass and Refraction BSDFs' distributions the core renders as Cycles does (Sharp is
+# GGX at roughness 0); the others (Multiscatter GGX, Ashikhmin-Shirley) render as GGX, reported.
+_MICROFACET = {'GGX': 'GGX', 'SHARP': 'GGX', 'BECKMANN': 'BECKMANN'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
@@ -215,26 +218,30 @@ class _Translator:
                           "roughness": self.value(n.inputs["Roughness"]),
                           "normal_linked": linked})
 
-    def _bsdf_glossy(self, n):
-        if n.distribution not in _GGX_LIKE:
+    def _distribution(self, n):
+        if n.distribution not in _MICROFACET:
             self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
+        return _MICROFACET.get(n.distribution, 'GGX')
+
+    def _bsdf_glossy(self, n):
+        distribution = self._distribution(n)
         linked = self.normal(n.inputs["Normal"])
         roughness = self.value(n.inputs["Roughness"])
         if n.distribution == 'SHARP':
             roughness = {"value": 0.0}
         return self._add({"kind": "GLOSSY", "color": self.color(n.inputs["Color"]),
-                          "roughness": roughness, "normal_linked": linked})
+                          "roughness": roughness, "distribution": distribution,
+                          "normal_linked": linked})
 
     def _bsdf_glass(self, n):
-        if n.distribution not in _GGX_LIKE:
-            self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
+        distribution = self._distribution(n)
         linked = self.normal(n.inputs["Normal"])
         roughness = self.value(n.inputs["Roughness"])
         if n.distribution == 'SHARP':
             roughness = {"value": 0.0}
         return self._add({"kind": "GLASS", "color": self.color(n.inputs["Color"]),
                           "roughness": roughness, "ior": self.value(n.inputs["IOR"]),
-                          "normal_linked": linked})
+                          "distribution": distribution, "normal_linked": linked})
 
     def _bsdf_refraction(self, n):
         index = self._bsdf_glass(n)  # the same inputs and distributions

@@ -577,6 +577,10 @@ int SceneBuilder::add_material(const py::dict& material) {
       read_color(d, "color", node.color);
       read_float(d, "roughness", node.roughness);
       read_float(d, "ior", node.ior);
+      static const std::pair<const char*, MicrofacetDistribution> kDistributions[] = {
+          {"GGX", MicrofacetDistribution::GGX}, {"BECKMANN", MicrofacetDistribution::Beckmann}};
+      node.distribution =
+          get_enum(d, "distribution", "GGX", kDistributions, "microfacet distribution");
       read_float(d, "strength", node.strength);
       read_float(d, "fac", node.fac);
       get(d, "a", node.a);

@@ -238,6 +238,18 @@ TEST(GradientUnbiased, GlossyReconnectedAndHalfVector) {
                   0.28f);
 }
 
+// Beckmann lobes take the same shifts: the reconnection at roughness 0.3, the half-vector copy at
+// 0.02, whose offset density and value are the Beckmann lobe's own.
+TEST(GradientUnbiased, BeckmannGlossyReconnectedAndHalfVector) {
+  for (float roughness : {0.3f, 0.02f}) {
+    Scene scene = make_scene(SceneKind::CornellGlossy, 16, roughness);
+    scene.materials[3].nodes[0].distribution = MicrofacetDistribution::Beckmann;
+    const bool rough = roughness > 0.1f;
+    expect_unbiased(rough ? "beckmann-rough" : "beckmann-smooth", scene, 4096, 1024,
+                    rough ? 0.25f : 0.29f);
+  }
+}
+
 // Russian roulette after a glossy bounce takes effect past the emission the next segment finds
 // (path_tracer.cpp, gradient_path_tracer.cpp). Roulette from the first bounce and a dark glossy
 // ball (q = sqrt(0.25) = 0.5 after it) make that rule decide much of the image: G-PT's primal
