@@ -9,7 +9,7 @@ void candidate_error(const FeatureBuffers& fb, const float* fa, const float* fb_
   const int W = fb.width;
   parallel_rows(fb.height, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
-      if (!(fb.valid[i] & kHalvesValid)) {
+      if (!(fb.valid[i] & kImagesValid)) {
         error[i] = 0.f;
         continue;
       }
@@ -25,7 +25,7 @@ void candidate_error(const FeatureBuffers& fb, const float* fa, const float* fb_
 }
 
 void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const float* fb_half,
-                     CandidateChoice& choice) {
+                     const float* filtered, CandidateChoice& choice) {
   const int W = fb.width, H = fb.height;
   const size_t n = size_t(W) * H;
   std::vector<float> raw(n), smooth(n);
@@ -42,8 +42,7 @@ void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const
       if (!first && !(smooth[i] < choice.error[i])) continue;
       choice.error[i] = smooth[i];
       choice.index[i] = uint8_t(index);
-      for (int c = 0; c < 3; ++c)
-        choice.image[3 * i + c] = 0.5f * (fa[3 * i + c] + fb_half[3 * i + c]);
+      for (int c = 0; c < 3; ++c) choice.image[3 * i + c] = filtered[3 * i + c];
     }
   });
 }

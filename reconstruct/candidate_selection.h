@@ -1,9 +1,8 @@
 // Per-pixel choice among candidate filters by an unbiased estimate of their error.
 //
-// With independent halves A and B (variances VA, VB) and their cross-filtered versions FA (from
-// A's values, B's weights) and FB, E[(FA - B)^2] = MSE(FA) + VB when FA does not depend on B's
-// noise, and the mean of the shared bias and the halved independent noise gives, for the final
-// (FA + FB) / 2:
+// With independent halves A and B (variances VA, VB) and their filtered versions FA (from A
+// alone) and FB (from B alone), E[(FA - B)^2] = MSE(FA) + VB, and the mean of the shared bias and
+// the halved independent noise gives, for (FA + FB) / 2:
 //   e = ((FA - B)^2 + (FB - A)^2) / 2 - (VA + VB) / 2 - (FA - FB)^2 / 4.
 // e is unbiased but noisy per pixel; it is averaged over a window before candidates are compared.
 #pragma once
@@ -18,7 +17,7 @@ namespace gdpt::detail {
 inline constexpr int kErrorSmoothingRadius = 10;
 
 struct CandidateChoice {
-  std::vector<float> image;    // RGB (FA + FB) / 2 of the chosen candidate
+  std::vector<float> image;    // RGB: the chosen candidate's filter applied to all samples
   std::vector<float> error;    // per pixel, its smoothed error estimate (mean over RGB)
   std::vector<uint8_t> index;  // per pixel, the chosen candidate
 };
@@ -27,9 +26,10 @@ struct CandidateChoice {
 // halves are missing.
 void candidate_error(const FeatureBuffers& fb, const float* fa, const float* fb_half, float* error);
 
-// Offers candidate `index`: pixels whose smoothed error beats the current choice take it (the
-// first candidate offered is taken everywhere; ties keep the earlier one).
+// Offers candidate `index` (halves filtered to fa, fb_half; the image of all samples to
+// `filtered`): pixels whose smoothed error beats the current choice take `filtered` (the first
+// candidate offered is taken everywhere; ties keep the earlier one).
 void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const float* fb_half,
-                     CandidateChoice& choice);
+                     const float* filtered, CandidateChoice& choice);
 
 }  // namespace gdpt::detail

@@ -1,7 +1,6 @@
 #include "reconstruct/feature_buffers.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include "reconstruct/parallel.h"
@@ -16,79 +15,25 @@ bool finite_n(const float* v, int n) {
   return true;
 }
 
-struct FeatureSource {
-  const float* values;
-  const float* variance;  // may be null
-  int channels;
-};
-
-// The features present, in the fixed order guide, albedo, normal, depth.
-std::vector<FeatureSource> feature_sources(const ReconstructionInput& in, const float* guide) {
-  std::vector<FeatureSource> s;
-  if (guide) s.push_back({guide, nullptr, 3});
-  if (in.albedo) s.push_back({in.albedo, in.albedo_variance, 3});
-  if (in.normal) s.push_back({in.normal, in.normal_variance, 3});
-  if (in.depth) s.push_back({in.depth, in.depth_variance, 1});
-  return s;
-}
-
-// Halves and their variances, masked; fills valid's kHalvesValid bit.
-void prepare_halves(const ReconstructionInput& in, FeatureBuffers& fb) {
+// Copies `n`-channel values and variances into the interleaved feature buffers at `offset`;
+// clears kFeaturesValid where a value or variance is not finite.
+void copy_feature(const float* values, const float* variance, int n, int offset,
+                  FeatureBuffers& fb) {
+  if (!values) return;
+  fb.features += n;
   const int W = fb.width;
-  const size_t n = size_t(W) * fb.height;
-  fb.a.assign(3 * n, 0.f);
-  fb.b.assign(3 * n, 0.f);
-  fb.half_var.assign(3 * n, 0.f);
-  const bool given = in.variance_a && in.variance_b;
   parallel_rows(fb.height, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
-      const float *pa = in.primal_a + 3 * i, *pb = in.primal_b + 3 * i;
-      bool ok = finite_n(pa, 3) && finite_n(pb, 3);
-      if (given)
-        ok = ok && finite_n(in.variance_a + 3 * i, 3) && finite_n(in.variance_b + 3 * i, 3);
-      if (!ok) continue;
-      fb.valid[i] |= kHalvesValid;
-      for (int c = 0; c < 3; ++c) {
-        fb.a[3 * i + c] = pa[c];
-        fb.b[3 * i + c] = pb[c];
-        const float d = pa[c] - pb[c];
-        // E[(A - B)^2] = Var A + Var B for independent halves.
-        fb.half_var[3 * i + c] = given ? 0.5f * (std::max(0.f, in.variance_a[3 * i + c]) +
-                                                 std::max(0.f, in.variance_b[3 * i + c]))
-                                       : 0.5f * d * d;
+      const float* v = values + size_t(n) * i;
+      const float* var = variance ? variance + size_t(n) * i : nullptr;
+      if (!finite_n(v, n) || (var && !finite_n(var, n))) {
+        fb.valid[i] &= uint8_t(~kFeaturesValid);
+        continue;
       }
-    }
-  });
-}
-
-// The 3x3 patch means of both halves and their variances (for the NLM weights).
-void prepare_patches(const ReconstructionInput& in, FeatureBuffers& fb) {
-  const int W = fb.width, H = fb.height;
-  const size_t n = size_t(W) * H;
-  fb.smooth_a.resize(3 * n);
-  fb.smooth_b.resize(3 * n);
-  box_filter(fb.a.data(), 3, W, H, 1, fb.smooth_a.data());
-  box_filter(fb.b.data(), 3, W, H, 1, fb.smooth_b.data());
-  // Per-half variance: given, or (A - B)^2 / 2 averaged over 5x5 (a single pixel's is too noisy
-  // to scale a distance by).
-  std::vector<float> va(3 * n), vb(3 * n);
-  const bool given = in.variance_a && in.variance_b;
-  parallel_rows(H, [&](int y0, int y1) {
-    for (size_t i = 3 * size_t(y0) * W; i < 3 * size_t(y1) * W; ++i) {
-      const bool ok = fb.valid[i / 3] & kHalvesValid;
-      va[i] = ok ? (given ? std::max(0.f, in.variance_a[i]) : fb.half_var[i]) : 0.f;
-      vb[i] = ok ? (given ? std::max(0.f, in.variance_b[i]) : fb.half_var[i]) : 0.f;
-    }
-  });
-  fb.patch_var_a.resize(3 * n);
-  fb.patch_var_b.resize(3 * n);
-  box_filter(va.data(), 3, W, H, given ? 1 : 2, fb.patch_var_a.data());
-  box_filter(vb.data(), 3, W, H, given ? 1 : 2, fb.patch_var_b.data());
-  // A 3x3 mean of independent pixels has a ninth of their variance.
-  parallel_rows(H, [&](int y0, int y1) {
-    for (size_t i = 3 * size_t(y0) * W; i < 3 * size_t(y1) * W; ++i) {
-      fb.patch_var_a[i] *= 1.f / 9.f;
-      fb.patch_var_b[i] *= 1.f / 9.f;
+      for (int c = 0; c < n; ++c) {
+        fb.feature[kFeatureChannels * i + offset + c] = v[c];
+        fb.feature_var[kFeatureChannels * i + offset + c] = var ? std::max(0.f, var[c]) : 0.f;
+      }
     }
   });
 }
@@ -131,83 +76,45 @@ void box_filter(const float* src, int channels, int width, int height, int radiu
   });
 }
 
-FeatureBuffers prepare_feature_buffers(const ReconstructionInput& in, const float* guide) {
+FeatureBuffers prepare_feature_buffers(const ReconstructionInput& in, const float* a,
+                                       const float* b, const float* all, const float* variance_a,
+                                       const float* variance_b) {
   FeatureBuffers fb;
   fb.width = in.width;
   fb.height = in.height;
-  const int W = in.width, H = in.height;
-  const size_t n = size_t(W) * H;
-  fb.valid.assign(n, 0);
-  prepare_halves(in, fb);
-
-  // Per feature channel: validity first, then sum and sum of squares over valid pixels.
-  const std::vector<FeatureSource> sources = feature_sources(in, guide);
-  parallel_rows(H, [&](int y0, int y1) {
+  const int W = in.width;
+  const size_t n = size_t(W) * in.height;
+  fb.a.assign(3 * n, 0.f);
+  fb.b.assign(3 * n, 0.f);
+  fb.all.assign(3 * n, 0.f);
+  fb.half_var.assign(3 * n, 0.f);
+  fb.valid.assign(n, kFeaturesValid);
+  const bool given = variance_a && variance_b;
+  parallel_rows(in.height, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
-      bool ok = true;
-      for (const auto& s : sources) {
-        ok = ok && finite_n(s.values + s.channels * i, s.channels);
-        if (s.variance) ok = ok && finite_n(s.variance + s.channels * i, s.channels);
-      }
-      if (ok) fb.valid[i] |= kFeaturesValid;
-    }
-  });
-  struct Channel {
-    const float* values;
-    const float* variance;
-    int stride, offset;
-    bool guide;
-  };
-  std::vector<Channel> channels;
-  for (const auto& s : sources)
-    for (int c = 0; c < s.channels; ++c)
-      channels.push_back({s.values, s.variance, s.channels, c, s.values == guide});
-  const auto moments = parallel_rows_sum<2 * kMaxFeatures + 1>(
-      H, [&](int y0, int y1, std::array<double, 2 * kMaxFeatures + 1>& m) {
-        for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
-          if (!(fb.valid[i] & kFeaturesValid)) continue;
-          m[2 * kMaxFeatures] += 1;
-          for (size_t k = 0; k < channels.size(); ++k) {
-            const double v = channels[k].values[channels[k].stride * i + channels[k].offset];
-            m[2 * k] += v;
-            m[2 * k + 1] += v * v;
-          }
-        }
-      });
-  // Keep the channels that vary; scale each to unit standard deviation over the image.
-  const double count = std::max(1.0, moments[2 * kMaxFeatures]);
-  std::vector<Channel> kept;
-  std::vector<float> scale;
-  for (size_t k = 0; k < channels.size(); ++k) {
-    const double mean = moments[2 * k] / count;
-    const double var = std::max(0.0, moments[2 * k + 1] / count - mean * mean);
-    if (!(var > 1e-12 * (1.0 + mean * mean))) continue;
-    kept.push_back(channels[k]);
-    scale.push_back(float(1.0 / std::sqrt(var)));
-  }
-  fb.count = int(kept.size());
-  const int d = fb.count;
-  for (int k = 0; k < d; ++k) {
-    fb.guide_colour[k] = kept[k].guide ? kept[k].offset : -1;
-    fb.guide_slope[k] = 1.f / scale[k];
-  }
-  fb.features.assign(n * d, 0.f);
-  fb.noise.assign(n * d, 0.f);
-  parallel_rows(H, [&](int y0, int y1) {
-    for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
-      if (!(fb.valid[i] & kFeaturesValid)) continue;
-      for (int k = 0; k < d; ++k) {
-        const Channel& ch = kept[k];
-        const size_t at = ch.stride * i + ch.offset;
-        fb.features[d * i + k] = ch.values[at] * scale[k];
-        if (ch.variance) fb.noise[d * i + k] = std::max(0.f, ch.variance[at]) * scale[k] * scale[k];
+      const size_t k = 3 * i;
+      bool ok = finite_n(a + k, 3) && finite_n(b + k, 3) && finite_n(all + k, 3);
+      if (given) ok = ok && finite_n(variance_a + k, 3) && finite_n(variance_b + k, 3);
+      if (!ok) continue;
+      fb.valid[i] |= kImagesValid;
+      for (int c = 0; c < 3; ++c) {
+        fb.a[k + c] = a[k + c];
+        fb.b[k + c] = b[k + c];
+        fb.all[k + c] = all[k + c];
+        const float d = a[k + c] - b[k + c];
+        // E[(A - B)^2] = Var A + Var B for independent halves.
+        fb.half_var[k + c] =
+            given ? 0.5f * (std::max(0.f, variance_a[k + c]) + std::max(0.f, variance_b[k + c]))
+                  : 0.5f * d * d;
       }
     }
   });
-  prepare_patches(in, fb);
-  for (size_t i = 0; i < n; ++i)
-    fb.missing +=
-        (fb.valid[i] & (kHalvesValid | kFeaturesValid)) != (kHalvesValid | kFeaturesValid);
+  fb.feature.assign(kFeatureChannels * n, 0.f);
+  fb.feature_var.assign(kFeatureChannels * n, 0.f);
+  copy_feature(in.albedo, in.albedo_variance, 3, 0, fb);
+  copy_feature(in.normal, in.normal_variance, 3, 3, fb);
+  copy_feature(in.depth, in.depth_variance, 1, 6, fb);
+  for (size_t i = 0; i < n; ++i) fb.missing += fb.valid[i] != (kImagesValid | kFeaturesValid);
   return fb;
 }
 

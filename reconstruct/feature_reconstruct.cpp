@@ -19,6 +19,11 @@ double since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
+int gradient_halves(const ReconstructionInput& in) {
+  return (in.gradient_x_a != nullptr) + (in.gradient_x_b != nullptr) +
+         (in.gradient_y_a != nullptr) + (in.gradient_y_b != nullptr);
+}
+
 void validate_feature(const ReconstructionInput& in, const ReconstructionSettings& s) {
   if (in.width <= 0 || in.height <= 0)
     throw std::invalid_argument("reconstruct: image size must be positive, got " +
@@ -27,69 +32,100 @@ void validate_feature(const ReconstructionInput& in, const ReconstructionSetting
     throw std::invalid_argument("reconstruct: the Feature norm needs both primal halves (A and B)");
   if ((in.variance_a == nullptr) != (in.variance_b == nullptr))
     throw std::invalid_argument("reconstruct: give the variances of both halves or of neither");
-  if (!(s.feature_guide_alpha > 0.f) || !std::isfinite(s.feature_guide_alpha))
-    throw std::invalid_argument("reconstruct: feature_guide_alpha must be > 0");
+  if (!(s.alpha > 0.f) || !std::isfinite(s.alpha))
+    throw std::invalid_argument("reconstruct: alpha must be > 0");
   const ReconstructionNorm g = s.feature_guide;
   if (g == ReconstructionNorm::Feature)
     throw std::invalid_argument("reconstruct: the Feature guide must be l1, l2, weighted or none");
   if (g != ReconstructionNorm::None && (!in.gradient_x || !in.gradient_y))
     throw std::invalid_argument(
         "reconstruct: the Feature norm's gradient-domain guide needs gradient_x and gradient_y");
+  const int halves = gradient_halves(in);
+  if (halves != 0 && halves != 4)
+    throw std::invalid_argument(
+        "reconstruct: give all four gradient halves (x and y of A and B) or none");
 }
 
-// The gradient-domain guide, from `primal` or else the halves' mean (non-finite where either is).
-std::vector<float> solve_guide(const ReconstructionInput& in, const ReconstructionSettings& s) {
-  std::vector<float> mean;
+// The images the filters run on: two independent halves and the image of all samples.
+struct FeatureBase {
+  std::vector<float> a, b, all;
+  const float *pa = nullptr, *pb = nullptr, *pall = nullptr;
+  const float *variance_a = nullptr, *variance_b = nullptr;
+  bool primal = true;
+};
+
+std::vector<float> solve(const ReconstructionInput& in, const ReconstructionSettings& s,
+                         ReconstructionNorm norm) {
   ReconstructionInput gi = in;
   gi.emission = nullptr;
-  if (!gi.primal) {
-    mean.resize(size_t(in.width) * in.height * 3);
-    for (size_t i = 0; i < mean.size(); ++i) mean[i] = 0.5f * (in.primal_a[i] + in.primal_b[i]);
-    gi.primal = mean.data();
-  }
+  gi.initial = nullptr;
   ReconstructionSettings gs = s;
-  gs.norm = s.feature_guide;
-  gs.alpha = s.feature_guide_alpha;
+  gs.norm = norm;
   gs.compute_objective = false;
   gs.progress = nullptr;
   return reconstruct(gi, gs);
 }
 
-}  // namespace
-
-std::vector<detail::CandidateFilter> default_feature_candidates() {
-  return {{1, 1.f}, {2, 1.f}};
+FeatureBase base_images(const ReconstructionInput& in, const ReconstructionSettings& s) {
+  FeatureBase base;
+  const size_t n3 = 3 * size_t(in.width) * in.height;
+  std::vector<float> mean;
+  if (!in.primal) {
+    mean.resize(n3);
+    for (size_t i = 0; i < n3; ++i) mean[i] = 0.5f * (in.primal_a[i] + in.primal_b[i]);
+  }
+  const float* primal = in.primal ? in.primal : mean.data();
+  if (s.feature_guide == ReconstructionNorm::None || gradient_halves(in) != 4) {
+    base.pa = in.primal_a;
+    base.pb = in.primal_b;
+    base.variance_a = in.variance_a;
+    base.variance_b = in.variance_b;
+    base.all = std::move(mean);
+    base.pall = in.primal ? in.primal : base.all.data();
+    return base;
+  }
+  ReconstructionInput all = in;
+  all.primal = primal;
+  base.all = solve(all, s, s.feature_guide);
+  // Each half's gradient-domain solution, for the error estimate only: L2 is exact and fast.
+  ReconstructionInput half = in;
+  half.variance = nullptr;
+  half.primal = in.primal_a, half.gradient_x = in.gradient_x_a, half.gradient_y = in.gradient_y_a;
+  base.a = solve(half, s, ReconstructionNorm::L2);
+  half.primal = in.primal_b, half.gradient_x = in.gradient_x_b, half.gradient_y = in.gradient_y_b;
+  base.b = solve(half, s, ReconstructionNorm::L2);
+  base.pa = base.a.data(), base.pb = base.b.data(), base.pall = base.all.data();
+  base.primal = false;
+  return base;
 }
 
-FeatureReconstruction feature_regression(const ReconstructionInput& input, const float* guide,
-                                         const std::vector<detail::CandidateFilter>& candidates) {
-  if (!input.primal_a || !input.primal_b)
-    throw std::invalid_argument("reconstruct: the Feature norm needs both primal halves (A and B)");
-  if (candidates.empty() || candidates.size() > 127)
-    throw std::invalid_argument("reconstruct: 1 to 127 candidate filters");
+}  // namespace
+
+FeatureReconstruction feature_filter(const ReconstructionInput& input, const float* a,
+                                     const float* b, const float* all, const float* variance_a,
+                                     const float* variance_b,
+                                     const std::vector<detail::BilateralCandidate>& candidates) {
+  if (candidates.empty() || candidates.size() > 255)
+    throw std::invalid_argument("reconstruct: 1 to 255 candidate filters");
   FeatureReconstruction r;
   auto t = std::chrono::steady_clock::now();
-  const detail::FeatureBuffers fb = detail::prepare_feature_buffers(input, guide);
-  r.features = fb.count;
+  const detail::FeatureBuffers fb =
+      detail::prepare_feature_buffers(input, a, b, all, variance_a, variance_b);
+  r.features = fb.features;
   r.missing = fb.missing;
   r.prepare_seconds = since(t);
 
-  const size_t n = size_t(input.width) * input.height;
-  const int variants = detail::has_guide(fb) ? 2 : 1;
-  std::vector<float> fa(variants * 3 * n), fbh(variants * 3 * n);
-  float* const out_a[2] = {fa.data(), fa.data() + 3 * n * (variants - 1)};
-  float* const out_b[2] = {fbh.data(), fbh.data() + 3 * n * (variants - 1)};
+  const size_t n3 = 3 * size_t(input.width) * input.height;
+  std::vector<float> fa(n3), fbh(n3), fall(n3);
+  const float* const images[3] = {fb.a.data(), fb.b.data(), fb.all.data()};
+  float* const out[3] = {fa.data(), fbh.data(), fall.data()};
   detail::CandidateChoice choice;
   for (size_t k = 0; k < candidates.size(); ++k) {
     t = std::chrono::steady_clock::now();
-    detail::cross_filter_half(fb, fb.a.data(), fb.smooth_b.data(), fb.patch_var_b.data(),
-                              candidates[k], out_a);
-    detail::cross_filter_half(fb, fb.b.data(), fb.smooth_a.data(), fb.patch_var_a.data(),
-                              candidates[k], out_b);
+    detail::bilateral_filter(fb, candidates[k], images, out, 3);
     r.filter_seconds += since(t);
     t = std::chrono::steady_clock::now();
-    for (int v = 0; v < variants; ++v)
-      detail::offer_candidate(fb, int(k) * variants + v, out_a[v], out_b[v], choice);
+    detail::offer_candidate(fb, int(k), fa.data(), fbh.data(), fall.data(), choice);
     r.select_seconds += since(t);
   }
   r.image = std::move(choice.image);
@@ -107,8 +143,7 @@ std::vector<float> reconstruct_feature(const ReconstructionInput& input,
     if (settings.progress) settings.progress(f);
   };
   progress(0.f);
-  std::vector<float> guide;
-  if (settings.feature_guide != ReconstructionNorm::None) guide = solve_guide(input, settings);
+  const FeatureBase base = base_images(input, settings);
   const double guide_seconds = since(start);
   progress(0.5f);
 
@@ -116,7 +151,7 @@ std::vector<float> reconstruct_feature(const ReconstructionInput& input,
   tbb::task_arena arena(threads);
   FeatureReconstruction fr;
   arena.execute([&] {
-    fr = feature_regression(input, guide.empty() ? nullptr : guide.data());
+    fr = feature_filter(input, base.pa, base.pb, base.pall, base.variance_a, base.variance_b);
     const int W = input.width;
     detail::parallel_rows(input.height, [&](int y0, int y1) {
       for (size_t i = 3 * size_t(y0) * W; i < 3 * size_t(y1) * W; ++i) {
@@ -131,6 +166,7 @@ std::vector<float> reconstruct_feature(const ReconstructionInput& input,
     *report = ReconstructionReport{};
     report->missing_values = fr.missing;
     report->guide_seconds = guide_seconds;
+    report->feature_filtered_primal = base.primal;
     report->seconds = since(start);
   }
   return std::move(fr.image);

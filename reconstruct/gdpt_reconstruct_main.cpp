@@ -39,7 +39,9 @@ constexpr const char* kUsage =
     "                        feature: regression on Primal A / Primal B (the samples' two\n"
     "                        halves), Gradient X / Y, Denoising Albedo, Denoising Normal and\n"
     "                        Denoising Depth (1 channel), all required; Primal A / B Variance and\n"
-    "                        Denoising Albedo / Normal / Depth Variance used when present\n"
+    "                        Denoising Albedo / Normal / Depth Variance used when present;\n"
+    "                        G-PT's gradients over the halves, Gradient X A / X B / Y A / Y B,\n"
+    "                        used when present (all four or none)\n"
     "  --layer NAME          view layer (default: the first layer with a Primal pass)\n"
     "  --view V              OCIO view transform for PNG/JPEG, e.g. Filmic or Standard\n"
     "                        (default: the config's default view; config from $OCIO or\n"
@@ -59,7 +61,11 @@ const std::vector<std::string> kFeatureOptional = {"Primal",
                                                    "Primal B Variance",
                                                    "Denoising Albedo Variance",
                                                    "Denoising Normal Variance",
-                                                   "Denoising Depth Variance"};
+                                                   "Denoising Depth Variance",
+                                                   "Gradient X A",
+                                                   "Gradient X B",
+                                                   "Gradient Y A",
+                                                   "Gradient Y B"};
 const std::vector<std::string> kScalarPasses = {"Denoising Depth", "Denoising Depth Variance"};
 
 struct Options {
@@ -205,6 +211,24 @@ void set_feature_input(const gdpt::ExrPasses& in, gdpt::ReconstructionInput& inp
   input.normal_variance = pass("Denoising Normal Variance");
   input.depth = pass("Denoising Depth");
   input.depth_variance = pass("Denoising Depth Variance");
+  // G-PT's gradients over the halves: all four or none.
+  const char* halves[4] = {"Gradient X A", "Gradient X B", "Gradient Y A", "Gradient Y B"};
+  const float** fields[4] = {&input.gradient_x_a, &input.gradient_x_b, &input.gradient_y_a,
+                             &input.gradient_y_b};
+  int present = 0;
+  std::string missing;
+  for (int k = 0; k < 4; ++k) {
+    *fields[k] = pass(halves[k]);
+    if (*fields[k])
+      ++present;
+    else
+      missing += std::string(missing.empty() ? "" : ", ") + halves[k];
+  }
+  if (present > 0 && present < 4)
+    throw gdpt::ExrError("layer '" + in.layer +
+                         "' has only some of Gradient X A, Gradient X B, Gradient Y A and "
+                         "Gradient Y B, which go together (missing " +
+                         missing + ")");
 }
 
 }  // namespace

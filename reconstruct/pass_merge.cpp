@@ -24,9 +24,13 @@ const std::map<std::string, std::string> kChannelVariances = {
     {"Denoising Albedo Variance", "Denoising Albedo"},
     {"Denoising Normal Variance", "Denoising Normal"},
     {"Denoising Depth Variance", "Denoising Depth"}};
-const std::set<std::string> kOtherPasses = {"Combined",      "Sample Count", "Primal A",
-                                            "Primal B",      "Variance",     "Gradient Halves",
-                                            "Shift Failures"};
+// Means over one half of the samples (true: the even global sample indices, A; false: the odd
+// ones, B): the primal's and G-PT's gradients'.
+const std::map<std::string, bool> kHalfMeanPasses = {
+    {"Primal A", true},      {"Primal B", false},    {"Gradient X A", true},
+    {"Gradient X B", false}, {"Gradient Y A", true}, {"Gradient Y B", false}};
+const std::set<std::string> kOtherPasses = {"Combined", "Sample Count", "Variance",
+                                            "Gradient Halves", "Shift Failures"};
 
 std::string range_text(uint32_t first, double count) {
   return std::to_string(first) + ".." + std::to_string(uint64_t(first) + uint64_t(count) - 1);
@@ -127,7 +131,8 @@ void Merger::check_compatible() {
       if (image.channels <= 0 || image.data.size() != pixels_ * size_t(image.channels))
         throw MergeError("pass '" + name + "' of '" + p.name + "' has the wrong size");
       if (!kMeanPasses.count(name) && !kFirstSamplePasses.count(name) &&
-          !kChannelVariances.count(name) && !kOtherPasses.count(name))
+          !kChannelVariances.count(name) && !kHalfMeanPasses.count(name) &&
+          !kOtherPasses.count(name))
         throw MergeError("'" + p.name + "' has a pass '" + name +
                          "' that GDPT does not write: the merge does not know how to combine it");
     }
@@ -211,7 +216,9 @@ PassImage Merger::weighted_mean(const std::string& name, bool even_half, bool od
 
 PassImage Merger::channel_variance(const std::string& name, const std::string& mean) const {
   require(mean, "'" + name + "' is merged with");
-  const bool even = mean == "Primal A", odd = mean == "Primal B";
+  const auto half = kHalfMeanPasses.find(mean);
+  const bool even = half != kHalfMeanPasses.end() && half->second;
+  const bool odd = half != kHalfMeanPasses.end() && !half->second;
   const int channels = pass(0, name).channels;
   if (pass(0, mean).channels != channels)
     throw MergeError("'" + name + "' and '" + mean + "' have different channel counts");
@@ -337,8 +344,8 @@ RenderPart Merger::run() {
       out = sample_count();
     else if (kMeanPasses.count(name) || name == "Combined")
       out = weighted_mean(name, false, false);
-    else if (name == "Primal A" || name == "Primal B")
-      out = weighted_mean(name, name == "Primal A", name == "Primal B");
+    else if (kHalfMeanPasses.count(name))
+      out = weighted_mean(name, kHalfMeanPasses.at(name), !kHalfMeanPasses.at(name));
     else if (kFirstSamplePasses.count(name))
       out = parts_[lowest_].passes.at(name);
     else if (kChannelVariances.count(name))
@@ -374,6 +381,18 @@ const float* pass_data(const RenderPart& part, const std::string& name, int chan
                      std::to_string(it->second.channels) + " channels, not " +
                      std::to_string(channels));
   return it->second.data.data();
+}
+
+// G-PT's gradients over the halves into `in` when the part has them: all four or none.
+void half_gradients(const RenderPart& part, ReconstructionInput& in) {
+  const char* names[4] = {"Gradient X A", "Gradient X B", "Gradient Y A", "Gradient Y B"};
+  const float** fields[4] = {&in.gradient_x_a, &in.gradient_x_b, &in.gradient_y_a,
+                             &in.gradient_y_b};
+  int present = 0;
+  for (const char* name : names) present += int(part.passes.count(name));
+  if (present == 0) return;
+  const char* why = "the Feature reconstruction needs with the other half gradients";
+  for (int k = 0; k < 4; ++k) *fields[k] = pass_data(part, names[k], 3, why);
 }
 
 }  // namespace
@@ -419,6 +438,7 @@ std::vector<float> rebuild_combined(const RenderPart& part, ReconstructionNorm n
     in.normal_variance = pass_data(part, "Denoising Normal Variance", 3, feature);
     in.depth = pass_data(part, "Denoising Depth", 1, feature);
     in.depth_variance = pass_data(part, "Denoising Depth Variance", 1, feature);
+    half_gradients(part, in);
   }
   ReconstructionSettings settings;
   settings.norm = norm;

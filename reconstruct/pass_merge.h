@@ -3,8 +3,8 @@
 //
 // Every pass the engine writes is a per-pixel mean over samples, a variance of such a mean, or
 // one sample's value, so parts combine exactly from their means and per-pixel sample counts:
-//   - means: weighted by the samples behind them (`Sample Count`; for Primal A / B the even /
-//     odd global sample indices of each part's range);
+//   - means: weighted by the samples behind them (`Sample Count`; for Primal A / B and G-PT's
+//     Gradient X / Y A / B the even / odd global sample indices of each part's range);
 //   - variances of means: pooled by Chan et al.'s parallel formula, M2 = sum M2_k + sum n_k
 //     (mean_k - mean)^2 with M2_k = V_k n_k (n_k - 1), from the matching mean pass (Variance's
 //     primal entry from the luminance of Primal; G-PT's gradient entries from `Gradient Halves`,

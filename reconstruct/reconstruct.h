@@ -15,11 +15,9 @@
 //             likelihood weighting); Jacobi-preconditioned CG from the L2 solution to
 //             `weighted_tolerance`.
 //   None      primal (+ emission).
-//   Feature   per-pixel first-order regression of the primal on feature buffers (albedo, normal,
-//             depth) and on a gradient-domain solution (feature_guide) as an extra feature, NFOR
-//             style: half A is regressed with weights from half B and vice versa, candidate
-//             filters are chosen per pixel by a cross-half error estimate, and the two halves'
-//             results averaged (feature_reconstruct.h).
+//   Feature   feature-guided edge-aware filters of the gradient-domain solution (feature_guide),
+//             chosen per pixel by an error estimate from two independent halves of the samples,
+//             each with its own gradient-domain solve (feature_reconstruct.h).
 // Non-finite inputs are missing data: a term (primal, dx or dy of a pixel) with any non-finite
 // channel gets zero weight. The output is always finite.
 #pragma once
@@ -58,13 +56,9 @@ struct ReconstructionSettings {
   // Fill ReconstructionReport::objective (one more pass over all buffers). Off by default: the
   // engine and the compositor node never read it; the CLI prints it, tests and benchmarks check it.
   bool compute_objective = false;
-  // Feature: the gradient-domain solution used as a guide feature (L1, L2 or None = no guide),
-  // solved with the settings above from `primal` (or the halves' mean) and the gradients.
+  // Feature: the gradient-domain solution that is filtered (L1, L2, Weighted at `alpha`, or None:
+  // the primal is filtered).
   ReconstructionNorm feature_guide = ReconstructionNorm::L1;
-  // The guide's alpha, lower than the image's: the guide then depends little on the halves'
-  // noise, which keeps the cross-half error estimate unbiased (the regression's intercept
-  // restores the level the guide drifts from).
-  float feature_guide_alpha = 0.02f;
   // Called with the completed fraction in [0, 1] (from the calling thread).
   std::function<void(float)> progress;
 };
@@ -114,7 +108,10 @@ struct ReconstructionReport {
   double seconds = 0.0;
   double relative_residual = 0.0;  // CG exit residual |b - A I| / |b| (0 for the direct solve)
   int missing_values = 0;          // non-finite input terms treated as missing
-  double guide_seconds = 0.0;      // Feature: of `seconds`, the gradient-domain guide's solve
+  double guide_seconds = 0.0;      // Feature: of `seconds`, the gradient-domain solves
+  // Feature: true when the primal was filtered instead of the gradient-domain solution (no
+  // gradient halves in the input, or feature_guide None).
+  bool feature_filtered_primal = false;
 };
 
 // Returns RGB `width * height * 3`. Throws std::invalid_argument on bad input (alpha <= 0, sizes,

@@ -20,12 +20,33 @@ double variance_of_mean(double sum, double sum2, uint32_t n) {
   return var / n;
 }
 
+// to += from for a struct of double sums, field by field.
 template <class T>
-void add_feature_sums(T& to, const T& from) {
+void add_sums(T& to, const T& from) {
   static_assert(sizeof(T) % sizeof(double) == 0);
   double* a = reinterpret_cast<double*>(&to);
   const double* b = reinterpret_cast<const double*>(&from);
   for (size_t k = 0; k < sizeof(T) / sizeof(double); ++k) a[k] += b[k];
+}
+
+// G-PT gradients along one axis from per-pixel sums of the one-sided halves, sum(i, backward, c),
+// and the samples behind them, inv(i) = 1 / count (0 for none): this pixel's forward half minus
+// the neighbour's (i + step) backward half, the neighbour's term only inside the image.
+template <class Sum, class Inv>
+void one_sided_differences(float* out, int width, int height, bool along_x, const Sum& sum,
+                           const Inv& inv) {
+  const size_t step = along_x ? 1 : size_t(width);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const size_t i = size_t(y) * width + x;
+      const bool inside = along_x ? x + 1 < width : y + 1 < height;
+      const double inv_here = inv(i), inv_next = inside ? inv(i + step) : 0.0;
+      for (int c = 0; c < 3; ++c) {
+        double v = sum(i, false, c) * inv_here;
+        if (inside) v -= sum(i + step, true, c) * inv_next;
+        out[3 * i + c] = float(v);
+      }
+    }
 }
 
 }  // namespace
@@ -45,6 +66,15 @@ void Film::set_gradients_from_primal(bool on) {
     HugePageVector<GradientAccumulator>().swap(grad_);
   else
     grad_.assign(pixel_count(), GradientAccumulator{});
+  allocate_half_gradients();
+}
+
+void Film::allocate_half_gradients() {
+  const bool on = !features_.empty() && !grad_.empty();
+  if (on)
+    half_a_grad_.assign(pixel_count(), HalfAGradients{});
+  else
+    HugePageVector<HalfAGradients>().swap(half_a_grad_);
 }
 
 void Film::enable_data_passes(bool normal, bool mist) {
@@ -54,10 +84,12 @@ void Film::enable_data_passes(bool normal, bool mist) {
 
 void Film::enable_feature_passes(bool on) {
   features_.assign(on ? pixel_count() : 0, FeatureAccumulator{});
+  allocate_half_gradients();
 }
 
 void Film::clear() {
   std::fill(features_.begin(), features_.end(), FeatureAccumulator{});
+  std::fill(half_a_grad_.begin(), half_a_grad_.end(), HalfAGradients{});
   std::fill(normal_.begin(), normal_.end(), 0.0);
   std::fill(mist_.begin(), mist_.end(), 0.0);
   std::fill(acc_.begin(), acc_.end(), Accumulator{});
@@ -67,7 +99,8 @@ void Film::clear() {
 }
 
 void Film::take_rows(Film& pass, int y0, int y1) {
-  if (pass.acc_.size() != acc_.size() || pass.grad_.size() != grad_.size())
+  if (pass.acc_.size() != acc_.size() || pass.grad_.size() != grad_.size() ||
+      pass.half_a_grad_.size() != half_a_grad_.size())
     throw std::logic_error("Film::take_rows: the pass film has another size or gradient layout");
   for (size_t i = size_t(y0) * width_, end = size_t(y1) * width_; i < end; ++i) {
     Accumulator& a = acc_[i];
@@ -103,8 +136,12 @@ void Film::take_rows(Film& pass, int y0, int y1) {
         pass.normal_[c] = 0.0;
       }
     if (!features_.empty()) {
-      add_feature_sums(features_[i], pass.features_[i]);
+      add_sums(features_[i], pass.features_[i]);
       pass.features_[i] = FeatureAccumulator{};
+    }
+    if (!half_a_grad_.empty()) {
+      add_sums(half_a_grad_[i], pass.half_a_grad_[i]);
+      pass.half_a_grad_[i] = HalfAGradients{};
     }
     if (!mist_.empty()) {
       mist_[i] += pass.mist_[i];
@@ -171,30 +208,65 @@ void Film::emission_rgb(float* out) const {
   }
 }
 
-// One routine for both axes: the neighbour of pixel i along the axis is i + step when `inside`;
-// G-PT gradients combine this pixel's forward half with the neighbour's backward half, PT ones are
-// forward differences of the primal means. The last column / row is 0 (Neumann).
+// One routine for both axes: the neighbour of pixel i along the axis is i + step. G-PT gradients
+// combine this pixel's forward half with the neighbour's backward half, PT ones are forward
+// differences of the primal means. The last column / row is 0 (Neumann).
 void Film::gradient_rgb(float* out, bool along_x, double (GradientAccumulator::*forward)[3],
                         double (GradientAccumulator::*backward)[3]) const {
-  const size_t step = along_x ? 1 : size_t(width_);
   const auto inv_samples = [&](size_t i) { return samples_[i] ? 1.0 / samples_[i] : 0.0; };
+  if (!gradients_from_primal_) {
+    const auto sum = [&](size_t i, bool back, int c) {
+      return (grad_[i].*(back ? backward : forward))[c];
+    };
+    one_sided_differences(out, width_, height_, along_x, sum, inv_samples);
+    return;
+  }
+  const size_t step = along_x ? 1 : size_t(width_);
   for (int y = 0; y < height_; ++y)
     for (int x = 0; x < width_; ++x) {
       const size_t i = size_t(y) * width_ + x;
       const bool inside = along_x ? x + 1 < width_ : y + 1 < height_;
-      const double inv = inv_samples(i);
-      const double inv_next = inside ? inv_samples(i + step) : 0.0;
-      for (int c = 0; c < 3; ++c) {
-        double v;
-        if (gradients_from_primal_) {
-          v = inside ? acc_[i + step].primal[c] * inv_next - acc_[i].primal[c] * inv : 0.0;
-        } else {
-          v = (grad_[i].*forward)[c] * inv;
-          if (inside) v -= (grad_[i + step].*backward)[c] * inv_next;
-        }
-        out[3 * i + c] = float(v);
-      }
+      const double inv = inv_samples(i), inv_next = inside ? inv_samples(i + step) : 0.0;
+      for (int c = 0; c < 3; ++c)
+        out[3 * i + c] =
+            inside ? float(acc_[i + step].primal[c] * inv_next - acc_[i].primal[c] * inv) : 0.0f;
     }
+}
+
+uint32_t Film::half_samples(SampleHalf half, size_t i) const {
+  const uint32_t even = even_sample_count(sample_offset_, samples_[i]);
+  return half == SampleHalf::A ? even : samples_[i] - even;
+}
+
+// Half A from its own sums, half B as the totals minus half A's.
+void Film::gradient_half_rgb(SampleHalf half, bool along_x, float* out) const {
+  if (half_a_grad_.empty()) {
+    std::fill(out, out + 3 * pixel_count(), 0.0f);
+    return;
+  }
+  using G = GradientAccumulator;
+  using A = HalfAGradients;
+  const auto forward = along_x ? &G::dx : &G::dy, backward = along_x ? &G::dx_left : &G::dy_down;
+  const auto forward_a = along_x ? &A::dx : &A::dy,
+             backward_a = along_x ? &A::dx_left : &A::dy_down;
+  const bool b = half == SampleHalf::B;
+  const auto sum = [&](size_t i, bool back, int c) {
+    const double a = (half_a_grad_[i].*(back ? backward_a : forward_a))[c];
+    return b ? (grad_[i].*(back ? backward : forward))[c] - a : a;
+  };
+  const auto inv = [&](size_t i) {
+    const uint32_t n = half_samples(half, i);
+    return n ? 1.0 / n : 0.0;
+  };
+  one_sided_differences(out, width_, height_, along_x, sum, inv);
+}
+
+void Film::gradient_x_half_rgb(SampleHalf half, float* out) const {
+  gradient_half_rgb(half, true, out);
+}
+
+void Film::gradient_y_half_rgb(SampleHalf half, float* out) const {
+  gradient_half_rgb(half, false, out);
 }
 
 void Film::gradient_x_rgb(float* out) const {
@@ -244,10 +316,10 @@ void Film::feature_sums(FeaturePass pass, size_t i, const double*& sum, const do
   n = samples_[i];
   switch (pass) {
     case FeaturePass::PrimalA:
-      sum = f.half_a, sum2 = f.half_a2, n = even_sample_count(sample_offset_, n);
+      sum = f.half_a, sum2 = f.half_a2, n = half_samples(SampleHalf::A, i);
       break;
     case FeaturePass::PrimalB:
-      sum = f.half_b, sum2 = f.half_b2, n = n - even_sample_count(sample_offset_, n);
+      sum = f.half_b, sum2 = f.half_b2, n = half_samples(SampleHalf::B, i);
       break;
     case FeaturePass::Albedo:
       sum = f.albedo, sum2 = f.albedo2;

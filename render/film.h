@@ -75,6 +75,15 @@ class Film {
   void feature_variance(FeaturePass pass, float* out) const;
   static int feature_channels(FeaturePass pass) { return pass == FeaturePass::Depth ? 1 : 3; }
   bool has_features() const { return !features_.empty(); }
+  // G-PT's gradients over the same halves of the samples, as gradient_x_rgb() / gradient_y_rgb()
+  // over each half alone: dx(x) = the mean of pixel x's G_right halves over its half-A (or B)
+  // samples - the mean of pixel x + 1's G_left halves over its own; 3 per pixel, 0 where a
+  // pixel's half has no samples (all 0 without has_half_gradients()). Kept with the feature
+  // passes on in a film that holds gradients (not in PT mode).
+  enum class SampleHalf : uint8_t { A, B };
+  void gradient_x_half_rgb(SampleHalf half, float* out) const;
+  void gradient_y_half_rgb(SampleHalf half, float* out) const;
+  bool has_half_gradients() const { return !half_a_grad_.empty(); }
   bool has_normal() const { return !normal_.empty(); }
   bool has_mist() const { return !mist_.empty(); }
   uint32_t samples(int x, int y) const { return samples_[size_t(y) * width_ + x]; }
@@ -123,10 +132,22 @@ class Film {
     double dx_left[3] = {0, 0, 0}, dx_left2 = 0;
     double dy_down[3] = {0, 0, 0}, dy_down2 = 0;
   };
+  // Half A's share of a GradientAccumulator's four halves: the sums over the samples of even
+  // global index (has_half_gradients()); half B's are the totals minus these.
+  struct HalfAGradients {
+    double dx[3] = {0, 0, 0}, dy[3] = {0, 0, 0};
+    double dx_left[3] = {0, 0, 0}, dy_down[3] = {0, 0, 0};
+  };
   Accumulator& pixel(int x, int y) { return acc_[size_t(y) * width_ + x]; }
   const Accumulator& pixel(int x, int y) const { return acc_[size_t(y) * width_ + x]; }
   // Only while the film holds gradients (!gradients_from_primal()).
   GradientAccumulator& gradients(int x, int y) { return grad_[size_t(y) * width_ + x]; }
+  // Pixel (x, y)'s half-A gradient sums when the sample of global index `sample_index` belongs
+  // to half A and the film keeps them, else null: where that sample adds its halves besides.
+  HalfAGradients* half_a_gradients(int x, int y, uint32_t sample_index) {
+    if (half_a_grad_.empty() || !in_half_a(sample_index)) return nullptr;
+    return &half_a_grad_[size_t(y) * width_ + x];
+  }
   void add_sample_count(int x, int y, uint32_t n = 1) { samples_[size_t(y) * width_ + x] += n; }
   // Sample 0's camera hit (view-axis distance > 0, pass indices); integrators call it for that
   // sample only.
@@ -146,8 +167,8 @@ class Film {
   void add_features(int x, int y, uint32_t sample_index, Spectrum primal, Spectrum albedo,
                     Vec3f normal, float depth) {
     FeatureAccumulator& f = features_[size_t(y) * width_ + x];
-    double* half = sample_index % 2 ? f.half_b : f.half_a;
-    double* half2 = sample_index % 2 ? f.half_b2 : f.half_a2;
+    double* half = in_half_a(sample_index) ? f.half_a : f.half_b;
+    double* half2 = in_half_a(sample_index) ? f.half_a2 : f.half_b2;
     if (!is_finite(albedo)) albedo = Spectrum(0.0f);
     if (!is_finite(normal)) normal = Vec3f();
     if (!std::isfinite(depth)) depth = 0.0f;
@@ -175,7 +196,8 @@ class Film {
   void clear();  // zero every accumulator and sample count
   // Allocates the Normal / Mist sums (none by default: films without them cost nothing).
   void enable_data_passes(bool normal, bool mist);
-  // Allocates the feature passes' sums (none by default).
+  // Allocates the feature passes' sums (none by default), and the half-A gradient sums when the
+  // film holds gradients.
   void enable_feature_passes(bool on);
   // The index of the render's first sample (RenderSettings::sample_offset): the feature passes'
   // halves are the even and odd global sample indices.
@@ -188,6 +210,11 @@ class Film {
  private:
   void gradient_rgb(float* out, bool along_x, double (GradientAccumulator::*forward)[3],
                     double (GradientAccumulator::*backward)[3]) const;
+  void gradient_half_rgb(SampleHalf half, bool along_x, float* out) const;
+  // Pixel i's samples in `half` (by the global sample index, sample_offset_ included).
+  uint32_t half_samples(SampleHalf half, size_t i) const;
+  // Half-A gradient sums exactly when there are feature passes and gradients.
+  void allocate_half_gradients();
 
   int width_ = 0, height_ = 0;
   // Per-pixel arrays in huge pages: a 1920x1080 film is 170-470 MB (huge_pages.h).
@@ -212,6 +239,7 @@ class Film {
   void feature_sums(FeaturePass pass, size_t i, const double*& sum, const double*& sum2,
                     uint32_t& n) const;
   HugePageVector<FeatureAccumulator> features_;  // empty when the feature passes are off
+  HugePageVector<HalfAGradients> half_a_grad_;   // empty unless features_ and grad_ are not
   bool gradients_from_primal_ = false;
   uint32_t sample_offset_ = 0;
 };

@@ -20,6 +20,7 @@ struct FeatureScene {
   int w = 0, h = 0;
   std::vector<float> truth, albedo, normal, depth;  // RGB / XYZ / 1 per pixel
   std::vector<float> a, b, primal, gx, gy;          // noisy halves, their mean, noisy gradients
+  std::vector<float> gxa, gxb, gya, gyb;            // the gradients' halves (gx their mean)
 
   // The reconstruction's input over these buffers (the features left out when `features` is off).
   ReconstructionInput input(bool features = true) const {
@@ -31,6 +32,10 @@ struct FeatureScene {
     in.gradient_y = gy.data();
     in.primal_a = a.data();
     in.primal_b = b.data();
+    in.gradient_x_a = gxa.data();
+    in.gradient_x_b = gxb.data();
+    in.gradient_y_a = gya.data();
+    in.gradient_y_b = gyb.data();
     if (features) {
       in.albedo = albedo.data();
       in.normal = normal.data();
@@ -92,7 +97,7 @@ inline FeatureScene make_feature_scene(int w, int h, float sigma_half, float sig
       s.depth[i] = dep;
     }
   std::mt19937 rng(seed);
-  std::normal_distribution<float> half(0.f, sigma_half), grad(0.f, sigma_gradient);
+  std::normal_distribution<float> half(0.f, sigma_half);
   s.a.resize(3 * n);
   s.b.resize(3 * n);
   s.primal.resize(3 * n);
@@ -101,14 +106,23 @@ inline FeatureScene make_feature_scene(int w, int h, float sigma_half, float sig
     s.b[i] = s.truth[i] + half(rng);
     s.primal[i] = 0.5f * (s.a[i] + s.b[i]);
   }
-  s.gx.assign(3 * n, 0.f);
-  s.gy.assign(3 * n, 0.f);
+  // Each gradient half has twice the variance of their mean, as the halves of the primal.
+  std::normal_distribution<float> grad_half(0.f, sigma_gradient * std::sqrt(2.f));
+  for (auto* g : {&s.gx, &s.gy, &s.gxa, &s.gxb, &s.gya, &s.gyb}) g->assign(3 * n, 0.f);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
       for (int c = 0; c < 3; ++c) {
         const size_t i = 3 * (size_t(y) * w + x) + c;
-        if (x + 1 < w) s.gx[i] = s.truth[i + 3] - s.truth[i] + grad(rng);
-        if (y + 1 < h) s.gy[i] = s.truth[i + 3 * size_t(w)] - s.truth[i] + grad(rng);
+        if (x + 1 < w) {
+          const float d = s.truth[i + 3] - s.truth[i];
+          s.gxa[i] = d + grad_half(rng), s.gxb[i] = d + grad_half(rng);
+          s.gx[i] = 0.5f * (s.gxa[i] + s.gxb[i]);
+        }
+        if (y + 1 < h) {
+          const float d = s.truth[i + 3 * size_t(w)] - s.truth[i];
+          s.gya[i] = d + grad_half(rng), s.gyb[i] = d + grad_half(rng);
+          s.gy[i] = 0.5f * (s.gya[i] + s.gyb[i]);
+        }
       }
   return s;
 }

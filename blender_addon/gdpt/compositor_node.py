@@ -20,7 +20,10 @@
 # composited silently. (Blender's composite_pre handlers do not run for a render's compositing.)
 #
 # Reconstruction rule (docs/user-guide.md): Image = solve(Primal, Gradient X, Gradient Y) + Emission,
-# through `_gdpt.reconstruct`, the same C++ code as the engine and the gdpt-reconstruct CLI.
+# through `_gdpt.reconstruct`, the same C++ code as the engine and the gdpt-reconstruct CLI. The
+# Feature norm also reads the render's feature passes from its Render Layers, and G-PT's gradients
+# over the primal's halves from the optional inputs Gradient X A / X B / Y A / Y B when all four
+# are linked.
 import os
 import sys
 import textwrap
@@ -38,11 +41,16 @@ from . import export_camera, native
 
 NODE_IDNAME = "CompositorNodeGDPTReconstruct"
 MARKER = "GDPT:"
-INPUTS = ("Primal", "Gradient X", "Gradient Y", "Emission")
+# G-PT's gradients over the primal's halves (Primal A / B's samples), optional inputs, all four
+# or none: with them the Feature norm solves each half on its own (film keys).
+HALF_GRADIENT_KEYS = {"Gradient X A": "gradient_x_a", "Gradient X B": "gradient_x_b",
+                      "Gradient Y A": "gradient_y_a", "Gradient Y B": "gradient_y_b"}
+INPUTS = ("Primal", "Gradient X", "Gradient Y", "Emission", *HALF_GRADIENT_KEYS)
 REQUIRED = INPUTS[:3]
-# Render Layers pass names the node can read, and their keys in the engine's film dict.
+# Render Layers pass names the node can read, and their keys in the engine's film dict: the
+# first four every render has.
 FILM_KEYS = {"Primal": "primal", "Gradient X": "gradient_x", "Gradient Y": "gradient_y",
-             "Emission": "emission"}
+             "Emission": "emission", **HALF_GRADIENT_KEYS}
 # The Feature norm's inputs besides (engine film keys): a render with the Feature reconstruction
 # caches them; they are not Blender passes, so the node reads them only from Render Layers.
 FEATURE_KEYS = tuple(f"{k}{v}" for k in ("primal_a", "primal_b", "denoising_albedo",
@@ -164,7 +172,9 @@ def _upstream(socket):
 def _source(scene, node, name):
     """Where input `name` reads from: ('LAYER', scene name, view layer, pass) or
     ('FILE', path, layer, pass); None for an unlinked optional input."""
-    found = _upstream(node.inputs[name])
+    # A node made before an input existed lacks its socket: that input is unlinked.
+    socket = node.inputs.get(name)
+    found = _upstream(socket) if socket is not None else None
     if found is None:
         if name in REQUIRED:
             raise InputError(f"input '{name}' is not linked: connect it to the '{name}' output "
@@ -224,6 +234,10 @@ def _array(source):
             raise NoCache(f"no cached passes of view layer '{layer}' of scene '{where}': the "
                           f"node is solved at the next render (F12); passes are kept in memory "
                           f"for this Blender session only")
+        if FILM_KEYS[pass_name] not in film:
+            raise InputError(f"the last render of view layer '{layer}' of scene '{where}' has no "
+                             f"pass '{pass_name}' (a G-PT render with the Feature "
+                             f"reconstruction has it)")
         return film[FILM_KEYS[pass_name]]
     return _read_file(where, layer, pass_name)
 
@@ -249,6 +263,11 @@ def _request(scene, node, threads, warm=False):
     if len(shapes) != 1:
         raise InputError("the inputs differ in resolution: "
                          + ", ".join(f"{n} {a.shape[1]}x{a.shape[0]}" for n, a in arrays.items()))
+    halves = [n for n in HALF_GRADIENT_KEYS if n in arrays]
+    if 0 < len(halves) < len(HALF_GRADIENT_KEYS):
+        raise InputError("link all four of " + ", ".join(HALF_GRADIENT_KEYS) + " or none "
+                         "(unlinked: " + ", ".join(n for n in HALF_GRADIENT_KEYS if n not in halves)
+                         + ")")
     layers = {(src[1], src[2]) for src in srcs.values() if src[0] == 'LAYER'}
     cached = _CACHE.get(layers.pop(), {}) if len(layers) == 1 else {}
     features = None
@@ -258,6 +277,8 @@ def _request(scene, node, threads, warm=False):
             raise InputError("the Feature norm needs Render Layers inputs from a Gradient PT "
                              "render with Reconstruction set to Feature (its feature passes)")
         features = {k: cached[k] for k in FEATURE_KEYS}
+        features.update({HALF_GRADIENT_KEYS[n]: np.ascontiguousarray(arrays[n], dtype=np.float32)
+                         for n in halves})
     emission = arrays.get("Emission")
     request = {
         "passes": [np.ascontiguousarray(arrays[n], dtype=np.float32) for n in REQUIRED],
@@ -475,7 +496,7 @@ def fill_after_render(scene, view_layer_name, film, threads, warn, placement=Non
         _CACHE.clear()
         return
     key = (scene.name, view_layer_name)
-    _CACHE[key] = {k: film[k] for k in FILM_KEYS.values()}
+    _CACHE[key] = {k: film[k] for k in FILM_KEYS.values() if k in film}
     _CACHE[key].update({k: film[k] for k in FEATURE_KEYS if k in film})
     _CACHE[key]["placement"] = placement
     _CACHE[key]["alpha"] = film.get("alpha")

@@ -42,6 +42,10 @@ _FILM_KEYS = {
     "Primal B": "primal_b",
     "Primal A Variance": "primal_a_variance",
     "Primal B Variance": "primal_b_variance",
+    "Gradient X A": "gradient_x_a",
+    "Gradient X B": "gradient_x_b",
+    "Gradient Y A": "gradient_y_a",
+    "Gradient Y B": "gradient_y_b",
 }
 
 # The feature passes, registered when the Feature reconstruction renders them
@@ -59,6 +63,16 @@ FEATURE_PASSES = (
     ("Denoising Albedo Variance", 3, "XYZ", 'VECTOR'),
     ("Denoising Normal Variance", 3, "XYZ", 'VECTOR'),
     ("Denoising Depth Variance", 1, "Z", 'VALUE'),
+)
+
+# G-PT's gradients over the primal's halves (the even / odd samples of Primal A / B), registered
+# with the feature passes in G-PT mode: the Feature reconstruction solves each half on its own.
+# In PT mode the gradients are the primal's differences, which Primal A / B already give.
+GRADIENT_HALF_PASSES = (
+    ("Gradient X A", 3, "RGB", 'COLOR'),
+    ("Gradient X B", 3, "RGB", 'COLOR'),
+    ("Gradient Y A", 3, "RGB", 'COLOR'),
+    ("Gradient Y B", 3, "RGB", 'COLOR'),
 )
 
 
@@ -80,6 +94,10 @@ def feature_passes_on(scene):
     return settings is not None and settings.reconstruction == 'FEATURE'
 
 
+def gradient_half_passes_on(scene):
+    """Whether the render computes G-PT's gradients over the halves: feature passes, G-PT."""
+    return feature_passes_on(scene) and scene.gdpt.mode == 'GPT'
+
 
 def register_passes(engine, scene, view_layer):
     engine.register_pass(scene, view_layer, "Combined", 4, "RGBA", 'COLOR')
@@ -100,6 +118,9 @@ def register_passes(engine, scene, view_layer):
         engine.register_pass(scene, view_layer, "Mist", 1, "Z", 'VALUE')
     if feature_passes_on(scene):
         for name, channels, chan_id, kind in FEATURE_PASSES:
+            engine.register_pass(scene, view_layer, name, channels, chan_id, kind)
+    if gradient_half_passes_on(scene):
+        for name, channels, chan_id, kind in GRADIENT_HALF_PASSES:
             engine.register_pass(scene, view_layer, name, channels, chan_id, kind)
     for name, channels, chan_id, kind in MERGE_PASSES:
         engine.register_pass(scene, view_layer, name, channels, chan_id, kind)

@@ -42,6 +42,15 @@ const char* const kFeatureVarianceKeys[FilmPasses::kFeatureCount] = {
     "primal_a_variance", "primal_b_variance", "denoising_albedo_variance",
     "denoising_normal_variance", "denoising_depth_variance"};
 
+// Film keys of FilmPasses::half_gradient, and the Film read-out of each.
+const char* const kHalfGradientKeys[FilmPasses::kHalfGradientCount] = {
+    "gradient_x_a", "gradient_x_b", "gradient_y_a", "gradient_y_b"};
+
+void read_half_gradient(const Film& film, int k, float* out) {
+  const Film::SampleHalf half = k % 2 ? Film::SampleHalf::B : Film::SampleHalf::A;
+  k < 2 ? film.gradient_x_half_rgb(half, out) : film.gradient_y_half_rgb(half, out);
+}
+
 int feature_channels(int k) {
   return Film::feature_channels(Film::FeaturePass(k));
 }
@@ -70,6 +79,8 @@ void for_each_pass(Passes& p, Add&& add) {
       add(kFeatureKeys[k], p.feature[k], feature_channels(k));
       add(kFeatureVarianceKeys[k], p.feature_variance[k], feature_channels(k));
     }
+  for (int k = 0; k < FilmPasses::kHalfGradientCount; ++k)
+    if (!p.half_gradient[k].empty()) add(kHalfGradientKeys[k], p.half_gradient[k], 3);
 }
 
 // The dict's size and sample count, before the passes.
@@ -119,6 +130,10 @@ void FilmPasses::read(const Film& film, int samples) {
     if (size == 0) continue;
     film.feature(Film::FeaturePass(k), feature[k].data());
     film.feature_variance(Film::FeaturePass(k), feature_variance[k].data());
+  }
+  for (int k = 0; k < kHalfGradientCount; ++k) {
+    half_gradient[k].resize(film.has_half_gradients() ? n * 3 : 0);
+    if (film.has_half_gradients()) read_half_gradient(film, k, half_gradient[k].data());
   }
   film.primal_rgb(primal.data());
   film.gradient_x_rgb(gradient_x.data());
@@ -334,7 +349,7 @@ py::array_t<float> reconstruct_arrays(
         throw std::invalid_argument(std::string(key) + ": wrong size");
       return held.back().data();
     };
-    held.reserve(2 * FilmPasses::kFeatureCount);
+    held.reserve(2 * FilmPasses::kFeatureCount + FilmPasses::kHalfGradientCount);
     const float** inputs[FilmPasses::kFeatureCount] = {&input.primal_a, &input.primal_b,
                                                        &input.albedo, &input.normal, &input.depth};
     const float** variances[FilmPasses::kFeatureCount] = {
@@ -344,6 +359,24 @@ py::array_t<float> reconstruct_arrays(
       *inputs[k] = pass(kFeatureKeys[k], feature_channels(k));
       *variances[k] = pass(kFeatureVarianceKeys[k], feature_channels(k));
     }
+    // G-PT's gradients over the halves: optional, all four or none.
+    int present = 0;
+    std::string missing;
+    for (const char* key : kHalfGradientKeys)
+      if (features->contains(key))
+        ++present;
+      else
+        missing += std::string(missing.empty() ? "" : ", ") + key;
+    if (present > 0 && present < FilmPasses::kHalfGradientCount)
+      throw std::invalid_argument(
+          "FEATURE reconstruction: the gradients over the sample halves (gradient_x_a, "
+          "gradient_x_b, gradient_y_a, gradient_y_b) go together; missing " +
+          missing);
+    const float** halves[FilmPasses::kHalfGradientCount] = {
+        &input.gradient_x_a, &input.gradient_x_b, &input.gradient_y_a, &input.gradient_y_b};
+    if (present > 0)
+      for (int k = 0; k < FilmPasses::kHalfGradientCount; ++k)
+        *halves[k] = pass(kHalfGradientKeys[k], 3);
   }
 
   std::vector<float> image;

@@ -39,6 +39,10 @@ struct FilmPasses {
   // Denoising Albedo / Normal / Depth, and each one's variance of its pixel mean.
   static constexpr int kFeatureCount = 5;
   HugePageVector<float> feature[kFeatureCount], feature_variance[kFeatureCount];
+  // G-PT's gradients over the primal's halves (Film::gradient_x_half_rgb): X A, X B, Y A, Y B;
+  // empty unless the film keeps them (feature passes in G-PT mode).
+  static constexpr int kHalfGradientCount = 4;
+  HugePageVector<float> half_gradient[kHalfGradientCount];
   void read(const Film& film, int samples);
   // numpy arrays that take the vectors over (this object is left empty).
   py::dict to_python_owning();
@@ -78,10 +82,12 @@ ReconstructionNorm parse_norm(const std::string& norm);
 
 // Reconstruction of numpy passes (the same code as the CLI and the engine). FEATURE reads the
 // feature passes from `features`, a dict with the film keys of FilmPasses (primal_a, primal_b,
-// denoising_albedo, ... and their *_variance). `progress` (optional, float32): its first value
-// follows the solved fraction, written without the GIL, for Python code polling a solve that runs
-// in another thread. `initial` (optional): a previous L1 result of reconstruct_arrays for the same
-// passes, which L1 warm-starts from (ReconstructionInput::initial).
+// denoising_albedo, ... and their *_variance), and G-PT's gradients over the halves when it
+// holds gradient_x_a, gradient_x_b, gradient_y_a and gradient_y_b (all four or none). `progress`
+// (optional, float32): its first value follows the solved fraction, written without the GIL, for
+// Python code polling a solve that runs in another thread. `initial` (optional): a previous L1
+// result of reconstruct_arrays for the same passes, which L1 warm-starts from
+// (ReconstructionInput::initial).
 py::array_t<float> reconstruct_arrays(
     const FloatArray& primal, const FloatArray& gradient_x, const FloatArray& gradient_y,
     const std::optional<FloatArray>& variance, const std::optional<FloatArray>& emission,

@@ -38,15 +38,21 @@ using shift::VertexType;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// Adds one half to a gradient accumulator (sum and squared luminance); a non-finite half counts
-// as 0, as a non-finite primal does.
-void add_half(Vec3d g, double* sum, double& sum2) {
+// Adds one half to a gradient accumulator (sum and squared luminance) and, unless null, to the
+// sum of its sample's half (Film::half_a_gradients); a non-finite half counts as 0, as a
+// non-finite primal does.
+void add_half(Vec3d g, double* sum, double& sum2, double* half_sum) {
   if (!(std::isfinite(g.x) && std::isfinite(g.y) && std::isfinite(g.z))) g = Vec3d();
   sum[0] += g.x;
   sum[1] += g.y;
   sum[2] += g.z;
   const double l = 0.2126 * g.x + 0.7152 * g.y + 0.0722 * g.z;
   sum2 += l * l;
+  if (half_sum) {
+    half_sum[0] += g.x;
+    half_sum[1] += g.y;
+    half_sum[2] += g.z;
+  }
 }
 
 // A survived roulette of continuation probability q: the base's throughput is divided by it, and
@@ -128,11 +134,13 @@ class GradientPathTracer final : public Integrator {
     grad.shift_attempts += r.attempts;
     grad.shift_failures += r.failures;
     // --- Gradient halves: dx(x) = G_right(x) - G_left(x + 1), likewise dy ---
+    // With the feature passes, a half-A sample's halves go to the half-A sums too.
     const bool* mask = cs.mask;
-    if (mask[kRight]) add_half(r.grad[kRight], grad.dx, grad.dx2);
-    if (mask[kUp]) add_half(r.grad[kUp], grad.dy, grad.dy2);
-    if (mask[kLeft]) add_half(r.grad[kLeft], grad.dx_left, grad.dx_left2);
-    if (mask[kDown]) add_half(r.grad[kDown], grad.dy_down, grad.dy_down2);
+    Film::HalfAGradients* a = film.half_a_gradients(x, y, s);
+    if (mask[kRight]) add_half(r.grad[kRight], grad.dx, grad.dx2, a ? a->dx : nullptr);
+    if (mask[kUp]) add_half(r.grad[kUp], grad.dy, grad.dy2, a ? a->dy : nullptr);
+    if (mask[kLeft]) add_half(r.grad[kLeft], grad.dx_left, grad.dx_left2, a ? a->dx_left : nullptr);
+    if (mask[kDown]) add_half(r.grad[kDown], grad.dy_down, grad.dy_down2, a ? a->dy_down : nullptr);
     return r.rays;
   }
 

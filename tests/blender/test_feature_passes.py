@@ -11,8 +11,12 @@
 #    checked: the regression spreads the ceiling's hot spot over the lamp, see the commit);
 #  - the EXR also holds Primal A / B and every variance: gdpt-reconstruct --norm feature on it
 #    gives the engine's Combined;
+#  - in G-PT mode (not in PT mode) the EXR holds Gradient X / Y A / B, G-PT's gradients over the
+#    same halves: over 16 samples (8 per half) (A + B) / 2 is Gradient X / Y to float rounding,
+#    and A and B differ;
 #  - the Gradient Reconstruct compositor node with norm Feature gives the engine's image from the
-#    Render Layers of a Feature render, and reports an error on an L1 render.
+#    Render Layers of a Feature render (with the half gradients linked too), reports an error on
+#    an L1 render and when only some of the half gradients are linked.
 import os
 import subprocess
 import sys
@@ -74,6 +78,8 @@ def main():
     grey = np.all(np.abs(albedo - 0.9) < 0.02, axis=-1)
     check(int(grey.sum()) == 0, f"no pixel has the mirror's albedo ({int(grey.sum())} do)")
     feature = combined(ch)
+    test_half_gradients(ch)
+    test_module_half_gradient_keys(ch, feature)
     test_command_line(ch, feature)
 
     l1 = combined(exr.read_exr(S.render_engine(scene, "l1", 'GDPT', SPP, reconstruction='L1')))
@@ -89,12 +95,75 @@ def main():
                                                        reconstruction='FEATURE')))
     pt_plain = combined(exr.read_exr(S.render_engine(scene, "pt_none", 'GDPT', SPP, mode='PT',
                                                      reconstruction='NONE')))
+    pt_passes = exr.read_exr(os.path.join(S.args()["out"], "pt_feature.exr"))
+    for name in HALF_GRADIENTS:
+        check(f"ViewLayer.{name}.R" not in pt_passes, f"a PT render has no {name} pass")
+    check("ViewLayer.Primal A.R" in pt_passes, "a PT Feature render has Primal A")
     e_pt_feature, e_pt = S.rel_mse(pt_feature, ref), S.rel_mse(pt_plain, ref)
     print(f"PT at {SPP} spp: relMSE Feature {e_pt_feature:.5f}, plain PT {e_pt:.5f}")
     mean_error = abs(float(pt_feature.mean()) / float(ref.mean()) - 1.0)
     check(mean_error < 0.02, f"PT + Feature: the reference's mean within {100 * mean_error:.2f}%")
     test_compositor_node(scene)
     print("feature passes: all checks passed")
+
+
+HALF_GRADIENTS = ("Gradient X A", "Gradient X B", "Gradient Y A", "Gradient Y B")
+
+
+def test_half_gradients(ch):
+    """G-PT's gradients over the halves: with 8 samples per half, their mean is the gradient."""
+    for name in HALF_GRADIENTS:
+        check(f"ViewLayer.{name}.R" in ch, f"the EXR has {name}")
+    for axis in "XY":
+        whole = exr.rgb(ch, f"ViewLayer.Gradient {axis}.")
+        a = exr.rgb(ch, f"ViewLayer.Gradient {axis} A.")
+        b = exr.rgb(ch, f"ViewLayer.Gradient {axis} B.")
+        # Each pass is a float32 rounding of a double mean: relative errors of 6e-8 each.
+        bound = 1e-6 * (np.abs(a) + np.abs(b) + np.abs(whole)) + 1e-9
+        err = np.abs(0.5 * (a + b) - whole)
+        check(np.all(err <= bound), f"(A + B) / 2 = Gradient {axis} (max error "
+                                    f"{float(err.max()):.2e}, worst error / bound "
+                                    f"{float((err / bound).max()):.3f})")
+        differ = float(np.mean(np.abs(a - b))) / max(float(np.mean(np.abs(whole))), 1e-12)
+        check(differ > 0.1, f"Gradient {axis} A and B differ: mean |A - B| / mean |Gradient "
+                            f"{axis}| = {differ:.3f}")
+
+
+def test_module_half_gradient_keys(ch, feature):
+    """_gdpt.reconstruct reads the half gradients from the features dict (gradient_x_a ...):
+    all four give the engine's Combined; three, or one of the wrong size, are refused by name."""
+    from gdpt import _gdpt
+
+    def get(name, channels):
+        return np.ascontiguousarray(np.stack([ch[f"ViewLayer.{name}.{c}"] for c in channels],
+                                             -1).squeeze(-1 if len(channels) == 1 else None),
+                                    dtype=np.float32)
+    features = {}
+    for name, key, channels in (("Primal A", "primal_a", "RGB"), ("Primal B", "primal_b", "RGB"),
+                                ("Denoising Albedo", "denoising_albedo", "RGB"),
+                                ("Denoising Normal", "denoising_normal", "XYZ"),
+                                ("Denoising Depth", "denoising_depth", "Z")):
+        features[key] = get(name, channels)
+        features[key + "_variance"] = get(name + " Variance", "Z" if channels == "Z" else "XYZ")
+    for name in HALF_GRADIENTS:
+        features[name.lower().replace(" ", "_")] = get(name, "RGB")
+
+    def solve(f):
+        return _gdpt.reconstruct(get("Primal", "RGB"), get("Gradient X", "RGB"),
+                                 get("Gradient Y", "RGB"), None, get("Emission", "RGB"),
+                                 'FEATURE', 0.2, 0, features=f)
+    err = float(np.abs(solve(features) - feature).max() / max(float(np.abs(feature).max()), 1e-6))
+    check(err < 1e-5, f"_gdpt.reconstruct with the half gradients = the engine's Combined "
+                      f"(max diff / max {err:.2e})")
+    three = {k: v for k, v in features.items() if k != "gradient_y_b"}
+    small = dict(features, gradient_x_a=features["gradient_x_a"][1:])
+    for bad, expect in ((three, "missing gradient_y_b"), (small, "gradient_x_a: wrong size")):
+        try:
+            solve(bad)
+            message = "(no error)"
+        except ValueError as e:
+            message = str(e)
+        check(expect in message, f"_gdpt.reconstruct refuses it: {message}")
 
 
 def test_command_line(ch, feature):
@@ -118,12 +187,27 @@ def test_compositor_node(scene):
     """The Gradient Reconstruct node with norm Feature on the Render Layers of a Feature render
     gives the engine's Combined; on an L1 render (no feature passes) it reports why not."""
     import gdpt.engine as engine_module
-    S.reconstruct_tree(scene, norm='FEATURE', alpha=0.2)
+    # The Render Layers node shows the half gradients once the scene renders G-PT + Feature.
+    S.setup_gdpt(scene, SPP, reconstruction='FEATURE')
+    scene.view_layers[0].update_render_passes()
+    node = S.reconstruct_tree(scene, norm='FEATURE', alpha=0.2)
+    tree = scene.node_tree
+    rl = next(n for n in tree.nodes if n.type == 'R_LAYERS')
+    for name in HALF_GRADIENTS:
+        tree.links.new(rl.outputs[name], node.inputs[name])
     ch = exr.read_exr(S.render_engine(scene, "node", 'GDPT', SPP, reconstruction='FEATURE'))
     composite = exr.rgb(ch, "Composite.Combined.")
     engine_rgb = exr.rgb(ch, "ViewLayer.Combined.")
     err = float(np.abs(composite - engine_rgb).max() / max(float(np.abs(engine_rgb).max()), 1e-6))
-    check(err < 1e-4, f"node (Feature) = the engine's Feature Combined (max diff / max {err:.2e})")
+    check(err < 1e-4, f"node (Feature, half gradients linked) = the engine's Feature Combined "
+                      f"(max diff / max {err:.2e})")
+    tree.links.remove(node.inputs["Gradient Y B"].links[0])
+    S.render_engine(scene, "node_three", 'GDPT', SPP, reconstruction='FEATURE')
+    warnings = engine_module.LAST_RENDER.get("warnings", [])
+    check(any("link all four" in w and "unlinked: Gradient Y B" in w for w in warnings),
+          f"three of the four half gradients linked: reported ({warnings})")
+    for name in HALF_GRADIENTS[:3]:
+        tree.links.remove(node.inputs[name].links[0])
     S.render_engine(scene, "node_l1", 'GDPT', SPP, reconstruction='L1')
     warnings = engine_module.LAST_RENDER.get("warnings", [])
     check(any("Feature norm needs" in w for w in warnings),

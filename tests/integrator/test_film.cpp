@@ -111,5 +111,62 @@ TEST(Film, PtFilmsCommitWithoutGradientAccumulators) {
   EXPECT_THROW(film.take_rows(gpt_pass, 0, 1), std::logic_error);
 }
 
+// The gradients over the samples' halves: half-A sums kept only with the feature passes in a
+// film that holds gradients; the parity is the global index's (sample_offset); read-out as
+// gradient_x_rgb over each half's own samples, half B = the totals minus half A.
+TEST(Film, GradientsOverTheSampleHalves) {
+  Film f(2, 1);
+  EXPECT_FALSE(f.has_half_gradients());  // no feature passes: no cost
+  f.enable_feature_passes(true);
+  ASSERT_TRUE(f.has_half_gradients());
+  f.set_sample_offset(1);  // samples 1, 2, 3: A = {2}, B = {1, 3}
+  EXPECT_EQ(f.half_a_gradients(0, 0, 1), nullptr);
+  EXPECT_EQ(f.half_a_gradients(0, 0, 3), nullptr);
+  ASSERT_NE(f.half_a_gradients(0, 0, 2), nullptr);
+  // Pixel 0: G_right sums 6 (all), 1 (A); pixel 1: G_left sums 9 (all), 3 (A).
+  f.gradients(0, 0).dx[0] = 6.0;
+  f.half_a_gradients(0, 0, 2)->dx[0] = 1.0;
+  f.gradients(1, 0).dx_left[0] = 9.0;
+  f.half_a_gradients(1, 0, 2)->dx_left[0] = 3.0;
+  f.add_sample_count(0, 0, 3);
+  f.add_sample_count(1, 0, 3);
+  using H = Film::SampleHalf;
+  std::vector<float> all(6), a(6), b(6), ya(6);
+  f.gradient_x_rgb(all.data());
+  f.gradient_x_half_rgb(H::A, a.data());
+  f.gradient_x_half_rgb(H::B, b.data());
+  f.gradient_y_half_rgb(H::A, ya.data());
+  EXPECT_FLOAT_EQ(all[0], 6.0f / 3.0f - 9.0f / 3.0f);
+  EXPECT_FLOAT_EQ(a[0], 1.0f / 1.0f - 3.0f / 1.0f);
+  EXPECT_FLOAT_EQ(b[0], 5.0f / 2.0f - 6.0f / 2.0f);
+  EXPECT_FLOAT_EQ((a[0] + 2.0f * b[0]) / 3.0f, all[0]);
+  EXPECT_FLOAT_EQ(a[3], 0.0f);  // the last column: pixel 1's G_right sums are 0
+  EXPECT_FLOAT_EQ(ya[0], 0.0f);
+  // Committed with the pass, cleared with the film.
+  Film film(2, 1);
+  film.enable_feature_passes(true);
+  film.set_sample_offset(1);
+  film.take_rows(f, 0, 1);
+  film.gradient_x_half_rgb(H::A, a.data());
+  EXPECT_FLOAT_EQ(a[0], -2.0f);
+  EXPECT_EQ(f.half_a_gradients(0, 0, 2)->dx[0], 0.0);
+  film.clear();
+  film.add_sample_count(0, 0, 3);
+  film.gradient_x_half_rgb(H::A, a.data());
+  EXPECT_FLOAT_EQ(a[0], 0.0f);
+  // Half B with no samples reads 0; a PT film keeps no half sums.
+  Film one(1, 1);
+  one.enable_feature_passes(true);
+  one.add_sample_count(0, 0, 1);
+  one.gradients(0, 0).dx[0] = 4.0;
+  one.half_a_gradients(0, 0, 0)->dx[0] = 4.0;
+  one.gradient_x_half_rgb(H::B, b.data());
+  EXPECT_FLOAT_EQ(b[0], 0.0f);
+  Film plain(1, 1);  // no half sums: refuses a pass that has them
+  EXPECT_THROW(plain.take_rows(one, 0, 1), std::logic_error);
+  one.set_gradients_from_primal(true);
+  EXPECT_FALSE(one.has_half_gradients());
+}
+
 }  // namespace
 }  // namespace gdpt

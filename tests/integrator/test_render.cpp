@@ -1180,6 +1180,92 @@ TEST(Render, FeaturePassesPrimalHalves) {
   EXPECT_FALSE(off.film().has_features());
 }
 
+// G-PT's gradients over the primal's halves (Film::gradient_x_half_rgb / gradient_y_half_rgb).
+struct HalfGradients {
+  std::vector<float> x, y, xa, xb, ya, yb;
+};
+
+HalfGradients render_half_gradients(const Scene& scene, RenderSettings s) {
+  s.mode = RenderSettings::Mode::GPT;
+  s.feature_passes = true;
+  RenderSession session(scene, s);
+  std::atomic<bool> cancel{false};
+  session.render(nullptr, cancel);
+  const Film& film = session.film();
+  EXPECT_TRUE(film.has_half_gradients());
+  HalfGradients g;
+  for (auto* v : {&g.x, &g.y, &g.xa, &g.xb, &g.ya, &g.yb}) v->resize(film.pixel_count() * 3);
+  film.gradient_x_rgb(g.x.data());
+  film.gradient_y_rgb(g.y.data());
+  using H = Film::SampleHalf;
+  film.gradient_x_half_rgb(H::A, g.xa.data());
+  film.gradient_x_half_rgb(H::B, g.xb.data());
+  film.gradient_y_half_rgb(H::A, g.ya.data());
+  film.gradient_y_half_rgb(H::B, g.yb.data());
+  return g;
+}
+
+// Two renders' halves agree where they hold the same samples (same values: sample values depend
+// only on seed, pixel and global index).
+void expect_same_half(const std::vector<float>& a, const std::vector<float>& b,
+                      const std::string& what) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t k = 0; k < a.size(); ++k)
+    ASSERT_NEAR(a[k], b[k], 1e-5f * (1.0f + std::fabs(b[k]))) << what << " " << k;
+}
+
+// The halves of G-PT's gradients: over 5 samples (A = indices 0, 2, 4; B = 1, 3), split across
+// passes, their count-weighted mean (3 A + 2 B) / 5 is Gradient X / Y to float rounding, and
+// they differ (independent noise). The parity is the global sample index's, as Primal A's: a
+// render of samples 1..3 has B = {1, 3}, the B of a render of samples 0..3, and A = {2}, the A
+// of a render of sample 2 alone. A PT film, or one without the feature passes, keeps none.
+TEST(Render, FeaturePassesGradientHalves) {
+  Scene scene;
+  scene.meshes.push_back(quad(10.0f));
+  scene.meshes.push_back(sphere(0.5f, 12, 8, {0, 0, 0.5f}));
+  scene.materials.push_back(diffuse(Spectrum(0.6f)));
+  scene.instances.push_back(place(0, 0));
+  scene.instances.push_back(place(1, 0));
+  scene.world.color = Spectrum(1.0f);
+  scene.camera = top_camera(8, 2.5f, 7.0f);
+  RenderSettings s = pt(5);
+  s.samples_per_pass = 2;
+  const HalfGradients g = render_half_gradients(scene, s);
+  double differ = 0.0, magnitude = 0.0;
+  for (size_t k = 0; k < g.x.size(); ++k) {
+    EXPECT_NEAR((3.0f * g.xa[k] + 2.0f * g.xb[k]) / 5.0f, g.x[k],
+                1e-6f * (1.0f + std::fabs(g.x[k])))
+        << k;
+    EXPECT_NEAR((3.0f * g.ya[k] + 2.0f * g.yb[k]) / 5.0f, g.y[k],
+                1e-6f * (1.0f + std::fabs(g.y[k])))
+        << k;
+    differ += std::fabs(g.xa[k] - g.xb[k]) + std::fabs(g.ya[k] - g.yb[k]);
+    magnitude += std::fabs(g.x[k]) + std::fabs(g.y[k]);
+  }
+  EXPECT_GT(magnitude / double(g.x.size()), 1e-3) << "no gradients";
+  EXPECT_GT(differ / double(g.x.size()), 1e-3) << "halves identical";
+
+  RenderSettings from1 = pt(3), all4 = pt(4), only2 = pt(1);
+  from1.sample_offset = 1;
+  only2.sample_offset = 2;
+  const HalfGradients g1 = render_half_gradients(scene, from1);
+  const HalfGradients g4 = render_half_gradients(scene, all4);
+  const HalfGradients g2 = render_half_gradients(scene, only2);
+  expect_same_half(g1.xb, g4.xb, "B of samples 1..3 against 0..3, x");
+  expect_same_half(g1.yb, g4.yb, "B of samples 1..3 against 0..3, y");
+  expect_same_half(g1.xa, g2.xa, "A of samples 1..3 against 2, x");
+  expect_same_half(g1.ya, g2.ya, "A of samples 1..3 against 2, y");
+
+  RenderSettings pt_features = pt(2);
+  pt_features.feature_passes = true;
+  RenderSession pt_session(scene, pt_features);
+  EXPECT_FALSE(pt_session.film().has_half_gradients());
+  RenderSettings gpt_plain = pt(2);
+  gpt_plain.mode = RenderSettings::Mode::GPT;
+  RenderSession plain_session(scene, gpt_plain);
+  EXPECT_FALSE(plain_session.film().has_half_gradients());
+}
+
 // Renders a sheet_over_floor scene under an 8 x 8 top view with direct light only and checks
 // its primal: `inside` on the sheet's square (pixels 2..5), `outside` around it.
 void expect_square(const Scene& scene, RenderSettings::Mode mode, float inside, float outside,

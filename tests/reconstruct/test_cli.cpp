@@ -274,7 +274,9 @@ TEST_F(Cli, FeatureNormReadsTheDenoisingPasses) {
 
   ReconstructionSettings settings;
   settings.norm = ReconstructionNorm::Feature;
-  const auto expected = reconstruct(sc.input(), settings);
+  ReconstructionInput in = sc.input();  // the file has no gradient halves
+  in.gradient_x_a = in.gradient_x_b = in.gradient_y_a = in.gradient_y_b = nullptr;
+  const auto expected = reconstruct(in, settings);
   EXPECT_LT(test::rms_error(out, expected), 1e-6);
   EXPECT_LT(test::relative_mse(out, sc.truth), 0.5 * test::relative_mse(sc.primal, sc.truth));
 
@@ -290,6 +292,47 @@ TEST_F(Cli, FeatureNormReadsTheDenoisingPasses) {
   const CliResult bad = run({path("in.exr"), "-o", path("x.exr"), "--norm", "nfor"});
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("feature"), std::string::npos) << bad.err;
+}
+
+// --norm feature reads G-PT's gradients over the halves when all four are present (the output is
+// reconstruct() with them) and refuses a layer that has only some of them.
+TEST_F(Cli, FeatureNormReadsTheHalfGradients) {
+  const test::FeatureScene sc = test::make_feature_scene(w_, h_, 0.1f, 0.05f, 9);
+  // Halves that differ from each other and average to the scene's gradients.
+  std::vector<float> gxa = sc.gx, gxb = sc.gx, gya = sc.gy, gyb = sc.gy;
+  for (size_t j = 0; j < gxa.size(); ++j) {
+    const float d = 0.02f * float(int(j * 7919 % 13) - 6);
+    gxa[j] += d, gxb[j] -= d, gya[j] -= d, gyb[j] += d;
+  }
+  std::map<std::string, std::vector<float>> passes = {{"Primal", sc.primal},
+                                                      {"Primal A", sc.a},
+                                                      {"Primal B", sc.b},
+                                                      {"Gradient X", sc.gx},
+                                                      {"Gradient Y", sc.gy},
+                                                      {"Denoising Albedo", sc.albedo},
+                                                      {"Denoising Normal", sc.normal},
+                                                      {"Denoising Depth", sc.depth},
+                                                      {"Gradient X A", gxa},
+                                                      {"Gradient X B", gxb},
+                                                      {"Gradient Y A", gya},
+                                                      {"Gradient Y B", gyb}};
+  write_multilayer_exr(path("halves.exr"), w_, h_, "ViewLayer", passes, {"Denoising Normal"});
+  const CliResult r = run({path("halves.exr"), "-o", path("out.exr"), "--norm", "feature"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  ReconstructionInput in = sc.input();
+  in.gradient_x_a = gxa.data(), in.gradient_x_b = gxb.data();
+  in.gradient_y_a = gya.data(), in.gradient_y_b = gyb.data();
+  ReconstructionSettings settings;
+  settings.norm = ReconstructionNorm::Feature;
+  EXPECT_LT(test::rms_error(read_rgba(path("out.exr")), reconstruct(in, settings)), 1e-6);
+
+  passes.erase("Gradient Y B");
+  write_multilayer_exr(path("three.exr"), w_, h_, "ViewLayer", passes, {"Denoising Normal"});
+  const CliResult some = run({path("three.exr"), "-o", path("y.exr"), "--norm", "feature"});
+  EXPECT_EQ(some.status, 1);
+  EXPECT_NE(some.err.find("go together (missing Gradient Y B)"), std::string::npos) << some.err;
+  EXPECT_EQ(std::count(some.err.begin(), some.err.end(), '\n'), 1) << some.err;
+  EXPECT_FALSE(fs::exists(path("y.exr")));
 }
 
 }  // namespace

@@ -66,6 +66,13 @@ RenderPart part_from_film(const Film& f, const RenderSettings& s, const std::str
       add(name + " Variance", c, [&](float* o) { f.feature_variance(pass, o); });
     }
   }
+  if (f.has_half_gradients()) {
+    using H = Film::SampleHalf;
+    add("Gradient X A", 3, [&](float* o) { f.gradient_x_half_rgb(H::A, o); });
+    add("Gradient X B", 3, [&](float* o) { f.gradient_x_half_rgb(H::B, o); });
+    add("Gradient Y A", 3, [&](float* o) { f.gradient_y_half_rgb(H::A, o); });
+    add("Gradient Y B", 3, [&](float* o) { f.gradient_y_half_rgb(H::B, o); });
+  }
   std::vector<float> alpha_pass(n);
   f.alpha(alpha_pass.data());
   const std::vector<float> rgb = rebuild_combined(p, *norm_from_name(norm), alpha, 2);
@@ -137,9 +144,12 @@ TEST(Merge, GptPartsEqualTheRenderOfAllSamples) {
                                          render_part(scene, s, 12, 4, "FEATURE")};
   const RenderPart merged = merge_render_parts(parts, {{}, {}, 2});
   EXPECT_EQ(merged.record.sample_offset, 0u);
+  // G-PT's gradients over the halves too, merged by the parts' even / odd sample counts.
+  ASSERT_TRUE(single.passes.count("Gradient X A") && single.passes.count("Gradient Y B"));
   expect_equal_passes(merged, single);
   // Not trivially equal: a part differs from the whole.
   EXPECT_GT(differences(parts[0], single)["Primal"], 1e-3);
+  EXPECT_GT(differences(parts[0], single)["Gradient X A"], 1e-3);
   EXPECT_GT(differences(parts[0], single)["Variance"], 1e-2);
 }
 
