@@ -138,6 +138,12 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
       d.corner_colors = mesh.corner_colors.data();
       d.corner_color_tris = uint32_t(std::min(mesh.corner_colors.size() / 3, tris));
     }
+    if (mesh.vertex_pointiness.size() == mesh.positions.size())
+      d.vertex_pointiness = mesh.vertex_pointiness.data();
+    if (!mesh.triangle_island_random.empty()) {
+      d.triangle_island_random = mesh.triangle_island_random.data();
+      d.island_random_tris = uint32_t(std::min(mesh.triangle_island_random.size(), tris));
+    }
     if (!mesh.corner_tangents.empty()) {
       if (mesh.corner_tangent_signs.size() != mesh.corner_tangents.size())
         throw std::invalid_argument("mesh " + std::to_string(inst.mesh) + ": " +
@@ -200,12 +206,19 @@ void EmbreeScene::set_materials(std::span<const Material> materials) {
   auto reads_coords = [&](int32_t m) {
     return m >= 0 && size_t(m) < materials.size() && materials[size_t(m)].reads_coordinates();
   };
+  auto reads_attributes = [&](int32_t m) {
+    return m >= 0 && size_t(m) < materials.size() &&
+           materials[size_t(m)].reads_surface_attributes();
+  };
   for (InstanceData& d : instances_) {
     d.writes_color =
         d.corner_colors != nullptr || reads(d.uniform_material) || reads(default_material_);
     d.perturbs_normal = perturbs(d.uniform_material) || perturbs(default_material_);
     d.writes_coords = reads_coords(d.uniform_material) || reads_coords(default_material_);
+    d.writes_attributes =
+        reads_attributes(d.uniform_material) || reads_attributes(default_material_);
     for (int32_t m : d.slot_materials) {
+      d.writes_attributes = d.writes_attributes || reads_attributes(m);
       d.writes_color = d.writes_color || reads(m);
       d.perturbs_normal = d.perturbs_normal || perturbs(m);
       d.writes_coords = d.writes_coords || reads_coords(m);
@@ -332,6 +345,19 @@ void compute_unit_normals(const Vec3f* positions, const uint32_t* indices, size_
 
 }  // namespace
 
+void EmbreeScene::write_attributes(const InstanceData& d, uint32_t primitive, const uint32_t* idx,
+                                   float u, float v, SurfaceHit& hit) {
+  SurfaceAttributes& a = hit.attributes;
+  a.barycentric = Vec2f(u, v);
+  a.pointiness = 0.0f;
+  if (d.vertex_pointiness) {
+    const float* P = d.vertex_pointiness;
+    a.pointiness = (1.0f - u - v) * P[idx[0]] + u * P[idx[1]] + v * P[idx[2]];
+  }
+  a.random_per_island =
+      primitive < d.island_random_tris ? d.triangle_island_random[primitive] : 0.0f;
+}
+
 void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v,
                                const Vec3f& dir, SurfaceHit& hit) const {
   const InstanceData& d = instances_[top_id];
@@ -386,6 +412,8 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
     }
     store3(hit.color, color);
   }
+  if (d.writes_attributes) [[unlikely]]
+    write_attributes(d, primitive, idx, u, v, hit);
   if (d.writes_coords) [[unlikely]] {
     const Vec3f* P = d.object_positions;
     const __m128 object =

@@ -34,6 +34,7 @@ struct SurfaceHit {
   Vec3f color;       // colour attribute (Mesh::corner_colors), 0 when the mesh has none; only set
                      // on instances that have one or whose materials read one
   TexCoords coords;  // object-space coordinates; only set on instances whose materials read them
+  SurfaceAttributes attributes;  // only set on instances whose materials read them
   // A normal map or bump replaced shading_normal; unperturbed_normal is the interpolated one
   // (for the bump shadowing of diffuse lobes, ClosureSet::set_bump_shadowing).
   bool perturbed = false;
@@ -45,7 +46,7 @@ struct SurfaceHit {
 
 // What a material sees of a hit.
 inline ShadingContext shading_context_of(const SurfaceHit& hit) {
-  return {hit.uv, hit.front_facing, &hit.color, &hit.coords};
+  return {hit.uv, hit.front_facing, &hit.color, &hit.coords, nullptr, nullptr, &hit.attributes};
 }
 
 // The view of `hit` from `wi_world` (unit, from the hit back along the incoming ray), for
@@ -225,6 +226,10 @@ class EmbreeScene {
     bool writes_color = false;     // hits fill SurfaceHit::color (set_materials)
     bool perturbs_normal = false;  // some material has a normal map or a bump (set_materials)
     bool writes_coords = false;    // some material reads Generated / Object / Position coordinates
+    bool writes_attributes = false;  // some material reads SurfaceAttributes (set_materials)
+    const float* vertex_pointiness = nullptr;       // Mesh::vertex_pointiness, or null
+    const float* triangle_island_random = nullptr;  // for primitives < island_random_tris
+    uint32_t island_random_tris = 0;
     const Vec3f* object_positions = nullptr;  // the Mesh's own (object-space) positions
     // Generated coordinates = object position * generated_scale + generated_offset (lanes).
     alignas(16) float generated_scale[4] = {};
@@ -260,10 +265,18 @@ class EmbreeScene {
                    const Material& material, size_t bump) const;
   // The shading context of a completed hit (its colour and coordinates where it has them).
   static ShadingContext shading_context(const InstanceData& d, const SurfaceHit& hit) {
-    return {hit.uv, true, d.writes_color ? &hit.color : nullptr,
-            d.writes_coords ? &hit.coords : nullptr};
+    return {hit.uv,
+            true,
+            d.writes_color ? &hit.color : nullptr,
+            d.writes_coords ? &hit.coords : nullptr,
+            nullptr,
+            nullptr,
+            d.writes_attributes ? &hit.attributes : nullptr};
   }
   static void set_generated_mapping(InstanceData& d, const Mesh& mesh);
+  // Fills hit.attributes (SurfaceAttributes) at barycentrics (u, v) of triangle `primitive`.
+  static void write_attributes(const InstanceData& d, uint32_t primitive, const uint32_t* idx,
+                               float u, float v, SurfaceHit& hit);
   const Scene* scene_ = nullptr;
 
   std::span<const Material> materials_;

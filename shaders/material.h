@@ -59,6 +59,9 @@ class Material {
   bool reads_view() const { return reads_view_; }
   // Some input reads the path (ShadingContext::path: Light Path): closures per hit, never cached.
   bool reads_path() const { return reads_path_; }
+  // Some input reads the Geometry node's Pointiness, Parametric or Random Per Island
+  // (ShadingContext::attributes).
+  bool reads_surface_attributes() const { return reads_surface_attributes_; }
 
  private:
   void cache_if_constant();
@@ -79,6 +82,7 @@ class Material {
   bool reads_coordinates_ = false;
   bool reads_view_ = false;
   bool reads_path_ = false;
+  bool reads_surface_attributes_ = false;
   Spectrum average_emission_{0.0f, 0.0f, 0.0f};
 };
 

@@ -37,6 +37,13 @@ struct PathView {
           transparent_depth = 0;
 };
 
+// The Geometry node's mesh attributes at a hit (see GeometryOutput).
+struct SurfaceAttributes {
+  float pointiness = 0.0f;         // Mesh::vertex_pointiness interpolated; 0 without
+  float random_per_island = 0.0f;  // Mesh::triangle_island_random of the triangle; 0 without
+  Vec2f barycentric;               // (u, v): the hit is (1 - u - v) p0 + u p1 + v p2
+};
+
 struct ShadingContext {
   Vec2f uv;                  // mesh UV (0 when the mesh has none)
   bool front_facing = true;  // the ray hit the side the geometric normal points to
@@ -53,6 +60,8 @@ struct ShadingContext {
   // The path when the caller knows it, else null (a camera ray of length 0). A material that
   // reads it (Material::reads_path) is evaluated per hit; a G-PT offset passes its own length.
   const PathView* path = nullptr;
+  // The hit's mesh attributes when its instance's materials read them, else null (they read 0).
+  const SurfaceAttributes* attributes = nullptr;
 };
 
 }  // namespace gdpt

@@ -24,7 +24,9 @@ struct TriangleLight {
   float area = 0.0f;
   Vec2f uv0, uv1, uv2;
   Vec3f color0{0.0f}, color1{0.0f}, color2{0.0f};  // colour attribute at the corners
-  uint32_t material = 0;                           // index into the materials span
+  float pointiness0 = 0.0f, pointiness1 = 0.0f, pointiness2 = 0.0f;  // Mesh::vertex_pointiness
+  float island_random = 0.0f;                                        // Mesh::triangle_island_random
+  uint32_t material = 0;  // index into the materials span
   float select_pmf = 0.0f;
   float max_edge2 = 0.0f;  // squared longest edge
 
@@ -99,6 +101,14 @@ struct TriangleLight {
     ctx.uv = uv_at(b.x, b.y);
     const Vec3f color = color0 * (1.0f - b.x - b.y) + color1 * b.x + color2 * b.y;
     ctx.color = &color;
+    SurfaceAttributes attributes;
+    if (m.reads_surface_attributes()) {
+      attributes.barycentric = b;
+      attributes.pointiness =
+          pointiness0 * (1.0f - b.x - b.y) + pointiness1 * b.x + pointiness2 * b.y;
+      attributes.random_per_island = island_random;
+      ctx.attributes = &attributes;
+    }
     ctx.front_facing = dot(dir, normal) < 0.0f;  // the receiver is on the normal's side
     ShadingGeometry view;
     if (m.reads_view()) {
