@@ -274,9 +274,9 @@ class EmbreeScene {
             d.writes_attributes ? &hit.attributes : nullptr};
   }
   static void set_generated_mapping(InstanceData& d, const Mesh& mesh);
-  // Fills hit.attributes (SurfaceAttributes) at barycentrics (u, v) of triangle `primitive`.
-  static void write_attributes(const InstanceData& d, uint32_t primitive, const uint32_t* idx,
-                               float u, float v, SurfaceHit& hit);
+  // The mesh attributes (SurfaceAttributes) at barycentrics (u, v) of triangle `primitive`.
+  static SurfaceAttributes attributes_at(const InstanceData& d, uint32_t primitive,
+                                         const uint32_t* idx, float u, float v);
   const Scene* scene_ = nullptr;
 
   std::span<const Material> materials_;
