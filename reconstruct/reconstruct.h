@@ -83,6 +83,13 @@ struct ReconstructionInput {
   const float* primal_b = nullptr;    // RGB
   const float* variance_a = nullptr;  // RGB variance of primal_a's pixel mean, optional
   const float* variance_b = nullptr;  // RGB, optional (both or none; else estimated from A - B)
+  // G-PT's gradients over the same two halves of the samples (forward differences as
+  // gradient_x / gradient_y), optional: with them each half gets its own gradient-domain solve,
+  // which lets the error of a filtered solution be estimated from the other half.
+  const float* gradient_x_a = nullptr;  // RGB
+  const float* gradient_x_b = nullptr;  // RGB
+  const float* gradient_y_a = nullptr;  // RGB
+  const float* gradient_y_b = nullptr;  // RGB
   // Optional guide features, each with an optional per-pixel variance of its pixel mean.
   const float* albedo = nullptr;           // RGB
   const float* albedo_variance = nullptr;  // RGB

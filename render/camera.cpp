@@ -177,6 +177,30 @@ void CameraModel::generate_offset_rays(Vec2f raster, Vec2f lens, const bool mask
   }
 }
 
+ShadingCamera CameraModel::shading_camera() const {
+  // Cycles clears the camera object's scale and looks down +z: unit columns, z negated.
+  Transform t = camera_to_world_;
+  for (int c = 0; c < 3; ++c) {
+    const float l = length(t.column(c));
+    const float s = (l > 0.0f ? 1.0f / l : 1.0f) * (c == 2 ? -1.0f : 1.0f);
+    for (int r = 0; r < 3; ++r) t.m[r][c] *= s;
+  }
+  ShadingCamera out;
+  out.camera_to_world = t;
+  out.world_to_camera = t.inverse();
+  out.orthographic = ortho_;
+  // One raster unit on the image plane at unit depth (perspective) or in world units.
+  const float sx = (right_ - left_) * inv_width_, sy = (top_ - bottom_) * inv_height_;
+  if (ortho_) {
+    out.pixel_x = sx * length(camera_to_world_.column(0));
+    out.pixel_y = sy * length(camera_to_world_.column(1));
+  } else {
+    out.pixel_x = sx * tan_half_;
+    out.pixel_y = sy * tan_half_;
+  }
+  return out;
+}
+
 bool CameraModel::project(Vec3f world, Vec2f& raster) const {
   const Vec3f p = world_to_camera_.point(world);
   Vec2f s;

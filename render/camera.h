@@ -16,6 +16,7 @@
 #include "core/transform.h"
 #include "core/vec.h"
 #include "scene/scene.h"
+#include "shaders/shading_context.h"
 
 namespace gdpt {
 
@@ -67,6 +68,9 @@ class CameraModel {
     const Vec3f c = world_to_camera_.point(world);
     return ortho_ ? std::fabs(c.z) : length(c);
   }
+
+  // The camera as shading nodes see it (Cycles' camera space, the pixel footprint).
+  ShadingCamera shading_camera() const;
 
   // World point -> raster position (pinhole); returns false behind the camera. For tests.
   bool project(Vec3f world, Vec2f& raster) const;

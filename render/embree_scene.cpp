@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "scene/generated_mapping.h"
+
 namespace gdpt {
 
 namespace {
@@ -82,12 +84,15 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
 
   // --- Top level: instances of shared meshes, world-space copies of single-use meshes ---
   top_ = rtcNewScene(device_);
+  // Sized once: hits keep pointers into it.
+  shading_instances_.resize(scene.instances.size());
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& inst = scene.instances[i];
     if (inst.mesh >= scene.meshes.size()) continue;
     const Mesh& mesh = scene.meshes[inst.mesh];
     if (mesh.triangle_count() == 0 || mesh.positions.empty()) continue;
     const Transform& T = inst.object_to_world;
+    shading_instances_[i] = {T, T.inverse(), mesh.positions.data(), mesh.indices.data()};
     const float det = T.m[0][0] * (T.m[1][1] * T.m[2][2] - T.m[1][2] * T.m[2][1]) -
                       T.m[0][1] * (T.m[1][0] * T.m[2][2] - T.m[1][2] * T.m[2][0]) +
                       T.m[0][2] * (T.m[1][0] * T.m[2][1] - T.m[1][1] * T.m[2][0]);
@@ -114,6 +119,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     if (id >= instances_.size()) instances_.resize(id + 1);
     InstanceData& d = instances_[id];
     d.index = uint32_t(i);
+    d.shading = &shading_instances_[i];
     d.world_space = world_positions != nullptr;
     d.winding = det < 0.0f ? -1.0f : 1.0f;
     d.positions = world_positions ? world_positions : mesh.positions.data();
@@ -227,27 +233,11 @@ void EmbreeScene::set_materials(std::span<const Material> materials) {
   }
 }
 
-// Generated = (p - location) / (2 size) + 0.5 (Cycles' mesh_texture_space); Blender's auto
-// texture space is the bounding box, with flat axes of size 1.
 void EmbreeScene::set_generated_mapping(InstanceData& d, const Mesh& mesh) {
-  Vec3f location = mesh.texspace_location, size = mesh.texspace_size;
-  if (size == Vec3f(0.0f)) {
-    constexpr float kInf = std::numeric_limits<float>::infinity();
-    Vec3f lo(kInf), hi(-kInf);
-    for (const Vec3f& p : mesh.positions) {
-      lo = min(lo, p);
-      hi = max(hi, p);
-    }
-    if (mesh.positions.empty()) lo = Vec3f(-1.0f), hi = Vec3f(1.0f);
-    location = (lo + hi) * 0.5f;
-    size = (hi - lo) * 0.5f;
-    for (int k = 0; k < 3; ++k)
-      if (size[k] == 0.0f) size[k] = 1.0f;
-  }
+  const GeneratedMapping g = generated_mapping(mesh);
   for (int k = 0; k < 3; ++k) {
-    const float scale = size[k] != 0.0f ? 0.5f / size[k] : 0.0f;
-    d.generated_scale[k] = scale;
-    d.generated_offset[k] = 0.5f - location[k] * scale;
+    d.generated_scale[k] = g.scale[k];
+    d.generated_offset[k] = g.offset[k];
   }
 }
 
@@ -364,6 +354,7 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
   const float w = 1.0f - u - v;
   hit.instance = d.index;
   hit.primitive = primitive;
+  hit.shading_instance = d.shading;
   const __m128 W = _mm_set1_ps(w), U = _mm_set1_ps(u), V = _mm_set1_ps(v);
 
   const __m128 p0 = load3(d.positions[idx[0]]), p1 = load3(d.positions[idx[1]]),

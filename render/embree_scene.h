@@ -40,13 +40,18 @@ struct SurfaceHit {
   bool perturbed = false;
   Vec3f unperturbed_normal;
   uint32_t instance = 0, primitive = 0;  // index in Scene::instances, triangle in its mesh
+  const ShadingInstance* shading_instance = nullptr;  // the instance as shading nodes see it
   int32_t material = -1;     // index into SceneContext::materials() (always valid after hit())
   bool front_facing = true;  // the ray came from the side geometric_normal points to
 };
 
 // What a material sees of a hit.
 inline ShadingContext shading_context_of(const SurfaceHit& hit) {
-  return {hit.uv, hit.front_facing, &hit.color, &hit.coords, nullptr, nullptr, &hit.attributes};
+  ShadingContext ctx{hit.uv, hit.front_facing, &hit.color, &hit.coords};
+  ctx.instance = hit.shading_instance;
+  ctx.primitive = hit.primitive;
+  ctx.attributes = &hit.attributes;
+  return ctx;
 }
 
 // The view of `hit` from `wi_world` (unit, from the hit back along the incoming ray), for
@@ -248,6 +253,7 @@ class EmbreeScene {
     // matrix (inverse transpose of its linear part), as SSE lanes (w = 0).
     alignas(16) float to_world_cols[4][4] = {};
     alignas(16) float normal_cols[3][4] = {};
+    const ShadingInstance* shading = nullptr;  // SurfaceHit::shading_instance
   };
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;
@@ -255,6 +261,7 @@ class EmbreeScene {
   std::vector<RTCScene> mesh_scenes_;
   std::vector<HugePageVector<UnitNormal>> unit_normals_;  // InstanceData::unit_normals' storage
   std::vector<InstanceData> instances_;                   // indexed by top-level Embree geometry id
+  std::vector<ShadingInstance> shading_instances_;        // indexed as Scene::instances
   // Replaces hit.shading_normal by what the material's normal chain (displacement, normal map,
   // bumps: MaterialDesc::bumps) makes of it (out of line: rare).
   [[gnu::noinline]] void perturb_normal(const InstanceData& d, uint32_t primitive, float u, float v,
@@ -265,13 +272,12 @@ class EmbreeScene {
                    const Material& material, size_t bump) const;
   // The shading context of a completed hit (its colour and coordinates where it has them).
   static ShadingContext shading_context(const InstanceData& d, const SurfaceHit& hit) {
-    return {hit.uv,
-            true,
-            d.writes_color ? &hit.color : nullptr,
-            d.writes_coords ? &hit.coords : nullptr,
-            nullptr,
-            nullptr,
-            d.writes_attributes ? &hit.attributes : nullptr};
+    ShadingContext ctx{hit.uv, true, d.writes_color ? &hit.color : nullptr,
+                       d.writes_coords ? &hit.coords : nullptr};
+    ctx.instance = hit.shading_instance;
+    ctx.primitive = hit.primitive;
+    ctx.attributes = d.writes_attributes ? &hit.attributes : nullptr;
+    return ctx;
   }
   static void set_generated_mapping(InstanceData& d, const Mesh& mesh);
   // The mesh attributes (SurfaceAttributes) at barycentrics (u, v) of triangle `primitive`.

@@ -24,6 +24,7 @@
 #include "render/lights/point_light.h"
 #include "render/lights/sun_light.h"
 #include "render/lights/triangle_light.h"
+#include "scene/generated_mapping.h"
 
 namespace gdpt {
 
@@ -74,7 +75,8 @@ struct LightSampler::Impl {
   std::span<const Material> materials;
   std::vector<lights::SunLight> suns;
   std::vector<lights::TriangleLight> triangles;
-  std::vector<uint64_t> triangle_keys;  // sorted, parallel to `triangles`
+  std::vector<ShadingInstance> shading_instances;  // per Scene::instances; triangles point in
+  std::vector<uint64_t> triangle_keys;             // sorted, parallel to `triangles`
 
   std::vector<Entry> entries;
   Distribution1D selection;
@@ -160,6 +162,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
 
   // --- Emissive triangles (instances in order, primitives in order: keys come out sorted) ----
   std::vector<int32_t> emissive_material;  // per slot of the current instance, -1 = not emissive
+  I.shading_instances.resize(scene.instances.size());  // sized once: triangles point in
   for (uint32_t inst_index = 0; inst_index < scene.instances.size(); ++inst_index) {
     const Instance& inst = scene.instances[inst_index];
     if (inst.mesh >= scene.meshes.size()) continue;
@@ -176,6 +179,11 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
     if (!any) continue;
     const Mesh& mesh = scene.meshes[inst.mesh];
     const Transform& m = inst.object_to_world;
+    const GeneratedMapping generated = generated_mapping(mesh);
+    ShadingInstance& shading = I.shading_instances[inst_index];
+    shading = {m, m.inverse(), mesh.positions.data(), mesh.indices.data()};
+    shading.generated_scale = generated.scale;
+    shading.generated_offset = generated.offset;
     for (uint32_t tri = 0; tri < mesh.triangle_count(); ++tri) {
       const int32_t slot = mesh.material_slot.empty() ? 0 : mesh.material_slot[tri];
       if (slot < 0 || size_t(slot) >= emissive_material.size()) continue;
@@ -212,6 +220,8 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
       if (tri < mesh.triangle_island_random.size())
         t.island_random = mesh.triangle_island_random[tri];
       t.material = uint32_t(mat);
+      t.instance = &shading;
+      t.primitive = tri;
       t.finish();
       const float p = t.power(materials[size_t(mat)].average_emission());
       if (!(p > 0.0f) || !std::isfinite(p)) continue;

@@ -147,6 +147,7 @@ void SceneContext::finish_shading(const RenderSettings& settings) {
   for (const Instance& inst : scene.instances) has_holdout_ = has_holdout_ || inst.holdout;
   lights_ = std::make_unique<LightSampler>(scene, materials_, textures_);
   camera_ = CameraModel(scene.camera);
+  for (Material& m : materials_) m.set_camera(camera_.shading_camera());
   pixel_filter_ = PixelFilter(settings.pixel_filter, settings.filter_width);
 
   // --- Feature mask: what the instanced geometry, lights, world and camera really use ---
@@ -193,6 +194,7 @@ SceneContext::~SceneContext() = default;
 void SceneContext::set_camera(const Camera& camera) {
   validate_camera(camera);
   camera_ = CameraModel(camera);
+  for (Material& m : materials_) m.set_camera(camera_.shading_camera());
   scene_features_ = (scene_features_ & ~(kSceneDoF | kSceneOrthographic)) | camera_features(camera);
   if (features_ != kAllFeatures) features_ = scene_features_;  // else force_all_features
 }

@@ -114,6 +114,11 @@ enum class InputNodeKind : uint8_t {
   LayerWeight,  // blend value_a; `channel` 0: the Fresnel output, 1: Facing (svm_node_layer_weight)
   Geometry,     // the Geometry node's `geometry_output` (Position is a Coordinates node)
   LightPath,    // the Light Path node's `light_path_output` (ShadingContext::path)
+  // Nodes that read the hit's instance, triangle or the camera (ShadingContext::instance,
+  // ShadingCamera), as Cycles 3.4's svm_node_vector_transform and svm_node_wireframe:
+  VectorTransform,  // vector a through `vector_transform` (a vector result)
+  Wireframe,        // 1 within value_a / 2 of the hit triangle's edge lines, else 0; in world
+                    // units, or with pixel_size in pixels of the camera's footprint at the hit
 };
 // The Light Path node's outputs (Cycles' svm_node_light_path for surface shading).
 enum class LightPathOutput : uint8_t {
@@ -178,6 +183,8 @@ struct InputNode {
   bool normal_linked = false;  // Fresnel, Layer Weight: Normal takes the normal map / bump
   GeometryOutput geometry_output = GeometryOutput::Normal;
   LightPathOutput light_path_output = LightPathOutput::IsCameraRay;
+  VectorTransformDesc vector_transform;
+  bool pixel_size = false;  // Wireframe: Use Pixel Size
   // Ramp: RGBA at fac = i / (n - 1), i < n (Blender's ColorRamp.evaluate, as Cycles bakes it),
   // interpolated linearly between entries unless the ramp is Constant; the result is the colour,
   // or the alpha as grey for the node's Alpha output.
@@ -205,13 +212,13 @@ struct InputNode {
 
 enum class ShaderNodeKind : uint8_t {
   Diffuse,      // Blender Diffuse BSDF: Lambert (roughness 0) or Oren-Nayar (roughness > 0)
-  Glossy,       // Blender Glossy BSDF, GGX (no Fresnel; colour scales), roughness -> alpha = r^2
-  Glass,        // Blender Glass BSDF, GGX dielectric; roughness 0 = smooth (delta)
+  Glossy,       // Blender Glossy BSDF, GGX or Beckmann (no Fresnel; colour scales), alpha = r^2
+  Glass,        // Blender Glass BSDF, GGX or Beckmann dielectric; roughness 0 = smooth (delta)
   Principled,   // Blender 3.4 Principled BSDF v1
   Emission,     // colour * strength (radiance, W/m^2/sr per unit strength as in Cycles)
   Transparent,  // straight-through transmission, colour scales
   Translucent,  // Blender Translucent BSDF: Lambertian transmission (diffuse, to the far side)
-  Refraction,   // Blender Refraction BSDF: the Glass BSDF's GGX refraction alone, no Fresnel
+  Refraction,   // Blender Refraction BSDF: the Glass BSDF's refraction alone, no Fresnel
   Velvet,       // Blender Velvet BSDF: Ashikhmin velvet, sigma = saturated roughness (Sigma)
   Mix,          // (1 - fac) * a + fac * b
   Add,          // a + b
@@ -219,11 +226,12 @@ enum class ShaderNodeKind : uint8_t {
 
 struct ShaderNode {
   ShaderNodeKind kind = ShaderNodeKind::Diffuse;
-  ColorInput color;           // base colour for every BSDF, emission colour for Emission
-  FloatInput roughness;       // Diffuse, Glossy, Glass, Principled
-  FloatInput ior{1.45f};      // Glass, Principled
-  FloatInput strength{1.0f};  // Emission
-  FloatInput fac{0.5f};       // Mix
+  ColorInput color;       // base colour for every BSDF, emission colour for Emission
+  FloatInput roughness;   // Diffuse, Glossy, Glass, Principled
+  FloatInput ior{1.45f};  // Glass, Principled
+  MicrofacetDistribution distribution = MicrofacetDistribution::GGX;  // Glossy, Glass, Refraction
+  FloatInput strength{1.0f};                                          // Emission
+  FloatInput fac{0.5f};                                               // Mix
   // Mix / Add children (indices into Material::nodes); -1: an unlinked shader input, no closure
   // (black, as Cycles).
   int32_t a = -1, b = -1;
@@ -232,8 +240,7 @@ struct ShaderNode {
   bool normal_linked = true;
   bool clearcoat_normal_linked = true;
 
-  // Principled BSDF v1 inputs beyond colour / roughness / ior (subsurface is ignored with a
-  // warning).
+  // Principled BSDF v1 inputs beyond colour / roughness / ior.
   FloatInput metallic{0.0f};
   FloatInput specular{0.5f};
   FloatInput specular_tint{0.0f};
@@ -247,6 +254,10 @@ struct ShaderNode {
   FloatInput alpha{1.0f};
   ColorInput emission{Spectrum(0.0f)};
   FloatInput emission_strength{1.0f};
+  // Subsurface weight and colour: the diffuse Cycles falls back to for a radius below its
+  // minimum (shaders/principled.h); a larger radius renders the same (the add-on reports it).
+  FloatInput subsurface{0.0f};
+  ColorInput subsurface_color{Spectrum(0.8f)};
 };
 
 // Blender's Normal Map node in tangent space, feeding the material's BSDF Normal inputs: the

@@ -106,6 +106,18 @@ enum class MusgraveType : uint8_t {
   RidgedMultifractal
 };
 
+// Blender's Vector Transform node: what the vector is (a point moves with the translation, a
+// normal with the inverse transpose) and the spaces it converts between.
+struct VectorTransformDesc {
+  enum class Type : uint8_t { Point, Vector, Normal } type = Type::Vector;
+  enum class Space : uint8_t { World, Object, Camera };
+  Space from = Space::World, to = Space::Object;
+};
+
+// The microfacet distribution of Blender's Glossy, Glass and Refraction BSDFs
+// (shaders/microfacet.h).
+enum class MicrofacetDistribution : uint8_t { GGX, Beckmann };
+
 struct BrickDesc {
   float offset = 0.5f;
   int offset_frequency = 2;

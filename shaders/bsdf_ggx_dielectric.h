@@ -1,4 +1,5 @@
-// GGX dielectric (Blender Glass BSDF; Principled v1 transmission), as Cycles 3.4.
+// Microfacet dielectric (Blender Glass and Refraction BSDFs, GGX or Beckmann by
+// Closure::distribution; Principled v1 transmission, GGX), as Cycles 3.4.
 //
 // Side: Closure::ior is the IOR below the frame normal relative to above it. wi.z > 0: the ray
 // crosses with eta = n_t / n_i = ior; wi.z < 0: with eta = 1 / ior. The integrators orient the
@@ -13,7 +14,8 @@
 //   transmission (wo.z < 0):  T (1 - F) D(h) G1(wi) G1(wo) eta^2 |wi.h| |wo.h|
 //                                          / (cos_i (wi.h + eta wo.h)^2), h ~ -(wi + eta wo)
 // with R(h) = weight (Glass) or weight * PrincipledFresnel(ior, f0)(wo.h) (Principled), and
-// T = weight * transmission_tint.
+// T = weight * transmission_tint. The density replaces G1(wi) G1(wo) by G1_visible(wi) (the
+// visible-normal sampler's, microfacet.h).
 // Radiance scaling: the transmitted part carries eta^2 relative to Walter et al.'s radiance
 // BTDF, i.e. radiance is NOT scaled by 1/eta^2 when it crosses the interface. This is what Cycles
 // does (bsdf_microfacet_ggx_eval_transmit multiplies by m_eta^2; the sharp refraction closure
@@ -25,6 +27,8 @@
 // P_R (Fresnel weighted by colour luminances), value = R F, transmission value = T (1 - F).
 // FresnelMode::RefractionOnly (Refraction BSDF): F = 0 throughout, so no reflection and the
 // transmission is T D G ... without (1 - F); total internal reflection still loses the sample.
+// drop_reflection / drop_refraction (Cycles' caustics toggles, one of the two closures left out):
+// the dropped part evaluates to 0 and is never sampled; the other keeps its F or (1 - F).
 #pragma once
 
 #include "shaders/closure.h"
@@ -55,9 +59,14 @@ inline Setup setup(const Closure& c, float cos_i, bool entering) {
   s.fresnel = c.fresnel == FresnelMode::RefractionOnly ? 0.0f : fresnel_dielectric(cos_i, s.eta);
   s.smooth = is_delta_alpha(c.alpha);
   s.pass_through = std::fabs(s.eta - 1.0f) < 1e-4f;
-  const float r = s.fresnel * selection_luminance(reflection_colour(c, s.eta, cos_i));
-  const float t = (1.0f - s.fresnel) * selection_luminance(c.weight * c.transmission_tint);
-  s.p_reflect = (r + t) > 0.0f ? r / (r + t) : s.fresnel;
+  const float r = c.drop_reflection
+                      ? 0.0f
+                      : s.fresnel * selection_luminance(reflection_colour(c, s.eta, cos_i));
+  const float t = c.drop_refraction
+                      ? 0.0f
+                      : (1.0f - s.fresnel) * selection_luminance(c.weight * c.transmission_tint);
+  const float fallback = c.drop_reflection ? 0.0f : c.drop_refraction ? 1.0f : s.fresnel;
+  s.p_reflect = (r + t) > 0.0f ? r / (r + t) : fallback;
   return s;
 }
 
@@ -65,17 +74,17 @@ inline Setup setup(const Closure& c, float cos_i, bool entering) {
 inline Spectrum eval_pdf_upper(const Closure& c, const Setup& st, Vec3f wi, Vec3f wo, float& pdf) {
   pdf = 0.0f;
   if (st.smooth || !(wi.z > 0.0f) || wo.z == 0.0f) return Spectrum(0.0f);
-  const GGX ggx(c.alpha);
+  const Microfacet mf(c.distribution, c.alpha);
   if (wo.z > 0.0f) {
     const Vec3f sum = wi + wo;
     const float len2 = length_squared(sum);
-    if (!(len2 > 0.0f) || st.fresnel <= 0.0f) return Spectrum(0.0f);
+    if (!(len2 > 0.0f) || st.fresnel <= 0.0f || c.drop_reflection) return Spectrum(0.0f);
     const Vec3f h = sum / std::sqrt(len2);
-    const float common = ggx.D(h) * ggx.G1(wi) / (4.0f * wi.z);
-    pdf = st.p_reflect * common;
-    return reflection_colour(c, st.eta, dot(wo, h)) * (st.fresnel * common * ggx.G1(wo));
+    const float common = mf.D(h) / (4.0f * wi.z);
+    pdf = st.p_reflect * common * mf.G1_visible(wi);
+    return reflection_colour(c, st.eta, dot(wo, h)) * (st.fresnel * common * mf.G1(wi) * mf.G1(wo));
   }
-  if (st.pass_through || st.fresnel >= 1.0f) return Spectrum(0.0f);
+  if (st.pass_through || st.fresnel >= 1.0f || c.drop_refraction) return Spectrum(0.0f);
   // Generalised half vector of the refraction, oriented to the outside (+z).
   Vec3f ht = wi + wo * st.eta;
   const float len2 = length_squared(ht);
@@ -87,9 +96,9 @@ inline Spectrum eval_pdf_upper(const Closure& c, const Setup& st, Vec3f wi, Vec3
   if (!(cos_ih > 0.0f && cos_oh < 0.0f)) return Spectrum(0.0f);
   const float denom = cos_ih + st.eta * cos_oh;
   const float jacobian = st.eta * st.eta * std::fabs(cos_oh) / (denom * denom);  // dwh / dwo
-  const float pdf_h = ggx.G1(wi) * cos_ih * ggx.D(ht) / wi.z;
-  pdf = (1.0f - st.p_reflect) * pdf_h * jacobian;
-  return c.weight * c.transmission_tint * ((1.0f - st.fresnel) * pdf_h * jacobian * ggx.G1(wo));
+  const float common = cos_ih * mf.D(ht) / wi.z * jacobian;
+  pdf = (1.0f - st.p_reflect) * common * mf.G1_visible(wi);
+  return c.weight * c.transmission_tint * ((1.0f - st.fresnel) * common * mf.G1(wi) * mf.G1(wo));
 }
 
 inline Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo) {
@@ -139,8 +148,7 @@ inline BsdfSample sample(const Closure& c, Vec3f wi_, float u_choice, Vec2f u) {
     return s;
   }
 
-  const GGX ggx(c.alpha);
-  const Vec3f m = ggx.sample_visible(wi, u);
+  const Vec3f m = Microfacet(c.distribution, c.alpha).sample_visible(wi, u);
   Vec3f wo;
   if (pick_reflection) {
     wo = reflect(wi, m);
@@ -165,8 +173,13 @@ inline float albedo_hint(const Closure& c, Vec3f wi) {
   const Setup st = setup(c, std::fabs(wi.z), wi.z > 0.0f);
   const float lw = selection_luminance(c.weight);
   if (!(lw > 0.0f)) return 1.0f;
-  const float r = st.fresnel * selection_luminance(reflection_colour(c, st.eta, std::fabs(wi.z)));
-  const float t = (1.0f - st.fresnel) * selection_luminance(c.weight * c.transmission_tint);
+  const float r =
+      c.drop_reflection
+          ? 0.0f
+          : st.fresnel * selection_luminance(reflection_colour(c, st.eta, std::fabs(wi.z)));
+  const float t = c.drop_refraction
+                      ? 0.0f
+                      : (1.0f - st.fresnel) * selection_luminance(c.weight * c.transmission_tint);
   return (r + t) / lw;
 }
 

@@ -1,9 +1,11 @@
-// GGX microfacet reflection, two-sided, as Cycles 3.4's `microfacet_ggx` (Glossy BSDF) and
-// `microfacet_ggx_fresnel` (Principled v1 specular):
+// Microfacet reflection (GGX, or Beckmann: Closure::distribution), two-sided, as Cycles 3.4's
+// `microfacet_ggx` / `microfacet_beckmann` (Glossy BSDF) and `microfacet_ggx_fresnel`
+// (Principled v1 specular):
 //   f |cos_o| = weight * F(wo.h) * D(h) G1(wi) G1(wo) / (4 cos_i),   h = normalize(wi + wo)
 // F = 1 for FresnelMode::None (the Glossy colour simply scales), and Cycles' Principled v1 blend
 // PrincipledFresnel(Closure::ior, Closure::f0) for FresnelMode::PrincipledV1.
-// Sampling: visible normals from wi, so value / pdf = F G1(wo).
+// Sampling: visible normals from wi, pdf = D(h) G1_visible(wi) / (4 cos_i), so value / pdf =
+// F G1(wo) for GGX (Beckmann: F G1(wi) G1(wo) / G1_visible(wi), Cycles' fit over the exact term).
 // alpha < kDeltaAlpha: a perfect mirror (delta), value = weight F(cos_i), pdf = 1.
 #pragma once
 
@@ -25,30 +27,30 @@ inline Spectrum eval_pdf_upper(const Closure& c, Vec3f wi, Vec3f wo, float& pdf)
   pdf = 0.0f;
   Vec3f h;
   if (!reflection_lobe::upper_half_vector(wi, wo, h)) return Spectrum(0.0f);
-  const GGX ggx(c.alpha);
-  const float d = ggx.D(h);
-  const float g1i = ggx.G1(wi);
-  const float common = d * g1i / (4.0f * wi.z);
-  pdf = common;
-  return c.weight * fresnel(c, dot(wo, h)) * (common * ggx.G1(wo));
+  const Microfacet mf(c.distribution, c.alpha);
+  const float common = mf.D(h) / (4.0f * wi.z);
+  pdf = common * mf.G1_visible(wi);
+  return c.weight * fresnel(c, dot(wo, h)) * (common * mf.G1(wi) * mf.G1(wo));
 }
 
 inline Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo) {
   return reflection_lobe::eval(c, wi, wo, eval_pdf_upper);
 }
 
-// Density only: D(h) G1(wi) / (4 cos_i), without the Fresnel and G1(wo) of the value.
+// Density only: D(h) G1_visible(wi) / (4 cos_i), without the Fresnel and masking of the value.
 inline float pdf(const Closure& c, Vec3f wi, Vec3f wo) {
   return reflection_lobe::pdf(c, wi, wo, [](const Closure& k, Vec3f i, Vec3f, Vec3f h) {
-    const GGX ggx(k.alpha);
-    return ggx.D(h) * ggx.G1(i) / (4.0f * i.z);
+    const Microfacet mf(k.distribution, k.alpha);
+    return mf.D(h) * mf.G1_visible(i) / (4.0f * i.z);
   });
 }
 
 inline BsdfSample sample(const Closure& c, Vec3f wi, float, Vec2f u) {
   return reflection_lobe::sample(
       c, wi, u, [](const Closure& k, float cos_i) { return k.weight * fresnel(k, cos_i); },
-      [](const Closure& k, Vec3f i, Vec2f v) { return GGX(k.alpha).sample_visible(i, v); },
+      [](const Closure& k, Vec3f i, Vec2f v) {
+        return Microfacet(k.distribution, k.alpha).sample_visible(i, v);
+      },
       eval_pdf_upper);
 }
 

@@ -17,6 +17,7 @@
 
 #include "core/frame.h"
 #include "core/vec.h"
+#include "scene/node_types.h"
 
 namespace gdpt {
 
@@ -25,12 +26,16 @@ enum class ClosureType : uint8_t {
   OrenNayar,          // Cycles' Oren-Nayar with sigma = roughness
   PrincipledDiffuse,  // Disney/Burley diffuse as in Cycles' Principled v1
   PrincipledSheen,    // Cycles' Principled v1 sheen (grazing retro-reflection)
-  GGXReflection,  // GGX with Fresnel mode below (Glossy: none; Principled specular: Schlick mix)
-  GGXDielectric,  // GGX glass: reflection + refraction by dielectric Fresnel; alpha 0 = smooth
-  Clearcoat,      // Cycles' Principled v1 clearcoat: GTR1, fixed masking, Fresnel of IOR 1.5
-  Transparent,    // straight through, delta
-  Translucent,    // diffuse transmission: color / pi on the far side
-  Velvet,         // Cycles' Ashikhmin velvet, alpha = Sigma
+  // Microfacet reflection (GGX or Closure::distribution) with the Fresnel mode below (Glossy:
+  // none; Principled specular: Schlick mix)
+  GGXReflection,
+  // Microfacet glass (GGX or Closure::distribution): reflection + refraction by dielectric
+  // Fresnel; alpha 0 = smooth
+  GGXDielectric,
+  Clearcoat,    // Cycles' Principled v1 clearcoat: GTR1, fixed masking, Fresnel of IOR 1.5
+  Transparent,  // straight through, delta
+  Translucent,  // diffuse transmission: color / pi on the far side
+  Velvet,       // Cycles' Ashikhmin velvet, alpha = Sigma
 };
 
 enum class FresnelMode : uint8_t {
@@ -45,8 +50,11 @@ enum class FresnelMode : uint8_t {
 struct Closure {
   ClosureType type = ClosureType::Lambert;
   FresnelMode fresnel = FresnelMode::None;
+  // GGXReflection, GGXDielectric: the microfacet distribution (Blender's Glossy, Glass and
+  // Refraction BSDFs offer Beckmann; Principled is GGX).
+  MicrofacetDistribution distribution = MicrofacetDistribution::GGX;
   Spectrum weight{1.0f, 1.0f, 1.0f};  // colour * mix weight
-  float alpha = 0.0f;                 // GGX alpha (= Blender roughness^2); diffuse roughness
+  float alpha = 0.0f;                 // microfacet alpha (= Blender roughness^2); diffuse roughness
   // Relative IOR: GGXDielectric: n(below the frame normal) / n(above), i.e. the IOR crossed by
   // a ray arriving with wi.z > 0 (Material sets 1/ior for back-face hits, since the integrators
   // orient the frame towards the ray); PrincipledV1 reflection: the IOR giving its F0.
@@ -60,6 +68,9 @@ struct Closure {
   // unlinked: Cycles gives those sd->N). Material data; per hit, the set evaluates such lobes
   // about that normal (ClosureSet::set_interpolated_normal).
   bool interpolated_normal = false;
+  // GGXDielectric: its reflected or its refracted part dropped, the other keeping its Fresnel
+  // weight (Cycles' caustics toggles remove one of the glass BSDF's two closures).
+  bool drop_reflection = false, drop_refraction = false;
 };
 
 enum LobeFlags : uint8_t {

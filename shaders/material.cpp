@@ -16,6 +16,7 @@
 #include "shaders/curves_node.h"
 #include "shaders/math_node.h"
 #include "shaders/microfacet.h"
+#include "shaders/object_nodes.h"
 #include "shaders/principled.h"
 #include "shaders/procedural_texture.h"
 #include "shaders/vector_math_node.h"
@@ -376,6 +377,12 @@ Spectrum input_node_result(const InputNode& n, const Inputs& in) {
     case InputNodeKind::LightPath:
       r = Spectrum(in.light_path(n.light_path_output));
       break;
+    case InputNodeKind::VectorTransform:
+      r = in.transformed(n.vector_transform, in.color(n.a));
+      break;
+    case InputNodeKind::Wireframe:
+      r = Spectrum(in.wireframe_factor(in.scalar(n.value_a), n.pixel_size));
+      break;
     case InputNodeKind::BrightContrast: {
       const float contrast = in.scalar(n.value_b);
       const float a = 1.0f + contrast, b = in.scalar(n.value_a) - contrast * 0.5f;
@@ -394,6 +401,7 @@ float input_node_scalar(const InputNode& n, const Inputs& in) {
   const Spectrum r = input_node_result(n, in);
   if ((n.kind == InputNodeKind::Coordinates || n.kind == InputNodeKind::VectorMath ||
        n.kind == InputNodeKind::CombineXyz || n.kind == InputNodeKind::VectorCurves ||
+       n.kind == InputNodeKind::VectorTransform ||
        (n.kind == InputNodeKind::Geometry && n.geometry_output != GeometryOutput::Backfacing)) &&
       !n.fac_output)
     return (r.x + r.y + r.z) * (1.0f / 3.0f);
@@ -402,7 +410,7 @@ float input_node_scalar(const InputNode& n, const Inputs& in) {
                     n.kind == InputNodeKind::ToBw || n.kind == InputNodeKind::FloatCurve ||
                     n.kind == InputNodeKind::SeparateHsv || n.kind == InputNodeKind::Fresnel ||
                     n.kind == InputNodeKind::LayerWeight || n.kind == InputNodeKind::Geometry ||
-                    n.kind == InputNodeKind::LightPath ||
+                    n.kind == InputNodeKind::LightPath || n.kind == InputNodeKind::Wireframe ||
                     (n.kind == InputNodeKind::Ramp && n.ramp_alpha) ||
                     n.fac_output;  // a texture's Fac / Distance
   return grey ? r.x : luminance(r);
@@ -414,6 +422,7 @@ struct PointInputs {
   std::span<const Texture> textures;
   std::span<const InputNode> nodes;
   ShadingContext at;
+  const ShadingCamera* camera;
   bool front_facing() const { return at.front_facing; }
 
   Spectrum attribute_color() const { return at.color ? *at.color : Spectrum(0.0f); }
@@ -443,6 +452,26 @@ struct PointInputs {
     return which == GeometryOutput::Normal       ? g.normal
            : which == GeometryOutput::TrueNormal ? g.true_normal
                                                  : g.incoming;
+  }
+
+  Vec3f transformed(const VectorTransformDesc& t, Vec3f v) const {
+    return vector_transform(v, t, at.instance, *camera);
+  }
+  // Wireframe of width `size` (world units, or pixels); 0 without the hit's triangle. The pixel
+  // width seen without a view: the surface head-on.
+  float wireframe_factor(float size, bool pixel_size) const {
+    if (!at.instance || !at.coords) return 0.0f;
+    Vec3f c[3];
+    for (int k = 0; k < 3; ++k) c[k] = at.instance->corner(at.primitive, k);
+    const Vec3f p = at.coords->position;
+    float width = size;
+    if (pixel_size) {
+      const Vec3f ng =
+          at.geometry ? at.geometry->true_normal : normalize(cross(c[1] - c[0], c[2] - c[0]));
+      const Vec3f wi = at.geometry ? at.geometry->incoming : ng;
+      width *= wireframe_pixel_width(pixel_footprint(*camera, p), ng, wi);
+    }
+    return wireframe(c, p, width);
   }
 
   // A texture's coordinates: the source (zero without object-space coordinates), then its
@@ -493,6 +522,9 @@ struct AverageInputs {
     if (is_surface_attribute(which)) return Vec3f(0.5f);  // their mean over a mesh, roughly
     return which == GeometryOutput::Backfacing ? Vec3f(0.0f) : Vec3f(0.0f, 0.0f, 1.0f);
   }
+  // Object and camera unknown: world space; wires over half of the surface.
+  Vec3f transformed(const VectorTransformDesc&, Vec3f v) const { return v; }
+  float wireframe_factor(float, bool) const { return 0.5f; }
   // As a light sample from a unit distance sees it (emitter power estimates).
   float light_path(LightPathOutput which) const {
     PathView p;
@@ -531,6 +563,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       const float r = saturate(in.scalar(n.roughness));
       c.type = ClosureType::GGXReflection;
       c.fresnel = FresnelMode::None;
+      c.distribution = n.distribution;
       c.alpha = r * r;
       c.weight = in.color(n.color) * w;
       out.add(c);
@@ -548,6 +581,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
         c.type = ClosureType::GGXDielectric;
         c.fresnel = n.kind == ShaderNodeKind::Refraction ? FresnelMode::RefractionOnly
                                                          : FresnelMode::Dielectric;
+        c.distribution = n.distribution;
         c.alpha = r * r;
         // The integrators orient the frame towards the incoming ray (as Cycles flips N for back
         // faces), so the closure's IOR is that of the far side: 1 / ior when leaving the object.
@@ -587,6 +621,11 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       p.clearcoat_roughness = in.scalar(n.clearcoat_roughness);
       p.alpha = in.scalar(n.alpha);
       p.emission = in.color(n.emission) * in.scalar(n.emission_strength);
+      p.subsurface = in.scalar(n.subsurface);
+      if (p.subsurface != 0.0f) {
+        p.subsurface_color = in.color(n.subsurface_color);
+        p.diffuse_ancestor = in.light_path(LightPathOutput::DiffuseDepth) > 0.0f;
+      }
       p.front_facing = in.front_facing();
       p.interpolated_normal = !n.normal_linked;
       p.clearcoat_interpolated_normal = !n.clearcoat_normal_linked;
@@ -742,6 +781,13 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
            !surface_attribute))
         reads_view_ = true;
       if (n.kind == InputNodeKind::LightPath) reads_path_ = true;
+      // Per instance and camera; Wireframe reads the hit's position and, in pixels, the view.
+      if (n.kind == InputNodeKind::VectorTransform) features_ |= kFeatureTextures;
+      if (n.kind == InputNodeKind::Wireframe) {
+        features_ |= kFeatureTextures;
+        reads_coordinates_ = true;
+        reads_view_ = reads_view_ || n.pixel_size;
+      }
       if (reads_vector(n.kind)) {
         features_ |= kFeatureTextures;
         note_vector(self, n.vector, depth);
@@ -836,6 +882,16 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         note(n.alpha);
         note(n.emission);
         note(n.emission_strength);
+        note(n.subsurface);
+        note(n.subsurface_color);
+        // After a diffuse bounce the subsurface mix becomes the base of the other lobes too.
+        const auto may_be_nonzero = [](const FloatInput& f) {
+          return varies(f) || f.value != 0.0f;
+        };
+        if (may_be_nonzero(n.subsurface) &&
+            (may_be_nonzero(n.metallic) || may_be_nonzero(n.specular_tint) ||
+             may_be_nonzero(n.sheen) || may_be_nonzero(n.transmission)))
+          reads_path_ = true;
         const bool specular = varies(n.specular) || varies(n.metallic) || n.specular.value > 0.0f ||
                               n.metallic.value > 0.0f;
         const bool transmission = (varies(n.transmission) || n.transmission.value > 0.0f) &&
@@ -875,9 +931,8 @@ void Material::cache_if_constant() {
   for (int side = 0; side < 2; ++side) {
     ClosureSet& set = constant_closures_[side];
     set.clear();
-    set.add_emission(walk(nodes_, root_,
-                          PointInputs{textures_, inputs_, ShadingContext{{0.0f, 0.0f}, side == 1}},
-                          &set));
+    const ShadingContext at{{0.0f, 0.0f}, side == 1};
+    set.add_emission(walk(nodes_, root_, PointInputs{textures_, inputs_, at, &camera_}, &set));
   }
   constant_ = true;
 }
@@ -888,24 +943,24 @@ void Material::evaluate(const ShadingContext& ctx, ClosureSet& out) const {
     return;
   }
   out.clear();
-  const Spectrum e = walk(nodes_, root_, PointInputs{textures_, inputs_, ctx}, &out);
+  const Spectrum e = walk(nodes_, root_, PointInputs{textures_, inputs_, ctx, &camera_}, &out);
   out.add_emission(e);
 }
 
 Spectrum Material::emission(const ShadingContext& ctx) const {
   if (!(features_ & kFeatureEmission)) return Spectrum(0.0f);
-  return walk(nodes_, root_, PointInputs{textures_, inputs_, ctx}, nullptr);
+  return walk(nodes_, root_, PointInputs{textures_, inputs_, ctx, &camera_}, nullptr);
 }
 
 Vec3f Material::normal_map_direction(const ShadingContext& at) const {
-  const Spectrum c = PointInputs{textures_, inputs_, at}.color(normal_map_.color);
+  const Spectrum c = PointInputs{textures_, inputs_, at, &camera_}.color(normal_map_.color);
   const float s = normal_map_.strength;
   return {2.0f * (c.x - 0.5f) * s, 2.0f * (c.y - 0.5f) * s,
           1.0f + (2.0f * (c.z - 0.5f) - 1.0f) * std::clamp(s, 0.0f, 1.0f)};
 }
 
 float Material::bump_height(size_t bump, const ShadingContext& at) const {
-  return PointInputs{textures_, inputs_, at}.scalar(bumps_[bump].height);
+  return PointInputs{textures_, inputs_, at, &camera_}.scalar(bumps_[bump].height);
 }
 
 }  // namespace gdpt

@@ -62,6 +62,9 @@ class Material {
   // Some input reads the Geometry node's Pointiness, Parametric or Random Per Island
   // (ShadingContext::attributes).
   bool reads_surface_attributes() const { return reads_surface_attributes_; }
+  // The camera Vector Transform's Camera space and Wireframe's pixel size read (set by the
+  // scene's owner before rendering; default: at the origin, looking down world +z).
+  void set_camera(const ShadingCamera& camera) { camera_ = camera; }
 
  private:
   void cache_if_constant();
@@ -84,6 +87,7 @@ class Material {
   bool reads_path_ = false;
   bool reads_surface_attributes_ = false;
   Spectrum average_emission_{0.0f, 0.0f, 0.0f};
+  ShadingCamera camera_;
 };
 
 }  // namespace gdpt

@@ -1,5 +1,7 @@
-// Isotropic GGX (Trowbridge-Reitz) microfacet distribution with the separable Smith masking term,
-// in the local frame (normal = +z), as Cycles 3.4's `microfacet_ggx`.
+// The microfacet distributions of the reflection and dielectric lobes: Microfacet, the one a
+// Closure names (GGX or Beckmann, shaders/beckmann.h), and the isotropic GGX (Trowbridge-Reitz)
+// distribution with the separable Smith masking term, in the local frame (normal = +z), as
+// Cycles 3.4's `microfacet_ggx`.
 //
 //  alpha: GGX width, Blender roughness^2, clamped to [0, 1] by the caller.
 //  D(m):       normal distribution, integrates to 1 over projected microfacet area.
@@ -14,6 +16,8 @@
 #include <cmath>
 
 #include "core/vec.h"
+#include "scene/node_types.h"
+#include "shaders/beckmann.h"
 
 namespace gdpt {
 
@@ -69,6 +73,31 @@ struct GGX {
     // Unstretch back to the alpha configuration.
     return normalize(Vec3f(alpha * nh.x, alpha * nh.y, std::max(1e-7f, nh.z)));
   }
+};
+
+// A closure's distribution. The lobes' value is D(h) G1(wi) G1(wo) ..., their sampler draws h
+// from the normals visible from wi, of density pdf_visible(wi, h) = G1_visible(wi) max(0, wi.h)
+// D(h) / wi.z. G1_visible is G1 for GGX; for Beckmann it is the exact Smith term, where the value
+// takes Cycles' rational fit.
+class Microfacet {
+ public:
+  Microfacet(MicrofacetDistribution d, float alpha)
+      : beckmann_(d == MicrofacetDistribution::Beckmann), ggx_(alpha), bk_(alpha) {}
+
+  float D(Vec3f m) const { return beckmann_ ? bk_.D(m) : ggx_.D(m); }
+  float G1(Vec3f w) const { return beckmann_ ? bk_.G1(w) : ggx_.G1(w); }
+  float G1_visible(Vec3f wi) const { return beckmann_ ? bk_.smith_G1(wi) : ggx_.G1(wi); }
+  float pdf_visible(Vec3f wi, Vec3f m) const {
+    return beckmann_ ? bk_.pdf_visible(wi, m) : ggx_.pdf_visible(wi, m);
+  }
+  Vec3f sample_visible(Vec3f wi, Vec2f u) const {
+    return beckmann_ ? bk_.sample_visible(wi, u) : ggx_.sample_visible(wi, u);
+  }
+
+ private:
+  bool beckmann_;
+  GGX ggx_;
+  Beckmann bk_;
 };
 
 }  // namespace gdpt

@@ -23,7 +23,12 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
   if (w <= 0.0f) return;
   out.add_emission(p.emission * w);
 
-  const Spectrum base = p.base_color;
+  // Cycles mixes without clamping the weight (the socket's range keeps it in [0, 1]).
+  const float subsurface = p.subsurface;
+  const Spectrum mixed = p.base_color * (1.0f - subsurface) + p.subsurface_color * subsurface;
+  const bool ancestor = p.diffuse_ancestor;
+  const Spectrum base = ancestor ? mixed : p.base_color;
+  const Spectrum diffuse_color = ancestor || subsurface > kWeightCutoff ? mixed : base;
   const float metallic = saturate(p.metallic);
   const float transmission = saturate(p.transmission);
   const float specular = std::max(0.0f, p.specular);
@@ -34,11 +39,11 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
   const float final_transmission = transmission * (1.0f - metallic);
   const float specular_weight = 1.0f - final_transmission;
 
-  // --- Diffuse (Burley with retro-reflection).
+  // --- Diffuse (Burley with retro-reflection; with subsurface, of the mixed colour).
   if (diffuse_weight > kWeightCutoff) {
     Closure d;
     d.type = ClosureType::PrincipledDiffuse;
-    d.weight = base * (w * diffuse_weight);
+    d.weight = diffuse_color * (w * diffuse_weight);
     d.alpha = roughness;
     d.interpolated_normal = p.interpolated_normal;
     out.add(d);

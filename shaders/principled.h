@@ -15,7 +15,12 @@
 //                weight 0.25 clearcoat; added on top, nothing below is attenuated
 //   emission     emission * emission_strength
 //   alpha        everything above times alpha, plus Transparent (white) times 1 - alpha
-// Subsurface, anisotropy and the multiscatter GGX variant are not modelled.
+//   subsurface   s > 0 tints the diffuse with mix(base, subsurface_color, s): Cycles' BSSRDF at
+//                radius 0 (bssrdf_setup) is its retro-reflection plus a Lambert part of that
+//                colour, the whole PrincipledDiffuse; after a diffuse bounce (diffuse_ancestor)
+//                Cycles uses that colour as the base of every lobe
+// Subsurface transport (radius > 0), anisotropy and the multiscatter GGX variant are not
+// modelled.
 // All weights are multiplied by `mix_weight` (the Mix/Add tree weight).
 #pragma once
 
@@ -36,7 +41,10 @@ struct PrincipledParams {
   float clearcoat = 0.0f;
   float clearcoat_roughness = 0.03f;
   float alpha = 1.0f;
-  Spectrum emission{0.0f};   // colour * strength
+  Spectrum emission{0.0f};  // colour * strength
+  float subsurface = 0.0f;
+  Spectrum subsurface_color{0.8f};
+  bool diffuse_ancestor = false;  // the path has bounced off a diffuse lobe (Cycles' flag)
   bool front_facing = true;  // false: the transmission closure gets 1 / ior (leaving the object)
   // Closure::interpolated_normal of the base lobes and of the clearcoat.
   bool interpolated_normal = false;

@@ -1,8 +1,10 @@
 // What a material needs to know about a hit point.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
+#include "core/transform.h"
 #include "core/vec.h"
 
 namespace gdpt {
@@ -44,6 +46,37 @@ struct SurfaceAttributes {
   Vec2f barycentric;               // (u, v): the hit is (1 - u - v) p0 + u p1 + v p2
 };
 
+// The instance a hit lies on, for nodes that read its placement or its triangle (Vector
+// Transform's Object space, Wireframe): Cycles' object transform and the mesh's corners.
+struct ShadingInstance {
+  Transform object_to_world, world_to_object;
+  const Vec3f* positions = nullptr;   // the mesh's object-space vertices
+  const uint32_t* indices = nullptr;  // 3 per triangle
+  // Generated = object * generated_scale + generated_offset (coords_at; hits carry their own).
+  Vec3f generated_scale{0.0f}, generated_offset{0.0f};
+  // Corner k of triangle `primitive`, in world space.
+  Vec3f corner(uint32_t primitive, int k) const {
+    return object_to_world.point(positions[indices[3 * size_t(primitive) + size_t(k)]]);
+  }
+  // The texture coordinates of world point p on it (a light sample's point).
+  TexCoords coords_at(Vec3f p) const {
+    const Vec3f object = world_to_object.point(p);
+    return {object * generated_scale + generated_offset, object, p};
+  }
+};
+
+// The render camera as shading nodes see it (Vector Transform's Camera space, Wireframe's pixel
+// size).
+struct ShadingCamera {
+  // Cycles' camera space: Blender's camera with its scale cleared and its z negated (x right,
+  // y up, z into the view).
+  Transform camera_to_world, world_to_camera;
+  // Perspective: one pixel's step on the image plane at unit depth (camera units); orthographic:
+  // one pixel's size in world units.
+  bool orthographic = false;
+  float pixel_x = 0.0f, pixel_y = 0.0f;
+};
+
 struct ShadingContext {
   Vec2f uv;                  // mesh UV (0 when the mesh has none)
   bool front_facing = true;  // the ray hit the side the geometric normal points to
@@ -60,6 +93,9 @@ struct ShadingContext {
   // The path when the caller knows it, else null (a camera ray of length 0). A material that
   // reads it (Material::reads_path) is evaluated per hit; a G-PT offset passes its own length.
   const PathView* path = nullptr;
+  // The hit's instance and triangle, else null (object space is world space, no triangle).
+  const ShadingInstance* instance = nullptr;
+  uint32_t primitive = 0;
   // The hit's mesh attributes when its instance's materials read them, else null (they read 0).
   const SurfaceAttributes* attributes = nullptr;
 };

@@ -60,7 +60,7 @@ red, _ = material("Red", "ShaderNodeBsdfDiffuse", Color=(0.65, 0.08, 0.06, 1))
 green, _ = material("Green", "ShaderNodeBsdfDiffuse", Color=(0.12, 0.5, 0.08, 1))
 glass, glass_bsdf = material("Glass", "ShaderNodeBsdfGlass", Color=(1, 1, 1, 1), Roughness=0.0,
                             IOR=1.5)
-glass_bsdf.distribution = 'SHARP'  # Blender 3.4's default is Beckmann, which GDPT renders as GGX
+glass_bsdf.distribution = 'SHARP'  # roughness 0 as a smooth glass (Blender 3.4's default: Beckmann)
 metal, _ = material("Metal", "ShaderNodeBsdfPrincipled", **{
     "Base Color": (0.95, 0.7, 0.4, 1), "Metallic": 1.0, "Roughness": 0.25})
 

@@ -3,14 +3,18 @@
 # Walks from the active Material Output's Surface input over the tree with its node groups
 # flattened (export_node_groups.py). Supported shader nodes: Principled BSDF, Diffuse, Glossy,
 # Glass, Emission (and, reported, Background: Cycles shows it as one on a surface), Transparent,
-# Mix Shader, Add Shader; a colour or float output on a shader
-# socket becomes an Emission, and an unlinked shader input is no closure (black), as in Cycles.
+# Mix Shader, Add Shader, Subsurface Scattering and Principled's subsurface (the diffuse Cycles
+# falls back to at radius 0; a larger radius renders the same, reported); a colour or float
+# output on a shader socket becomes an Emission, and an unlinked shader input is no closure
+# (black), as in Cycles.
 # Inputs may be constants, RGB / Value nodes, colour / math / curve nodes, Blackbody, Fresnel,
 # Layer Weight, Geometry (Normal, True Normal, Incoming, Backfacing, Pointiness, Parametric, Random
-# Per Island; Tangent reported, 0.5 standing in) and Light Path (read per path: its own direction
-# and state), image and procedural textures read at UV, Generated or Object coordinates,
-# optionally through a Mapping node. The Displacement output (a Displacement node) renders as Cycles' Bump Only. Reroutes
-# and muted nodes are followed. Anything else is reported once per material (naming the node)
+# Per Island; Tangent reported, 0.5 standing in), Light Path (read per path: its own direction and
+# state), Vector Transform (World / Object / Camera, Cycles' camera space) and Wireframe (per
+# triangle; Use Pixel Size reported: the camera's pixel), image and procedural textures read at UV,
+# Generated or Object coordinates, optionally through a Mapping node. The Displacement output (a
+# Displacement node) renders as Cycles' Bump Only. Reroutes and muted nodes are followed. Anything
+# else is reported once per material (naming the node)
 # and followed through its mute pass-through link when it has one; otherwise a
 # magenta diffuse (shaders) or the socket's own value (inputs) stands in, so the render still
 # completes. A material whose translation fails (or that the core rejects) renders magenta, with
@@ -29,9 +33,15 @@ IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 _SHADERS = {
     'BSDF_PRINCIPLED', 'BSDF_DIFFUSE', 'BSDF_GLOSSY', 'BSDF_GLASS', 'EMISSION',
     'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSLUCENT', 'BSDF_VELVET',
-    'BSDF_REFRACTION',
+    'BSDF_REFRACTION', 'SUBSURFACE_SCATTERING',
 }
+# Cycles turns a BSSRDF channel of a smaller radius into a diffuse BSDF (BSSRDF_MIN_RADIUS).
+_BSSRDF_MIN_RADIUS = 1e-8
+_NO_TRANSPORT = "subsurface scattering, rendered as diffuse (no subsurface transport), of"
 _GGX_LIKE = {'GGX', 'SHARP'}
+# The Glossy, Glass and Refraction BSDFs' distributions the core renders as Cycles does (Sharp is
+# GGX at roughness 0); the others (Multiscatter GGX, Ashikhmin-Shirley) render as GGX, reported.
+_MICROFACET = {'GGX': 'GGX', 'SHARP': 'GGX', 'BECKMANN': 'BECKMANN'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
@@ -39,7 +49,8 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'TEX_COORD', 'UVMAP', 'MAPPING', 'SEPXYZ', 'TEX_VORONOI', 'TEX_GRADIENT',
                 'TEX_WAVE', 'TEX_MUSGRAVE', 'TEX_WHITE_NOISE', 'TEX_MAGIC', 'VECT_MATH', 'COMBXYZ',
                 'TEX_BRICK', 'CURVE_RGB', 'CURVE_VEC', 'CURVE_FLOAT', 'BLACKBODY', 'SEPHSV',
-                'COMBHSV', 'FRESNEL', 'LAYER_WEIGHT', 'NEW_GEOMETRY', 'LIGHT_PATH'}
+                'COMBHSV', 'FRESNEL', 'LAYER_WEIGHT', 'NEW_GEOMETRY', 'LIGHT_PATH',
+                'VECT_TRANSFORM', 'WIREFRAME'}
 # The Geometry node's outputs the core reads from the view of the hit or from the mesh there
 # (Position: coordinates).
 _GEOMETRY_OUTPUTS = {'Normal', 'True Normal', 'Incoming', 'Backfacing', 'Pointiness', 'Parametric',
@@ -152,14 +163,17 @@ class _Translator:
         i = n.inputs
         if n.distribution not in _GGX_LIKE:
             self.warn(n, f"distribution {n.distribution} of")
-        if i["Subsurface"].is_linked or i["Subsurface"].default_value > 0.0:
-            self.warn(n, "subsurface scattering of")
+        subsurface = i["Subsurface"]
+        has_subsurface = subsurface.is_linked or subsurface.default_value != 0.0
+        if has_subsurface:
+            # Cycles' radius is Subsurface Radius x Subsurface.
+            self._warn_transport(n, i["Subsurface Radius"], subsurface)
         normal_linked = self.normal(i["Normal"])
         clearcoat_normal_linked = self.normal(i["Clearcoat Normal"])
         if i["Tangent"].is_linked:
             self.warn(self._source(i["Tangent"]).node if self._source(i["Tangent"]) else n,
                       "normal / tangent input node")
-        return self._add({
+        d = {
             "kind": "PRINCIPLED",
             "color": self.color(i["Base Color"]),
             "metallic": self.value(i["Metallic"]),
@@ -177,7 +191,33 @@ class _Translator:
             "emission": self.color(i["Emission"]),
             "emission_strength": self.value(i["Emission Strength"]),
             "alpha": self.value(i["Alpha"]),
-        })
+        }
+        if has_subsurface:
+            d["subsurface"] = self.value(subsurface)
+            d["subsurface_color"] = self.color(i["Subsurface Color"])
+        return self._add(d)
+
+    def _warn_transport(self, n, radius, scale):
+        """Reports a BSSRDF whose radius (radius x scale, per channel) may reach Cycles' minimum:
+        Cycles carries light under the surface there, Gradient PT renders the diffuse it falls
+        back to below the minimum."""
+        r = tuple(radius.default_value)
+        if radius.is_linked:
+            transport = True
+        elif scale.is_linked:
+            transport = any(c != 0.0 for c in r)  # the scale may take either sign
+        else:
+            transport = max(c * scale.default_value for c in r) >= _BSSRDF_MIN_RADIUS
+        if transport:
+            self.warn(n, _NO_TRANSPORT)
+
+    def _subsurface_scattering(self, n):
+        # Cycles' BSSRDF of radius 0 is a Lambert diffuse of the node's Color (bssrdf_setup).
+        i = n.inputs
+        self._warn_transport(n, i["Radius"], i["Scale"])
+        linked = self.normal(i["Normal"])
+        return self._add({"kind": "DIFFUSE", "color": self.color(i["Color"]),
+                          "roughness": {"value": 0.0}, "normal_linked": linked})
 
     def _bsdf_diffuse(self, n):
         linked = self.normal(n.inputs["Normal"])
@@ -185,26 +225,30 @@ class _Translator:
                           "roughness": self.value(n.inputs["Roughness"]),
                           "normal_linked": linked})
 
-    def _bsdf_glossy(self, n):
-        if n.distribution not in _GGX_LIKE:
+    def _distribution(self, n):
+        if n.distribution not in _MICROFACET:
             self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
+        return _MICROFACET.get(n.distribution, 'GGX')
+
+    def _bsdf_glossy(self, n):
+        distribution = self._distribution(n)
         linked = self.normal(n.inputs["Normal"])
         roughness = self.value(n.inputs["Roughness"])
         if n.distribution == 'SHARP':
             roughness = {"value": 0.0}
         return self._add({"kind": "GLOSSY", "color": self.color(n.inputs["Color"]),
-                          "roughness": roughness, "normal_linked": linked})
+                          "roughness": roughness, "distribution": distribution,
+                          "normal_linked": linked})
 
     def _bsdf_glass(self, n):
-        if n.distribution not in _GGX_LIKE:
-            self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
+        distribution = self._distribution(n)
         linked = self.normal(n.inputs["Normal"])
         roughness = self.value(n.inputs["Roughness"])
         if n.distribution == 'SHARP':
             roughness = {"value": 0.0}
         return self._add({"kind": "GLASS", "color": self.color(n.inputs["Color"]),
                           "roughness": roughness, "ior": self.value(n.inputs["IOR"]),
-                          "normal_linked": linked})
+                          "distribution": distribution, "normal_linked": linked})
 
     def _bsdf_refraction(self, n):
         index = self._bsdf_glass(n)  # the same inputs and distributions
@@ -683,6 +727,19 @@ class _Translator:
             d = {"kind": "LAYER_WEIGHT", "value_a": self.value(node.inputs["Blend"]),
                  "channel": 0 if out.name == "Fresnel" else 1,
                  "normal_linked": self._view_normal(node.inputs["Normal"])}
+        elif node.type == 'VECT_TRANSFORM':
+            d = {"kind": "VECTOR_TRANSFORM", "vector_type": node.vector_type,
+                 "from": node.convert_from, "to": node.convert_to,
+                 "a": self.color(node.inputs["Vector"])}
+        elif node.type == 'WIREFRAME':
+            # Use Pixel Size: the camera's pixel at the hit stands in for Cycles' ray
+            # differentials, which it equals only where the camera sees the surface directly.
+            if node.use_pixel_size:
+                self.warn(node, "Use Pixel Size seen other than by the camera (reflections, "
+                          "refractions, indirect light: wires as wide as the camera's pixel at "
+                          "the hit, not Cycles' ray differentials) of")
+            d = {"kind": "WIREFRAME", "value_a": self.value(node.inputs["Size"]),
+                 "pixel_size": bool(node.use_pixel_size)}
         elif node.type == 'BLACKBODY':
             d = {"kind": "BLACKBODY", "value_a": self.value(node.inputs["Temperature"])}
         elif node.type == 'RGBTOBW':

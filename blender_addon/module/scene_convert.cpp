@@ -163,7 +163,9 @@ InputNode read_input_node(const py::dict& d) {
       {"FRESNEL", InputNodeKind::Fresnel},
       {"LAYER_WEIGHT", InputNodeKind::LayerWeight},
       {"GEOMETRY", InputNodeKind::Geometry},
-      {"LIGHT_PATH", InputNodeKind::LightPath}};
+      {"LIGHT_PATH", InputNodeKind::LightPath},
+      {"VECTOR_TRANSFORM", InputNodeKind::VectorTransform},
+      {"WIREFRAME", InputNodeKind::Wireframe}};
   n.kind = get_enum(d, "kind", "MIX", kKinds, "input node kind");
   static const std::pair<const char*, MixBlend> kBlends[] = {{"MIX", MixBlend::Mix},
                                                              {"ADD", MixBlend::Add},
@@ -304,6 +306,18 @@ InputNode read_input_node(const py::dict& d) {
     n.geometry_output = get_enum(d, "output", "Normal", kGeometry, "geometry output");
   if (n.kind == InputNodeKind::LightPath)
     n.light_path_output = get_enum(d, "output", "Is Camera Ray", kLightPath, "light path output");
+  // Vector Transform: Blender's vector_type, convert_from and convert_to.
+  if (n.kind == InputNodeKind::VectorTransform) {
+    using T = VectorTransformDesc;
+    static const std::pair<const char*, T::Type> kTypes[] = {
+        {"POINT", T::Type::Point}, {"VECTOR", T::Type::Vector}, {"NORMAL", T::Type::Normal}};
+    static const std::pair<const char*, T::Space> kSpaces[] = {
+        {"WORLD", T::Space::World}, {"OBJECT", T::Space::Object}, {"CAMERA", T::Space::Camera}};
+    n.vector_transform.type = get_enum(d, "vector_type", "VECTOR", kTypes, "vector transform type");
+    n.vector_transform.from = get_enum(d, "from", "WORLD", kSpaces, "vector transform space");
+    n.vector_transform.to = get_enum(d, "to", "OBJECT", kSpaces, "vector transform space");
+  }
+  get(d, "pixel_size", n.pixel_size);
   // Brick: {"offset", "offset_frequency", "squash", "squash_frequency"} (the node's properties).
   if (d.contains("brick")) {
     const auto b = d["brick"].cast<py::dict>();
@@ -580,6 +594,10 @@ int SceneBuilder::add_material(const py::dict& material) {
       read_color(d, "color", node.color);
       read_float(d, "roughness", node.roughness);
       read_float(d, "ior", node.ior);
+      static const std::pair<const char*, MicrofacetDistribution> kDistributions[] = {
+          {"GGX", MicrofacetDistribution::GGX}, {"BECKMANN", MicrofacetDistribution::Beckmann}};
+      node.distribution =
+          get_enum(d, "distribution", "GGX", kDistributions, "microfacet distribution");
       read_float(d, "strength", node.strength);
       read_float(d, "fac", node.fac);
       get(d, "a", node.a);
@@ -597,6 +615,8 @@ int SceneBuilder::add_material(const py::dict& material) {
       read_float(d, "alpha", node.alpha);
       read_color(d, "emission", node.emission);
       read_float(d, "emission_strength", node.emission_strength);
+      read_float(d, "subsurface", node.subsurface);
+      read_color(d, "subsurface_color", node.subsurface_color);
       desc.nodes.push_back(node);
     }
   }
@@ -638,7 +658,8 @@ int SceneBuilder::add_material(const py::dict& material) {
           &node.fac.texture, &node.metallic.texture, &node.specular.texture,
           &node.specular_tint.texture, &node.transmission.texture, &node.sheen.texture,
           &node.sheen_tint.texture, &node.clearcoat.texture, &node.clearcoat_roughness.texture,
-          &node.alpha.texture, &node.emission.texture, &node.emission_strength.texture}) {
+          &node.alpha.texture, &node.emission.texture, &node.emission_strength.texture,
+          &node.subsurface.texture, &node.subsurface_color.texture}) {
       if (t->image >= int32_t(scene_.images.size()))
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
     }

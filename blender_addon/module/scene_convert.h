@@ -13,9 +13,10 @@
 //             matrix, color (3), power, radius, spot_size, spot_blend, sun_angle, size_x, size_y
 //   world:    color (3), strength, image (int), rotation (12 floats)
 //   material: name, root, nodes: list of dicts {kind: 'DIFFUSE'|'GLOSSY'|'GLASS'|'PRINCIPLED'|
-//             'EMISSION'|'TRANSPARENT'|'MIX'|'ADD', a, b, and inputs color, roughness, ior,
+//             'EMISSION'|'TRANSPARENT'|'MIX'|'ADD', a, b, distribution 'GGX'|'BECKMANN' (Glossy,
+//             Glass, Refraction), and inputs color, roughness, ior,
 //             strength, fac, metallic, specular, specular_tint, transmission, alpha, emission,
-//             emission_strength}; a colour input is {value: (3), image, mapping (12), coordinates
+//             emission_strength, subsurface, subsurface_color}; a colour input is {value: (3), image, mapping (12), coordinates
 //             'UV'|'GENERATED'|'OBJECT', interpolation 'Linear'|'Closest', extension
 //             'REPEAT'|'EXTEND'|'CLIP', node}, a float input the same with a scalar value and
 //             channel 'LUMINANCE'|'RED'|'ALPHA'; input nodes (inputs) {kind, ..., vector:

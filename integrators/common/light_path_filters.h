@@ -8,8 +8,9 @@
 //    where pdf is the lowest BSDF sampling density along the path (delta bounces not counted).
 //  - Caustics off: after a diffuse bounce (the last scattering, transparent crossings aside),
 //    glossy reflection lobes (reflective) and refraction lobes (refractive) are dropped. A glass
-//    lobe (reflection and refraction in one lobe) is dropped when both are off; with one off it
-//    stays whole (Cycles drops its reflected or refracted part alone).
+//    lobe (Glass BSDF, Principled transmission: Cycles' two closures, reflection weighted by F
+//    and refraction by 1 - F, in one lobe) loses its reflected or refracted part, or all of it
+//    when both are off.
 #pragma once
 
 #include <cmath>
@@ -58,6 +59,10 @@ class LightPathFilters {
           (kind == Kind::Glass && no_reflection && no_refraction)) {
         set.remove(i);
         continue;
+      }
+      if (kind == Kind::Glass) {
+        c.drop_reflection = no_reflection;
+        c.drop_refraction = no_refraction;
       }
       if (kind != Kind::Other && c.alpha < blur) c.alpha = blur;
     }

@@ -26,7 +26,9 @@ struct TriangleLight {
   Vec3f color0{0.0f}, color1{0.0f}, color2{0.0f};  // colour attribute at the corners
   float pointiness0 = 0.0f, pointiness1 = 0.0f, pointiness2 = 0.0f;  // Mesh::vertex_pointiness
   float island_random = 0.0f;                                        // Mesh::triangle_island_random
-  uint32_t material = 0;  // index into the materials span
+  uint32_t material = 0;                      // index into the materials span
+  const ShadingInstance* instance = nullptr;  // its instance, for the material's nodes
+  uint32_t primitive = 0;                     // its triangle in the instance's mesh
   float select_pmf = 0.0f;
   float max_edge2 = 0.0f;  // squared longest edge
 
@@ -110,6 +112,14 @@ struct TriangleLight {
       ctx.attributes = &attributes;
     }
     ctx.front_facing = dot(dir, normal) < 0.0f;  // the receiver is on the normal's side
+    // As a hit on the triangle sees its instance (Vector Transform, Wireframe, coordinates).
+    ctx.instance = instance;
+    ctx.primitive = primitive;
+    TexCoords coords;
+    if (instance && m.reads_coordinates()) {
+      coords = instance->coords_at(p);
+      ctx.coords = &coords;
+    }
     ShadingGeometry view;
     if (m.reads_view()) {
       // Seen from the receiver; the triangle keeps no corner normals: the flat one stands in.

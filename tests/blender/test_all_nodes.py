@@ -153,6 +153,23 @@ def main():
     geometry_outputs_translate(builder, images, export_materials)
     print(f"{len(materials)} materials, {reported} with warnings", flush=True)
 
+    # Microfacet distributions: Beckmann is rendered as Cycles does, silently; Multiscatter GGX
+    # and Ashikhmin-Shirley are rendered as GGX, reported.
+    for node_type, distribution, exported, warned in (
+            ("ShaderNodeBsdfGlossy", 'BECKMANN', 'BECKMANN', False),
+            ("ShaderNodeBsdfGlass", 'BECKMANN', 'BECKMANN', False),
+            ("ShaderNodeBsdfRefraction", 'BECKMANN', 'BECKMANN', False),
+            ("ShaderNodeBsdfGlossy", 'GGX', 'GGX', False),
+            ("ShaderNodeBsdfGlass", 'SHARP', 'GGX', False),
+            ("ShaderNodeBsdfGlass", 'MULTI_GGX', 'GGX', True),
+            ("ShaderNodeBsdfGlossy", 'ASHIKHMIN_SHIRLEY', 'GGX', True)):
+        m = S.shader_material(f"{node_type}:{distribution}", node_type, distribution=distribution)
+        warnings = []
+        d = export_materials.translate_material(m, images, warnings.append)
+        got = d["nodes"][d["root"]].get("distribution")
+        check(got == exported and bool(warnings) == warned,
+              f"{node_type} {distribution}: exported as {got}, warnings {warnings}")
+
     # All of them in one frame: a grid of small quads, each its own material.
     cols = math.ceil(math.sqrt(len(materials)))
     for k, m in enumerate(materials):

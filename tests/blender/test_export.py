@@ -10,7 +10,10 @@
 #  - n-gons (convex and concave), all flat (no normals), material indices;
 #  - custom split normals;
 #  - an evaluated mesh (Subdivision Surface modifier) from the depsgraph;
-#  - the object's ray visibility flags as the core's bits, and their panel.
+#  - the object's ray visibility flags as the core's bits, and their panel;
+#  - subsurface materials: Principled's subsurface and the Subsurface Scattering node become the
+#    diffuse Cycles falls back to, reported once per material by node name when the radius is
+#    not 0 (Cycles would carry light under the surface).
 import os
 import sys
 
@@ -121,7 +124,61 @@ def compare(name, mesh, tangents=False):
     return ref
 
 
+def translated(material):
+    from gdpt.export_materials import translate_material
+    warnings = []
+    d = translate_material(material, {}, warnings.append)
+    return d, warnings
+
+
+def subsurface_translation():
+    def principled(name, radius, twice=False):
+        m = S.shader_material(name, "ShaderNodeBsdfPrincipled", **{
+            "Base Color": (0.8, 0.2, 0.1, 1), "Subsurface": 0.7,
+            "Subsurface Color": (0.1, 0.3, 0.9, 1), "Subsurface Radius": radius})
+        if twice:  # the node reached twice (through a Mix Shader) is still reported once
+            nt = m.node_tree
+            mix = nt.nodes.new("ShaderNodeMixShader")
+            bsdf = nt.nodes["Principled BSDF"]
+            nt.links.new(bsdf.outputs[0], mix.inputs[1])
+            nt.links.new(bsdf.outputs[0], mix.inputs[2])
+            nt.links.new(mix.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+        return m
+
+    transport = "subsurface scattering, rendered as diffuse (no subsurface transport), of " \
+        "'{}'"
+    d, warnings = translated(principled("sss_zero", (0.0, 0.0, 0.0)))
+    node = d["nodes"][d["root"]]
+    check(not warnings and node["kind"] == "PRINCIPLED" and
+          abs(node["subsurface"]["value"] - 0.7) < 1e-6 and
+          np.allclose(node["subsurface_color"]["value"], (0.1, 0.3, 0.9)),
+          "Principled subsurface of radius 0: translated with its weight and colour, no warning")
+    for twice in (False, True):
+        _, warnings = translated(principled(f"sss_radius_{twice}", (1.0, 0.2, 0.1), twice))
+        check(len(warnings) == 1 and transport.format("Principled BSDF") in warnings[0],
+              f"Principled subsurface of radius > 0{' reached twice' if twice else ''}: one "
+              f"warning naming the node ({warnings})")
+    d, warnings = translated(S.shader_material("plain", "ShaderNodeBsdfPrincipled"))
+    check(not warnings and "subsurface" not in d["nodes"][d["root"]],
+          "Principled without subsurface: no subsurface inputs, no warning")
+    for scale, radius, expect_warning in ((1.0, (0.0, 0.0, 0.0), False),
+                                          (0.0, (1.0, 0.2, 0.1), False),
+                                          (1.0, (-1.0, 0.0, 0.0), False),
+                                          (0.05, (1.0, 0.0, 0.0), True)):
+        m = S.shader_material(f"sss_node_{scale}_{radius}", "ShaderNodeSubsurfaceScattering",
+                              Color=(0.2, 0.8, 0.3, 1), Radius=radius, Scale=scale)
+        d, warnings = translated(m)
+        node = d["nodes"][d["root"]]
+        check(node["kind"] == "DIFFUSE" and node["roughness"]["value"] == 0.0 and
+              np.allclose(node["color"]["value"], (0.2, 0.8, 0.3)) and
+              len(warnings) == int(expect_warning) and
+              all(transport.format("Subsurface Scattering") in w for w in warnings),
+              f"Subsurface Scattering node, radius {radius} x scale {scale}: a Lambert diffuse of "
+              f"its colour, {'one warning' if expect_warning else 'no warning'} ({warnings})")
+
+
 def main():
+    subsurface_translation()
     S.clear()
     red, green = S.diffuse("red", (0.8, 0.1, 0.1)), S.diffuse("green", (0.1, 0.8, 0.1))
 

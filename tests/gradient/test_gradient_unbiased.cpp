@@ -238,6 +238,18 @@ TEST(GradientUnbiased, GlossyReconnectedAndHalfVector) {
                   0.28f);
 }
 
+// Beckmann lobes take the same shifts: the reconnection at roughness 0.3, the half-vector copy at
+// 0.02, whose offset density and value are the Beckmann lobe's own.
+TEST(GradientUnbiased, BeckmannGlossyReconnectedAndHalfVector) {
+  for (float roughness : {0.3f, 0.02f}) {
+    Scene scene = make_scene(SceneKind::CornellGlossy, 16, roughness);
+    scene.materials[3].nodes[0].distribution = MicrofacetDistribution::Beckmann;
+    const bool rough = roughness > 0.1f;
+    expect_unbiased(rough ? "beckmann-rough" : "beckmann-smooth", scene, 4096, 1024,
+                    rough ? 0.25f : 0.29f);
+  }
+}
+
 // Russian roulette after a glossy bounce takes effect past the emission the next segment finds
 // (path_tracer.cpp, gradient_path_tracer.cpp). Roulette from the first bounce and a dark glossy
 // ball (q = sqrt(0.25) = 0.5 after it) make that rule decide much of the image: G-PT's primal
@@ -553,6 +565,39 @@ TEST(GradientUnbiased, GeometryNodeMeshAttributes) {
                                 geometry(GeometryOutput::Pointiness));
   scene.materials[3] = glossy({0.9f, 0.9f, 0.9f}, 0.0f);
   expect_unbiased("geometry-attributes-mirror", scene, 4096, 1024, 0.16f);
+}
+
+// Materials that read the hit's instance, its triangle and the camera (Vector Transform,
+// Wireframe): an offset path's vertex evaluates them with its own instance and triangle, as PT
+// does (shading_context_of), and a reconnected vertex seen from its own direction for wires in
+// pixels. The white walls mix dark and light by the world y of their object +z (the floor
+// light, the ceiling dark), the coloured walls show wires 0.15 wide in white (each quad's
+// diagonal too), the box 2-pixel wires in yellow.
+TEST(GradientUnbiased, ObjectDependentMaterials) {
+  Scene scene = make_scene(SceneKind::CornellDiffuse, 32);
+  InputNode up;
+  up.kind = InputNodeKind::VectorTransform;
+  up.a = ColorInput(Spectrum(0.0f, 0.0f, 1.0f));
+  up.vector_transform = {VectorTransformDesc::Type::Normal, VectorTransformDesc::Space::Object,
+                         VectorTransformDesc::Space::World};
+  InputNode up_y;
+  up_y.kind = InputNodeKind::Separate;
+  up_y.a.node = 1;
+  up_y.channel = 1;
+  scene.materials[0] =
+      view_mix(diffuse({0.05f, 0.05f, 0.05f}), diffuse({0.95f, 0.9f, 0.85f}), up_y);
+  scene.materials[0].inputs.push_back(up);
+  InputNode wire;
+  wire.kind = InputNodeKind::Wireframe;
+  wire.value_a = FloatInput(0.15f);
+  scene.materials[1] = view_mix(diffuse({0.6f, 0.05f, 0.05f}), diffuse({0.95f, 0.9f, 0.9f}), wire);
+  scene.materials[2] = view_mix(diffuse({0.05f, 0.4f, 0.05f}), diffuse({0.95f, 0.9f, 0.9f}), wire);
+  InputNode pixel_wire = wire;
+  pixel_wire.value_a = FloatInput(2.0f);
+  pixel_wire.pixel_size = true;
+  scene.materials[3] =
+      view_mix(diffuse({0.2f, 0.2f, 0.7f}), diffuse({0.9f, 0.8f, 0.1f}), pixel_wire);
+  expect_unbiased("object-dependent", scene, 4096, 1024, 0.1f);
 }
 
 TEST(GradientIntegrator, DeterministicAcrossThreadCounts) {

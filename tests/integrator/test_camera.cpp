@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iterator>
 
 #include "core/warp_disk.h"
 #include "render/camera.h"
+#include "shaders/object_nodes.h"
 
 namespace gdpt {
 namespace {
@@ -173,6 +175,39 @@ TEST(Camera, ConcentricDiskIsInsideAndCoversTheDisk) {
     }
   // Uniform on the unit disk: E[r^2] = 1/2.
   EXPECT_NEAR(mean_r2 / (n * n), 0.5, 2e-3);
+}
+
+// Shading nodes' camera (Vector Transform, Wireframe): Cycles' camera space clears the camera
+// object's scale and looks down +z; the pixel footprint at a point is the change of the camera
+// ray's direction over one pixel (Cycles' dD, averaged over x and y) times its distance.
+TEST(Camera, ShadingCameraIsCyclesCameraSpace) {
+  Camera c = base_camera(200, 100);
+  // Scaled 2x, turned 90 degrees about y (looking down world -x), at (1, 2, 3).
+  c.camera_to_world = Transform::from_rows(
+      std::data({0.0f, 0.0f, 2.0f, 1.0f, 0.0f, 2.0f, 0.0f, 2.0f, -2.0f, 0.0f, 0.0f, 3.0f}));
+  const CameraModel model(c);
+  const ShadingCamera s = model.shading_camera();
+  const Vec3f p = s.world_to_camera.point({-3.0f, 2.5f, 3.0f});  // 4 ahead, 0.5 up
+  EXPECT_NEAR(p.x, 0.0f, 1e-6f);
+  EXPECT_NEAR(p.y, 0.5f, 1e-6f);
+  EXPECT_NEAR(p.z, 4.0f, 1e-6f);
+  const Vec3f right = s.camera_to_world.vector({1.0f, 0.0f, 0.0f});  // unit: scale cleared
+  EXPECT_NEAR(right.z, -1.0f, 1e-6f);
+  EXPECT_FALSE(s.orthographic);
+  for (const Vec2f raster : {Vec2f(100.0f, 50.0f), Vec2f(150.3f, 70.2f), Vec2f(3.5f, 96.0f)}) {
+    const Ray r = model.generate_ray(raster, {0.5f, 0.5f});
+    const Ray rx = model.generate_ray(raster + Vec2f(1.0f, 0.0f), {0.5f, 0.5f});
+    const Ray ry = model.generate_ray(raster + Vec2f(0.0f, 1.0f), {0.5f, 0.5f});
+    const float want =
+        5.0f * 0.5f * (length(rx.direction - r.direction) + length(ry.direction - r.direction));
+    EXPECT_NEAR(pixel_footprint(s, r.origin + r.direction * 5.0f), want, 1e-3f * want);
+  }
+  // Orthographic: the pixel's size (ortho scale 6 over 200 pixels), wherever the point is.
+  c.projection = Camera::Projection::Orthographic;
+  c.camera_to_world = Transform();
+  const ShadingCamera o = CameraModel(c).shading_camera();
+  EXPECT_TRUE(o.orthographic);
+  EXPECT_NEAR(pixel_footprint(o, {1.0f, 2.0f, -30.0f}), 0.03f, 1e-7f);
 }
 
 }  // namespace

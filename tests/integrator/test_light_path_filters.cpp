@@ -1,7 +1,7 @@
 // Cycles' Filter Glossy and caustics rules (integrators/common/light_path_filters.h) on closure
 // sets, and the path state they read (PathState::scattered): the blur roughness against Cycles'
-// formula sqrt(1 - pdf / blur_glossy) / 2, which lobes each toggle drops, and that nothing
-// changes with the rules off or on the camera path.
+// formula sqrt(1 - pdf / blur_glossy) / 2, which lobes (or glass parts) each toggle drops, and
+// that nothing changes with the rules off or on the camera path.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -125,6 +125,12 @@ TEST(LightPathFilters, CausticsTogglesDropLobesAfterADiffuseBounce) {
     EXPECT_EQ(count_type(set, ClosureType::GGXDielectric, FresnelMode::Dielectric), int(k.glass));
     EXPECT_EQ(count_type(set, ClosureType::GGXDielectric, FresnelMode::RefractionOnly),
               int(k.refraction));
+    // The glass lobe left with one toggle off has lost that part alone (Cycles' split).
+    for (int i = 0; i < set.count(); ++i)
+      if (set[i].type == ClosureType::GGXDielectric && set[i].fresnel == FresnelMode::Dielectric) {
+        EXPECT_EQ(set[i].drop_reflection, !k.reflective);
+        EXPECT_EQ(set[i].drop_refraction, !k.refractive);
+      }
     EXPECT_EQ(set[0].type, ClosureType::Lambert);  // order kept
     ClosureSet untouched = mixed_set();
     f.apply(after_glossy, untouched);

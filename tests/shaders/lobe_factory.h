@@ -66,6 +66,16 @@ inline Closure glass(float alpha, float ior, Spectrum c = Spectrum(1.0f)) {
   k.ior = ior;
   return k;
 }
+// A Glossy, Glass or Refraction lobe with Blender's Beckmann distribution instead of GGX.
+inline Closure beckmann(Closure k) {
+  k.distribution = MicrofacetDistribution::Beckmann;
+  return k;
+}
+inline Closure refraction(float alpha, float ior, Spectrum c = Spectrum(1.0f)) {
+  Closure k = glass(alpha, ior, c);
+  k.fresnel = FresnelMode::RefractionOnly;
+  return k;
+}
 inline Closure transparent(Spectrum c = Spectrum(1.0f)) {
   Closure k;
   k.type = ClosureType::Transparent;

@@ -26,10 +26,10 @@ std::vector<Case> lobe_cases() {
   cases.push_back({"PrincipledSheen", set_of({principled_sheen()})});
   cases.push_back({"Translucent", set_of({translucent()})});
   for (float a : {0.0f, 0.3f}) {  // Refraction BSDF: refraction alone, smooth and rough
-    Closure r = glass(a, 1.5f);
-    r.fresnel = FresnelMode::RefractionOnly;
-    cases.push_back({"Refraction" + std::to_string(int(a * 100 + 0.5f)), set_of({r})});
+    cases.push_back(
+        {"Refraction" + std::to_string(int(a * 100 + 0.5f)), set_of({refraction(a, 1.5f)})});
   }
+  cases.push_back({"BeckmannRefraction30", set_of({beckmann(refraction(0.3f, 1.5f))})});
   cases.push_back({"Velvet02", set_of({velvet(0.2f)})});
   cases.push_back({"Velvet1", set_of({velvet(1.0f)})});
   cases.push_back(
@@ -42,6 +42,14 @@ std::vector<Case> lobe_cases() {
         {"GGXPrincipled" + s, set_of({ggx_principled(a, 1.5f, Spectrum(0.9f, 0.5f, 0.1f))})});
     cases.push_back({"Glass" + s, set_of({glass(a, 1.5f)})});
     cases.push_back({"Clearcoat" + s, set_of({clearcoat(a)})});
+    cases.push_back({"Beckmann" + s, set_of({beckmann(ggx(a))})});
+    cases.push_back({"BeckmannGlass" + s, set_of({beckmann(glass(a, 1.5f))})});
+  }
+  // Glass with one part dropped (Cycles' caustics toggles): the other part alone.
+  for (const bool reflection : {true, false}) {
+    Closure g = glass(0.2f, 1.5f);
+    (reflection ? g.drop_refraction : g.drop_reflection) = true;
+    cases.push_back({reflection ? "GlassReflectionPart20" : "GlassRefractionPart20", set_of({g})});
   }
   // Principled-like glass: tinted refraction, Fresnel-coloured reflection.
   {
@@ -108,6 +116,7 @@ TEST_P(BsdfChi2, SampleMatchesPdf) {
   auto density = [&](Vec3f wo) { return double(set.pdf(wi, wo)); };
   const Chi2Result r = chi2_test(sampler, density, kSamples, 1234 + GetParam().angle_index);
   const double level = sidak(0.01, tests);
+  RecordProperty("p_value", std::to_string(r.p_value));  // in --gtest_output=xml
   EXPECT_GE(r.p_value, level) << c.name << " cos_i=" << wi.z << ": chi2=" << r.chi2
                               << " dof=" << r.dof << " pdf mass=" << r.pdf_mass
                               << " sampled mass=" << r.sampled_mass << " " << r.message;

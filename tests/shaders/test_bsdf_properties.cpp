@@ -57,6 +57,9 @@ TEST(BsdfEnergy, SampleWeightsIntegrateEval) {
       set_of({ggx_principled(0.25f, 1.5f, Spectrum(0.9f, 0.6f, 0.3f))}),
       set_of({glass(0.3f, 1.5f)}),
       set_of({principled_diffuse(0.5f, Spectrum(0.5f)), ggx(0.4f, Spectrum(0.5f))}),
+      set_of({beckmann(ggx(0.3f))}),
+      set_of({beckmann(ggx(1.0f))}),
+      set_of({beckmann(glass(0.3f, 1.5f))}),
   };
   for (size_t i = 0; i < std::size(sets); ++i) {
     for (float c : {0.9f, 0.4f, -0.5f}) {
@@ -82,10 +85,14 @@ TEST(BsdfEnergy, GgxWhiteFurnaceLossIsSmallForSmoothAndLargerForRough) {
 }
 
 TEST(BsdfReciprocity, ReflectionLobesAreSymmetric) {
-  const Closure lobes[] = {
-      lambert(),          oren_nayar(0.6f), principled_diffuse(0.8f),
-      principled_sheen(), ggx(0.3f),        ggx_principled(0.15f, 1.6f, Spectrum(0.7f, 0.4f, 0.2f)),
-      clearcoat(0.1f)};
+  const Closure lobes[] = {lambert(),
+                           oren_nayar(0.6f),
+                           principled_diffuse(0.8f),
+                           principled_sheen(),
+                           ggx(0.3f),
+                           ggx_principled(0.15f, 1.6f, Spectrum(0.7f, 0.4f, 0.2f)),
+                           clearcoat(0.1f),
+                           beckmann(ggx(0.3f))};
   Pcg32 rng(3);
   for (const Closure& c : lobes) {
     const ClosureSet set = set_of({c});
@@ -107,23 +114,24 @@ TEST(BsdfReciprocity, GlassTransmissionCarriesEtaSquared) {
   // Without the 1/eta^2 radiance scaling (Cycles' convention) the microfacet BTDF satisfies
   // f(wi, wo) / (1 - F(wi)) = eta^2 f(wo, wi) / (1 - F(wo)), eta = n(wo side) / n(wi side).
   const float ior = 1.5f;
-  const ClosureSet set = set_of({glass(0.3f, ior)});
-  Pcg32 rng(5);
-  int checked = 0;
-  for (int i = 0; i < 2000; ++i) {
-    const Vec3f a = direction(0.1 + 0.9 * rng.uniform(), 2 * M_PI * rng.uniform());
-    const Vec3f b = direction(-0.1 - 0.9 * rng.uniform(), 2 * M_PI * rng.uniform());
-    const float fab = set.eval(a, b).y / std::fabs(b.z);
-    const float fba = set.eval(b, a).y / std::fabs(a.z);
-    // Cycles 3.4 splits by the Fresnel term at the shading normal: the reverse direction may be
-    // beyond the critical angle (F = 1), where the lobe is not reciprocal at all.
-    if (fab < 1e-6f || fresnel_dielectric(b.z, 1.0f / ior) >= 1.0f) continue;
-    const float lhs = fab / (1.0f - fresnel_dielectric(a.z, ior));
-    const float rhs = ior * ior * fba / (1.0f - fresnel_dielectric(b.z, 1.0f / ior));
-    EXPECT_NEAR(lhs, rhs, 1e-3f * lhs);
-    ++checked;
+  for (const ClosureSet& set : {set_of({glass(0.3f, ior)}), set_of({beckmann(glass(0.3f, ior))})}) {
+    Pcg32 rng(5);
+    int checked = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3f a = direction(0.1 + 0.9 * rng.uniform(), 2 * M_PI * rng.uniform());
+      const Vec3f b = direction(-0.1 - 0.9 * rng.uniform(), 2 * M_PI * rng.uniform());
+      const float fab = set.eval(a, b).y / std::fabs(b.z);
+      const float fba = set.eval(b, a).y / std::fabs(a.z);
+      // Cycles 3.4 splits by the Fresnel term at the shading normal: the reverse direction may be
+      // beyond the critical angle (F = 1), where the lobe is not reciprocal at all.
+      if (fab < 1e-6f || fresnel_dielectric(b.z, 1.0f / ior) >= 1.0f) continue;
+      const float lhs = fab / (1.0f - fresnel_dielectric(a.z, ior));
+      const float rhs = ior * ior * fba / (1.0f - fresnel_dielectric(b.z, 1.0f / ior));
+      EXPECT_NEAR(lhs, rhs, 1e-3f * lhs);
+      ++checked;
+    }
+    EXPECT_GT(checked, 100);
   }
-  EXPECT_GT(checked, 100);
 }
 
 TEST(Fresnel, NormalIncidenceAndKnownAngle) {
@@ -194,6 +202,47 @@ TEST(SmoothGlass, TotalInternalReflectionReflectsEverything) {
     EXPECT_TRUE(s.lobe & kLobeReflection);
     EXPECT_NEAR(s.weight().x, 1.0f, 1e-6f);
     EXPECT_LT(s.wo.z, 0.0f);
+  }
+}
+
+// Cycles' caustics toggles leave one of the glass BSDF's two closures: dropping a part keeps the
+// other's values (weighted by F or 1 - F at the shading normal) and never samples the dropped one.
+TEST(GlassParts, DroppingOnePartKeepsTheOther) {
+  const float ior = 1.5f;
+  for (const float alpha : {0.0f, 0.3f}) {
+    const Closure whole = glass(alpha, ior);
+    Closure refl = whole, refr = whole;
+    refl.drop_refraction = true;
+    refr.drop_reflection = true;
+    const ClosureSet full = set_of({whole}), reflection = set_of({refl}),
+                     refraction = set_of({refr});
+    Pcg32 rng(11);
+    for (int i = 0; i < 200; ++i) {
+      const Vec3f wi = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+      const float fr = fresnel_dielectric(wi.z, ior);
+      const Vec2f u(rng.uniform(), rng.uniform());
+      const float choice = rng.uniform();
+      const BsdfSample a = reflection.sample(wi, choice, u), b = refraction.sample(wi, choice, u);
+      if (a.valid) {
+        EXPECT_TRUE(a.lobe & kLobeReflection);
+        if (alpha == 0.0f) {
+          EXPECT_NEAR(a.weight().y, fr, 1e-5f);  // F, chosen always
+        }
+      }
+      if (b.valid) {
+        EXPECT_TRUE(b.lobe & kLobeTransmission);
+        if (alpha == 0.0f) {
+          EXPECT_NEAR(b.weight().y, 1.0f - fr, 1e-5f);
+        }
+      }
+      if (alpha == 0.0f) continue;
+      const Vec3f up = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+      const Vec3f down = direction(-0.05 - 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+      EXPECT_EQ(reflection.eval(wi, down).y, 0.0f);
+      EXPECT_EQ(refraction.eval(wi, up).y, 0.0f);
+      EXPECT_NEAR(reflection.eval(wi, up).y, full.eval(wi, up).y, 1e-6f);
+      EXPECT_NEAR(refraction.eval(wi, down).y, full.eval(wi, down).y, 1e-6f);
+    }
   }
 }
 
@@ -389,6 +438,9 @@ TEST(BsdfRobustness, NoNaNOrInfInDegenerateConfigurations) {
     lobes.push_back(ggx_principled(a, 1.5f, Spectrum(0.5f)));
     lobes.push_back(glass(a, 1.5f));
     lobes.push_back(glass(a, 1.00001f));
+    lobes.push_back(beckmann(ggx(a)));
+    lobes.push_back(beckmann(glass(a, 1.5f)));
+    lobes.push_back(beckmann(refraction(a, 1.5f)));
     lobes.push_back(clearcoat(a));
     lobes.push_back(kept(clearcoat(a)));
   }

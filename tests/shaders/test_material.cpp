@@ -207,6 +207,44 @@ TEST(Material, PrincipledSheenFollowsCycles) {
   EXPECT_FALSE(sheen_of(0.8f, 1.0f).has_value());
 }
 
+// Subsurface s: Cycles' BSSRDF below its minimum radius is the whole PrincipledDiffuse
+// (retro-reflection and Lambert parts) of mix(base, subsurface colour, s); on camera paths the
+// other lobes keep the base colour, after a diffuse bounce they take the mix too.
+TEST(Material, PrincipledSubsurfaceIsCyclesDiffuseFallback) {
+  const Spectrum base(0.8f, 0.2f, 0.1f), sss(0.1f, 0.3f, 0.9f);
+  const Spectrum mixed = base * 0.3f + sss * 0.7f;
+  MaterialDesc d;
+  ShaderNode n = node(ShaderNodeKind::Principled, base);
+  n.subsurface = FloatInput(0.7f);
+  n.subsurface_color = ColorInput(sss);
+  n.metallic = FloatInput(0.2f);
+  d.nodes.push_back(n);
+  d.root = 0;
+  const Material m(d, {});
+  EXPECT_TRUE(m.reads_path());  // the metallic lobe's colour depends on the path
+  for (const int16_t diffuse_depth : {0, 1}) {
+    PathView path;
+    path.depth = path.diffuse_depth = diffuse_depth;
+    ShadingContext ctx{{0.25f, 0.25f}, true};
+    ctx.path = &path;
+    ClosureSet s;
+    m.evaluate(ctx, s);
+    ASSERT_EQ(s.count(), 2);
+    EXPECT_EQ(s[0].type, ClosureType::PrincipledDiffuse);
+    expect_spectrum(s[0].weight, mixed * 0.8f);
+    EXPECT_EQ(s[1].type, ClosureType::GGXReflection);
+    const Spectrum metal = diffuse_depth > 0 ? mixed : base;
+    expect_spectrum(s[1].f0, Spectrum(0.08f * 0.5f * 0.8f) + metal * 0.2f);
+  }
+  // Without lobes that read the base colour the material stays constant.
+  d.nodes[0].metallic = FloatInput(0.0f);
+  const Material plain(d, {});
+  EXPECT_FALSE(plain.reads_path());
+  expect_spectrum(eval(plain)[0].weight, mixed);
+  d.nodes[0].subsurface = FloatInput(0.0f);
+  expect_spectrum(eval(Material(d, {}))[0].weight, base);
+}
+
 // Clearcoat: a Clearcoat lobe of alpha clearcoat_roughness^2, weight 0.25 clearcoat (times alpha
 // and the mix weight, not reduced by metallic or transmission), whose Fresnel is the dielectric
 // one of IOR 1.5: a smooth coat reflects 0.25 F(cos_i) of the light at every incidence. Lobes

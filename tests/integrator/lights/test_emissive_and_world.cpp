@@ -7,6 +7,7 @@
 
 #include "light_test_util.h"
 #include "render/light_sampler.h"
+#include "shaders/object_nodes.h"
 
 namespace gdpt {
 namespace {
@@ -191,5 +192,81 @@ TEST(ConstantWorld, IsSeenButNotSampled) {
   EXPECT_TRUE(world_only.empty());
 }
 
+// A light sample evaluates the emitter's material as a hit on it would: with its instance, its
+// triangle and its texture coordinates (Cycles sets up the shader at the sampled point of the
+// object). A quad of two triangles, turned 90 degrees about z, scaled 2x and moved; emission
+// colours: a Wireframe 0.3 wide, a Vector Transform of (0.5, -0.2, 0.9) from object to world,
+// the Object and Generated coordinates.
+TEST(EmissiveTriangle, LightSamplesSeeTheirInstance) {
+  Scene scene = test::black_scene();
+  Mesh quad;
+  quad.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  scene.meshes.push_back(quad);
+  const float rows[12] = {0, -2, 0, 0.5f, 2, 0, 0, 0.25f, 0, 0, 2, 3};
+  const Transform to_world = Transform::from_rows(rows);
+  const Transform to_object = to_world.inverse();
+  InputNode wire;
+  wire.kind = InputNodeKind::Wireframe;
+  wire.value_a = FloatInput(0.3f);
+  InputNode turned;
+  turned.kind = InputNodeKind::VectorTransform;
+  turned.a = ColorInput(Spectrum(0.5f, -0.2f, 0.9f));
+  turned.vector_transform = {VectorTransformDesc::Type::Vector, VectorTransformDesc::Space::Object,
+                             VectorTransformDesc::Space::World};
+  InputNode object, generated;
+  object.kind = generated.kind = InputNodeKind::Coordinates;
+  object.vector.source = TexCoordSource::Object;
+  generated.vector.source = TexCoordSource::Generated;
+  for (const InputNode& node : {wire, turned, object, generated}) {
+    MaterialDesc d = test::emission_material({0, 0, 0}, 1.0f);
+    d.inputs = {node};
+    d.nodes[0].color = ColorInput(Spectrum(0.0f));
+    d.nodes[0].color.node = 0;
+    scene.materials.push_back(d);
+  }
+  std::vector<Material> materials;
+  for (const MaterialDesc& d : scene.materials)
+    materials.emplace_back(d, std::span<const Texture>{});
+  for (uint32_t m = 0; m < materials.size(); ++m) {
+    Scene one = scene;
+    Instance inst;
+    inst.mesh = 0;
+    inst.object_to_world = to_world;
+    inst.slot_material = {int32_t(m)};
+    one.instances = {inst};
+    const LightSampler lights(one, materials, {});
+    ASSERT_FALSE(lights.empty());
+    int wires = 0;
+    const int n = 400;
+    for (int i = 0; i < n; ++i) {
+      const Vec2f u((i % 20 + 0.5f) / 20.0f, (i / 20 + 0.5f) / 20.0f);
+      const LightSample s = lights.sample({0.3f, 0.2f, 0.0f}, (i + 0.5f) / n, u);
+      ASSERT_TRUE(s.valid);
+      const Vec3f o = to_object.point(s.position);
+      Vec3f want;
+      if (m == 0) {
+        // Triangle 0 or 1 of the quad: the one whose side of the diagonal holds the point.
+        const uint32_t t = o.x >= o.y ? 0 : 1;
+        Vec3f c[3];
+        for (int k = 0; k < 3; ++k) c[k] = to_world.point(quad.positions[quad.indices[3 * t + k]]);
+        want = Vec3f(wireframe(c, s.position, 0.3f));
+        wires += want.x > 0.0f ? 1 : 0;
+      } else if (m == 1) {
+        want = {0.2f * 2.0f, 0.5f * 2.0f, 0.9f * 2.0f};
+      } else {
+        want = m == 2 ? o : (o + Vec3f(1.0f)) * 0.5f;
+      }
+      EXPECT_NEAR(s.radiance.x, want.x, 1e-4f) << m << " " << i;
+      EXPECT_NEAR(s.radiance.y, want.y, 1e-4f) << m << " " << i;
+      EXPECT_NEAR(s.radiance.z, want.z, 1e-4f) << m << " " << i;
+    }
+    // Both wires (the edges and the diagonal) and the faces between them were sampled.
+    if (m == 0) {
+      EXPECT_GT(wires, n / 10);
+      EXPECT_LT(wires, n * 9 / 10);
+    }
+  }
+}
 }  // namespace
 }  // namespace gdpt
