@@ -1,5 +1,6 @@
-// GGX microfacet reflection, two-sided, as Cycles 3.4's `microfacet_ggx` (Glossy BSDF) and
-// `microfacet_ggx_fresnel` (Principled v1 specular):
+// GGX microfacet reflection (isotropic, or anisotropic about the lobe's tangent), two-sided, as
+// Cycles 3.4's `microfacet_ggx` (Glossy BSDF) and `microfacet_ggx_fresnel` (Principled v1
+// specular):
 //   f |cos_o| = weight * F(wo.h) * D(h) G1(wi) G1(wo) / (4 cos_i),   h = normalize(wi + wo)
 // F = 1 for FresnelMode::None (the Glossy colour simply scales), and Cycles' Principled v1 blend
 // PrincipledFresnel(Closure::ior, Closure::f0) for FresnelMode::PrincipledV1.
@@ -20,11 +21,28 @@ inline Spectrum fresnel(const Closure& c, float cos_h) {
   return PrincipledFresnel(c.ior, c.f0)(cos_h);
 }
 
+// A direction in the anisotropic lobe's own frame (its tangent on +x), and back.
+inline Vec3f to_tangent(const Closure& c, Vec3f w) {
+  return {c.rotation.x * w.x + c.rotation.y * w.y, c.rotation.x * w.y - c.rotation.y * w.x, w.z};
+}
+inline Vec3f from_tangent(const Closure& c, Vec3f w) {
+  return {c.rotation.x * w.x - c.rotation.y * w.y, c.rotation.y * w.x + c.rotation.x * w.y, w.z};
+}
+
+// The anisotropic lobe: the same formulas with AnisoGGX in the lobe's frame.
+inline Spectrum eval_pdf_aniso(const Closure& c, Vec3f wi, Vec3f wo, Vec3f h, float& pdf) {
+  const AnisoGGX ggx(c.alpha, c.alpha_y);
+  const float common = ggx.D(to_tangent(c, h)) * ggx.G1(to_tangent(c, wi)) / (4.0f * wi.z);
+  pdf = common;
+  return c.weight * fresnel(c, dot(wo, h)) * (common * ggx.G1(to_tangent(c, wo)));
+}
+
 // wi, wo already mirrored to wi.z > 0. Returns eval, writes the pdf.
 inline Spectrum eval_pdf_upper(const Closure& c, Vec3f wi, Vec3f wo, float& pdf) {
   pdf = 0.0f;
   Vec3f h;
   if (!reflection_lobe::upper_half_vector(wi, wo, h)) return Spectrum(0.0f);
+  if (is_anisotropic(c)) return eval_pdf_aniso(c, wi, wo, h, pdf);
   const GGX ggx(c.alpha);
   const float d = ggx.D(h);
   const float g1i = ggx.G1(wi);
@@ -40,6 +58,10 @@ inline Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo) {
 // Density only: D(h) G1(wi) / (4 cos_i), without the Fresnel and G1(wo) of the value.
 inline float pdf(const Closure& c, Vec3f wi, Vec3f wo) {
   return reflection_lobe::pdf(c, wi, wo, [](const Closure& k, Vec3f i, Vec3f, Vec3f h) {
+    if (is_anisotropic(k)) {
+      const AnisoGGX ggx(k.alpha, k.alpha_y);
+      return ggx.D(to_tangent(k, h)) * ggx.G1(to_tangent(k, i)) / (4.0f * i.z);
+    }
     const GGX ggx(k.alpha);
     return ggx.D(h) * ggx.G1(i) / (4.0f * i.z);
   });
@@ -48,7 +70,10 @@ inline float pdf(const Closure& c, Vec3f wi, Vec3f wo) {
 inline BsdfSample sample(const Closure& c, Vec3f wi, float, Vec2f u) {
   return reflection_lobe::sample(
       c, wi, u, [](const Closure& k, float cos_i) { return k.weight * fresnel(k, cos_i); },
-      [](const Closure& k, Vec3f i, Vec2f v) { return GGX(k.alpha).sample_visible(i, v); },
+      [](const Closure& k, Vec3f i, Vec2f v) {
+        if (!is_anisotropic(k)) return GGX(k.alpha).sample_visible(i, v);
+        return from_tangent(k, AnisoGGX(k.alpha, k.alpha_y).sample_visible(to_tangent(k, i), v));
+      },
       eval_pdf_upper);
 }
 

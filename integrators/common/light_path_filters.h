@@ -59,7 +59,9 @@ class LightPathFilters {
         set.remove(i);
         continue;
       }
-      if (kind != Kind::Other && c.alpha < blur) c.alpha = blur;
+      if (kind == Kind::Other) continue;
+      if (c.alpha < blur) c.alpha = blur;
+      if (is_anisotropic(c) && c.alpha_y < blur) c.alpha_y = blur;  // Cycles raises both widths
     }
   }
 
