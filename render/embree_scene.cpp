@@ -392,6 +392,7 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
         interpolate(load3(P[idx[0]]), load3(P[idx[1]]), load3(P[idx[2]]), W, U, V);
     store3(hit.coords.object, object);
     hit.coords.position = hit.position;
+    hit.coords.normal_cols = d.normal_cols;
     store3(hit.coords.generated, _mm_add_ps(_mm_mul_ps(object, _mm_load_ps(d.generated_scale)),
                                             _mm_load_ps(d.generated_offset)));
   }

@@ -52,8 +52,8 @@ struct Closure {
   // Anisotropic GGX (GGXReflection): alpha is the width along the lobe's tangent, alpha_y along
   // its bitangent; alpha_y < 0: isotropic. The lobe's tangent is local (rotation.x, rotation.y,
   // 0): the shading frame's x axis follows `tangent` (world; the material's Tangent input,
-  // neither projected nor rotated: shading_frame() in core/shading_frame.h), and `rotation` is
-  // (cos, sin) of the Anisotropic Rotation about the normal from there.
+  // neither projected nor rotated: shading_frame() in integrators/common/surface_frame.h), and
+  // `rotation` is (cos, sin) of the Anisotropic Rotation about the normal from there.
   float alpha_y = -1.0f;
   Vec2f rotation{1.0f, 0.0f};
   Vec3f tangent{0.0f, 0.0f, 0.0f};

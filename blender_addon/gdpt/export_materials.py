@@ -2,6 +2,7 @@
 #
 # Walks from the active Material Output's Surface input over the tree with its node groups
 # flattened (export_node_groups.py). Supported shader nodes: Principled BSDF, Diffuse, Glossy,
+# Anisotropic (GGX; its Tangent: Cycles' default radial tangent, a Tangent node or a vector),
 # Glass, Emission (and, reported, Background: Cycles shows it as one on a surface), Transparent,
 # Mix Shader, Add Shader; a colour or float output on a shader
 # socket becomes an Emission, and an unlinked shader input is no closure (black), as in Cycles.
@@ -29,7 +30,7 @@ IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 _SHADERS = {
     'BSDF_PRINCIPLED', 'BSDF_DIFFUSE', 'BSDF_GLOSSY', 'BSDF_GLASS', 'EMISSION',
     'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSLUCENT', 'BSDF_VELVET',
-    'BSDF_REFRACTION',
+    'BSDF_REFRACTION', 'BSDF_ANISOTROPIC',
 }
 _GGX_LIKE = {'GGX', 'SHARP'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
@@ -150,9 +151,6 @@ class _Translator:
             self.warn(n, "subsurface scattering of")
         normal_linked = self.normal(i["Normal"])
         clearcoat_normal_linked = self.normal(i["Clearcoat Normal"])
-        if i["Tangent"].is_linked:
-            self.warn(self._source(i["Tangent"]).node if self._source(i["Tangent"]) else n,
-                      "normal / tangent input node")
         return self._add({
             "kind": "PRINCIPLED",
             "color": self.color(i["Base Color"]),
@@ -171,6 +169,9 @@ class _Translator:
             "emission": self.color(i["Emission"]),
             "emission_strength": self.value(i["Emission Strength"]),
             "alpha": self.value(i["Alpha"]),
+            "anisotropy": self.value(i["Anisotropic"]),
+            "rotation": self.value(i["Anisotropic Rotation"]),
+            "tangent": self.tangent(i["Tangent"]),
         })
 
     def _bsdf_diffuse(self, n):
@@ -188,6 +189,16 @@ class _Translator:
             roughness = {"value": 0.0}
         return self._add({"kind": "GLOSSY", "color": self.color(n.inputs["Color"]),
                           "roughness": roughness, "normal_linked": linked})
+
+    def _bsdf_anisotropic(self, n):
+        if n.distribution != 'GGX':
+            self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
+        linked = self.normal(n.inputs["Normal"])
+        return self._add({"kind": "ANISOTROPIC", "color": self.color(n.inputs["Color"]),
+                          "roughness": self.value(n.inputs["Roughness"]),
+                          "anisotropy": self.value(n.inputs["Anisotropy"]),
+                          "rotation": self.value(n.inputs["Rotation"]),
+                          "tangent": self.tangent(n.inputs["Tangent"]), "normal_linked": linked})
 
     def _bsdf_glass(self, n):
         if n.distribution not in _GGX_LIKE:
@@ -261,6 +272,21 @@ class _Translator:
             return True
         self.warn(node, _SECOND_PERTURBATION)
         return False
+
+    def tangent(self, socket):
+        """An anisotropic lobe's Tangent input (TangentInput): unlinked, or the Geometry node's
+        Tangent, is Cycles' default, radial about the object's Z axis; a Tangent node is radial
+        about its axis; any other vector is read as it is (world space)."""
+        out = self._source(socket)
+        if out is None or (out.node.type == 'NEW_GEOMETRY' and out.name == "Tangent"):
+            return {"source": "RADIAL", "axis": 2}
+        node = out.node
+        if node.type == 'TANGENT':
+            if node.direction_type == 'RADIAL':
+                return {"source": "RADIAL", "axis": "XYZ".index(node.axis)}
+            self.warn(node, "UV Map direction (radial about Z stands in) of")
+            return {"source": "RADIAL", "axis": 2}
+        return {"source": "VECTOR", "vector": self.color(socket)}
 
     def _view_normal(self, socket):
         """A Fresnel / Layer Weight Normal input: unlinked or the Geometry node's Normal is the
