@@ -442,9 +442,10 @@ struct PointInputs {
     if (t.source == TangentInput::Source::Vector) return color(t.vector);
     if (!at.coords) return Vec3f(0.0f);
     const Vec3f g = at.coords->generated - Vec3f(0.5f);
-    const Vec3f local = t.axis == 0   ? Vec3f(0.0f, -g.z, g.y)
-                        : t.axis == 1 ? Vec3f(-g.z, 0.0f, g.x)
-                                      : Vec3f(-g.y, g.x, 0.0f);
+    const Vec3f local = t.source == TangentInput::Source::UVMap ? at.coords->uv_tangent
+                        : t.axis == 0                           ? Vec3f(0.0f, -g.z, g.y)
+                        : t.axis == 1                           ? Vec3f(-g.z, 0.0f, g.x)
+                                                                : Vec3f(-g.y, g.x, 0.0f);
     const float(*n)[4] = at.coords->normal_cols;
     if (!n) return local;
     Vec3f w(0.0f);
@@ -809,7 +810,7 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       note(t.vector);
       return;
     }
-    if (t.source == TangentInput::Source::Radial) reads_coordinates_ = true;
+    reads_coordinates_ = true;  // TexCoords carries the generated coordinates and UV tangent
     features_ |= kFeatureTextures;
   };
   auto visit = [&](auto&& self, int32_t i, int depth) -> void {

@@ -2,7 +2,8 @@
 #
 # Walks from the active Material Output's Surface input over the tree with its node groups
 # flattened (export_node_groups.py). Supported shader nodes: Principled BSDF, Diffuse, Glossy,
-# Anisotropic (GGX; its Tangent: Cycles' default radial tangent, a Tangent node or a vector),
+# Anisotropic (GGX; its Tangent: Cycles' default radial tangent, a Tangent node, Radial or UV Map,
+# or a vector),
 # Glass, Emission (and, reported, Background: Cycles shows it as one on a surface), Transparent,
 # Mix Shader, Add Shader; a colour or float output on a shader
 # socket becomes an Emission, and an unlinked shader input is no closure (black), as in Cycles.
@@ -82,6 +83,7 @@ class _Translator:
         self.chain_nodes = set()
         self.inputs = []  # colour / math input nodes (MaterialDesc::inputs)
         self.color_attribute = None  # name read by Color Attribute nodes ("": the render one)
+        self.uv_tangents = False  # a Tangent node reads the UV map's tangents
         self.input_index = {}  # node name -> index in self.inputs
         self.current = None  # the node being translated (named when translation fails)
 
@@ -276,7 +278,8 @@ class _Translator:
     def tangent(self, socket):
         """An anisotropic lobe's Tangent input (TangentInput): unlinked, or the Geometry node's
         Tangent, is Cycles' default, radial about the object's Z axis; a Tangent node is radial
-        about its axis; any other vector is read as it is (world space)."""
+        about its axis or its UV map's tangent (the active render UV map's MikkTSpace tangents,
+        exported with the mesh); any other vector is read as it is (world space)."""
         out = self._source(socket)
         if out is None or (out.node.type == 'NEW_GEOMETRY' and out.name == "Tangent"):
             return {"source": "RADIAL", "axis": 2}
@@ -284,8 +287,11 @@ class _Translator:
         if node.type == 'TANGENT':
             if node.direction_type == 'RADIAL':
                 return {"source": "RADIAL", "axis": "XYZ".index(node.axis)}
-            self.warn(node, "UV Map direction (radial about Z stands in) of")
-            return {"source": "RADIAL", "axis": 2}
+            if node.uv_map:
+                self.warn(node, f"UV map '{node.uv_map}' (the active render UV map's tangents "
+                          "are used) of")
+            self.uv_tangents = True
+            return {"source": "UV_MAP"}
         return {"source": "VECTOR", "vector": self.color(socket)}
 
     def _view_normal(self, socket):
@@ -868,6 +874,8 @@ def _translate_tree(material, t, warn):
         d["bumps"] = bumps
     if t.color_attribute is not None:
         d["color_attribute"] = t.color_attribute
+    if t.uv_tangents:
+        d["uv_tangents"] = True
     return d
 
 
@@ -878,7 +886,8 @@ class MaterialCache:
         self.images = images
         self.warn = warn
         self.index = {}
-        self.normal_mapped = set()  # scene material indices with a normal map
+        # Scene material indices that read the UV map's tangents (a normal map, a Tangent node).
+        self.normal_mapped = set()
         self.color_attributes = {}  # scene material index -> colour attribute name it reads
 
     def get(self, material):
@@ -894,7 +903,7 @@ class MaterialCache:
                 self.warn(f"material '{material.name}': {e}; rendered magenta")
                 desc = dict(magenta_material(material.name), pass_index=material.pass_index)
                 self.index[key] = self.builder.add_material(desc)
-            if "normal_map" in desc:
+            if "normal_map" in desc or desc.get("uv_tangents"):
                 self.normal_mapped.add(self.index[key])
             if "color_attribute" in desc:
                 self.color_attributes[self.index[key]] = desc["color_attribute"]

@@ -350,6 +350,14 @@ TEST(Material, AnisotropicWidthsAndRadialTangent) {
   EXPECT_NEAR(ps[0].alpha, 0.09f / aspect, 1e-6f);
   EXPECT_NEAR(ps[0].alpha_y, 0.09f * aspect, 1e-6f);
   expect_spectrum(ps[0].tangent, Vec3f(0.0f, 0.0f, 0.3f));
+
+  // A Tangent node's UV Map direction: the mesh's tangent through the same normal matrix.
+  d.nodes[0].anisotropy = FloatInput(0.8f);
+  d.nodes[0].tangent.source = TangentInput::Source::UVMap;
+  tc.uv_tangent = Vec3f(0.0f, 2.0f, 0.0f);
+  ClosureSet uv;
+  Material(d, {}).evaluate(at, uv);
+  expect_spectrum(uv[0].tangent, Vec3f(0.0f, 0.0f, 2.0f));
 }
 
 // A texture's vector can be any input node's result (TexCoordSource::Node): a Checker read at
