@@ -133,7 +133,9 @@ enum class LightPathOutput : uint8_t {
 };
 // The Geometry node's outputs read from ShadingContext::geometry (world space, flipped to the
 // incoming side as Cycles' sd->N / sd->Ng), and Backfacing (1 on a back face, else 0).
-enum class GeometryOutput : uint8_t { Normal, TrueNormal, Incoming, Backfacing };
+// Tangent: Cycles' default tangent (TangentInput's radial about Z) made normal to the
+// interpolated normal.
+enum class GeometryOutput : uint8_t { Normal, TrueNormal, Incoming, Backfacing, Tangent };
 enum class MixBlend : uint8_t {
   Mix,
   Add,

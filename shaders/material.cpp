@@ -432,6 +432,12 @@ struct PointInputs {
     if (which == GeometryOutput::Backfacing) return Vec3f(at.front_facing ? 0.0f : 1.0f);
     if (!at.geometry) return Vec3f(0.0f, 0.0f, 1.0f);
     const ShadingGeometry& g = *at.geometry;
+    if (which == GeometryOutput::Tangent) {
+      // Cycles' primitive_tangent: cross(N, normalize(cross(T, N))).
+      const Vec3f c = cross(tangent(TangentInput{}), g.normal);
+      const float len = length(c);
+      return len > 0.0f ? cross(g.normal, c / len) : Vec3f(0.0f);
+    }
     return which == GeometryOutput::Normal       ? g.normal
            : which == GeometryOutput::TrueNormal ? g.true_normal
                                                  : g.incoming;
@@ -775,6 +781,10 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       if (n.kind == InputNodeKind::Fresnel || n.kind == InputNodeKind::LayerWeight ||
           (n.kind == InputNodeKind::Geometry && n.geometry_output != GeometryOutput::Backfacing))
         reads_view_ = true;
+      if (n.kind == InputNodeKind::Geometry && n.geometry_output == GeometryOutput::Tangent) {
+        reads_coordinates_ = true;
+        features_ |= kFeatureTextures;
+      }
       if (n.kind == InputNodeKind::LightPath) reads_path_ = true;
       if (reads_vector(n.kind)) {
         features_ |= kFeatureTextures;

@@ -43,7 +43,7 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'TEX_BRICK', 'CURVE_RGB', 'CURVE_VEC', 'CURVE_FLOAT', 'BLACKBODY', 'SEPHSV',
                 'COMBHSV', 'FRESNEL', 'LAYER_WEIGHT', 'NEW_GEOMETRY', 'LIGHT_PATH'}
 # The Geometry node's outputs the core reads from the view of the hit (Position: coordinates).
-_GEOMETRY_OUTPUTS = {'Normal', 'True Normal', 'Incoming', 'Backfacing'}
+_GEOMETRY_OUTPUTS = {'Normal', 'True Normal', 'Incoming', 'Backfacing', 'Tangent'}
 # The Light Path node's outputs in object materials (Is Volume Scatter Ray: no volumes, 0).
 _LIGHT_PATH_OUTPUTS = {'Is Camera Ray', 'Is Shadow Ray', 'Is Diffuse Ray', 'Is Glossy Ray',
                        'Is Singular Ray', 'Is Reflection Ray', 'Is Transmission Ray',

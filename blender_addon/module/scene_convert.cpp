@@ -281,7 +281,8 @@ InputNode read_input_node(const py::dict& d) {
       {"Normal", GeometryOutput::Normal},
       {"True Normal", GeometryOutput::TrueNormal},
       {"Incoming", GeometryOutput::Incoming},
-      {"Backfacing", GeometryOutput::Backfacing}};
+      {"Backfacing", GeometryOutput::Backfacing},
+      {"Tangent", GeometryOutput::Tangent}};
   static const std::pair<const char*, LightPathOutput> kLightPath[] = {
       {"Is Camera Ray", LightPathOutput::IsCameraRay},
       {"Is Shadow Ray", LightPathOutput::IsShadowRay},

@@ -358,6 +358,24 @@ TEST(Material, AnisotropicWidthsAndRadialTangent) {
   ClosureSet uv;
   Material(d, {}).evaluate(at, uv);
   expect_spectrum(uv[0].tangent, Vec3f(0.0f, 0.0f, 2.0f));
+
+  // Geometry's Tangent output: the default tangent made unit and normal to N (Cycles'
+  // primitive_tangent), here an emission colour. World radial (0, 0, 0.4) about N = (0, 0.6, 0.8).
+  MaterialDesc e;
+  InputNode geometry;
+  geometry.kind = InputNodeKind::Geometry;
+  geometry.geometry_output = GeometryOutput::Tangent;
+  e.inputs.push_back(geometry);
+  ShaderNode emit = node(ShaderNodeKind::Emission);
+  emit.color.node = 0;
+  e.nodes.push_back(emit);
+  e.root = 0;
+  const Material em(e, {});
+  EXPECT_TRUE(em.reads_coordinates());
+  const ShadingGeometry view{Vec3f(0, 0, 1), Vec3f(0, 0.6f, 0.8f), Vec3f(0, 0.6f, 0.8f),
+                             Vec3f(0, 0.6f, 0.8f)};
+  at.geometry = &view;
+  expect_spectrum(em.emission(at), Vec3f(0.0f, -0.8f, 0.6f), 1e-5f);
 }
 
 // A texture's vector can be any input node's result (TexCoordSource::Node): a Checker read at
