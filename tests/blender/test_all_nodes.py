@@ -129,7 +129,8 @@ def main():
     print(f"{len(materials)} materials, {reported} with warnings", flush=True)
 
     # Microfacet distributions: Beckmann is rendered as Cycles does, silently; Multiscatter GGX
-    # and Ashikhmin-Shirley are rendered as GGX, reported.
+    # and Ashikhmin-Shirley are rendered as GGX, reported. The Anisotropic BSDF is GGX only (no
+    # distribution exported): its Beckmann is reported.
     for node_type, distribution, exported, warned in (
             ("ShaderNodeBsdfGlossy", 'BECKMANN', 'BECKMANN', False),
             ("ShaderNodeBsdfGlass", 'BECKMANN', 'BECKMANN', False),
@@ -137,7 +138,9 @@ def main():
             ("ShaderNodeBsdfGlossy", 'GGX', 'GGX', False),
             ("ShaderNodeBsdfGlass", 'SHARP', 'GGX', False),
             ("ShaderNodeBsdfGlass", 'MULTI_GGX', 'GGX', True),
-            ("ShaderNodeBsdfGlossy", 'ASHIKHMIN_SHIRLEY', 'GGX', True)):
+            ("ShaderNodeBsdfGlossy", 'ASHIKHMIN_SHIRLEY', 'GGX', True),
+            ("ShaderNodeBsdfAnisotropic", 'GGX', None, False),
+            ("ShaderNodeBsdfAnisotropic", 'BECKMANN', None, True)):
         m = S.shader_material(f"{node_type}:{distribution}", node_type, distribution=distribution)
         warnings = []
         d = export_materials.translate_material(m, images, warnings.append)
