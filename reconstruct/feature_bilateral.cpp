@@ -11,6 +11,9 @@ namespace gdpt::detail {
 namespace {
 
 inline constexpr int kMaxImages = 3;
+inline constexpr int kMaxRanges = kColourToleranceCount;
+// Feature distances beyond this give weights below 1e-5 of the centre's: skipped.
+inline constexpr float kNegligibleDistance = 23.f;
 // Keeps the relative colour tolerance finite on black pixels.
 inline constexpr float kRangeFloor = 1e-3f;
 
@@ -61,35 +64,42 @@ void identity_filter(const FeatureBuffers& fb, const float* const* images, float
 }  // namespace
 
 std::vector<BilateralCandidate> default_bilateral_candidates() {
-  std::vector<BilateralCandidate> c = {{0, 0.f}};
-  for (int radius : {1, 2, 3, 5})
-    for (float range : {0.05f, 0.2f, 0.f}) c.push_back({radius, range});
+  std::vector<BilateralCandidate> c = {{{0, 1}, 0.f}};
+  for (const BilateralWindow& w : kWindows)
+    for (float range : kColourTolerances) c.push_back({w, range});
   return c;
 }
 
-void bilateral_filter(const FeatureBuffers& fb, const BilateralCandidate& candidate,
-                      const float* const* images, float* const* out, int count) {
-  const int W = fb.width, H = fb.height, r = candidate.radius;
+void bilateral_filter(const FeatureBuffers& fb, const BilateralWindow& window, const float* ranges,
+                      int range_count, const float* const* images, int count, float* const* out) {
+  const int W = fb.width, H = fb.height, r = window.radius, step = window.stride;
   if (r == 0) {
-    identity_filter(fb, images, out, count);
+    for (int t = 0; t < range_count; ++t) identity_filter(fb, images, out + t * count, count);
     return;
   }
-  const float inv_range2 = candidate.range > 0.f ? 1.f / (candidate.range * candidate.range) : 0.f;
+  float inv_range2[kMaxRanges];
+  for (int t = 0; t < range_count; ++t)
+    inv_range2[t] = ranges[t] > 0.f ? 1.f / (ranges[t] * ranges[t]) : 0.f;
   parallel_rows(H, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < W; ++x) {
         const size_t i = size_t(y) * W + x;
         const bool centre_features = fb.valid[i] & kFeaturesValid;
         // A missing centre has no colour to compare with: features alone weigh its neighbours.
-        const float range_weight = (fb.valid[i] & kImagesValid) ? inv_range2 : 0.f;
-        float num[kMaxImages][3] = {}, den[kMaxImages] = {}, scale[kMaxImages];
+        const bool centre_colour = fb.valid[i] & kImagesValid;
+        float num[kMaxRanges][kMaxImages][3] = {}, den[kMaxRanges][kMaxImages] = {};
+        float scale[kMaxImages];
         for (int k = 0; k < count; ++k) {
           const float* p = images[k] + 3 * i;
           const float lum = std::max(0.f, (p[0] + p[1] + p[2]) * (1.f / 3.f)) + kRangeFloor;
-          scale[k] = range_weight / (3.f * lum * lum);
+          scale[k] = centre_colour ? 1.f / (3.f * lum * lum) : 0.f;
         }
-        for (int yy = std::max(0, y - r); yy <= std::min(H - 1, y + r); ++yy)
-          for (int xx = std::max(0, x - r); xx <= std::min(W - 1, x + r); ++xx) {
+        for (int dy = -r; dy <= r; dy += step) {
+          const int yy = y + dy;
+          if (yy < 0 || yy >= H) continue;
+          for (int dx = -r; dx <= r; dx += step) {
+            const int xx = x + dx;
+            if (xx < 0 || xx >= W) continue;
             const size_t j = size_t(yy) * W + xx;
             if (!(fb.valid[j] & kImagesValid)) continue;
             if (!centre_features && j != i) continue;
@@ -97,22 +107,27 @@ void bilateral_filter(const FeatureBuffers& fb, const BilateralCandidate& candid
             if (centre_features) {
               if (!(fb.valid[j] & kFeaturesValid)) continue;
               df = feature_distance(fb, i, j);
+              if (df > kNegligibleDistance) continue;
             }
+            const float wf = std::exp(-0.5f * df);
             for (int k = 0; k < count; ++k) {
               const float *p = images[k] + 3 * i, *q = images[k] + 3 * j;
-              float d = df;
-              if (range_weight > 0.f) {
-                const float d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2];
-                d += (d0 * d0 + d1 * d1 + d2 * d2) * scale[k];
+              const float d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2];
+              const float dc = (d0 * d0 + d1 * d1 + d2 * d2) * scale[k];
+              for (int t = 0; t < range_count; ++t) {
+                const float w =
+                    inv_range2[t] > 0.f ? wf * std::exp(-0.5f * dc * inv_range2[t]) : wf;
+                for (int c = 0; c < 3; ++c) num[t][k][c] += w * q[c];
+                den[t][k] += w;
               }
-              const float w = std::exp(-0.5f * d);
-              for (int c = 0; c < 3; ++c) num[k][c] += w * q[c];
-              den[k] += w;
             }
           }
-        for (int k = 0; k < count; ++k)
-          for (int c = 0; c < 3; ++c)
-            out[k][3 * i + c] = den[k] > 0.f ? num[k][c] / den[k] : images[k][3 * i + c];
+        }
+        for (int t = 0; t < range_count; ++t)
+          for (int k = 0; k < count; ++k)
+            for (int c = 0; c < 3; ++c)
+              out[t * count + k][3 * i + c] =
+                  den[t][k] > 0.f ? num[t][k][c] / den[t][k] : images[k][3 * i + c];
       }
   });
 }

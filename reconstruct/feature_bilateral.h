@@ -16,18 +16,35 @@ inline constexpr float kAlbedoTolerance = 0.05f;
 inline constexpr float kNormalTolerance = 0.1f;
 inline constexpr float kDepthTolerance = 0.05f;
 
+struct BilateralWindow {
+  int radius = 0;  // taps up to radius pixels away; 0 is the identity
+  int stride = 1;  // pixels between taps
+};
+
+// The windows (3, 5 and 7 px dense, 9 px every other pixel) and colour tolerances (relative to the
+// centre's brightness; 0: none) of the candidate set.
+inline constexpr BilateralWindow kWindows[] = {{1, 1}, {2, 1}, {3, 1}, {4, 2}};
+inline constexpr float kColourTolerances[] = {0.05f, 0.2f, 0.f};
+inline constexpr int kColourToleranceCount = 3;
+
 struct BilateralCandidate {
-  int radius = 0;     // window (2 radius + 1)^2; 0 is the identity
-  float range = 0.f;  // colour tolerance relative to the centre's brightness; 0: none
+  BilateralWindow window;
+  float range = 0.f;
 };
 
 // The candidate set: the identity first, then each window with each colour tolerance.
 std::vector<BilateralCandidate> default_bilateral_candidates();
 
-// Filters `images` (count RGB images, each 0 where fb marks it missing) into `out`: the feature
-// weights are shared, the colour weights come from each image itself (so a filtered half depends
-// on that half alone). Missing pixels get weight 0; a pixel without valid features keeps its value.
-void bilateral_filter(const FeatureBuffers& fb, const BilateralCandidate& candidate,
-                      const float* const* images, float* const* out, int count);
+// Filters `images` (count RGB images, each 0 where fb marks it missing) with each of the `ranges`
+// colour tolerances at once into out[r * count + k]: the feature weights are shared, the colour
+// weights come from each image itself (so a filtered half depends on that half alone). Missing
+// pixels get weight 0; a pixel without valid features keeps its value.
+void bilateral_filter(const FeatureBuffers& fb, const BilateralWindow& window, const float* ranges,
+                      int range_count, const float* const* images, int count, float* const* out);
+
+inline void bilateral_filter(const FeatureBuffers& fb, const BilateralCandidate& candidate,
+                             const float* const* images, float* const* out, int count) {
+  bilateral_filter(fb, candidate.window, &candidate.range, 1, images, count, out);
+}
 
 }  // namespace gdpt::detail

@@ -103,10 +103,7 @@ FeatureBase base_images(const ReconstructionInput& in, const ReconstructionSetti
 
 FeatureReconstruction feature_filter(const ReconstructionInput& input, const float* a,
                                      const float* b, const float* all, const float* variance_a,
-                                     const float* variance_b,
-                                     const std::vector<detail::BilateralCandidate>& candidates) {
-  if (candidates.empty() || candidates.size() > 255)
-    throw std::invalid_argument("reconstruct: 1 to 255 candidate filters");
+                                     const float* variance_b) {
   FeatureReconstruction r;
   auto t = std::chrono::steady_clock::now();
   const detail::FeatureBuffers fb =
@@ -115,18 +112,29 @@ FeatureReconstruction feature_filter(const ReconstructionInput& input, const flo
   r.missing = fb.missing;
   r.prepare_seconds = since(t);
 
+  // Per colour tolerance: the two halves and the image of all samples, filtered.
+  constexpr int kTol = detail::kColourToleranceCount;
   const size_t n3 = 3 * size_t(input.width) * input.height;
-  std::vector<float> fa(n3), fbh(n3), fall(n3);
+  std::vector<float> filtered(size_t(kTol) * 3 * n3);
+  float* out[kTol * 3];
+  for (int k = 0; k < kTol * 3; ++k) out[k] = filtered.data() + size_t(k) * n3;
   const float* const images[3] = {fb.a.data(), fb.b.data(), fb.all.data()};
-  float* const out[3] = {fa.data(), fbh.data(), fall.data()};
   detail::CandidateChoice choice;
-  for (size_t k = 0; k < candidates.size(); ++k) {
+  int index = 0;
+  auto offer = [&](int tolerances) {
     t = std::chrono::steady_clock::now();
-    detail::bilateral_filter(fb, candidates[k], images, out, 3);
-    r.filter_seconds += since(t);
-    t = std::chrono::steady_clock::now();
-    detail::offer_candidate(fb, int(k), fa.data(), fbh.data(), fall.data(), choice);
+    for (int k = 0; k < tolerances; ++k, ++index)
+      detail::offer_candidate(fb, index, out[3 * k], out[3 * k + 1], out[3 * k + 2], choice);
     r.select_seconds += since(t);
+  };
+  const float none = 0.f;
+  detail::bilateral_filter(fb, detail::BilateralWindow{0, 1}, &none, 1, images, 3, out);
+  offer(1);
+  for (const detail::BilateralWindow& w : detail::kWindows) {
+    t = std::chrono::steady_clock::now();
+    detail::bilateral_filter(fb, w, detail::kColourTolerances, kTol, images, 3, out);
+    r.filter_seconds += since(t);
+    offer(kTol);
   }
   r.image = std::move(choice.image);
   r.error = std::move(choice.error);

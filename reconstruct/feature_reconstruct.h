@@ -10,9 +10,10 @@
 //   3. per pixel the candidate with the smallest smoothed error estimate of the halves
 //      (candidate_selection.h); output = that candidate applied to all samples (+ emission).
 //
-// Memory beyond the inputs: about 160 bytes per pixel, 160 MB per megapixel (feature buffers
-// 56, the three base images and their filtered copies 72, the choice 17, error scratch 12), plus
-// the gradient-domain solves' own buffers while they run.
+// Memory beyond the inputs: about 280 bytes per pixel, 280 MB per megapixel (feature buffers
+// 105, the solved halves and image 36, their copies filtered with the three colour tolerances
+// 108, the choice 17, error scratch 12), plus the gradient-domain solves' own buffers while they
+// run.
 #pragma once
 
 #include <vector>
@@ -32,13 +33,12 @@ struct FeatureReconstruction {
 };
 
 // Steps 2 and 3 on given base images (RGB): halves `a`, `b` (variances optional, both or
-// neither) and `all`, with the features of `input`, in the caller's TBB arena.
+// neither) and `all`, with the features of `input`, in the caller's TBB arena. chosen[i] indexes
+// detail::default_bilateral_candidates().
 FeatureReconstruction feature_filter(const ReconstructionInput& input, const float* a,
                                      const float* b, const float* all,
                                      const float* variance_a = nullptr,
-                                     const float* variance_b = nullptr,
-                                     const std::vector<detail::BilateralCandidate>& candidates =
-                                         detail::default_bilateral_candidates());
+                                     const float* variance_b = nullptr);
 
 // reconstruct() for ReconstructionNorm::Feature: the base images, then feature_filter, then the
 // output rule (+ emission, non-finite -> 0).

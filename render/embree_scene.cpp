@@ -144,6 +144,12 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
       d.corner_colors = mesh.corner_colors.data();
       d.corner_color_tris = uint32_t(std::min(mesh.corner_colors.size() / 3, tris));
     }
+    if (mesh.vertex_pointiness.size() == mesh.positions.size())
+      d.vertex_pointiness = mesh.vertex_pointiness.data();
+    if (!mesh.triangle_island_random.empty()) {
+      d.triangle_island_random = mesh.triangle_island_random.data();
+      d.island_random_tris = uint32_t(std::min(mesh.triangle_island_random.size(), tris));
+    }
     if (!mesh.corner_tangents.empty()) {
       if (mesh.corner_tangent_signs.size() != mesh.corner_tangents.size())
         throw std::invalid_argument("mesh " + std::to_string(inst.mesh) + ": " +
@@ -206,12 +212,19 @@ void EmbreeScene::set_materials(std::span<const Material> materials) {
   auto reads_coords = [&](int32_t m) {
     return m >= 0 && size_t(m) < materials.size() && materials[size_t(m)].reads_coordinates();
   };
+  auto reads_attributes = [&](int32_t m) {
+    return m >= 0 && size_t(m) < materials.size() &&
+           materials[size_t(m)].reads_surface_attributes();
+  };
   for (InstanceData& d : instances_) {
     d.writes_color =
         d.corner_colors != nullptr || reads(d.uniform_material) || reads(default_material_);
     d.perturbs_normal = perturbs(d.uniform_material) || perturbs(default_material_);
     d.writes_coords = reads_coords(d.uniform_material) || reads_coords(default_material_);
+    d.writes_attributes =
+        reads_attributes(d.uniform_material) || reads_attributes(default_material_);
     for (int32_t m : d.slot_materials) {
+      d.writes_attributes = d.writes_attributes || reads_attributes(m);
       d.writes_color = d.writes_color || reads(m);
       d.perturbs_normal = d.perturbs_normal || perturbs(m);
       d.writes_coords = d.writes_coords || reads_coords(m);
@@ -322,6 +335,18 @@ void compute_unit_normals(const Vec3f* positions, const uint32_t* indices, size_
 
 }  // namespace
 
+SurfaceAttributes EmbreeScene::attributes_at(const InstanceData& d, uint32_t primitive,
+                                             const uint32_t* idx, float u, float v) {
+  SurfaceAttributes a;
+  a.barycentric = Vec2f(u, v);
+  if (d.vertex_pointiness) {
+    const float* P = d.vertex_pointiness;
+    a.pointiness = (1.0f - u - v) * P[idx[0]] + u * P[idx[1]] + v * P[idx[2]];
+  }
+  if (primitive < d.island_random_tris) a.random_per_island = d.triangle_island_random[primitive];
+  return a;
+}
+
 void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, float v,
                                const Vec3f& dir, SurfaceHit& hit) const {
   const InstanceData& d = instances_[top_id];
@@ -377,6 +402,8 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
     }
     store3(hit.color, color);
   }
+  if (d.writes_attributes) [[unlikely]]
+    hit.attributes = attributes_at(d, primitive, idx, u, v);
   if (d.writes_coords) [[unlikely]] {
     const Vec3f* P = d.object_positions;
     const __m128 object =
@@ -483,9 +510,11 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
   }
   const Vec3f e1 = p[1] - p[0], e2 = p[2] - p[0];
   const Vec3f o1 = P[idx[1]] - P[idx[0]], o2 = P[idx[2]] - P[idx[0]];
-  // Directions in world (a) and object (o) space and their UV steps, per unit step.
+  // Directions in world (a) and object (o) space and their UV and barycentric steps, per unit
+  // step.
   Vec3f a[2] = {e1, e2}, o[2] = {o1, o2};
   Vec2f duv[2] = {Vec2f(0.0f, 0.0f), Vec2f(0.0f, 0.0f)};
+  Vec2f dbary[2] = {Vec2f(1.0f, 0.0f), Vec2f(0.0f, 1.0f)};
   if (primitive < d.corner_uv_tris) {
     const Vec2f* T = d.corner_uvs + size_t(primitive) * 3;
     const float du1 = T[1].x - T[0].x, dv1 = T[1].y - T[0].y;
@@ -496,6 +525,8 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
       a[1] = (e2 * du1 - e1 * du2) / det;
       o[0] = (o1 * dv2 - o2 * dv1) / det;
       o[1] = (o2 * du1 - o1 * du2) / det;
+      dbary[0] = Vec2f(dv2 / det, -dv1 / det);
+      dbary[1] = Vec2f(-du2 / det, du1 / det);
       duv[0] = Vec2f(1.0f, 0.0f);
       duv[1] = Vec2f(0.0f, 1.0f);
     } else {
@@ -523,6 +554,14 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
         shifted.generated[c] = base.generated[c] + o[k][c] * kStep * d.generated_scale[c];
     }
     at.coords = d.writes_coords ? &shifted : nullptr;
+    // Mesh attributes (Pointiness, Parametric) move with the step too, as Cycles differentiates
+    // them for bump.
+    SurfaceAttributes moved;
+    if (d.writes_attributes) {
+      const Vec2f b = hit.attributes.barycentric + dbary[k] * kStep;
+      moved = attributes_at(d, primitive, idx, b.x, b.y);
+    }
+    at.attributes = d.writes_attributes ? &moved : nullptr;
     h[k + 1] = material.bump_height(bump, at);
   }
   Vec3f grad = (g0 * (h[1] - h[0]) + g1 * (h[2] - h[0])) / kStep;

@@ -34,6 +34,7 @@ struct SurfaceHit {
   Vec3f color;       // colour attribute (Mesh::corner_colors), 0 when the mesh has none; only set
                      // on instances that have one or whose materials read one
   TexCoords coords;  // object-space coordinates; only set on instances whose materials read them
+  SurfaceAttributes attributes;  // only set on instances whose materials read them
   // A normal map or bump replaced shading_normal; unperturbed_normal is the interpolated one
   // (for the bump shadowing of diffuse lobes, ClosureSet::set_bump_shadowing).
   bool perturbed = false;
@@ -49,6 +50,7 @@ inline ShadingContext shading_context_of(const SurfaceHit& hit) {
   ShadingContext ctx{hit.uv, hit.front_facing, &hit.color, &hit.coords};
   ctx.instance = hit.shading_instance;
   ctx.primitive = hit.primitive;
+  ctx.attributes = &hit.attributes;
   return ctx;
 }
 
@@ -229,6 +231,10 @@ class EmbreeScene {
     bool writes_color = false;     // hits fill SurfaceHit::color (set_materials)
     bool perturbs_normal = false;  // some material has a normal map or a bump (set_materials)
     bool writes_coords = false;    // some material reads Generated / Object / Position coordinates
+    bool writes_attributes = false;  // some material reads SurfaceAttributes (set_materials)
+    const float* vertex_pointiness = nullptr;       // Mesh::vertex_pointiness, or null
+    const float* triangle_island_random = nullptr;  // for primitives < island_random_tris
+    uint32_t island_random_tris = 0;
     const Vec3f* object_positions = nullptr;  // the Mesh's own (object-space) positions
     // Generated coordinates = object position * generated_scale + generated_offset (lanes).
     alignas(16) float generated_scale[4] = {};
@@ -270,9 +276,13 @@ class EmbreeScene {
                        d.writes_coords ? &hit.coords : nullptr};
     ctx.instance = hit.shading_instance;
     ctx.primitive = hit.primitive;
+    ctx.attributes = d.writes_attributes ? &hit.attributes : nullptr;
     return ctx;
   }
   static void set_generated_mapping(InstanceData& d, const Mesh& mesh);
+  // The mesh attributes (SurfaceAttributes) at barycentrics (u, v) of triangle `primitive`.
+  static SurfaceAttributes attributes_at(const InstanceData& d, uint32_t primitive,
+                                         const uint32_t* idx, float u, float v);
   const Scene* scene_ = nullptr;
 
   std::span<const Material> materials_;

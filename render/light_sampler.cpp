@@ -212,6 +212,13 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
         t.color1 = mesh.corner_colors[size_t(tri) * 3 + 1];
         t.color2 = mesh.corner_colors[size_t(tri) * 3 + 2];
       }
+      if (mesh.vertex_pointiness.size() == mesh.positions.size()) {
+        t.pointiness0 = mesh.vertex_pointiness[idx[0]];
+        t.pointiness1 = mesh.vertex_pointiness[idx[1]];
+        t.pointiness2 = mesh.vertex_pointiness[idx[2]];
+      }
+      if (tri < mesh.triangle_island_random.size())
+        t.island_random = mesh.triangle_island_random[tri];
       t.material = uint32_t(mat);
       t.instance = &shading;
       t.primitive = tri;

@@ -86,6 +86,8 @@ bool same_mesh(const Mesh& a, const Mesh& b) {
          same_data(a.corner_tangents, b.corner_tangents) &&
          same_data(a.corner_tangent_signs, b.corner_tangent_signs) &&
          same_data(a.corner_colors, b.corner_colors) &&
+         same_data(a.vertex_pointiness, b.vertex_pointiness) &&
+         same_data(a.triangle_island_random, b.triangle_island_random) &&
          same_data(a.material_slot, b.material_slot) &&
          same_data(a.vertex_normals, b.vertex_normals) &&
          std::memcmp(&a.texspace_location, &b.texspace_location, sizeof(Vec3f)) == 0 &&

@@ -137,10 +137,26 @@ enum class LightPathOutput : uint8_t {
   TransmissionDepth,
 };
 // The Geometry node's outputs read from ShadingContext::geometry (world space, flipped to the
-// incoming side as Cycles' sd->N / sd->Ng), and Backfacing (1 on a back face, else 0).
-// Tangent: Cycles' default tangent (TangentInput's radial about Z) made normal to the
-// interpolated normal.
-enum class GeometryOutput : uint8_t { Normal, TrueNormal, Incoming, Backfacing, Tangent };
+// incoming side as Cycles' sd->N / sd->Ng), Backfacing (1 on a back face, else 0), Tangent
+// (Cycles' default tangent, TangentInput's radial about Z, made normal to the interpolated normal),
+// and those read from ShadingContext::attributes (Mesh::vertex_pointiness,
+// Mesh::triangle_island_random, and Parametric: Cycles' (1 - u - v, u, 0) of the hit's
+// barycentrics).
+enum class GeometryOutput : uint8_t {
+  Normal,
+  TrueNormal,
+  Incoming,
+  Backfacing,
+  Tangent,
+  Pointiness,
+  Parametric,
+  RandomPerIsland
+};
+// Geometry outputs that come from the mesh at the hit rather than from the view.
+inline bool is_surface_attribute(GeometryOutput o) {
+  return o == GeometryOutput::Pointiness || o == GeometryOutput::Parametric ||
+         o == GeometryOutput::RandomPerIsland;
+}
 enum class MixBlend : uint8_t {
   Mix,
   Add,

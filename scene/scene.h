@@ -28,6 +28,11 @@ struct Mesh {
   // 3 per triangle, for Color Attribute nodes: the attribute's linear RGB; empty = none (the
   // node reads black, as in Cycles).
   std::vector<Vec3f> corner_colors;
+  // For the Geometry node, computed only for meshes whose materials read them (both empty =
+  // none: they read 0): Pointiness per vertex (in [0, 1], interpolated over the triangle) and
+  // Random Per Island per triangle (Cycles' hash of the triangle's island).
+  std::vector<float> vertex_pointiness;
+  std::vector<float> triangle_island_random;
   std::vector<int32_t> material_slot;  // per triangle; empty = slot 0
   // Per-vertex shading normals, used when corner_normals is empty: what a smooth mesh without
   // split normals has, in a sixth of the memory (a 1M-triangle smooth mesh: 6 MB instead of the

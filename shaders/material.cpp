@@ -439,6 +439,14 @@ struct PointInputs {
   // A Geometry output; without a view, the front of a surface facing +z seen head-on.
   Vec3f geometry_output(GeometryOutput which) const {
     if (which == GeometryOutput::Backfacing) return Vec3f(at.front_facing ? 0.0f : 1.0f);
+    if (is_surface_attribute(which)) {
+      if (!at.attributes) return Vec3f(0.0f);
+      const SurfaceAttributes& a = *at.attributes;
+      const Vec2f b = a.barycentric;
+      return which == GeometryOutput::Pointiness        ? Vec3f(a.pointiness)
+             : which == GeometryOutput::RandomPerIsland ? Vec3f(a.random_per_island)
+                                                        : Vec3f(1.0f - b.x - b.y, b.x, 0.0f);
+    }
     if (!at.geometry) return Vec3f(0.0f, 0.0f, 1.0f);
     const ShadingGeometry& g = *at.geometry;
     if (which == GeometryOutput::Tangent) {
@@ -533,6 +541,8 @@ struct AverageInputs {
   // The view is unknown: a mid-range cosine, a surface facing +z seen from the front.
   float view_cosine(bool) const { return 0.5f; }
   Vec3f geometry_output(GeometryOutput which) const {
+    if (which == GeometryOutput::Parametric) return Vec3f(1.0f / 3.0f, 1.0f / 3.0f, 0.0f);
+    if (is_surface_attribute(which)) return Vec3f(0.5f);  // their mean over a mesh, roughly
     return which == GeometryOutput::Backfacing ? Vec3f(0.0f) : Vec3f(0.0f, 0.0f, 1.0f);
   }
   // Object and camera unknown: world space; wires over half of the surface.
@@ -817,8 +827,15 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
         reads_color_attribute_ = true;
       }
       // Backfacing alone is a function of the side, which the per-side cache keys on.
+      const bool surface_attribute =
+          n.kind == InputNodeKind::Geometry && is_surface_attribute(n.geometry_output);
+      if (surface_attribute) {
+        features_ |= kFeatureTextures;
+        reads_surface_attributes_ = true;
+      }
       if (n.kind == InputNodeKind::Fresnel || n.kind == InputNodeKind::LayerWeight ||
-          (n.kind == InputNodeKind::Geometry && n.geometry_output != GeometryOutput::Backfacing))
+          (n.kind == InputNodeKind::Geometry && n.geometry_output != GeometryOutput::Backfacing &&
+           !surface_attribute))
         reads_view_ = true;
       if (n.kind == InputNodeKind::Geometry && n.geometry_output == GeometryOutput::Tangent) {
         reads_coordinates_ = true;

@@ -59,6 +59,9 @@ class Material {
   bool reads_view() const { return reads_view_; }
   // Some input reads the path (ShadingContext::path: Light Path): closures per hit, never cached.
   bool reads_path() const { return reads_path_; }
+  // Some input reads the Geometry node's Pointiness, Parametric or Random Per Island
+  // (ShadingContext::attributes).
+  bool reads_surface_attributes() const { return reads_surface_attributes_; }
   // The camera Vector Transform's Camera space and Wireframe's pixel size read (set by the
   // scene's owner before rendering; default: at the origin, looking down world +z).
   void set_camera(const ShadingCamera& camera) { camera_ = camera; }
@@ -82,6 +85,7 @@ class Material {
   bool reads_coordinates_ = false;
   bool reads_view_ = false;
   bool reads_path_ = false;
+  bool reads_surface_attributes_ = false;
   Spectrum average_emission_{0.0f, 0.0f, 0.0f};
   ShadingCamera camera_;
 };

@@ -45,6 +45,13 @@ struct PathView {
           transparent_depth = 0;
 };
 
+// The Geometry node's mesh attributes at a hit (see GeometryOutput).
+struct SurfaceAttributes {
+  float pointiness = 0.0f;         // Mesh::vertex_pointiness interpolated; 0 without
+  float random_per_island = 0.0f;  // Mesh::triangle_island_random of the triangle; 0 without
+  Vec2f barycentric;               // (u, v): the hit is (1 - u - v) p0 + u p1 + v p2
+};
+
 // The instance a hit lies on, for nodes that read its placement or its triangle (Vector
 // Transform's Object space, Wireframe): Cycles' object transform and the mesh's corners.
 struct ShadingInstance {
@@ -95,6 +102,8 @@ struct ShadingContext {
   // The hit's instance and triangle, else null (object space is world space, no triangle).
   const ShadingInstance* instance = nullptr;
   uint32_t primitive = 0;
+  // The hit's mesh attributes when its instance's materials read them, else null (they read 0).
+  const SurfaceAttributes* attributes = nullptr;
 };
 
 }  // namespace gdpt

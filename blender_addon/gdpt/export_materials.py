@@ -9,13 +9,13 @@
 # or float output on a shader socket becomes an Emission, and an unlinked shader input is no
 # closure (black), as in Cycles.
 # Inputs may be constants, RGB / Value nodes, colour / math / curve nodes, Blackbody, Fresnel,
-# Layer Weight, Geometry (Normal, True Normal, Incoming, Backfacing, Tangent; Pointiness and the
-# others reported, 0.5 standing in), Light Path (read per path: its own direction and state),
-# Vector Transform (World / Object / Camera, Cycles' camera space) and Wireframe (per triangle;
-# Use Pixel Size reported: the camera's pixel), image and procedural textures read at UV,
-# Generated or Object coordinates, optionally through a Mapping node. The Displacement output (a
-# Displacement node) renders as Cycles' Bump Only. Reroutes and muted nodes are followed.
-# Anything else is reported once per material (naming the node)
+# Layer Weight, Geometry (Normal, True Normal, Incoming, Backfacing, Tangent, Pointiness,
+# Parametric, Random Per Island), Light Path (read per path: its own direction and state), Vector
+# Transform (World / Object / Camera, Cycles' camera space) and Wireframe (per triangle; Use Pixel
+# Size reported: the camera's pixel), image and procedural textures read at UV, Generated or
+# Object coordinates, optionally through a Mapping node. The Displacement output (a Displacement
+# node) renders as Cycles' Bump Only. Reroutes and muted nodes are followed. Anything else is
+# reported once per material (naming the node)
 # and followed through its mute pass-through link when it has one; otherwise a
 # magenta diffuse (shaders) or the socket's own value (inputs) stands in, so the render still
 # completes. A material whose translation fails (or that the core rejects) renders magenta, with
@@ -52,8 +52,13 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'TEX_BRICK', 'CURVE_RGB', 'CURVE_VEC', 'CURVE_FLOAT', 'BLACKBODY', 'SEPHSV',
                 'COMBHSV', 'FRESNEL', 'LAYER_WEIGHT', 'NEW_GEOMETRY', 'LIGHT_PATH',
                 'VECT_TRANSFORM', 'WIREFRAME'}
-# The Geometry node's outputs the core reads from the view of the hit (Position: coordinates).
-_GEOMETRY_OUTPUTS = {'Normal', 'True Normal', 'Incoming', 'Backfacing', 'Tangent'}
+# The Geometry node's outputs the core reads from the view of the hit or from the mesh there
+# (Position: coordinates).
+_GEOMETRY_OUTPUTS = {'Normal', 'True Normal', 'Incoming', 'Backfacing', 'Tangent', 'Pointiness',
+                     'Parametric', 'Random Per Island'}
+# Those the mesh export computes for the meshes whose materials read them (Mesh::vertex_pointiness,
+# Mesh::triangle_island_random), by the names GeometryExporter passes on.
+_MESH_ATTRIBUTE_OUTPUTS = {'Pointiness': 'pointiness', 'Random Per Island': 'random_per_island'}
 # The Light Path node's outputs in object materials (Is Volume Scatter Ray: no volumes, 0).
 _LIGHT_PATH_OUTPUTS = {'Is Camera Ray', 'Is Shadow Ray', 'Is Diffuse Ray', 'Is Glossy Ray',
                        'Is Singular Ray', 'Is Reflection Ray', 'Is Transmission Ray',
@@ -94,6 +99,7 @@ class _Translator:
         self.inputs = []  # colour / math input nodes (MaterialDesc::inputs)
         self.color_attribute = None  # name read by Color Attribute nodes ("": the render one)
         self.uv_tangents = False  # a Tangent node reads the UV map's tangents
+        self.mesh_attributes = set()  # _MESH_ATTRIBUTE_OUTPUTS' values the material reads
         self.input_index = {}  # node name -> index in self.inputs
         self.current = None  # the node being translated (named when translation fails)
 
@@ -491,9 +497,8 @@ class _Translator:
         return d
 
     def _unsupported_geometry(self, node, out):
-        """A Geometry output Gradient PT does not compute (Pointiness, Parametric,
-        Random Per Island): reported by name; 0.5 stands in, as Cycles' Pointiness of a flat
-        surface."""
+        """A Geometry output Gradient PT does not compute (none of Blender 3.4's; one a later
+        version adds): reported by name; 0.5 stands in."""
         if node.type != 'NEW_GEOMETRY' or out.name in _GEOMETRY_OUTPUTS or out.name == "Position":
             return False
         self.warn(node, f"output {out.name} (0.5 stands in) of")
@@ -744,6 +749,8 @@ class _Translator:
             d = {"kind": "LIGHT_PATH", "output": out.name}
         elif node.type == 'NEW_GEOMETRY' and out.name in _GEOMETRY_OUTPUTS:
             d = {"kind": "GEOMETRY", "output": out.name}
+            if out.name in _MESH_ATTRIBUTE_OUTPUTS:
+                self.mesh_attributes.add(_MESH_ATTRIBUTE_OUTPUTS[out.name])
         elif node.type == 'FRESNEL':
             d = {"kind": "FRESNEL", "value_a": self.value(node.inputs["IOR"]),
                  "normal_linked": self._view_normal(node.inputs["Normal"])}
@@ -932,6 +939,8 @@ def _translate_tree(material, t, warn):
         d["color_attribute"] = t.color_attribute
     if t.uv_tangents:
         d["uv_tangents"] = True
+    if t.mesh_attributes:
+        d["mesh_attributes"] = sorted(t.mesh_attributes)
     return d
 
 
@@ -945,6 +954,7 @@ class MaterialCache:
         # Scene material indices that read the UV map's tangents (a normal map, a Tangent node).
         self.normal_mapped = set()
         self.color_attributes = {}  # scene material index -> colour attribute name it reads
+        self.mesh_attributes = {}  # scene material index -> Geometry node attributes it reads
 
     def get(self, material):
         """Scene material index for a Blender material, -1 for an empty slot."""
@@ -963,10 +973,17 @@ class MaterialCache:
                 self.normal_mapped.add(self.index[key])
             if "color_attribute" in desc:
                 self.color_attributes[self.index[key]] = desc["color_attribute"]
+            if "mesh_attributes" in desc:
+                self.mesh_attributes[self.index[key]] = frozenset(desc["mesh_attributes"])
         return self.index[key]
 
     def has_normal_map(self, index):
         return index in self.normal_mapped
+
+    def geometry_attributes(self, index):
+        """The Geometry node attributes material `index` reads ('pointiness',
+        'random_per_island'), a frozenset."""
+        return self.mesh_attributes.get(index, frozenset())
 
     def color_attribute(self, index):
         """Name of the colour attribute material `index` reads ("" for the render one), or

@@ -165,12 +165,27 @@ def _loop_colors(mesh, name, warn):
     return np.ascontiguousarray(rgb, dtype=np.float32).ravel()
 
 
-def add_mesh(builder, mesh, tangents=False, warn=print, color_attribute=None):
+def _add_geometry_attributes(builder, index, mesh, attributes):
+    """Blender's edges (and vertex normals, for Pointiness) for the Geometry node attributes
+    the module computes as Cycles does (blender_addon/module/mesh_attributes.h)."""
+    edges = _empty(len(mesh.edges) * 2, np.int32)
+    mesh.edges.foreach_get("vertices", edges)
+    normals = np.empty(0, dtype=np.float32)
+    if "pointiness" in attributes:
+        normals = _empty(len(mesh.vertices) * 3, np.float32)
+        mesh.vertex_normals.foreach_get("vector", normals)
+    builder.set_mesh_geometry_attributes(index, edges, normals, "pointiness" in attributes,
+                                         "random_per_island" in attributes)
+
+
+def add_mesh(builder, mesh, tangents=False, warn=print, color_attribute=None,
+             geometry_attributes=frozenset()):
     """Adds `mesh` to the scene; returns its index, or -1 when it has no faces. Only Blender's
     own arrays (vertices, loops, polygons) are read here; the module builds the triangles and
     gathers the corner attributes in C++. `tangents`: also the UV map's tangents (for materials
     with a Normal Map node); `color_attribute`: also that colour attribute ("" for the render
-    one; None: none), for Color Attribute nodes."""
+    one; None: none), for Color Attribute nodes; `geometry_attributes`: the Geometry node's
+    Pointiness / Random Per Island ('pointiness', 'random_per_island') to compute."""
     poly_count = len(mesh.polygons)
     if poly_count == 0:
         return -1
@@ -196,6 +211,8 @@ def add_mesh(builder, mesh, tangents=False, warn=print, color_attribute=None):
         index = builder.add_mesh_loops(positions, loop_vertex, corner_loops, normals, per_loop,
                                        loop_uvs, np.ascontiguousarray(tri_material),
                                        loop_tangents, loop_colors)
+    if geometry_attributes:
+        _add_geometry_attributes(builder, index, mesh, geometry_attributes)
     # Texture space for Generated coordinates (Blender computes the automatic one on access).
     builder.set_mesh_texspace(index, tuple(mesh.texspace_location), tuple(mesh.texspace_size))
     return index
@@ -220,7 +237,8 @@ def _matrix12(m):
 
 
 class MeshStore:
-    """The viewport's meshes from its last export, by (object name, tangents, colours): a later
+    """The viewport's meshes from its last export, by (object name, tangents, colours, geometry
+    attributes): a later
     export adds them back without reading Blender's mesh, unless `forget` dropped the object
     (its geometry changed)."""
 
@@ -255,29 +273,31 @@ class GeometryExporter:
         # MeshStore of the viewport (meshes kept from its last export), or None.
         self.store = store
 
-    def _mesh_for(self, obj, tangents, colors):
+    def _mesh_for(self, obj, tangents, colors, attributes):
         # Meshes: the evaluated mesh datablock (modifiers applied) is what instances share.
         # Other types: to_mesh() depends on the object's own modifiers, so key by the original
-        # object (instances of it in collections or particles still share one mesh). Tangents and
-        # colours are read only for objects whose materials use them (part of the key).
+        # object (instances of it in collections or particles still share one mesh). Tangents,
+        # colours and geometry attributes are read only for objects whose materials use them
+        # (part of the key).
         if obj.type == 'MESH':
-            key = (obj.data.as_pointer(), tangents, colors)
+            key = (obj.data.as_pointer(), tangents, colors, attributes)
         else:
-            key = ("object", obj.original.as_pointer(), tangents, colors)
+            key = ("object", obj.original.as_pointer(), tangents, colors, attributes)
         if key in self.mesh_index:
             return self.mesh_index[key]
-        stored_key = (obj.original.name_full, tangents, colors)
+        stored_key = (obj.original.name_full, tangents, colors, attributes)
         if self.store is not None and stored_key in self.store.meshes:
             index = self.store.add_to(self.builder, stored_key)
             self.mesh_index[key] = index
             return index
         if obj.type == 'MESH':
             mesh = obj.data
-            index = self._add_mesh(mesh, tangents, colors)
+            index = self._add_mesh(mesh, tangents, colors, attributes)
         else:
             mesh = obj.to_mesh()
             try:
-                index = self._add_mesh(mesh, tangents, colors) if mesh is not None else -1
+                index = (self._add_mesh(mesh, tangents, colors, attributes)
+                         if mesh is not None else -1)
             finally:
                 obj.to_mesh_clear()
         self.mesh_index[key] = index
@@ -285,11 +305,11 @@ class GeometryExporter:
             self.store.keep(self.builder, stored_key, index)
         return index
 
-    def _add_mesh(self, mesh, tangents, colors):
+    def _add_mesh(self, mesh, tangents, colors, attributes):
         # The module rejects malformed arrays (NaN vertices, indices out of range) with a
         # ValueError naming the array: the render goes on without that mesh.
         try:
-            return add_mesh(self.builder, mesh, tangents, self.warn, colors)
+            return add_mesh(self.builder, mesh, tangents, self.warn, colors, attributes)
         except ValueError as e:
             self.warn(f"mesh '{mesh.name}' skipped: {e}")
             return -1
@@ -305,7 +325,9 @@ class GeometryExporter:
         tangents = any(self.materials.has_normal_map(index) for index in slots)
         colors = next((self.materials.color_attribute(index) for index in slots
                        if self.materials.color_attribute(index) is not None), None)
-        mesh = self._mesh_for(obj, tangents, colors)
+        attributes = frozenset().union(*(self.materials.geometry_attributes(index)
+                                         for index in slots))
+        mesh = self._mesh_for(obj, tangents, colors, attributes)
         if mesh < 0:
             return
         self.builder.add_instance(mesh, _matrix12(matrix), slots, obj.pass_index,

@@ -140,6 +140,9 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("add_stored_mesh", &SceneBuilder::add_stored_mesh, py::arg("stored"))
       .def("set_mesh_texspace", &SceneBuilder::set_mesh_texspace, py::arg("index"),
            py::arg("location"), py::arg("size"))
+      .def("set_mesh_geometry_attributes", &SceneBuilder::set_mesh_geometry_attributes,
+           py::arg("index"), py::arg("edges").noconvert(), py::arg("vertex_normals").noconvert(),
+           py::arg("pointiness"), py::arg("random_per_island"))
       .def_property_readonly("mesh_count", &SceneBuilder::mesh_count)
       .def_property_readonly("instance_count", &SceneBuilder::instance_count)
       .def_property_readonly("triangle_count", &SceneBuilder::triangle_count);

@@ -10,6 +10,7 @@
 
 #include <pybind11/stl.h>  // lists to std::vector (colour ramp tables)
 
+#include "blender_addon/module/mesh_attributes.h"
 #include "blender_addon/module/mesh_ingest.h"
 #include "core/huge_pages.h"
 #include "shaders/image_io.h"
@@ -284,7 +285,10 @@ InputNode read_input_node(const py::dict& d) {
       {"True Normal", GeometryOutput::TrueNormal},
       {"Incoming", GeometryOutput::Incoming},
       {"Backfacing", GeometryOutput::Backfacing},
-      {"Tangent", GeometryOutput::Tangent}};
+      {"Tangent", GeometryOutput::Tangent},
+      {"Pointiness", GeometryOutput::Pointiness},
+      {"Parametric", GeometryOutput::Parametric},
+      {"Random Per Island", GeometryOutput::RandomPerIsland}};
   static const std::pair<const char*, LightPathOutput> kLightPath[] = {
       {"Is Camera Ray", LightPathOutput::IsCameraRay},
       {"Is Shadow Ray", LightPathOutput::IsShadowRay},
@@ -514,6 +518,15 @@ void SceneBuilder::set_mesh_texspace(int index, const py::sequence& location,
   }
 }
 
+void SceneBuilder::set_mesh_geometry_attributes(int index, const IntArray& edges,
+                                                const FloatArray& vertex_normals, bool pointiness,
+                                                bool random_per_island) {
+  if (index < 0 || size_t(index) >= scene_.meshes.size())
+    throw std::invalid_argument("set_mesh_geometry_attributes: mesh index out of range");
+  ingest::add_geometry_attributes(scene_.meshes[size_t(index)], view(edges), view(vertex_normals),
+                                  pointiness, random_per_island);
+}
+
 py::dict SceneBuilder::mesh_arrays(int index) const {
   if (index < 0 || size_t(index) >= scene_.meshes.size())
     throw std::invalid_argument("mesh_arrays: mesh index out of range");
@@ -535,6 +548,10 @@ py::dict SceneBuilder::mesh_arrays(int index) const {
   d["corner_tangent_signs"] =
       copy(m.corner_tangent_signs, {m.corner_tangent_signs.empty() ? 0 : t, 3}, 0.0f);
   d["corner_colors"] = copy(m.corner_colors, {m.corner_colors.empty() ? 0 : t, 3, 3}, 0.0f);
+  d["vertex_pointiness"] =
+      copy(m.vertex_pointiness, {py::ssize_t(m.vertex_pointiness.size())}, 0.0f);
+  d["triangle_island_random"] =
+      copy(m.triangle_island_random, {py::ssize_t(m.triangle_island_random.size())}, 0.0f);
   return d;
 }
 

@@ -101,6 +101,12 @@ class SceneBuilder {
   // Blender's texture space of mesh `index` (Mesh.texspace_location / texspace_size), for
   // Generated texture coordinates.
   void set_mesh_texspace(int index, const py::sequence& location, const py::sequence& size);
+  // The Geometry node's Pointiness and / or Random Per Island of mesh `index`, computed from
+  // Blender's edges (2 per edge) and vertex normals (3 per vertex; used for Pointiness only), for
+  // meshes whose materials read them.
+  void set_mesh_geometry_attributes(int index, const IntArray& edges,
+                                    const FloatArray& vertex_normals, bool pointiness,
+                                    bool random_per_island);
   size_t mesh_count() const { return scene_.meshes.size(); }
   size_t instance_count() const { return scene_.instances.size(); }
   size_t triangle_count() const;

@@ -24,9 +24,11 @@ struct TriangleLight {
   float area = 0.0f;
   Vec2f uv0, uv1, uv2;
   Vec3f color0{0.0f}, color1{0.0f}, color2{0.0f};  // colour attribute at the corners
-  uint32_t material = 0;                           // index into the materials span
-  const ShadingInstance* instance = nullptr;       // its instance, for the material's nodes
-  uint32_t primitive = 0;                          // its triangle in the instance's mesh
+  float pointiness0 = 0.0f, pointiness1 = 0.0f, pointiness2 = 0.0f;  // Mesh::vertex_pointiness
+  float island_random = 0.0f;                                        // Mesh::triangle_island_random
+  uint32_t material = 0;                      // index into the materials span
+  const ShadingInstance* instance = nullptr;  // its instance, for the material's nodes
+  uint32_t primitive = 0;                     // its triangle in the instance's mesh
   float select_pmf = 0.0f;
   float max_edge2 = 0.0f;  // squared longest edge
 
@@ -101,6 +103,14 @@ struct TriangleLight {
     ctx.uv = uv_at(b.x, b.y);
     const Vec3f color = color0 * (1.0f - b.x - b.y) + color1 * b.x + color2 * b.y;
     ctx.color = &color;
+    SurfaceAttributes attributes;
+    if (m.reads_surface_attributes()) {
+      attributes.barycentric = b;
+      attributes.pointiness =
+          pointiness0 * (1.0f - b.x - b.y) + pointiness1 * b.x + pointiness2 * b.y;
+      attributes.random_per_island = island_random;
+      ctx.attributes = &attributes;
+    }
     ctx.front_facing = dot(dir, normal) < 0.0f;  // the receiver is on the normal's side
     // As a hit on the triangle sees its instance (Vector Transform, Wireframe, coordinates).
     ctx.instance = instance;

@@ -823,6 +823,128 @@ def case_color_attribute(scene):
     return 3
 
 
+# geometry_attributes: four emissive tiles seen from above by an orthographic camera on a black
+# world (name, centre): each shows one Geometry output computed from its mesh.
+GEOMETRY_TILES = (("displaced grid Pointiness", (-2.75, 2.75)),
+                  ("edge-split cube Pointiness", (2.75, 2.75)),
+                  ("Parametric", (-2.75, -2.75)), ("Random Per Island", (2.75, -2.75)))
+GEOMETRY_VIEW, GEOMETRY_RESOLUTION, GEOMETRY_TILE = 11.5, 256, 4.0
+
+
+def _geometry_material(name, output, ramp=None):
+    """Emission of the Geometry node's `output`, through a linear Color Ramp from black at
+    ramp[0] to warm white at ramp[1] when ramp is given."""
+    m = S.shader_material(name, "ShaderNodeEmission", Strength=1.0)
+    nt = m.node_tree
+    emit = next(node for node in nt.nodes if node.type == 'EMISSION')
+    geometry = nt.nodes.new("ShaderNodeNewGeometry")
+    source = geometry.outputs[output]
+    if ramp is not None:
+        node = nt.nodes.new("ShaderNodeValToRGB")
+        elements = node.color_ramp.elements
+        elements[0].position, elements[0].color = ramp[0], (0.0, 0.0, 0.05, 1.0)
+        elements[1].position, elements[1].color = ramp[1], (1.0, 0.8, 0.5, 1.0)
+        nt.links.new(source, node.inputs["Fac"])
+        source = node.outputs["Color"]
+    nt.links.new(source, emit.inputs["Color"])
+    return m
+
+
+def _grid(n, size):
+    """An n x n grid of quads, size x size metres, centred at the origin: (verts, faces)."""
+    verts = [(size * (i / n - 0.5), size * (j / n - 0.5), 0.0)
+             for j in range(n + 1) for i in range(n + 1)]
+    faces = [(j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1,
+              (j + 1) * (n + 1) + i) for j in range(n) for i in range(n)]
+    return verts, faces
+
+
+def case_geometry_attributes(scene):
+    # The Geometry node's mesh attributes, as Cycles computes them at sync. Pointiness through a
+    # sharp ramp on a 48 x 48 grid displaced by a Displace modifier (Clouds: bumps and cavities)
+    # and on a cube whose edges an Edge Split modifier splits (Cycles welds the split vertices:
+    # without, each face would read a flat 0.5); Parametric on 2 x 2 quads (the triangles'
+    # barycentric corners); Random Per Island on nine separate quads in one mesh.
+    S.camera((0, 0, 10), (0, 0, 0), ortho_scale=GEOMETRY_VIEW)
+    scene.world.color = (0, 0, 0)
+    scene.render.resolution_x = scene.render.resolution_y = GEOMETRY_RESOLUTION
+    (_, grid_at), (_, cube_at), (_, param_at), (_, island_at) = GEOMETRY_TILES
+    verts, faces = _grid(48, GEOMETRY_TILE)
+    grid = S.mesh_object("displaced", verts, faces,
+                         _geometry_material("cavities", "Pointiness", (0.45, 0.56)), smooth=True)
+    grid.location = (*grid_at, 0.0)
+    clouds = bpy.data.textures.new("clouds", 'CLOUDS')
+    clouds.noise_scale = 0.6
+    displace = grid.modifiers.new("displace", 'DISPLACE')
+    displace.texture, displace.strength = clouds, 0.8
+    h = 1.5
+    corners = [(x, y, z) for z in (-h, h) for y in (-h, h) for x in (-h, h)]
+    cube_faces = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2),
+                  (1, 3, 7, 5)]
+    cube = S.mesh_object("split_cube", corners, cube_faces,
+                         _geometry_material("corners", "Pointiness", (0.45, 0.75)))
+    cube.location = (*cube_at, -h)
+    split = cube.modifiers.new("split", 'EDGE_SPLIT')
+    split.split_angle = 0.0
+    verts, faces = _grid(2, GEOMETRY_TILE)
+    S.mesh_object("parametric", verts, faces,
+                  _geometry_material("parametric", "Parametric")).location = (*param_at, 0.0)
+    verts, faces = [], []
+    for k in range(9):
+        x, y = (k % 3 - 1) * 1.35, (k // 3 - 1) * 1.35
+        faces.append(tuple(range(len(verts), len(verts) + 4)))
+        verts += [(x - 0.6, y - 0.6, 0), (x + 0.6, y - 0.6, 0), (x + 0.6, y + 0.6, 0),
+                  (x - 0.6, y + 0.6, 0)]
+    S.mesh_object("islands", verts, faces, _geometry_material(
+        "islands", "Random Per Island", (0.0, 1.0))).location = (*island_at, 0.0)
+    return 2
+
+
+def case_pointiness_bump(scene):
+    # A Bump node whose height is Pointiness ("edge wear" set-ups): Cycles differentiates the
+    # attribute over the triangle. The displaced grid of case geometry_attributes emits Layer
+    # Weight's Facing of the bumped normal, seen from above (no lighting: the bump alone).
+    S.camera((0, 0, 10), (0, 0, 0), ortho_scale=4.2)
+    scene.world.color = (0, 0, 0)
+    scene.render.resolution_x = scene.render.resolution_y = 160
+    m = S.shader_material("worn", "ShaderNodeEmission", Strength=1.0)
+    nt = m.node_tree
+    emit = next(node for node in nt.nodes if node.type == 'EMISSION')
+    geometry = nt.nodes.new("ShaderNodeNewGeometry")
+    bump = nt.nodes.new("ShaderNodeBump")
+    bump.inputs["Distance"].default_value = 0.3
+    weight = nt.nodes.new("ShaderNodeLayerWeight")
+    weight.inputs["Blend"].default_value = 0.5
+    nt.links.new(geometry.outputs["Pointiness"], bump.inputs["Height"])
+    nt.links.new(bump.outputs["Normal"], weight.inputs["Normal"])
+    nt.links.new(weight.outputs["Facing"], emit.inputs["Color"])
+    verts, faces = _grid(48, GEOMETRY_TILE)
+    grid = S.mesh_object("worn", verts, faces, m, smooth=True)
+    clouds = bpy.data.textures.new("clouds", 'CLOUDS')
+    clouds.noise_scale = 0.6
+    displace = grid.modifiers.new("displace", 'DISPLACE')
+    displace.texture, displace.strength = clouds, 0.8
+    return 1
+
+
+def whole_frame(image):
+    """The frame as one region (cases of directly seen emission held to a region's bound)."""
+    return [("frame", image)]
+
+
+def geometry_regions(image):
+    """(label, pixels) of each GEOMETRY_TILES tile, 2 pixels inside its square."""
+    ppm = GEOMETRY_RESOLUTION / GEOMETRY_VIEW
+    half = 1.5  # the smallest tile's (the cube's) half-width
+    regions = []
+    for label, (x, y) in GEOMETRY_TILES:
+        x, y = x + GEOMETRY_VIEW / 2, y + GEOMETRY_VIEW / 2
+        rows = slice(int((y - half) * ppm) + 2, int((y + half) * ppm) - 2)
+        cols = slice(int((x - half) * ppm) + 2, int((x + half) * ppm) - 2)
+        regions.append((label, image[rows, cols, :]))
+    return regions
+
+
 def ridged_heights(size=128):
     """A smooth height image (sinusoidal ridges), Non-Color, packed: the bump and displacement
     cases' height field."""
@@ -1727,10 +1849,13 @@ SAMPLE_SCALE = {"glass": 2, "beckmann_glossy": 4, "beckmann_glass": 2, "anisotro
 # (label, pixels) pairs, each held to the case's bound. math_nodes measured at most 3.7e-5 per
 # operation (Inverse Sqrt, near its pole; a Smooth Maximum computed as a plain maximum: 6.0e-4); vector_math's strips with discontinuities (Refract's
 # total internal reflection, the distorted checker's edges) carry anti-aliasing noise, 1e-4 - 2e-4
-# at half the default counts.
+# at half the default counts. geometry_attributes measured 1.6e-5 on its worst tile (0.13 - 10 with
+# the 0.5 stand-in), pointiness_bump 5.0e-6 over the frame (0.041 with the height's step
+# not moving Pointiness).
 REGIONS = {"math_nodes": (math_regions, 1e-4), "vector_math": (vector_regions, 5e-4),
            "brick_texture": (brick_regions, 5e-4), "voronoi_features": (voronoi_regions, 5e-4),
-           "curve_nodes": (curve_regions, 5e-4)}
+           "curve_nodes": (curve_regions, 5e-4), "geometry_attributes": (geometry_regions, 5e-4),
+           "pointiness_bump": (whole_frame, 1e-4)}
 
 
 # Pixel filter (scene.cycles.pixel_filter_type, filter_width) set on both engines; the common

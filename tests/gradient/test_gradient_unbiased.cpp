@@ -553,6 +553,38 @@ TEST(GradientUnbiased, ViewDependentMaterials) {
   expect_unbiased("view-dependent", scene, 4096, 1024, 0.1f);
 }
 
+// The Geometry node's mesh attributes (Pointiness, Parametric, Random Per Island) vary over the
+// surface like a texture: an offset path that hits its own point must read its own values. The
+// white surfaces mix by Parametric (the quads' two triangles), the red wall by Random Per Island
+// (one value per triangle: an edge along the diagonal); the ball mixes a diffuse and a glossy by
+// a Pointiness pattern. Then the ball is a mirror and the green wall mixes by Pointiness: offsets
+// copy the mirror's half-vector and shade their own wall hits.
+TEST(GradientUnbiased, GeometryNodeMeshAttributes) {
+  auto geometry = [](GeometryOutput output) {
+    InputNode n;
+    n.kind = InputNodeKind::Geometry;
+    n.geometry_output = output;
+    return n;
+  };
+  Scene scene = make_scene(SceneKind::CornellDiffuse, 32);
+  scene.meshes[0].triangle_island_random = {0.1f, 0.9f};
+  scene.meshes[0].vertex_pointiness = {0.1f, 0.9f, 0.3f, 0.7f};
+  Mesh& ball = scene.meshes[1];
+  for (const Vec3f& p : ball.positions)
+    ball.vertex_pointiness.push_back(0.5f + 0.5f * std::sin(12.0f * p.x + 9.0f * p.y));
+  scene.materials[0] = view_mix(diffuse({0.05f, 0.05f, 0.05f}), diffuse({0.95f, 0.9f, 0.85f}),
+                                geometry(GeometryOutput::Parametric));
+  scene.materials[1] = view_mix(diffuse({0.95f, 0.9f, 0.9f}), diffuse({0.6f, 0.05f, 0.05f}),
+                                geometry(GeometryOutput::RandomPerIsland));
+  scene.materials[3] = view_mix(diffuse({0.5f, 0.5f, 0.8f}), glossy({0.9f, 0.9f, 0.9f}, 0.3f),
+                                geometry(GeometryOutput::Pointiness));
+  expect_unbiased("geometry-attributes", scene, 4096, 1024, 0.1f);
+  scene.materials[2] = view_mix(diffuse({0.9f, 0.9f, 0.9f}), diffuse({0.05f, 0.5f, 0.05f}),
+                                geometry(GeometryOutput::Pointiness));
+  scene.materials[3] = glossy({0.9f, 0.9f, 0.9f}, 0.0f);
+  expect_unbiased("geometry-attributes-mirror", scene, 4096, 1024, 0.16f);
+}
+
 // Materials that read the hit's instance, its triangle and the camera (Vector Transform,
 // Wireframe): an offset path's vertex evaluates them with its own instance and triangle, as PT
 // does (shading_context_of), and a reconnected vertex seen from its own direction for wires in
