@@ -410,6 +410,12 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
         interpolate(load3(P[idx[0]]), load3(P[idx[1]]), load3(P[idx[2]]), W, U, V);
     store3(hit.coords.object, object);
     hit.coords.position = hit.position;
+    hit.coords.normal_cols = d.normal_cols;
+    hit.coords.uv_tangent = Vec3f(0.0f);
+    if (primitive < d.corner_tangent_tris) {
+      const Vec3f* T = d.corner_tangents + size_t(primitive) * 3;
+      store3(hit.coords.uv_tangent, interpolate(load3(T[0]), load3(T[1]), load3(T[2]), W, U, V));
+    }
     store3(hit.coords.generated, _mm_add_ps(_mm_mul_ps(object, _mm_load_ps(d.generated_scale)),
                                             _mm_load_ps(d.generated_offset)));
   }

@@ -137,14 +137,17 @@ enum class LightPathOutput : uint8_t {
   TransmissionDepth,
 };
 // The Geometry node's outputs read from ShadingContext::geometry (world space, flipped to the
-// incoming side as Cycles' sd->N / sd->Ng), Backfacing (1 on a back face, else 0), and those read
-// from ShadingContext::attributes (Mesh::vertex_pointiness, Mesh::triangle_island_random, and
-// Parametric: Cycles' (1 - u - v, u, 0) of the hit's barycentrics).
+// incoming side as Cycles' sd->N / sd->Ng), Backfacing (1 on a back face, else 0), Tangent
+// (Cycles' default tangent, TangentInput's radial about Z, made normal to the interpolated normal),
+// and those read from ShadingContext::attributes (Mesh::vertex_pointiness,
+// Mesh::triangle_island_random, and Parametric: Cycles' (1 - u - v, u, 0) of the hit's
+// barycentrics).
 enum class GeometryOutput : uint8_t {
   Normal,
   TrueNormal,
   Incoming,
   Backfacing,
+  Tangent,
   Pointiness,
   Parametric,
   RandomPerIsland
@@ -220,8 +223,24 @@ enum class ShaderNodeKind : uint8_t {
   Translucent,  // Blender Translucent BSDF: Lambertian transmission (diffuse, to the far side)
   Refraction,   // Blender Refraction BSDF: the Glass BSDF's refraction alone, no Fresnel
   Velvet,       // Blender Velvet BSDF: Ashikhmin velvet, sigma = saturated roughness (Sigma)
-  Mix,          // (1 - fac) * a + fac * b
-  Add,          // a + b
+  // Blender Anisotropic BSDF, GGX: alpha = r^2 scaled by (1 - anisotropy) along the tangent and
+  // divided by it across (the reverse for negative anisotropy, clamped to +-0.99), the tangent
+  // turned by Rotation * 2 pi about the normal (Cycles 3.4's svm anisotropic closure).
+  Anisotropic,
+  Mix,  // (1 - fac) * a + fac * b
+  Add,  // a + b
+};
+
+// The tangent an anisotropic lobe reads (Anisotropic BSDF / Principled Tangent inputs). Radial:
+// Blender's Tangent node, Radial, about an object axis: the direction around that axis through
+// the generated coordinates (object space, centred on 0.5), taken to world space as a normal is
+// (Cycles' svm_node_tangent); an unlinked input is the Geometry node's Tangent, Radial about Z.
+// UVMap: the mesh's MikkTSpace tangent of its UV map (Mesh::corner_tangents). Vector: another
+// node's world-space vector.
+struct TangentInput {
+  enum class Source : uint8_t { Radial, UVMap, Vector } source = Source::Radial;
+  uint8_t axis = 2;  // Radial: 0 X, 1 Y, 2 Z
+  ColorInput vector{Spectrum(0.0f)};
 };
 
 struct ShaderNode {
@@ -252,6 +271,11 @@ struct ShaderNode {
   FloatInput clearcoat{0.0f};
   FloatInput clearcoat_roughness{0.03f};
   FloatInput alpha{1.0f};
+  // Anisotropic BSDF (Anisotropy, Rotation, Tangent), Principled (Anisotropic, Anisotropic
+  // Rotation, Tangent).
+  FloatInput anisotropy{0.0f};
+  FloatInput rotation{0.0f};
+  TangentInput tangent;
   ColorInput emission{Spectrum(0.0f)};
   FloatInput emission_strength{1.0f};
   // Subsurface weight and colour: the diffuse Cycles falls back to for a radius below its

@@ -120,6 +120,16 @@ class ClosureSet {
   bool uses_lobe_choice() const {
     return count_ > 1 || (count_ == 1 && closures_[0].type == ClosureType::GGXDielectric);
   }
+  // The world tangent of the first anisotropic lobe, which the shading frame's x axis follows
+  // (shading_frame() in integrators/common/surface_frame.h); false without one.
+  bool anisotropic_tangent(Vec3f& tangent) const {
+    for (int i = 0; i < count_; ++i)
+      if (is_anisotropic(closures_[i])) {
+        tangent = closures_[i].tangent;
+        return true;
+      }
+    return false;
+  }
   // Minimum roughness over non-delta lobes (1 for pure diffuse); 0 if only delta lobes.
   float roughness() const;
   bool has_delta() const;

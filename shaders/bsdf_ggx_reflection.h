@@ -1,6 +1,6 @@
-// Microfacet reflection (GGX, or Beckmann: Closure::distribution), two-sided, as Cycles 3.4's
-// `microfacet_ggx` / `microfacet_beckmann` (Glossy BSDF) and `microfacet_ggx_fresnel`
-// (Principled v1 specular):
+// Microfacet reflection (GGX, or Beckmann: Closure::distribution; GGX lobes may be anisotropic
+// about the lobe's tangent), two-sided, as Cycles 3.4's `microfacet_ggx` / `microfacet_beckmann`
+// (Glossy BSDF) and `microfacet_ggx_fresnel` (Principled v1 specular):
 //   f |cos_o| = weight * F(wo.h) * D(h) G1(wi) G1(wo) / (4 cos_i),   h = normalize(wi + wo)
 // F = 1 for FresnelMode::None (the Glossy colour simply scales), and Cycles' Principled v1 blend
 // PrincipledFresnel(Closure::ior, Closure::f0) for FresnelMode::PrincipledV1.
@@ -22,11 +22,28 @@ inline Spectrum fresnel(const Closure& c, float cos_h) {
   return PrincipledFresnel(c.ior, c.f0)(cos_h);
 }
 
+// A direction in the anisotropic lobe's own frame (its tangent on +x), and back.
+inline Vec3f to_tangent(const Closure& c, Vec3f w) {
+  return {c.rotation.x * w.x + c.rotation.y * w.y, c.rotation.x * w.y - c.rotation.y * w.x, w.z};
+}
+inline Vec3f from_tangent(const Closure& c, Vec3f w) {
+  return {c.rotation.x * w.x - c.rotation.y * w.y, c.rotation.y * w.x + c.rotation.x * w.y, w.z};
+}
+
+// The anisotropic lobe: the same formulas with AnisoGGX in the lobe's frame.
+inline Spectrum eval_pdf_aniso(const Closure& c, Vec3f wi, Vec3f wo, Vec3f h, float& pdf) {
+  const AnisoGGX ggx(c.alpha, c.alpha_y);
+  const float common = ggx.D(to_tangent(c, h)) * ggx.G1(to_tangent(c, wi)) / (4.0f * wi.z);
+  pdf = common;
+  return c.weight * fresnel(c, dot(wo, h)) * (common * ggx.G1(to_tangent(c, wo)));
+}
+
 // wi, wo already mirrored to wi.z > 0. Returns eval, writes the pdf.
 inline Spectrum eval_pdf_upper(const Closure& c, Vec3f wi, Vec3f wo, float& pdf) {
   pdf = 0.0f;
   Vec3f h;
   if (!reflection_lobe::upper_half_vector(wi, wo, h)) return Spectrum(0.0f);
+  if (is_anisotropic(c)) return eval_pdf_aniso(c, wi, wo, h, pdf);
   const Microfacet mf(c.distribution, c.alpha);
   const float common = mf.D(h) / (4.0f * wi.z);
   pdf = common * mf.G1_visible(wi);
@@ -40,6 +57,10 @@ inline Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo) {
 // Density only: D(h) G1_visible(wi) / (4 cos_i), without the Fresnel and masking of the value.
 inline float pdf(const Closure& c, Vec3f wi, Vec3f wo) {
   return reflection_lobe::pdf(c, wi, wo, [](const Closure& k, Vec3f i, Vec3f, Vec3f h) {
+    if (is_anisotropic(k)) {
+      const AnisoGGX ggx(k.alpha, k.alpha_y);
+      return ggx.D(to_tangent(k, h)) * ggx.G1(to_tangent(k, i)) / (4.0f * i.z);
+    }
     const Microfacet mf(k.distribution, k.alpha);
     return mf.D(h) * mf.G1_visible(i) / (4.0f * i.z);
   });
@@ -49,7 +70,8 @@ inline BsdfSample sample(const Closure& c, Vec3f wi, float, Vec2f u) {
   return reflection_lobe::sample(
       c, wi, u, [](const Closure& k, float cos_i) { return k.weight * fresnel(k, cos_i); },
       [](const Closure& k, Vec3f i, Vec2f v) {
-        return Microfacet(k.distribution, k.alpha).sample_visible(i, v);
+        if (!is_anisotropic(k)) return Microfacet(k.distribution, k.alpha).sample_visible(i, v);
+        return from_tangent(k, AnisoGGX(k.alpha, k.alpha_y).sample_visible(to_tangent(k, i), v));
       },
       eval_pdf_upper);
 }

@@ -13,6 +13,8 @@
 //    (or 1 for diffuse lobes) over the non-delta lobes; a sampled delta lobe counts as 0.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 #include "core/frame.h"
@@ -55,6 +57,14 @@ struct Closure {
   MicrofacetDistribution distribution = MicrofacetDistribution::GGX;
   Spectrum weight{1.0f, 1.0f, 1.0f};  // colour * mix weight
   float alpha = 0.0f;                 // microfacet alpha (= Blender roughness^2); diffuse roughness
+  // Anisotropic GGX (GGXReflection, distribution GGX): alpha is the width along the lobe's tangent,
+  // alpha_y along its bitangent; alpha_y < 0: isotropic. The lobe's tangent is local (rotation.x,
+  // rotation.y, 0): the shading frame's x axis follows `tangent` (world; the material's Tangent
+  // input, neither projected nor rotated: shading_frame() in integrators/common/surface_frame.h),
+  // and `rotation` is (cos, sin) of the Anisotropic Rotation about the normal from there.
+  float alpha_y = -1.0f;
+  Vec2f rotation{1.0f, 0.0f};
+  Vec3f tangent{0.0f, 0.0f, 0.0f};
   // Relative IOR: GGXDielectric: n(below the frame normal) / n(above), i.e. the IOR crossed by
   // a ray arriving with wi.z > 0 (Material sets 1/ior for back-face hits, since the integrators
   // orient the frame towards the ray); PrincipledV1 reflection: the IOR giving its F0.
@@ -72,6 +82,18 @@ struct Closure {
   // weight (Cycles' caustics toggles remove one of the glass BSDF's two closures).
   bool drop_reflection = false, drop_refraction = false;
 };
+
+inline bool is_anisotropic(const Closure& c) {
+  return c.alpha_y >= 0.0f;
+}
+// The narrower width: what roughness() reports of the lobe.
+inline float min_alpha(const Closure& c) {
+  return is_anisotropic(c) ? std::min(c.alpha, c.alpha_y) : c.alpha;
+}
+// The width tested for a perfect mirror: Cycles' alpha_x alpha_y <= 1e-7.
+inline float mirror_test_alpha(const Closure& c) {
+  return is_anisotropic(c) ? std::sqrt(c.alpha * c.alpha_y) : c.alpha;
+}
 
 enum LobeFlags : uint8_t {
   kLobeReflection = 1 << 0,

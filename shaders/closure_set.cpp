@@ -59,25 +59,36 @@ float lobe_pdf_local(const Closure& c, Vec3f wi,
 }
 float lobe_albedo_hint_local(const Closure& c, Vec3f wi){GDPT_DISPATCH(c, albedo_hint(c, wi))}
 
+// The frame of a lobe about its own normal n; an anisotropic lobe's x axis is the shading frame's
+// (its tangent) projected onto the plane of n, as Cycles' make_orthonormals_tangent.
+Frame lobe_frame(const Closure& c, Vec3f n) {
+  if (!is_anisotropic(c)) return Frame(n);
+  const Vec3f s = Vec3f(1.0f, 0.0f, 0.0f) - n * n.x;
+  const float len2 = length_squared(s);
+  if (!(len2 > 1e-12f)) return Frame(n);
+  const Vec3f x = s / std::sqrt(len2);
+  return Frame(x, cross(n, x), n);
+}
+
 // A lobe of a set with own frames: one that keeps the interpolated normal `n` sees wi and wo in
 // the frame of n.
 Spectrum lobe_eval_framed(const Closure& c, Vec3f n, Vec3f wi, Vec3f wo) {
   if (c.interpolated_normal) {
-    const Frame f(n);
+    const Frame f = lobe_frame(c, n);
     return lobe_eval_local(c, f.to_local(wi), f.to_local(wo));
   }
   return lobe_eval_local(c, wi, wo);
 }
 float lobe_pdf_framed(const Closure& c, Vec3f n, Vec3f wi, Vec3f wo) {
   if (c.interpolated_normal) {
-    const Frame f(n);
+    const Frame f = lobe_frame(c, n);
     return lobe_pdf_local(c, f.to_local(wi), f.to_local(wo));
   }
   return lobe_pdf_local(c, wi, wo);
 }
 BsdfSample lobe_sample_framed(const Closure& c, Vec3f n, Vec3f wi, float u_choice, Vec2f u) {
   if (c.interpolated_normal) {
-    const Frame f(n);
+    const Frame f = lobe_frame(c, n);
     const Vec3f wi_local = f.to_local(wi);
     BsdfSample s = lobe_sample_local(c, wi_local, u_choice, u);
     if (!s.valid) return s;
@@ -95,7 +106,7 @@ BsdfSample lobe_sample_framed(const Closure& c, Vec3f n, Vec3f wi, float u_choic
   return lobe_sample_local(c, wi, u_choice, u);
 }
 float lobe_albedo_hint_framed(const Closure& c, Vec3f n, Vec3f wi) {
-  if (c.interpolated_normal) return lobe_albedo_hint_local(c, Frame(n).to_local(wi));
+  if (c.interpolated_normal) return lobe_albedo_hint_local(c, lobe_frame(c, n).to_local(wi));
   return lobe_albedo_hint_local(c, wi);
 }
 // The lobe calls of a set with own frames (kFramed; `n` ClosureSet::interpolated_) or without:
@@ -128,7 +139,7 @@ bool lobe_is_delta(const Closure& c) {
       return true;
     case ClosureType::GGXReflection:
     case ClosureType::Clearcoat:
-      return is_delta_alpha(c.alpha);
+      return is_delta_alpha(mirror_test_alpha(c));
     case ClosureType::GGXDielectric:
       // An index-matched rough interface still has a (zero-weight) glossy reflection; its
       // transmission is a delta pass-through, so it counts as delta for classification.
@@ -356,7 +367,7 @@ float ClosureSet::roughness() const {
     const Closure& c = closures_[i];
     if (lobe_is_delta(c) && !(c.type == ClosureType::GGXDielectric && !is_delta_alpha(c.alpha)))
       continue;
-    r = std::min(r, lobe_is_diffuse(c) ? 1.0f : std::clamp(c.alpha, 0.0f, 1.0f));
+    r = std::min(r, lobe_is_diffuse(c) ? 1.0f : std::clamp(min_alpha(c), 0.0f, 1.0f));
   }
   return r > 1.0f ? (count_ > 0 && has_delta() ? 0.0f : 1.0f) : r;
 }

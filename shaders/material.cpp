@@ -449,6 +449,12 @@ struct PointInputs {
     }
     if (!at.geometry) return Vec3f(0.0f, 0.0f, 1.0f);
     const ShadingGeometry& g = *at.geometry;
+    if (which == GeometryOutput::Tangent) {
+      // Cycles' primitive_tangent: cross(N, normalize(cross(T, N))).
+      const Vec3f c = cross(tangent(TangentInput{}), g.normal);
+      const float len = length(c);
+      return len > 0.0f ? cross(g.normal, c / len) : Vec3f(0.0f);
+    }
     return which == GeometryOutput::Normal       ? g.normal
            : which == GeometryOutput::TrueNormal ? g.true_normal
                                                  : g.incoming;
@@ -472,6 +478,22 @@ struct PointInputs {
       width *= wireframe_pixel_width(pixel_footprint(*camera, p), ng, wi);
     }
     return wireframe(c, p, width);
+  }
+
+  // An anisotropic lobe's tangent, world space, neither normalised nor projected (TangentInput).
+  Vec3f tangent(const TangentInput& t) const {
+    if (t.source == TangentInput::Source::Vector) return color(t.vector);
+    if (!at.coords) return Vec3f(0.0f);
+    const Vec3f g = at.coords->generated - Vec3f(0.5f);
+    const Vec3f local = t.source == TangentInput::Source::UVMap ? at.coords->uv_tangent
+                        : t.axis == 0                           ? Vec3f(0.0f, -g.z, g.y)
+                        : t.axis == 1                           ? Vec3f(-g.z, 0.0f, g.x)
+                                                                : Vec3f(-g.y, g.x, 0.0f);
+    const float(*n)[4] = at.coords->normal_cols;
+    if (!n) return local;
+    Vec3f w(0.0f);
+    for (int c = 0; c < 3; ++c) w += Vec3f(n[c][0], n[c][1], n[c][2]) * local[c];
+    return w;
   }
 
   // A texture's coordinates: the source (zero without object-space coordinates), then its
@@ -512,6 +534,7 @@ struct AverageInputs {
   bool front_facing() const { return true; }
   // Procedural textures average to their mid value (Vec3f(0.5) through input_node_result).
   Vec3f vector(const TextureVector&) const { return Vec3f(0.5f); }
+  Vec3f tangent(const TangentInput&) const { return Vec3f(1.0f, 0.0f, 0.0f); }  // unused
 
   // Unknown without the mesh: white, an upper bound for power estimates (emitter selection).
   Spectrum attribute_color() const { return Spectrum(1.0f); }
@@ -545,6 +568,23 @@ struct AverageInputs {
   }
 };
 
+// The Anisotropic BSDF's widths from alpha = r^2 and the clamped anisotropy a (Cycles 3.4):
+// narrower along the tangent for a > 0, across it for a < 0; equal widths stay isotropic.
+void set_anisotropy(Closure& c, float alpha, float a) {
+  const float ax = a < 0.0f ? alpha / (1.0f + a) : alpha * (1.0f - a);
+  const float ay = a < 0.0f ? alpha * (1.0f + a) : alpha / (1.0f - a);
+  c.alpha = saturate(ax);
+  c.alpha_y = saturate(ay);
+  if (c.alpha == c.alpha_y) c.alpha_y = -1.0f;
+}
+
+// The lobe's tangent (world) and its rotation about the normal, `turns` of a full turn.
+void orient(Closure& c, Vec3f tangent, float turns) {
+  c.tangent = tangent;
+  const float angle = 2.0f * kPi * turns;
+  c.rotation = turns != 0.0f ? Vec2f(std::cos(angle), std::sin(angle)) : Vec2f(1.0f, 0.0f);
+}
+
 // Adds the lobes of one BSDF node (weight w) to `out`.
 template <class Inputs>
 void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
@@ -565,6 +605,16 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       c.fresnel = FresnelMode::None;
       c.distribution = n.distribution;
       c.alpha = r * r;
+      c.weight = in.color(n.color) * w;
+      out.add(c);
+      return;
+    }
+    case ShaderNodeKind::Anisotropic: {
+      const float r = saturate(in.scalar(n.roughness));
+      c.type = ClosureType::GGXReflection;
+      c.fresnel = FresnelMode::None;
+      set_anisotropy(c, r * r, std::clamp(in.scalar(n.anisotropy), -0.99f, 0.99f));
+      if (is_anisotropic(c)) orient(c, in.tangent(n.tangent), in.scalar(n.rotation));
       c.weight = in.color(n.color) * w;
       out.add(c);
       return;
@@ -629,6 +679,13 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       p.front_facing = in.front_facing();
       p.interpolated_normal = !n.normal_linked;
       p.clearcoat_interpolated_normal = !n.clearcoat_normal_linked;
+      p.anisotropic = in.scalar(n.anisotropy);
+      if (p.anisotropic != 0.0f) {
+        Closure oriented;
+        orient(oriented, in.tangent(n.tangent), in.scalar(n.rotation));
+        p.tangent = oriented.tangent;
+        p.rotation = oriented.rotation;
+      }
       add_principled_closures(p, w, out);
       return;
     }
@@ -780,6 +837,10 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
           (n.kind == InputNodeKind::Geometry && n.geometry_output != GeometryOutput::Backfacing &&
            !surface_attribute))
         reads_view_ = true;
+      if (n.kind == InputNodeKind::Geometry && n.geometry_output == GeometryOutput::Tangent) {
+        reads_coordinates_ = true;
+        features_ |= kFeatureTextures;
+      }
       if (n.kind == InputNodeKind::LightPath) reads_path_ = true;
       // Per instance and camera; Wireframe reads the hit's position and, in pixels, the view.
       if (n.kind == InputNodeKind::VectorTransform) features_ |= kFeatureTextures;
@@ -816,6 +877,15 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
     }
   };
   auto note = [&](const auto& input) { note_input(note_input, input, 0); };
+  // A tangent varies over the surface unless it is a constant vector: closures per hit.
+  auto note_tangent = [&](const TangentInput& t) {
+    if (t.source == TangentInput::Source::Vector) {
+      note(t.vector);
+      return;
+    }
+    reads_coordinates_ = true;  // TexCoords carries the generated coordinates and UV tangent
+    features_ |= kFeatureTextures;
+  };
   auto visit = [&](auto&& self, int32_t i, int depth) -> void {
     check_node(i);
     if (depth > kMaxTreeDepth)
@@ -836,6 +906,15 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
       case ShaderNodeKind::Glossy:
         note(n.color);
         note(n.roughness);
+        features_ |= kFeatureGlossy;
+        if (may_be_delta(n.roughness)) features_ |= kFeatureDelta;
+        return;
+      case ShaderNodeKind::Anisotropic:
+        note(n.color);
+        note(n.roughness);
+        note(n.anisotropy);
+        note(n.rotation);
+        note_tangent(n.tangent);
         features_ |= kFeatureGlossy;
         if (may_be_delta(n.roughness)) features_ |= kFeatureDelta;
         return;
@@ -892,6 +971,11 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
             (may_be_nonzero(n.metallic) || may_be_nonzero(n.specular_tint) ||
              may_be_nonzero(n.sheen) || may_be_nonzero(n.transmission)))
           reads_path_ = true;
+        note(n.anisotropy);
+        if (varies(n.anisotropy) || n.anisotropy.value != 0.0f) {
+          note(n.rotation);
+          note_tangent(n.tangent);
+        }
         const bool specular = varies(n.specular) || varies(n.metallic) || n.specular.value > 0.0f ||
                               n.metallic.value > 0.0f;
         const bool transmission = (varies(n.transmission) || n.transmission.value > 0.0f) &&

@@ -1,7 +1,8 @@
 // The microfacet distributions of the reflection and dielectric lobes: Microfacet, the one a
-// Closure names (GGX or Beckmann, shaders/beckmann.h), and the isotropic GGX (Trowbridge-Reitz)
-// distribution with the separable Smith masking term, in the local frame (normal = +z), as
-// Cycles 3.4's `microfacet_ggx`.
+// Closure names (GGX or Beckmann, shaders/beckmann.h), the isotropic GGX (Trowbridge-Reitz)
+// distribution with the separable Smith masking term, and the anisotropic GGX (AnisoGGX, widths
+// alpha_x along local x, the tangent, and alpha_y along local y), in the local frame
+// (normal = +z), as Cycles 3.4's `microfacet_ggx`.
 //
 //  alpha: GGX width, Blender roughness^2, clamped to [0, 1] by the caller.
 //  D(m):       normal distribution, integrates to 1 over projected microfacet area.
@@ -98,6 +99,53 @@ class Microfacet {
   bool beckmann_;
   GGX ggx_;
   Beckmann bk_;
+};
+
+// Anisotropic GGX, the same quantities as GGX with the slope widths alpha_x (x) and alpha_y (y);
+// equal widths give GGX's distribution (GGX keeps its own code for the isotropic lobes).
+struct AnisoGGX {
+  float ax, ay;
+
+  AnisoGGX(float alpha_x, float alpha_y) : ax(alpha_x), ay(alpha_y) {}
+
+  // 1 / (pi ax ay (x^2/ax^2 + y^2/ay^2 + z^2)^2)
+  float D(Vec3f m) const {
+    if (m.z <= 0.0f) return 0.0f;
+    const float sx = m.x / ax, sy = m.y / ay;
+    const float t = sx * sx + sy * sy + m.z * m.z;
+    return 1.0f / (kPi * ax * ay * t * t);
+  }
+
+  // 2 |z| / (|z| + sqrt(z^2 + ax^2 x^2 + ay^2 y^2)): the projected width along w's azimuth.
+  float G1(Vec3f w) const {
+    const float z = std::fabs(w.z);
+    if (z == 0.0f) return 0.0f;
+    const float px = ax * w.x, py = ay * w.y;
+    return 2.0f * z / (z + std::sqrt(z * z + px * px + py * py));
+  }
+
+  float pdf_visible(Vec3f wi, Vec3f m) const {
+    const float cos_im = dot(wi, m);
+    if (cos_im <= 0.0f || wi.z <= 0.0f) return 0.0f;
+    return G1(wi) * cos_im * D(m) / wi.z;
+  }
+
+  // Heitz 2018 with the stretch (ax, ay): the hemisphere configuration is isotropic.
+  Vec3f sample_visible(Vec3f wi, Vec2f u) const {
+    const Vec3f vh = normalize(Vec3f(ax * wi.x, ay * wi.y, wi.z));
+    const float len2 = vh.x * vh.x + vh.y * vh.y;
+    const Vec3f t1 =
+        len2 > 0.0f ? Vec3f(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : Vec3f(1.0f, 0.0f, 0.0f);
+    const Vec3f t2 = cross(vh, t1);
+    const float r = std::sqrt(u.x);
+    const float phi = 2.0f * kPi * u.y;
+    const float p1 = r * std::cos(phi);
+    float p2 = r * std::sin(phi);
+    const float s = 0.5f * (1.0f + vh.z);
+    p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
+    const Vec3f nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2));
+    return normalize(Vec3f(ax * nh.x, ay * nh.y, std::max(1e-7f, nh.z)));
+  }
 };
 
 }  // namespace gdpt

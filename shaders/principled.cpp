@@ -69,6 +69,15 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
     s.fresnel = FresnelMode::PrincipledV1;
     s.weight = Spectrum(w * specular_weight);
     s.alpha = ggx_alpha;
+    if (p.anisotropic != 0.0f) {
+      // Cycles' safe_sqrtf; a zero aspect saturates alpha_x to 1.
+      const float aspect = std::sqrt(std::max(0.0f, 1.0f - 0.9f * p.anisotropic));
+      s.alpha = saturate(ggx_alpha / aspect);
+      s.alpha_y = saturate(ggx_alpha * aspect);
+      if (s.alpha == s.alpha_y) s.alpha_y = -1.0f;
+      s.tangent = p.tangent;
+      s.rotation = p.rotation;
+    }
     // F0 = 0.08 specular; keep the IOR finite for specular >= 12.5.
     const float sqrt_f0 = std::min(std::sqrt(0.08f * specular), 0.999f);
     s.ior = 2.0f / (1.0f - sqrt_f0) - 1.0f;

@@ -41,6 +41,11 @@ struct PrincipledParams {
   float clearcoat = 0.0f;
   float clearcoat_roughness = 0.03f;
   float alpha = 1.0f;
+  // Anisotropic: the specular lobe's widths r^2 / aspect along the tangent and r^2 aspect across,
+  // aspect = sqrt(1 - 0.9 anisotropic); tangent (world) and rotation as Closure's.
+  float anisotropic = 0.0f;
+  Vec3f tangent{0.0f};
+  Vec2f rotation{1.0f, 0.0f};
   Spectrum emission{0.0f};  // colour * strength
   float subsurface = 0.0f;
   Spectrum subsurface_color{0.8f};

@@ -29,7 +29,7 @@ inline bool upper_half_vector(Vec3f wi, Vec3f wo, Vec3f& h) {
 
 template <class Upper>
 Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo, Upper upper) {
-  if (is_delta_alpha(c.alpha) || !(wi.z * wo.z > 0.0f)) return Spectrum(0.0f);
+  if (is_delta_alpha(mirror_test_alpha(c)) || !(wi.z * wo.z > 0.0f)) return Spectrum(0.0f);
   const MirroredPair p(wi, wo);
   float pdf;
   return upper(c, p.wi, p.wo, pdf);
@@ -37,7 +37,7 @@ Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo, Upper upper) {
 
 template <class Density>
 float pdf(const Closure& c, Vec3f wi, Vec3f wo, Density density) {
-  if (is_delta_alpha(c.alpha) || !(wi.z * wo.z > 0.0f)) return 0.0f;
+  if (is_delta_alpha(mirror_test_alpha(c)) || !(wi.z * wo.z > 0.0f)) return 0.0f;
   const MirroredPair p(wi, wo);
   Vec3f h;
   return upper_half_vector(p.wi, p.wo, h) ? density(c, p.wi, p.wo, h) : 0.0f;
@@ -50,7 +50,7 @@ BsdfSample sample(const Closure& c, Vec3f wi_, Vec2f u, Mirror mirror, Normal no
   const float sign = wi_.z < 0.0f ? -1.0f : 1.0f;
   const Vec3f wi = flip_z(wi_, sign);
   s.eta = 1.0f;
-  if (is_delta_alpha(c.alpha)) {
+  if (is_delta_alpha(mirror_test_alpha(c))) {
     s.wo = flip_z(Vec3f(-wi.x, -wi.y, wi.z), sign);
     s.value = mirror(c, wi.z);
     s.pdf = 1.0f;
@@ -64,7 +64,7 @@ BsdfSample sample(const Closure& c, Vec3f wi_, Vec2f u, Mirror mirror, Normal no
   s.value = upper(c, wi, wo, s.pdf);
   if (!(s.pdf > 0.0f)) return s;
   s.wo = flip_z(wo, sign);
-  s.roughness = c.alpha;
+  s.roughness = min_alpha(c);
   s.lobe = kLobeReflection | kLobeGlossy;
   s.valid = true;
   return s;

@@ -14,6 +14,12 @@ struct TexCoords {
   Vec3f generated;  // TexCoordSource::Generated
   Vec3f object;     // TexCoordSource::Object
   Vec3f position;   // TexCoordSource::Position (world space)
+  // Columns of the instance's normal matrix (object to world, the inverse transpose), 4 floats
+  // each; null: identity. Radial tangents are object-space directions taken to world space so.
+  const float (*normal_cols)[4] = nullptr;
+  // The mesh's MikkTSpace tangent of its UV map (Mesh::corner_tangents), object space,
+  // interpolated; zero where the mesh has none.
+  Vec3f uv_tangent{0.0f};
 };
 
 // The hit as seen along the incoming ray, for nodes that read the view (Fresnel, Layer Weight,

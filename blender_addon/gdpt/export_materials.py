@@ -2,19 +2,20 @@
 #
 # Walks from the active Material Output's Surface input over the tree with its node groups
 # flattened (export_node_groups.py). Supported shader nodes: Principled BSDF, Diffuse, Glossy,
-# Glass, Emission (and, reported, Background: Cycles shows it as one on a surface), Transparent,
-# Mix Shader, Add Shader, Subsurface Scattering and Principled's subsurface (the diffuse Cycles
-# falls back to at radius 0; a larger radius renders the same, reported); a colour or float
-# output on a shader socket becomes an Emission, and an unlinked shader input is no closure
-# (black), as in Cycles.
+# Anisotropic (GGX; its Tangent: Cycles' default radial tangent, a Tangent node, Radial or UV Map,
+# or a vector), Glass, Emission (and, reported, Background: Cycles shows it as one on a surface),
+# Transparent, Mix Shader, Add Shader, Subsurface Scattering and Principled's subsurface (the
+# diffuse Cycles falls back to at radius 0; a larger radius renders the same, reported); a colour
+# or float output on a shader socket becomes an Emission, and an unlinked shader input is no
+# closure (black), as in Cycles.
 # Inputs may be constants, RGB / Value nodes, colour / math / curve nodes, Blackbody, Fresnel,
-# Layer Weight, Geometry (Normal, True Normal, Incoming, Backfacing, Pointiness, Parametric, Random
-# Per Island; Tangent reported, 0.5 standing in), Light Path (read per path: its own direction and
-# state), Vector Transform (World / Object / Camera, Cycles' camera space) and Wireframe (per
-# triangle; Use Pixel Size reported: the camera's pixel), image and procedural textures read at UV,
-# Generated or Object coordinates, optionally through a Mapping node. The Displacement output (a
-# Displacement node) renders as Cycles' Bump Only. Reroutes and muted nodes are followed. Anything
-# else is reported once per material (naming the node)
+# Layer Weight, Geometry (Normal, True Normal, Incoming, Backfacing, Tangent, Pointiness,
+# Parametric, Random Per Island), Light Path (read per path: its own direction and state), Vector
+# Transform (World / Object / Camera, Cycles' camera space) and Wireframe (per triangle; Use Pixel
+# Size reported: the camera's pixel), image and procedural textures read at UV, Generated or
+# Object coordinates, optionally through a Mapping node. The Displacement output (a Displacement
+# node) renders as Cycles' Bump Only. Reroutes and muted nodes are followed. Anything else is
+# reported once per material (naming the node)
 # and followed through its mute pass-through link when it has one; otherwise a
 # magenta diffuse (shaders) or the socket's own value (inputs) stands in, so the render still
 # completes. A material whose translation fails (or that the core rejects) renders magenta, with
@@ -33,7 +34,7 @@ IDENTITY12 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 _SHADERS = {
     'BSDF_PRINCIPLED', 'BSDF_DIFFUSE', 'BSDF_GLOSSY', 'BSDF_GLASS', 'EMISSION',
     'BSDF_TRANSPARENT', 'MIX_SHADER', 'ADD_SHADER', 'BSDF_TRANSLUCENT', 'BSDF_VELVET',
-    'BSDF_REFRACTION', 'SUBSURFACE_SCATTERING',
+    'BSDF_REFRACTION', 'SUBSURFACE_SCATTERING', 'BSDF_ANISOTROPIC',
 }
 # Cycles turns a BSSRDF channel of a smaller radius into a diffuse BSDF (BSSRDF_MIN_RADIUS).
 _BSSRDF_MIN_RADIUS = 1e-8
@@ -53,8 +54,8 @@ _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPAR
                 'VECT_TRANSFORM', 'WIREFRAME'}
 # The Geometry node's outputs the core reads from the view of the hit or from the mesh there
 # (Position: coordinates).
-_GEOMETRY_OUTPUTS = {'Normal', 'True Normal', 'Incoming', 'Backfacing', 'Pointiness', 'Parametric',
-                     'Random Per Island'}
+_GEOMETRY_OUTPUTS = {'Normal', 'True Normal', 'Incoming', 'Backfacing', 'Tangent', 'Pointiness',
+                     'Parametric', 'Random Per Island'}
 # Those the mesh export computes for the meshes whose materials read them (Mesh::vertex_pointiness,
 # Mesh::triangle_island_random), by the names GeometryExporter passes on.
 _MESH_ATTRIBUTE_OUTPUTS = {'Pointiness': 'pointiness', 'Random Per Island': 'random_per_island'}
@@ -97,6 +98,7 @@ class _Translator:
         self.chain_nodes = set()
         self.inputs = []  # colour / math input nodes (MaterialDesc::inputs)
         self.color_attribute = None  # name read by Color Attribute nodes ("": the render one)
+        self.uv_tangents = False  # a Tangent node reads the UV map's tangents
         self.mesh_attributes = set()  # _MESH_ATTRIBUTE_OUTPUTS' values the material reads
         self.input_index = {}  # node name -> index in self.inputs
         self.current = None  # the node being translated (named when translation fails)
@@ -170,9 +172,6 @@ class _Translator:
             self._warn_transport(n, i["Subsurface Radius"], subsurface)
         normal_linked = self.normal(i["Normal"])
         clearcoat_normal_linked = self.normal(i["Clearcoat Normal"])
-        if i["Tangent"].is_linked:
-            self.warn(self._source(i["Tangent"]).node if self._source(i["Tangent"]) else n,
-                      "normal / tangent input node")
         d = {
             "kind": "PRINCIPLED",
             "color": self.color(i["Base Color"]),
@@ -191,6 +190,9 @@ class _Translator:
             "emission": self.color(i["Emission"]),
             "emission_strength": self.value(i["Emission Strength"]),
             "alpha": self.value(i["Alpha"]),
+            "anisotropy": self.value(i["Anisotropic"]),
+            "rotation": self.value(i["Anisotropic Rotation"]),
+            "tangent": self.tangent(i["Tangent"]),
         }
         if has_subsurface:
             d["subsurface"] = self.value(subsurface)
@@ -239,6 +241,16 @@ class _Translator:
         return self._add({"kind": "GLOSSY", "color": self.color(n.inputs["Color"]),
                           "roughness": roughness, "distribution": distribution,
                           "normal_linked": linked})
+
+    def _bsdf_anisotropic(self, n):
+        if n.distribution != 'GGX':
+            self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
+        linked = self.normal(n.inputs["Normal"])
+        return self._add({"kind": "ANISOTROPIC", "color": self.color(n.inputs["Color"]),
+                          "roughness": self.value(n.inputs["Roughness"]),
+                          "anisotropy": self.value(n.inputs["Anisotropy"]),
+                          "rotation": self.value(n.inputs["Rotation"]),
+                          "tangent": self.tangent(n.inputs["Tangent"]), "normal_linked": linked})
 
     def _bsdf_glass(self, n):
         distribution = self._distribution(n)
@@ -311,6 +323,25 @@ class _Translator:
             return True
         self.warn(node, _SECOND_PERTURBATION)
         return False
+
+    def tangent(self, socket):
+        """An anisotropic lobe's Tangent input (TangentInput): unlinked, or the Geometry node's
+        Tangent, is Cycles' default, radial about the object's Z axis; a Tangent node is radial
+        about its axis or its UV map's tangent (the active render UV map's MikkTSpace tangents,
+        exported with the mesh); any other vector is read as it is (world space)."""
+        out = self._source(socket)
+        if out is None or (out.node.type == 'NEW_GEOMETRY' and out.name == "Tangent"):
+            return {"source": "RADIAL", "axis": 2}
+        node = out.node
+        if node.type == 'TANGENT':
+            if node.direction_type == 'RADIAL':
+                return {"source": "RADIAL", "axis": "XYZ".index(node.axis)}
+            if node.uv_map:
+                self.warn(node, f"UV map '{node.uv_map}' (the active render UV map's tangents "
+                          "are used) of")
+            self.uv_tangents = True
+            return {"source": "UV_MAP"}
+        return {"source": "VECTOR", "vector": self.color(socket)}
 
     def _view_normal(self, socket):
         """A Fresnel / Layer Weight Normal input: unlinked or the Geometry node's Normal is the
@@ -466,8 +497,8 @@ class _Translator:
         return d
 
     def _unsupported_geometry(self, node, out):
-        """A Geometry output Gradient PT does not compute (Tangent): reported by name; 0.5
-        stands in."""
+        """A Geometry output Gradient PT does not compute (none of Blender 3.4's; one a later
+        version adds): reported by name; 0.5 stands in."""
         if node.type != 'NEW_GEOMETRY' or out.name in _GEOMETRY_OUTPUTS or out.name == "Position":
             return False
         self.warn(node, f"output {out.name} (0.5 stands in) of")
@@ -906,6 +937,8 @@ def _translate_tree(material, t, warn):
         d["bumps"] = bumps
     if t.color_attribute is not None:
         d["color_attribute"] = t.color_attribute
+    if t.uv_tangents:
+        d["uv_tangents"] = True
     if t.mesh_attributes:
         d["mesh_attributes"] = sorted(t.mesh_attributes)
     return d
@@ -918,7 +951,8 @@ class MaterialCache:
         self.images = images
         self.warn = warn
         self.index = {}
-        self.normal_mapped = set()  # scene material indices with a normal map
+        # Scene material indices that read the UV map's tangents (a normal map, a Tangent node).
+        self.normal_mapped = set()
         self.color_attributes = {}  # scene material index -> colour attribute name it reads
         self.mesh_attributes = {}  # scene material index -> Geometry node attributes it reads
 
@@ -935,7 +969,7 @@ class MaterialCache:
                 self.warn(f"material '{material.name}': {e}; rendered magenta")
                 desc = dict(magenta_material(material.name), pass_index=material.pass_index)
                 self.index[key] = self.builder.add_material(desc)
-            if "normal_map" in desc:
+            if "normal_map" in desc or desc.get("uv_tangents"):
                 self.normal_mapped.add(self.index[key])
             if "color_attribute" in desc:
                 self.color_attributes[self.index[key]] = desc["color_attribute"]

@@ -285,6 +285,7 @@ InputNode read_input_node(const py::dict& d) {
       {"True Normal", GeometryOutput::TrueNormal},
       {"Incoming", GeometryOutput::Incoming},
       {"Backfacing", GeometryOutput::Backfacing},
+      {"Tangent", GeometryOutput::Tangent},
       {"Pointiness", GeometryOutput::Pointiness},
       {"Parametric", GeometryOutput::Parametric},
       {"Random Per Island", GeometryOutput::RandomPerIsland}};
@@ -381,6 +382,20 @@ InputNode read_input_node(const py::dict& d) {
   return n;
 }
 
+// {"source": "RADIAL" | "UV_MAP" | "VECTOR", "axis": 0-2 (RADIAL), "vector": colour input}.
+void read_tangent(const py::dict& d, TangentInput& t) {
+  static const std::pair<const char*, TangentInput::Source> kSources[] = {
+      {"RADIAL", TangentInput::Source::Radial},
+      {"UV_MAP", TangentInput::Source::UVMap},
+      {"VECTOR", TangentInput::Source::Vector}};
+  t.source = get_enum(d, "source", "RADIAL", kSources, "tangent source");
+  int axis = 2;
+  get(d, "axis", axis);
+  if (axis < 0 || axis > 2) throw std::invalid_argument("tangent axis out of range (0-2)");
+  t.axis = uint8_t(axis);
+  read_color(d, "vector", t.vector);
+}
+
 ShaderNodeKind to_kind(const std::string& kind) {
   if (kind == "DIFFUSE") return ShaderNodeKind::Diffuse;
   if (kind == "GLOSSY") return ShaderNodeKind::Glossy;
@@ -391,6 +406,7 @@ ShaderNodeKind to_kind(const std::string& kind) {
   if (kind == "TRANSLUCENT") return ShaderNodeKind::Translucent;
   if (kind == "REFRACTION") return ShaderNodeKind::Refraction;
   if (kind == "VELVET") return ShaderNodeKind::Velvet;
+  if (kind == "ANISOTROPIC") return ShaderNodeKind::Anisotropic;
   if (kind == "MIX") return ShaderNodeKind::Mix;
   if (kind == "ADD") return ShaderNodeKind::Add;
   bad_enum("shader node kind", kind);
@@ -617,6 +633,9 @@ int SceneBuilder::add_material(const py::dict& material) {
       read_float(d, "emission_strength", node.emission_strength);
       read_float(d, "subsurface", node.subsurface);
       read_color(d, "subsurface_color", node.subsurface_color);
+      read_float(d, "anisotropy", node.anisotropy);
+      read_float(d, "rotation", node.rotation);
+      if (d.contains("tangent")) read_tangent(d["tangent"].cast<py::dict>(), node.tangent);
       desc.nodes.push_back(node);
     }
   }
@@ -653,13 +672,27 @@ int SceneBuilder::add_material(const py::dict& material) {
   for (const ShaderNode& node : desc.nodes) {
     if (node.a < -1 || node.a >= n || node.b < -1 || node.b >= n)
       throw std::invalid_argument("material '" + desc.name + "': child index out of range");
-    for (const TextureLookup* t :
-         {&node.color.texture, &node.roughness.texture, &node.ior.texture, &node.strength.texture,
-          &node.fac.texture, &node.metallic.texture, &node.specular.texture,
-          &node.specular_tint.texture, &node.transmission.texture, &node.sheen.texture,
-          &node.sheen_tint.texture, &node.clearcoat.texture, &node.clearcoat_roughness.texture,
-          &node.alpha.texture, &node.emission.texture, &node.emission_strength.texture,
-          &node.subsurface.texture, &node.subsurface_color.texture}) {
+    for (const TextureLookup* t : {&node.color.texture,
+                                   &node.roughness.texture,
+                                   &node.ior.texture,
+                                   &node.strength.texture,
+                                   &node.fac.texture,
+                                   &node.metallic.texture,
+                                   &node.specular.texture,
+                                   &node.specular_tint.texture,
+                                   &node.transmission.texture,
+                                   &node.sheen.texture,
+                                   &node.sheen_tint.texture,
+                                   &node.clearcoat.texture,
+                                   &node.clearcoat_roughness.texture,
+                                   &node.alpha.texture,
+                                   &node.emission.texture,
+                                   &node.emission_strength.texture,
+                                   &node.subsurface.texture,
+                                   &node.subsurface_color.texture,
+                                   &node.anisotropy.texture,
+                                   &node.rotation.texture,
+                                   &node.tangent.vector.texture}) {
       if (t->image >= int32_t(scene_.images.size()))
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
     }

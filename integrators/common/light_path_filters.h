@@ -64,7 +64,9 @@ class LightPathFilters {
         c.drop_reflection = no_reflection;
         c.drop_refraction = no_refraction;
       }
-      if (kind != Kind::Other && c.alpha < blur) c.alpha = blur;
+      if (kind == Kind::Other) continue;
+      if (c.alpha < blur) c.alpha = blur;
+      if (is_anisotropic(c) && c.alpha_y < blur) c.alpha_y = blur;  // Cycles raises both widths
     }
   }
 

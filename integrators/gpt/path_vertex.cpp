@@ -81,7 +81,7 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
   // The frame PT uses: a shading normal facing away from wi stays (the BSDFs see wi below it).
   const SurfaceFrame sf = facing_frame(hit, wi_world);
   v.ng = sf.ng;
-  v.frame = Frame(sf.ns);
+  v.frame = shading_frame(sf.ns, *v.closures);
   v.wi = v.frame.to_local(wi_world);
   // With bump shadowing where the normal is not the interpolated one (bump_shadowing.h).
   v.closures = &shading_closures(*v.closures, v.own, hit, v.frame, v.ng, wi_world, sf.rotated);

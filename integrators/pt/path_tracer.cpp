@@ -212,7 +212,7 @@ class PathTracer final : public Integrator {
       if (!material_closures.has_bsdf()) break;
       const Vec3f wi_world = -ray.direction;
       const SurfaceFrame sf = facing_frame(hit, wi_world);
-      const Frame frame(sf.ns);
+      const Frame frame = shading_frame(sf.ns, material_closures);
       const Vec3f wi = frame.to_local(wi_world);
       // With bump shadowing where the normal is not the interpolated one (bump_shadowing.h).
       const ClosureSet& closures = shading_closures(material_closures, closure_scratch, hit, frame,

@@ -93,8 +93,9 @@ def background_falloff():
     return m
 
 
-# The Geometry node's outputs Gradient PT does not compute (each reported, 0.5 standing in).
-GEOMETRY_UNSUPPORTED = {"Tangent"}
+# The Geometry node's outputs Gradient PT does not compute (each reported, 0.5 standing in): none
+# of Blender 3.4's.
+GEOMETRY_UNSUPPORTED = set()
 
 
 def geometry_outputs_translate(builder, images, export_materials):
@@ -154,7 +155,8 @@ def main():
     print(f"{len(materials)} materials, {reported} with warnings", flush=True)
 
     # Microfacet distributions: Beckmann is rendered as Cycles does, silently; Multiscatter GGX
-    # and Ashikhmin-Shirley are rendered as GGX, reported.
+    # and Ashikhmin-Shirley are rendered as GGX, reported. The Anisotropic BSDF is GGX only (no
+    # distribution exported): its Beckmann is reported.
     for node_type, distribution, exported, warned in (
             ("ShaderNodeBsdfGlossy", 'BECKMANN', 'BECKMANN', False),
             ("ShaderNodeBsdfGlass", 'BECKMANN', 'BECKMANN', False),
@@ -162,7 +164,9 @@ def main():
             ("ShaderNodeBsdfGlossy", 'GGX', 'GGX', False),
             ("ShaderNodeBsdfGlass", 'SHARP', 'GGX', False),
             ("ShaderNodeBsdfGlass", 'MULTI_GGX', 'GGX', True),
-            ("ShaderNodeBsdfGlossy", 'ASHIKHMIN_SHIRLEY', 'GGX', True)):
+            ("ShaderNodeBsdfGlossy", 'ASHIKHMIN_SHIRLEY', 'GGX', True),
+            ("ShaderNodeBsdfAnisotropic", 'GGX', None, False),
+            ("ShaderNodeBsdfAnisotropic", 'BECKMANN', None, True)):
         m = S.shader_material(f"{node_type}:{distribution}", node_type, distribution=distribution)
         warnings = []
         d = export_materials.translate_material(m, images, warnings.append)

@@ -1750,7 +1750,64 @@ def case_chained_bump(scene):
     return 3
 
 
+def case_anisotropic(scene):
+    # Anisotropic BSDF (GGX) on Cycles' default tangent (radial about the object's Z axis through
+    # its generated coordinates), turned a quarter turn: a small lamp's highlight stretched along
+    # the latitudes, and the room seen in a brushed-metal ball.
+    lit_room(scene)
+    area_ceiling(size=0.4, energy=120.0)
+    m = S.shader_material("brushed", "ShaderNodeBsdfAnisotropic", Color=(0.9, 0.7, 0.5, 1),
+                          Roughness=0.3, Anisotropy=0.8, Rotation=0.25, distribution='GGX')
+    S.uv_sphere("ball", 0.9, (0, 0.2, 0.9), m)
+    return 4
+
+
+def case_principled_anisotropic(scene):
+    # Principled BSDF's Anisotropic / Anisotropic Rotation on a metal: the specular lobe alone is
+    # anisotropic (r^2 / aspect and r^2 aspect), on the default radial tangent.
+    lit_room(scene)
+    area_ceiling(size=0.4, energy=120.0)
+    m = S.shader_material("brushed_principled", "ShaderNodeBsdfPrincipled", **{
+        "Base Color": (0.9, 0.6, 0.3, 1), "Metallic": 1.0, "Roughness": 0.3,
+        "Anisotropic": 0.8, "Anisotropic Rotation": 0.25, "distribution": 'GGX'})
+    S.uv_sphere("ball", 0.9, (0, 0.2, 0.9), m)
+    return 4
+
+
+def case_anisotropic_uv(scene):
+    # Anisotropic BSDF on a Tangent node's UV Map direction (the mesh's MikkTSpace tangents): a
+    # panel tilted towards the camera under the lamp, its streak along the UV map's u axis.
+    lit_room(scene)
+    area_ceiling(size=0.4, energy=120.0)
+    m = S.shader_material("brushed_uv", "ShaderNodeBsdfAnisotropic", Color=(0.8, 0.8, 0.9, 1),
+                          Roughness=0.3, Anisotropy=0.8, Rotation=0.1, distribution='GGX')
+    nt = m.node_tree
+    tangent = nt.nodes.new("ShaderNodeTangent")
+    tangent.direction_type = 'UV_MAP'
+    nt.links.new(tangent.outputs["Tangent"], nt.nodes["Anisotropic BSDF"].inputs["Tangent"])
+    S.plane("panel", 1.8, (0, 0.3, 1.0), rotation=(math.radians(60), 0, math.radians(20)),
+            material=m)
+    return 4
+
+
+def _set_input(material, node, socket, value):
+    bpy.data.materials[material].node_tree.nodes[node].inputs[socket].default_value = value
+
+
 CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case_")}
+
+# Cases rendered once more by Gradient PT with their feature taken away, which must then exceed
+# the bound (the feature is what makes them agree): name -> (what, function(scene)).
+MUST_DIFFER = {
+    "anisotropic": ("rendered isotropic (Anisotropy 0)",
+                    lambda scene: _set_input("brushed", "Anisotropic BSDF", "Anisotropy", 0.0)),
+    "anisotropic_uv": ("on the radial tangent instead of the UV map's",
+                       lambda scene: setattr(bpy.data.materials["brushed_uv"].node_tree
+                                             .nodes["Tangent"], "direction_type", 'RADIAL')),
+    "principled_anisotropic": ("rendered isotropic (Anisotropic 0)",
+                               lambda scene: _set_input("brushed_principled", "Principled BSDF",
+                                                        "Anisotropic", 0.0)),
+}
 
 # Cases whose noise floor at the default counts lies near the threshold render more samples on
 # both sides: rough glass (caustics through a rough interface) measured relMSE 0.0097 with
@@ -1774,9 +1831,15 @@ CASES = {name[5:]: fn for name, fn in globals().items() if name.startswith("case
 # normal is treated as a perturbation (bump shadowing on), which the bounds do not separate.
 # beckmann_glossy: relMSE 0.016 at the default counts, 0.0038 at 4x (noise of the balls'
 # reflections).
+# anisotropic: relMSE 0.0132 at the default counts, 0.0037 at 4x, mean 1.0000 (noise: a lobe of
+# alpha 0.018 across the tangent reflecting a small lamp); 0.085 rendered isotropic.
+# principled_anisotropic: relMSE 0.0017, mean 1.0003 at 4x; 0.015 rendered isotropic.
+# anisotropic_uv: relMSE 0.0013, mean 1.0008 at 4x; 0.38 on the radial tangent.
 # math_nodes, voronoi_features: directly seen emission only, at half the counts
 # (Smooth F1 hashes 125 cells per lookup: 37 s for GDPT at the default counts).
-SAMPLE_SCALE = {"glass": 2, "beckmann_glossy": 4, "beckmann_glass": 2, "refraction": 2, "ray_visibility": 4, "bounce_limits": 4, "normal_map": 4,
+SAMPLE_SCALE = {"glass": 2, "beckmann_glossy": 4, "beckmann_glass": 2, "anisotropic": 4,
+                "principled_anisotropic": 4, "anisotropic_uv": 4, "refraction": 2,
+                "ray_visibility": 4, "bounce_limits": 4, "normal_map": 4,
                 "input_nodes": 2, "adjust_nodes": 2, "bump": 4, "displacement": 4, "chained_bump": 4,
                 "math_nodes": 0.5, "voronoi_features": 0.5, "curve_nodes": 0.5,
                 "refractive_caustics_off": 2}
@@ -1845,6 +1908,8 @@ BOTH_MODES = {"normal_map", "clearcoat", "world_camera_view", "area_visible", "a
 # bound stays at most THRESHOLD. Other sample counts (GDPT_TEST_SAMPLES, ...) use THRESHOLD
 # alone.
 FLOORS = {
+    "anisotropic/GPT": (3.7e-3, 9.0e-3), "principled_anisotropic/GPT": (1.8e-3, 2.6e-3),
+    "anisotropic_uv/GPT": (1.4e-3, 4.0e-3),
     "area_camera_visible/GPT": (5.9e-4, 1.2e-3), "area_camera_visible/PT": (1.2e-3, 2.4e-3),
     "area_disk/GPT": (6.1e-4, 1.4e-3), "area_visible/GPT": (5.0e-4, 6.8e-4),
     "area_visible/PT": (9.9e-4, 1.5e-3), "curve_nodes/GPT": (4.4e-6, 5.9e-6),
@@ -2007,6 +2072,15 @@ def run_case(name, out_dir, mode=None):
               f"{THRESHOLD})", flush=True)
         if not err_box > THRESHOLD:
             bad_regions.append(f"box filter agrees too (relMSE {err_box:.4f})")
+    if name in MUST_DIFFER:
+        what, change = MUST_DIFFER[name]
+        change(scene)
+        other = S.read_rgb(render_gdpt(pixel_filter, "_without"))
+        err_other = S.rel_mse(other, b)
+        print(f"  Gradient PT {what}: relMSE {err_other:.5f} (must exceed {frame_bound:.2e})",
+              flush=True)
+        if not err_other > frame_bound:
+            bad_regions.append(f"{what} agrees too (relMSE {err_other:.4f})")
     if light_paths:
         plain = S.read_rgb(render_gdpt(pixel_filter, "_common", {}))
         err_plain = S.rel_mse(plain, b)

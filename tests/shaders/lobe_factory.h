@@ -43,6 +43,14 @@ inline Closure ggx(float alpha, Spectrum c = Spectrum(1.0f)) {
   k.alpha = alpha;
   return k;
 }
+// Anisotropic GGX: widths ax along the lobe's tangent, ay across it, the tangent at `angle`
+// (radians) from the local x axis.
+inline Closure aniso_ggx(float ax, float ay, float angle = 0.0f, Spectrum c = Spectrum(1.0f)) {
+  Closure k = ggx(ax, c);
+  k.alpha_y = ay;
+  k.rotation = Vec2f(std::cos(angle), std::sin(angle));
+  return k;
+}
 inline Closure ggx_principled(float alpha, float ior, Spectrum cspec0) {
   Closure k = ggx(alpha);
   k.fresnel = FresnelMode::PrincipledV1;

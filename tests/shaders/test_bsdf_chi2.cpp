@@ -51,6 +51,16 @@ std::vector<Case> lobe_cases() {
     (reflection ? g.drop_refraction : g.drop_reflection) = true;
     cases.push_back({reflection ? "GlassReflectionPart20" : "GlassRefractionPart20", set_of({g})});
   }
+  // Anisotropic GGX: narrow across a rotated tangent, wide along it, and the reverse.
+  cases.push_back({"AnisoGGX05x40", set_of({aniso_ggx(0.05f, 0.4f, 0.3f)})});
+  cases.push_back({"AnisoGGX50x10", set_of({aniso_ggx(0.5f, 0.1f, 2.0f)})});
+  {
+    Closure a = aniso_ggx(0.3f, 0.08f, 1.0f);
+    a.fresnel = FresnelMode::PrincipledV1;
+    a.ior = 1.5f;
+    a.f0 = Spectrum(0.9f, 0.5f, 0.1f);
+    cases.push_back({"AnisoGGXPrincipled30x8", set_of({a})});
+  }
   // Principled-like glass: tinted refraction, Fresnel-coloured reflection.
   {
     Closure g = glass(0.2f, 1.45f);
@@ -73,6 +83,8 @@ std::vector<Case> lobe_cases() {
   // Lobes about their own normal (a clearcoat on the interpolated normal under a bump), alone
   // and mixed with a lobe about the shading normal.
   cases.push_back({"GGXOwnNormal20", set_of({kept(ggx(0.2f))}, Vec3f(0.4f, -0.2f, 0.9f))});
+  cases.push_back(
+      {"AnisoGGXOwnNormal", set_of({kept(aniso_ggx(0.1f, 0.4f, 0.5f))}, Vec3f(0.4f, -0.2f, 0.9f))});
   cases.push_back(
       {"MixDiffuseCoatOwnNormal",
        set_of({principled_diffuse(0.5f, Spectrum(0.4f, 0.3f, 0.2f)), kept(clearcoat(0.05f))},

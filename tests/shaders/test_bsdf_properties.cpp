@@ -60,6 +60,7 @@ TEST(BsdfEnergy, SampleWeightsIntegrateEval) {
       set_of({beckmann(ggx(0.3f))}),
       set_of({beckmann(ggx(1.0f))}),
       set_of({beckmann(glass(0.3f, 1.5f))}),
+      set_of({aniso_ggx(0.05f, 0.6f, 0.4f)}),
   };
   for (size_t i = 0; i < std::size(sets); ++i) {
     for (float c : {0.9f, 0.4f, -0.5f}) {
@@ -92,7 +93,8 @@ TEST(BsdfReciprocity, ReflectionLobesAreSymmetric) {
                            ggx(0.3f),
                            ggx_principled(0.15f, 1.6f, Spectrum(0.7f, 0.4f, 0.2f)),
                            clearcoat(0.1f),
-                           beckmann(ggx(0.3f))};
+                           beckmann(ggx(0.3f)),
+                           aniso_ggx(0.08f, 0.5f, 1.2f)};
   Pcg32 rng(3);
   for (const Closure& c : lobes) {
     const ClosureSet set = set_of({c});
@@ -427,6 +429,57 @@ TEST(ClosureSet, LobeAboutItsOwnNormalIsTheRotatedLobe) {
     }
     EXPECT_GT(nonzero, 100);
   }
+}
+
+// Anisotropic GGX of equal widths is GGX, and its white furnace loses no more than GGX's of the
+// wider width (single scattering: the narrow direction loses less).
+TEST(AnisotropicGgx, EqualWidthsAreTheIsotropicLobe) {
+  Pcg32 rng(21);
+  for (float a : {0.05f, 0.3f, 0.9f}) {
+    const ClosureSet iso = set_of({ggx(a)}), aniso = set_of({aniso_ggx(a, a, 0.8f)});
+    for (int i = 0; i < 200; ++i) {
+      const Vec3f wi = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+      const Vec3f wo = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+      float pi, pa;
+      const float fi = iso.eval_pdf(wi, wo, pi).y, fa = aniso.eval_pdf(wi, wo, pa).y;
+      EXPECT_NEAR(fa, fi, 1e-4f * std::max(1.0f, fi)) << a;
+      EXPECT_NEAR(pa, pi, 1e-4f * std::max(1.0f, pi)) << a;
+    }
+  }
+  const Vec3f wi = incident(0.8f);
+  const double wide = albedo_quadrature(set_of({ggx(0.6f)}), wi);
+  const double mixed = albedo_quadrature(set_of({aniso_ggx(0.05f, 0.6f, 0.3f)}), wi);
+  EXPECT_GT(mixed, wide);
+  EXPECT_LE(mixed, 1.0 + 1e-3);
+}
+
+// Rotating the tangent by 90 degrees swaps the widths: (ax, ay) at angle t + pi/2 is (ay, ax) at
+// t, for values, densities and samples.
+TEST(AnisotropicGgx, QuarterTurnSwapsTheWidths) {
+  const float t = 0.4f;
+  const ClosureSet turned = set_of({aniso_ggx(0.1f, 0.5f, t + 0.5f * float(M_PI))});
+  const ClosureSet swapped = set_of({aniso_ggx(0.5f, 0.1f, t)});
+  const ClosureSet unswapped = set_of({aniso_ggx(0.1f, 0.5f, t)});
+  Pcg32 rng(8);
+  double differs = 0.0;
+  for (int i = 0; i < 300; ++i) {
+    const Vec3f wi = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+    const Vec3f wo = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+    float p_t, p_s;
+    const float f_t = turned.eval_pdf(wi, wo, p_t).y, f_s = swapped.eval_pdf(wi, wo, p_s).y;
+    EXPECT_NEAR(f_t, f_s, 1e-4f * std::max(1.0f, f_s));
+    EXPECT_NEAR(p_t, p_s, 1e-4f * std::max(1.0f, p_s));
+    differs += std::fabs(unswapped.eval(wi, wo).y - f_s);
+    const Vec2f u(rng.uniform(), rng.uniform());
+    const BsdfSample a = turned.sample(wi, 0.5f, u), b = swapped.sample(wi, 0.5f, u);
+    ASSERT_EQ(a.valid, b.valid);
+    if (a.valid) {
+      EXPECT_NEAR(a.wo.x, b.wo.x, 1e-4f);
+      EXPECT_NEAR(a.wo.y, b.wo.y, 1e-4f);
+      EXPECT_NEAR(a.wo.z, b.wo.z, 1e-4f);
+    }
+  }
+  EXPECT_GT(differs, 1.0) << "the widths matter: unrotated (ax, ay) is another lobe";
 }
 
 // Degenerate inputs: zero roughness, exactly grazing wi (z = 0), wo = -wi, wo = wi, poles.

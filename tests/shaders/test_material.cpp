@@ -330,6 +330,92 @@ TEST(Material, GlassNodes) {
   EXPECT_EQ(s[0].type, ClosureType::Transparent);
 }
 
+// Anisotropic BSDF (Cycles 3.4): alpha = r^2 times (1 - a) along the tangent and over it across
+// (swapped for a < 0), Rotation in turns; the default tangent runs around the object's Z axis
+// through the generated coordinates, taken to world space by the normal matrix. Principled:
+// r^2 / aspect and r^2 aspect, aspect = sqrt(1 - 0.9 a), on the specular lobe only.
+TEST(Material, AnisotropicWidthsAndRadialTangent) {
+  MaterialDesc d;
+  ShaderNode a = node(ShaderNodeKind::Anisotropic, Spectrum(0.9f));
+  a.roughness = FloatInput(0.3f);
+  a.anisotropy = FloatInput(0.8f);
+  a.rotation = FloatInput(0.25f);
+  d.nodes.push_back(a);
+  d.root = 0;
+  const Material m(d, {});
+  EXPECT_TRUE(m.reads_coordinates());
+  EXPECT_TRUE(m.features() & kFeatureTextures);  // per hit: the tangent varies
+  // Normal matrix of a quarter turn about x: object y -> world z.
+  const float cols[3][4] = {{1, 0, 0, 0}, {0, 0, 1, 0}, {0, -1, 0, 0}};
+  TexCoords tc;
+  tc.generated = Vec3f(0.9f, 0.5f, 0.2f);
+  tc.normal_cols = cols;
+  ShadingContext at{{0.0f, 0.0f}, true};
+  at.coords = &tc;
+  ClosureSet s;
+  m.evaluate(at, s);
+  ASSERT_EQ(s.count(), 1);
+  EXPECT_NEAR(s[0].alpha, 0.09f * 0.2f, 1e-6f);
+  EXPECT_NEAR(s[0].alpha_y, 0.09f / 0.2f, 1e-5f);
+  EXPECT_NEAR(s[0].rotation.x, 0.0f, 1e-6f);
+  EXPECT_NEAR(s[0].rotation.y, 1.0f, 1e-6f);
+  // Object-space radial tangent (-(y - 0.5), x - 0.5, 0) = (0, 0.4, 0), world (0, 0, 0.4).
+  expect_spectrum(s[0].tangent, Vec3f(0.0f, 0.0f, 0.4f));
+
+  d.nodes[0].anisotropy = FloatInput(-0.5f);
+  ClosureSet neg;
+  Material(d, {}).evaluate(at, neg);
+  EXPECT_NEAR(neg[0].alpha, 0.09f / 0.5f, 1e-6f);
+  EXPECT_NEAR(neg[0].alpha_y, 0.09f * 0.5f, 1e-6f);
+  d.nodes[0].anisotropy = FloatInput(0.0f);
+  ClosureSet iso;
+  Material(d, {}).evaluate(at, iso);
+  EXPECT_FALSE(is_anisotropic(iso[0]));
+  EXPECT_FLOAT_EQ(iso[0].alpha, 0.09f);
+
+  MaterialDesc p;
+  ShaderNode pr = node(ShaderNodeKind::Principled, Spectrum(0.8f, 0.5f, 0.3f));
+  pr.roughness = FloatInput(0.3f);
+  pr.metallic = FloatInput(1.0f);
+  pr.anisotropy = FloatInput(0.8f);
+  pr.tangent.axis = 0;  // radial about X: (0, -(z - 0.5), y - 0.5) = (0, 0.3, 0)
+  p.nodes.push_back(pr);
+  p.root = 0;
+  ClosureSet ps;
+  Material(p, {}).evaluate(at, ps);
+  ASSERT_EQ(ps.count(), 1);
+  const float aspect = std::sqrt(1.0f - 0.72f);
+  EXPECT_NEAR(ps[0].alpha, 0.09f / aspect, 1e-6f);
+  EXPECT_NEAR(ps[0].alpha_y, 0.09f * aspect, 1e-6f);
+  expect_spectrum(ps[0].tangent, Vec3f(0.0f, 0.0f, 0.3f));
+
+  // A Tangent node's UV Map direction: the mesh's tangent through the same normal matrix.
+  d.nodes[0].anisotropy = FloatInput(0.8f);
+  d.nodes[0].tangent.source = TangentInput::Source::UVMap;
+  tc.uv_tangent = Vec3f(0.0f, 2.0f, 0.0f);
+  ClosureSet uv;
+  Material(d, {}).evaluate(at, uv);
+  expect_spectrum(uv[0].tangent, Vec3f(0.0f, 0.0f, 2.0f));
+
+  // Geometry's Tangent output: the default tangent made unit and normal to N (Cycles'
+  // primitive_tangent), here an emission colour. World radial (0, 0, 0.4) about N = (0, 0.6, 0.8).
+  MaterialDesc e;
+  InputNode geometry;
+  geometry.kind = InputNodeKind::Geometry;
+  geometry.geometry_output = GeometryOutput::Tangent;
+  e.inputs.push_back(geometry);
+  ShaderNode emit = node(ShaderNodeKind::Emission);
+  emit.color.node = 0;
+  e.nodes.push_back(emit);
+  e.root = 0;
+  const Material em(e, {});
+  EXPECT_TRUE(em.reads_coordinates());
+  const ShadingGeometry view{Vec3f(0, 0, 1), Vec3f(0, 0.6f, 0.8f), Vec3f(0, 0.6f, 0.8f),
+                             Vec3f(0, 0.6f, 0.8f)};
+  at.geometry = &view;
+  expect_spectrum(em.emission(at), Vec3f(0.0f, -0.8f, 0.6f), 1e-5f);
+}
+
 // A texture's vector can be any input node's result (TexCoordSource::Node): a Checker read at
 // Vector Math (UV + (0.3, 0, 0)) equals a Checker read at UV through a Mapping that adds the
 // same; a vector (a coordinate, a Vector Math Vector) read by a float socket is the mean of its
