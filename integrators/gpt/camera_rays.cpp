@@ -16,7 +16,7 @@ uint64_t trace_camera_grid(const GptContext& g, const Tile& tile, int W, int H, 
   // The image-wide jitter: a sampler keyed to no pixel, (-1, -1). Every pixel takes the same
   // filter sample, so a neighbour's base ray is this pixel's offset ray.
   Sampler image_wide;
-  image_wide.start(g.settings.seed, -1, -1, s);
+  start_sample(g, image_wide, -1, -1, s);
   const Vec2f jitter = image_wide.get2d(Sampler::kDimCamera);
   const PixelFilter& filter = g.ctx.pixel_filter();
   grid.x0 = std::max(tile.x0 - 1, 0);
@@ -69,7 +69,7 @@ uint64_t trace_camera_row(const GptContext& g, int W, int H, int x0, int y, int 
     row.valid[i] = i < n;
     if (!row.valid[i]) continue;
     const int x = x0 + i;
-    row.sampler[i].start(g.settings.seed, x + rx, y + ry, s);
+    start_sample(g, row.sampler[i], x + rx, y + ry, s);
     const Vec2f jitter = row.sampler[i].get2d(Sampler::kDimCamera);
     row.lens[i] = row.sampler[i].get2d(Sampler::kDimLens);
     row.raster[i] = g.ctx.pixel_filter().raster(x + rx, y + ry, jitter);

@@ -87,7 +87,7 @@ class GradientPathTracer final : public Integrator {
         for (int y = tile.y0; y < tile.y1; ++y)
           for (int x = tile.x0; x < tile.x1; ++x) {
             Sampler sampler;
-            sampler.start(g_.settings.seed, x + rx, y + ry, s);
+            start_sample(g_, sampler, x + rx, y + ry, s);
             offset_mask(W, H, x, y, mask);
             const CameraSample cs = grid_sample(grid, x, y, mask);
             // Depth and index passes: the first sample's camera hit (sample 0, as Cycles).
