@@ -16,11 +16,11 @@
 //             'EMISSION'|'TRANSPARENT'|'MIX'|'ADD', a, b, distribution 'GGX'|'BECKMANN' (Glossy,
 //             Glass, Refraction), and inputs color, roughness, ior,
 //             strength, fac, metallic, specular, specular_tint, transmission, alpha, emission,
-//             emission_strength, subsurface, subsurface_color}; a colour input is {value: (3), image, mapping (12), coordinates
-//             'UV'|'GENERATED'|'OBJECT', interpolation 'Linear'|'Closest', extension
-//             'REPEAT'|'EXTEND'|'CLIP', node}, a float input the same with a scalar value and
-//             channel 'LUMINANCE'|'RED'|'ALPHA'; input nodes (inputs) {kind, ..., vector:
-//             {coordinates, mapping} for 'CHECKER' / 'NOISE', fac_output}.
+//             emission_strength, subsurface, subsurface_color}; a colour input is {value: (3),
+//             image, mapping (12), coordinates 'UV'|'GENERATED'|'OBJECT', interpolation
+//             'Linear'|'Closest', extension 'REPEAT'|'EXTEND'|'CLIP', node}, a float input the same
+//             with a scalar value and channel 'LUMINANCE'|'RED'|'ALPHA'; input nodes (inputs)
+//             {kind, ..., vector: {coordinates, mapping} for 'CHECKER' / 'NOISE', fac_output}.
 #pragma once
 
 #include <pybind11/numpy.h>
