@@ -28,6 +28,26 @@ inline bool is_delta_alpha(float alpha) {
   return alpha < kDeltaAlpha;
 }
 
+// GGX's normals visible from wi (Heitz 2018): stretch wi by (ax, ay) to the isotropic hemisphere
+// configuration, sample the projected hemisphere there, unstretch.
+inline Vec3f sample_ggx_visible(Vec3f wi, float ax, float ay, Vec2f u) {
+  const Vec3f vh = normalize(Vec3f(ax * wi.x, ay * wi.y, wi.z));
+  // Orthonormal basis around vh (t1 horizontal).
+  const float len2 = vh.x * vh.x + vh.y * vh.y;
+  const Vec3f t1 =
+      len2 > 0.0f ? Vec3f(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : Vec3f(1.0f, 0.0f, 0.0f);
+  const Vec3f t2 = cross(vh, t1);
+  // Uniform point on the disk, then squash its lower half onto the projected hemisphere.
+  const float r = std::sqrt(u.x);
+  const float phi = 2.0f * kPi * u.y;
+  const float p1 = r * std::cos(phi);
+  float p2 = r * std::sin(phi);
+  const float s = 0.5f * (1.0f + vh.z);
+  p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
+  const Vec3f nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2));
+  return normalize(Vec3f(ax * nh.x, ay * nh.y, std::max(1e-7f, nh.z)));
+}
+
 struct GGX {
   float alpha;
   float alpha2;
@@ -55,25 +75,7 @@ struct GGX {
     return G1(wi) * cos_im * D(m) / wi.z;
   }
 
-  Vec3f sample_visible(Vec3f wi, Vec2f u) const {
-    // Stretch the view direction to the hemisphere configuration (alpha = 1).
-    const Vec3f vh = normalize(Vec3f(alpha * wi.x, alpha * wi.y, wi.z));
-    // Orthonormal basis around vh (t1 horizontal).
-    const float len2 = vh.x * vh.x + vh.y * vh.y;
-    const Vec3f t1 =
-        len2 > 0.0f ? Vec3f(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : Vec3f(1.0f, 0.0f, 0.0f);
-    const Vec3f t2 = cross(vh, t1);
-    // Uniform point on the disk, then squash its lower half onto the projected hemisphere.
-    const float r = std::sqrt(u.x);
-    const float phi = 2.0f * kPi * u.y;
-    const float p1 = r * std::cos(phi);
-    float p2 = r * std::sin(phi);
-    const float s = 0.5f * (1.0f + vh.z);
-    p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
-    const Vec3f nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2));
-    // Unstretch back to the alpha configuration.
-    return normalize(Vec3f(alpha * nh.x, alpha * nh.y, std::max(1e-7f, nh.z)));
-  }
+  Vec3f sample_visible(Vec3f wi, Vec2f u) const { return sample_ggx_visible(wi, alpha, alpha, u); }
 };
 
 // A closure's distribution. The lobes' value is D(h) G1(wi) G1(wo) ..., their sampler draws h
@@ -130,22 +132,7 @@ struct AnisoGGX {
     return G1(wi) * cos_im * D(m) / wi.z;
   }
 
-  // Heitz 2018 with the stretch (ax, ay): the hemisphere configuration is isotropic.
-  Vec3f sample_visible(Vec3f wi, Vec2f u) const {
-    const Vec3f vh = normalize(Vec3f(ax * wi.x, ay * wi.y, wi.z));
-    const float len2 = vh.x * vh.x + vh.y * vh.y;
-    const Vec3f t1 =
-        len2 > 0.0f ? Vec3f(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : Vec3f(1.0f, 0.0f, 0.0f);
-    const Vec3f t2 = cross(vh, t1);
-    const float r = std::sqrt(u.x);
-    const float phi = 2.0f * kPi * u.y;
-    const float p1 = r * std::cos(phi);
-    float p2 = r * std::sin(phi);
-    const float s = 0.5f * (1.0f + vh.z);
-    p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
-    const Vec3f nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2));
-    return normalize(Vec3f(ax * nh.x, ay * nh.y, std::max(1e-7f, nh.z)));
-  }
+  Vec3f sample_visible(Vec3f wi, Vec2f u) const { return sample_ggx_visible(wi, ax, ay, u); }
 };
 
 }  // namespace gdpt
