@@ -79,8 +79,10 @@ dev: deps
 
 # QUICK=1: only the equal-time report against Cycles, reduced (under ten minutes).
 QUICK ?= 0
+# KEEP=cycles_default,cycles_unbiased: reuse Cycles' curves of the previous report run.
+KEEP ?=
 bench: build install-addon
-	QUICK=$(QUICK) bash scripts/bench.sh $(BUILD)
+	QUICK=$(QUICK) KEEP=$(KEEP) bash scripts/bench.sh $(BUILD)
 
 # Per-material agreement with Cycles over a library of material scripts (not in CI):
 #   make materials LIB=/path/to/scripts [ONLY=Name,Name]

@@ -147,8 +147,14 @@ def measure_scene(name, args, blender, log):
     result["void"] = result["cross_engine_relmse"]["pt~cycles_unbiased"] > CROSS_VOID
     result["predicted_improvement"] = M.gradient_energy_ratio(ref["pt"])
     crops = {}
+    kept = kept_curves(name, args)
+    for curve, points in kept.items():
+        result["curves"][curve] = points
+        crops[curve] = rgb(os.path.join(cache, f"{curve}_{args.crop_budget}s.exr"))
     for budget in args.budgets:
         for method in RENDERED:  # interleaved: every method once per budget, in turn
+            if method in kept:
+                continue
             path = os.path.join(cache, f"{method}_{budget}s.exr")
             info = render(blender, blend, method, path, seconds=budget, seed=7)
             images = {}
@@ -175,6 +181,21 @@ def measure_scene(name, args, blender, log):
     crops["reference"] = ref["pt"]
     summarise(result)
     return result, crops
+
+
+def kept_curves(name, args):
+    """{curve: points} of the --keep methods, taken from the scene's previous result file.
+
+    Only Cycles' curves may be kept: Cycles does not change with GDPT's code, so a quiet earlier
+    run of it on the same machine, Blender and budgets stands for a new one."""
+    if not args.keep:
+        return {}
+    with open(os.path.join(args.results, f"{name}.json")) as f:
+        old = json.load(f)
+    if old["budgets"] != args.budgets or old["resolution"] != args.res:
+        sys.exit(f"run.py: --keep needs the previous run's budgets and resolution for {name}")
+    args.kept_from = old["meta"].get("kept_from") or {k: old["meta"][k] for k in ("commit", "date")}
+    return {m: old["curves"][m] for m in args.keep}
 
 
 def summarise(result):
@@ -305,7 +326,11 @@ def write_doc(results, meta, path, figures):
         + (f" (page and ratios rewritten from its JSON by `run.py --doc-only` at commit "
            f"{meta['page_commit']})" if meta.get("page_commit") else "")
         + ". Every figure below comes from `bench/results/<scene>.json` of that "
-        "run; rerun the command to regenerate this page.",
+        "run; rerun the command to regenerate this page."
+        + (f" Curves of {', '.join(meta['kept'])} are those of the run at commit "
+           f"{meta['kept_from']['commit']} on {meta['kept_from']['date']} (same machine, Blender "
+           "and budgets; `run.py --keep`): Cycles does not depend on GDPT's code."
+           if meta.get("kept") else ""),
         "",
         "relMSE is measured against each method's own converged reference (two independent "
         f"halves of {results[0]['reference_seconds_per_half']:g} s each, whose noise is "
@@ -417,6 +442,9 @@ def main():
     p.add_argument("--doc-only", action="store_true",
                    help="rewrite the page and plots from bench/results/<scene>.json, no rendering")
     p.add_argument("--res", help="WIDTHxHEIGHT (default 320x240)")
+    p.add_argument("--keep", help="comma-separated Cycles methods whose curves are taken from the "
+                   "previous bench/results/<scene>.json instead of rendered again "
+                   "(cycles_default, cycles_unbiased); their renders must be in the cache")
     p.add_argument("--out-doc", default=os.path.join(ROOT, "docs", "benchmarks.md"))
     p.add_argument("--results", default=os.path.join(ROOT, "bench", "results"))
     p.add_argument("--cache", default=os.path.join(ROOT, "bench", "results", "cache"),
@@ -424,6 +452,9 @@ def main():
     args = p.parse_args()
     args.build = os.path.abspath(args.build)
     quick = args.quick
+    args.keep = args.keep.split(",") if args.keep else []
+    if any(m not in ("cycles_default", "cycles_unbiased") for m in args.keep):
+        sys.exit("run.py: --keep takes only cycles_default and cycles_unbiased")
     args.scenes = (args.scenes or ("cornell_panel,interior" if quick else ",".join(SCENES))).split(",")
     args.budgets = [float(b) if "." in b else int(b) for b in
                     (args.budgets or ("2,4,8" if quick else "5,10,20,40,80")).split(",")]
@@ -441,7 +472,8 @@ def main():
                                                                             "--untracked-files=no") else ""),
             "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
             "machine": f"{platform.machine()}, {os.cpu_count()} cores",
-            "command": "make bench" + (" QUICK=1" if quick else ""), "crop_budget": args.crop_budget}
+            "command": "make bench" + (" QUICK=1" if quick else "")
+            + (f" KEEP={','.join(args.keep)}" if args.keep else ""), "crop_budget": args.crop_budget}
     if args.doc_only:
         return rewrite_doc(args, fig_dir, doc_dir)
     blender = Blender(args.build)
@@ -450,6 +482,8 @@ def main():
         for name in args.scenes:
             print(f"scene {name}", flush=True)
             result, crops = measure_scene(name, args, blender, lambda s: print(s, flush=True))
+            if args.keep:
+                meta.update(kept=args.keep, kept_from=args.kept_from)
             result["meta"] = meta
             with open(os.path.join(args.results, f"{name}.json"), "w") as f:
                 json.dump(result, f, indent=1)

@@ -39,3 +39,26 @@ for f in ("cornell_panel_relmse.png", "cornell_panel_crops.png"):
     assert os.path.getsize(os.path.join(out, "doc", "benchmarks", f)) > 1000, f
 print(f"ok: harness wrote every curve; references agree (relMSE {cross:.2e})")
 PY
+# --keep: Cycles' curves come from the run above, its renders are not made again, GDPT's are.
+stamp() { stat -c %Y "$out/cache/cornell_panel_48x36/$1"; }
+cp "$out/results/cornell_panel.json" "$out/first.json"
+before=("$(stamp cycles_default_1s.exr)" "$(stamp cycles_unbiased_2s.exr)" "$(stamp pt_1s.exr)")
+sleep 1
+/usr/bin/python3 "$root/bench/report/run.py" --build "$build" --scenes cornell_panel \
+  --budgets 1,2 --ref-seconds 3 --res 48x36 --results "$out/results" --cache "$out/cache" \
+  --out-doc "$out/doc/benchmarks.md" --keep cycles_default,cycles_unbiased
+[ "$(stamp cycles_default_1s.exr)" = "${before[0]}" ] && [ "$(stamp cycles_unbiased_2s.exr)" = "${before[1]}" ]
+[ "$(stamp pt_1s.exr)" != "${before[2]}" ]
+/usr/bin/python3 - "$out" <<'PY'
+import json, os, sys
+out = sys.argv[1]
+first = json.load(open(os.path.join(out, "first.json")))
+r = json.load(open(os.path.join(out, "results", "cornell_panel.json")))
+for c in ("cycles_default", "cycles_unbiased"):
+    assert r["curves"][c] == first["curves"][c], c
+assert len(r["curves"]["pt"]) == 2 and r["curves"]["pt"] != first["curves"]["pt"]
+assert r["meta"]["kept_from"]["commit"] == first["meta"]["commit"], r["meta"]
+doc = open(os.path.join(out, "doc", "benchmarks.md")).read()
+assert "Curves of cycles_default, cycles_unbiased are those of the run at commit" in doc
+print("ok: --keep reused Cycles' curves and rendered GDPT's again")
+PY
