@@ -77,6 +77,9 @@ struct FilterJob {
   const FeatureBuffers& fb;
   int radius, stride;
   const float* inv_range2;  // per colour tolerance; 0: none
+  // Per colour tolerance: the one 4x wider whose colour weight, to the 16th power, is this one's
+  // (four squarings instead of an exponential), or -1.
+  const int* squared_from;
   int ranges;
   const float* const* images;
   int count;
@@ -157,7 +160,7 @@ void feature_weights(const FilterJob& job, const ChunkPlanes& p, int y, int dy, 
 // Adds the tap (dx, dy) to the sums of the pixels [x0, x1) of row y (block starting at xb).
 void add_tap(const FilterJob& job, const ChunkPlanes& p, int y, int dy, int dx, int x0, int x1,
              int xb, const float* scale, BlockSums& s) {
-  float wf[kBlock], dc[kBlock];
+  float wf[kBlock], dc[kBlock], colour[kMaxRanges][kBlock];
   feature_weights(job, p, y, dy, dx, x0, x1, xb, wf);
   for (int k = 0; k < job.count; ++k) {
     const float *p0 = p.channel(k, 0, y), *p1 = p.channel(k, 1, y), *p2 = p.channel(k, 2, y);
@@ -168,12 +171,23 @@ void add_tap(const FilterJob& job, const ChunkPlanes& p, int y, int dy, int dx, 
       dc[x - xb] = (d0 * d0 + d1 * d1 + d2 * d2) * scale[kBlock * k + x - xb];
     }
     for (int t = 0; t < job.ranges; ++t) {
-      float *n0 = s.num[t][k][0], *n1 = s.num[t][k][1], *n2 = s.num[t][k][2], *den = s.den[t][k];
       const float inv = job.inv_range2[t];
-      if (inv > 0.f) {
+      if (inv > 0.f && job.squared_from[t] < 0)
+        for (int x = x0; x < x1; ++x) colour[t][x - xb] = exp_nonpositive(-0.5f * dc[x - xb] * inv);
+    }
+    for (int t = 0; t < job.ranges; ++t) {
+      if (job.squared_from[t] < 0) continue;
+      const float* from = colour[job.squared_from[t]];
+      for (int x = x0; x < x1; ++x) {
+        const float e2 = from[x - xb] * from[x - xb], e4 = e2 * e2, e8 = e4 * e4;
+        colour[t][x - xb] = e8 * e8;
+      }
+    }
+    for (int t = 0; t < job.ranges; ++t) {
+      float *n0 = s.num[t][k][0], *n1 = s.num[t][k][1], *n2 = s.num[t][k][2], *den = s.den[t][k];
+      if (job.inv_range2[t] > 0.f) {
         for (int x = x0; x < x1; ++x) {
-          const float a = wf[x - xb], e = exp_nonpositive(-0.5f * dc[x - xb] * inv);
-          const float w = masked(a > 0.f, a * e);
+          const float a = wf[x - xb], w = masked(a > 0.f, a * colour[t][x - xb]);
           n0[x - xb] += w * q[0][x], n1[x - xb] += w * q[1][x], n2[x - xb] += w * q[2][x];
           den[x - xb] += w;
         }
@@ -240,7 +254,17 @@ void bilateral_filter(const FeatureBuffers& fb, const BilateralWindow& window, c
   float inv_range2[kMaxRanges];
   for (int t = 0; t < range_count; ++t)
     inv_range2[t] = ranges[t] > 0.f ? 1.f / (ranges[t] * ranges[t]) : 0.f;
-  const FilterJob job{fb,          window.radius, window.stride, inv_range2,
+  int squared_from[kMaxRanges];
+  for (int t = 0; t < range_count; ++t) {
+    squared_from[t] = -1;
+    for (int u = 0; u < range_count; ++u)
+      if (inv_range2[u] > 0.f &&
+          std::abs(inv_range2[t] - 16.f * inv_range2[u]) <= 1e-6f * inv_range2[t])
+        squared_from[t] = u;
+  }
+  for (int t = 0; t < range_count; ++t)  // from a weight computed directly only
+    if (squared_from[t] >= 0 && squared_from[squared_from[t]] >= 0) squared_from[t] = -1;
+  const FilterJob job{fb,          window.radius, window.stride, inv_range2, squared_from,
                       range_count, images,        count,         out};
   parallel_rows(fb.height, [&](int y0, int y1) {
     const ChunkPlanes planes = chunk_planes(job, y0, y1);
