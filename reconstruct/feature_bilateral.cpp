@@ -131,15 +131,15 @@ void feature_weights(const FilterJob& job, const ChunkPlanes& p, int y, int dy, 
                      int x1, int xb, float* wf) {
   const FeatureBuffers& fb = job.fb;
   const size_t n = size_t(fb.width) * fb.height;
-  const size_t i0 = size_t(y) * fb.width, j0 = size_t(y + dy) * fb.width + dx;
+  const size_t i0 = size_t(y) * fb.width, j0 = size_t(y + dy) * fb.width;
   const float* f = fb.feature.data();
   const float* v = fb.feature_var.data();
   const int32_t* vi = p.valid_row(y);
-  const int32_t* vj = p.valid_row(y + dy) + dx;
+  const int32_t* vj = p.valid_row(y + dy);
   const bool centre_tap = dx == 0 && dy == 0;
   const float ta = kAlbedoTolerance * kAlbedoTolerance, tn = kNormalTolerance * kNormalTolerance;
   for (int x = x0; x < x1; ++x) {
-    const size_t i = i0 + x, j = j0 + x;
+    const size_t i = i0 + x, j = j0 + x + dx;
     float d = 0.f;
     for (int c = 0; c < 3; ++c) {
       const size_t ca = c * n, cn = (3 + c) * n;
@@ -151,8 +151,8 @@ void feature_weights(const FilterJob& job, const ChunkPlanes& p, int y, int dy, 
     d += dd * dd / (td * td + v[cd + i] + v[cd + j] + 1e-12f);
     const bool centre_features = vi[x] & kFeaturesValid;
     // A centre without features weighs its neighbours by colour alone, so only itself.
-    const bool near = bool(vj[x] & kFeaturesValid) & (d <= kNegligibleDistance);
-    const bool keep = bool(vj[x] & kImagesValid) & (centre_features ? near : centre_tap);
+    const bool near = bool(vj[x + dx] & kFeaturesValid) & (d <= kNegligibleDistance);
+    const bool keep = bool(vj[x + dx] & kImagesValid) & (centre_features ? near : centre_tap);
     wf[x - xb] = masked(keep, exp_nonpositive(-0.5f * (centre_features ? d : 0.f)));
   }
 }
@@ -164,10 +164,10 @@ void add_tap(const FilterJob& job, const ChunkPlanes& p, int y, int dy, int dx, 
   feature_weights(job, p, y, dy, dx, x0, x1, xb, wf);
   for (int k = 0; k < job.count; ++k) {
     const float *p0 = p.channel(k, 0, y), *p1 = p.channel(k, 1, y), *p2 = p.channel(k, 2, y);
-    const float* q[3] = {p.channel(k, 0, y + dy) + dx, p.channel(k, 1, y + dy) + dx,
-                         p.channel(k, 2, y + dy) + dx};
+    // The tap's colours, offset by dx (inside the row for x in [x0, x1)).
+    const float* q[3] = {p.channel(k, 0, y + dy), p.channel(k, 1, y + dy), p.channel(k, 2, y + dy)};
     for (int x = x0; x < x1; ++x) {
-      const float d0 = q[0][x] - p0[x], d1 = q[1][x] - p1[x], d2 = q[2][x] - p2[x];
+      const float d0 = q[0][x + dx] - p0[x], d1 = q[1][x + dx] - p1[x], d2 = q[2][x + dx] - p2[x];
       dc[x - xb] = (d0 * d0 + d1 * d1 + d2 * d2) * scale[kBlock * k + x - xb];
     }
     for (int t = 0; t < job.ranges; ++t) {
@@ -188,13 +188,17 @@ void add_tap(const FilterJob& job, const ChunkPlanes& p, int y, int dy, int dx, 
       if (job.inv_range2[t] > 0.f) {
         for (int x = x0; x < x1; ++x) {
           const float a = wf[x - xb], w = masked(a > 0.f, a * colour[t][x - xb]);
-          n0[x - xb] += w * q[0][x], n1[x - xb] += w * q[1][x], n2[x - xb] += w * q[2][x];
+          n0[x - xb] += w * q[0][x + dx];
+          n1[x - xb] += w * q[1][x + dx];
+          n2[x - xb] += w * q[2][x + dx];
           den[x - xb] += w;
         }
       } else {
         for (int x = x0; x < x1; ++x) {
           const float w = wf[x - xb];
-          n0[x - xb] += w * q[0][x], n1[x - xb] += w * q[1][x], n2[x - xb] += w * q[2][x];
+          n0[x - xb] += w * q[0][x + dx];
+          n1[x - xb] += w * q[1][x + dx];
+          n2[x - xb] += w * q[2][x + dx];
           den[x - xb] += w;
         }
       }
