@@ -1,7 +1,9 @@
 #include "reconstruct/feature_bilateral.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 
 #include "reconstruct/parallel.h"
@@ -16,23 +18,32 @@ inline constexpr int kMaxRanges = kColourToleranceCount;
 inline constexpr float kNegligibleDistance = 23.f;
 // Keeps the relative colour tolerance finite on black pixels.
 inline constexpr float kRangeFloor = 1e-3f;
+// Pixels of a row filtered together: their sums stay in L1 while every tap adds to them.
+inline constexpr int kBlock = 64;
 
-// -log of the feature weight between pixels i and j (before the factor 1/2).
-float feature_distance(const FeatureBuffers& fb, size_t i, size_t j) {
-  const float* fi = fb.feature.data() + kFeatureChannels * i;
-  const float* fj = fb.feature.data() + kFeatureChannels * j;
-  const float* vi = fb.feature_var.data() + kFeatureChannels * i;
-  const float* vj = fb.feature_var.data() + kFeatureChannels * j;
-  const float ta = kAlbedoTolerance * kAlbedoTolerance, tn = kNormalTolerance * kNormalTolerance;
-  const float td = kDepthTolerance * fi[6];
-  float d = 0.f;
-  for (int c = 0; c < 3; ++c) {
-    const float da = fi[c] - fj[c], dn = fi[3 + c] - fj[3 + c];
-    d += da * da / (ta + vi[c] + vj[c]) + dn * dn / (tn + vi[3 + c] + vj[3 + c]);
-  }
-  const float dd = fi[6] - fj[6];
-  if (dd != 0.f) d += dd * dd / (td * td + vi[6] + vj[6] + 1e-12f);
-  return d;
+// v where `keep`, else 0: a select by bit mask, so the loops over pixels stay branch-free.
+inline float masked(bool keep, float v) {
+  return std::bit_cast<float>(std::bit_cast<uint32_t>(v) & (0u - uint32_t(keep)));
+}
+
+// e^x for x <= 0 (0 below -87, NaN for NaN) within 2 ulp of std::exp, in plain arithmetic so that
+// the loops over pixels vectorise (std::exp is a libm call per value).
+inline float exp_nonpositive(float x) {
+  constexpr float kLow = -87.f, kShift = 12582912.f;  // 1.5 * 2^23: adding it rounds to integer
+  const float xc = x < kLow ? kLow : x;
+  const float t = xc * 1.44269504f + kShift;
+  const float n = t - kShift;
+  const float r = (xc - n * 0.693359375f) - n * -2.12194440e-4f;  // x - n ln 2 in two parts
+  float p = 1.9875691500e-4f;
+  p = p * r + 1.3981999507e-3f;
+  p = p * r + 8.3334519073e-3f;
+  p = p * r + 4.1665795894e-2f;
+  p = p * r + 1.6666665459e-1f;
+  p = p * r + 5.0000001201e-1f;
+  p = p * r * r + r + 1.f;
+  const int32_t e = std::bit_cast<int32_t>(t) - std::bit_cast<int32_t>(kShift);
+  const float scale = std::bit_cast<float>((e + 127) << 23);
+  return masked(!(x < kLow), p * scale);
 }
 
 // The identity, except that a missing pixel takes the mean of its valid 3x3 neighbours (its
@@ -61,6 +72,174 @@ void identity_filter(const FeatureBuffers& fb, const float* const* images, float
   });
 }
 
+// One filter call's inputs and outputs.
+struct FilterJob {
+  const FeatureBuffers& fb;
+  int radius, stride;
+  const float* inv_range2;  // per colour tolerance; 0: none
+  // Per colour tolerance: the one 4x wider whose colour weight, to the 16th power, is this one's
+  // (four squarings instead of an exponential), or -1.
+  const int* squared_from;
+  int ranges;
+  const float* const* images;
+  int count;
+  float* const* out;
+};
+
+// The rows [y0 - radius, y1 + radius) of a chunk, clipped to the image, as planes: the images'
+// channels and the validity bits, so that the loops over pixels read contiguous floats.
+struct ChunkPlanes {
+  int first_row = 0, width = 0;
+  std::vector<float> colour;   // (image * 3 + channel) planes
+  std::vector<int32_t> valid;  // FeatureValidity bits
+  size_t plane = 0;            // floats per plane
+  const float* channel(int k, int c, int y) const {
+    return colour.data() + size_t(3 * k + c) * plane + size_t(y - first_row) * width;
+  }
+  const int32_t* valid_row(int y) const { return valid.data() + size_t(y - first_row) * width; }
+};
+
+ChunkPlanes chunk_planes(const FilterJob& job, int y0, int y1) {
+  const int W = job.fb.width, H = job.fb.height;
+  ChunkPlanes p;
+  p.first_row = std::max(0, y0 - job.radius);
+  const int last = std::min(H, y1 + job.radius);
+  p.width = W;
+  p.plane = size_t(last - p.first_row) * W;
+  p.colour.resize(3 * job.count * p.plane);
+  p.valid.resize(p.plane);
+  const size_t base = size_t(p.first_row) * W;
+  for (size_t i = 0; i < p.plane; ++i) p.valid[i] = job.fb.valid[base + i];
+  for (int k = 0; k < job.count; ++k)
+    for (int c = 0; c < 3; ++c) {
+      float* d = p.colour.data() + size_t(3 * k + c) * p.plane;
+      const float* s = job.images[k] + 3 * base + c;
+      for (size_t i = 0; i < p.plane; ++i) d[i] = s[3 * i];
+    }
+  return p;
+}
+
+// Per pixel of a block: the sums of weighted colours and weights, per tolerance and image.
+struct BlockSums {
+  float num[kMaxRanges][kMaxImages][3][kBlock];
+  float den[kMaxRanges][kMaxImages][kBlock];
+};
+
+// Feature weights of the tap (dx, dy) for the pixels [x0, x1) of row y (0 for a tap left out).
+// wf[x - xb] for x in [x0, x1).
+void feature_weights(const FilterJob& job, const ChunkPlanes& p, int y, int dy, int dx, int x0,
+                     int x1, int xb, float* wf) {
+  const FeatureBuffers& fb = job.fb;
+  const size_t n = size_t(fb.width) * fb.height;
+  const size_t i0 = size_t(y) * fb.width, j0 = size_t(y + dy) * fb.width;
+  const float* f = fb.feature.data();
+  const float* v = fb.feature_var.data();
+  const int32_t* vi = p.valid_row(y);
+  const int32_t* vj = p.valid_row(y + dy);
+  const bool centre_tap = dx == 0 && dy == 0;
+  const float ta = kAlbedoTolerance * kAlbedoTolerance, tn = kNormalTolerance * kNormalTolerance;
+  for (int x = x0; x < x1; ++x) {
+    const size_t i = i0 + x, j = j0 + x + dx;
+    float d = 0.f;
+    for (int c = 0; c < 3; ++c) {
+      const size_t ca = c * n, cn = (3 + c) * n;
+      const float da = f[ca + i] - f[ca + j], dn = f[cn + i] - f[cn + j];
+      d += da * da / (ta + v[ca + i] + v[ca + j]) + dn * dn / (tn + v[cn + i] + v[cn + j]);
+    }
+    const size_t cd = 6 * n;
+    const float td = kDepthTolerance * f[cd + i], dd = f[cd + i] - f[cd + j];
+    d += dd * dd / (td * td + v[cd + i] + v[cd + j] + 1e-12f);
+    const bool centre_features = vi[x] & kFeaturesValid;
+    // A centre without features weighs its neighbours by colour alone, so only itself.
+    const bool near = bool(vj[x + dx] & kFeaturesValid) & (d <= kNegligibleDistance);
+    const bool keep = bool(vj[x + dx] & kImagesValid) & (centre_features ? near : centre_tap);
+    wf[x - xb] = masked(keep, exp_nonpositive(-0.5f * (centre_features ? d : 0.f)));
+  }
+}
+
+// Adds the tap (dx, dy) to the sums of the pixels [x0, x1) of row y (block starting at xb).
+void add_tap(const FilterJob& job, const ChunkPlanes& p, int y, int dy, int dx, int x0, int x1,
+             int xb, const float* scale, BlockSums& s) {
+  float wf[kBlock], dc[kBlock], colour[kMaxRanges][kBlock];
+  feature_weights(job, p, y, dy, dx, x0, x1, xb, wf);
+  for (int k = 0; k < job.count; ++k) {
+    const float *p0 = p.channel(k, 0, y), *p1 = p.channel(k, 1, y), *p2 = p.channel(k, 2, y);
+    // The tap's colours, offset by dx (inside the row for x in [x0, x1)).
+    const float* q[3] = {p.channel(k, 0, y + dy), p.channel(k, 1, y + dy), p.channel(k, 2, y + dy)};
+    for (int x = x0; x < x1; ++x) {
+      const float d0 = q[0][x + dx] - p0[x], d1 = q[1][x + dx] - p1[x], d2 = q[2][x + dx] - p2[x];
+      dc[x - xb] = (d0 * d0 + d1 * d1 + d2 * d2) * scale[kBlock * k + x - xb];
+    }
+    for (int t = 0; t < job.ranges; ++t) {
+      const float inv = job.inv_range2[t];
+      if (inv > 0.f && job.squared_from[t] < 0)
+        for (int x = x0; x < x1; ++x) colour[t][x - xb] = exp_nonpositive(-0.5f * dc[x - xb] * inv);
+    }
+    for (int t = 0; t < job.ranges; ++t) {
+      if (job.squared_from[t] < 0) continue;
+      const float* from = colour[job.squared_from[t]];
+      for (int x = x0; x < x1; ++x) {
+        const float e2 = from[x - xb] * from[x - xb], e4 = e2 * e2, e8 = e4 * e4;
+        colour[t][x - xb] = e8 * e8;
+      }
+    }
+    for (int t = 0; t < job.ranges; ++t) {
+      float *n0 = s.num[t][k][0], *n1 = s.num[t][k][1], *n2 = s.num[t][k][2], *den = s.den[t][k];
+      if (job.inv_range2[t] > 0.f) {
+        for (int x = x0; x < x1; ++x) {
+          const float a = wf[x - xb], w = masked(a > 0.f, a * colour[t][x - xb]);
+          n0[x - xb] += w * q[0][x + dx];
+          n1[x - xb] += w * q[1][x + dx];
+          n2[x - xb] += w * q[2][x + dx];
+          den[x - xb] += w;
+        }
+      } else {
+        for (int x = x0; x < x1; ++x) {
+          const float w = wf[x - xb];
+          n0[x - xb] += w * q[0][x + dx];
+          n1[x - xb] += w * q[1][x + dx];
+          n2[x - xb] += w * q[2][x + dx];
+          den[x - xb] += w;
+        }
+      }
+    }
+  }
+}
+
+// Filters the pixels [xb, xe) of row y: every tap in the order of the window's rows.
+void filter_block(const FilterJob& job, const ChunkPlanes& p, int y, int xb, int xe, BlockSums& s) {
+  const int W = job.fb.width, H = job.fb.height, r = job.radius;
+  float scale[kMaxImages * kBlock];
+  const int32_t* vi = p.valid_row(y);
+  for (int k = 0; k < job.count; ++k) {
+    const float *p0 = p.channel(k, 0, y), *p1 = p.channel(k, 1, y), *p2 = p.channel(k, 2, y);
+    for (int x = xb; x < xe; ++x) {
+      const float lum = std::max(0.f, (p0[x] + p1[x] + p2[x]) * (1.f / 3.f)) + kRangeFloor;
+      // A missing centre has no colour to compare with: features alone weigh its neighbours.
+      scale[kBlock * k + x - xb] = (vi[x] & kImagesValid) ? 1.f / (3.f * lum * lum) : 0.f;
+    }
+  }
+  std::memset(&s, 0, sizeof(s));
+  for (int dy = -r; dy <= r; dy += job.stride) {
+    if (y + dy < 0 || y + dy >= H) continue;
+    for (int dx = -r; dx <= r; dx += job.stride) {
+      const int x0 = std::max(xb, -dx), x1 = std::min(xe, W - dx);
+      if (x0 < x1) add_tap(job, p, y, dy, dx, x0, x1, xb, scale, s);
+    }
+  }
+  const size_t row = size_t(y) * W;
+  for (int t = 0; t < job.ranges; ++t)
+    for (int k = 0; k < job.count; ++k) {
+      float* o = job.out[t * job.count + k] + 3 * row;
+      const float* in = job.images[k] + 3 * row;
+      for (int x = xb; x < xe; ++x) {
+        const float den = s.den[t][k][x - xb];
+        for (int c = 0; c < 3; ++c)
+          o[3 * x + c] = den > 0.f ? s.num[t][k][c][x - xb] / den : in[3 * x + c];
+      }
+    }
+}
+
 }  // namespace
 
 std::vector<BilateralCandidate> default_bilateral_candidates() {
@@ -72,63 +251,31 @@ std::vector<BilateralCandidate> default_bilateral_candidates() {
 
 void bilateral_filter(const FeatureBuffers& fb, const BilateralWindow& window, const float* ranges,
                       int range_count, const float* const* images, int count, float* const* out) {
-  const int W = fb.width, H = fb.height, r = window.radius, step = window.stride;
-  if (r == 0) {
+  if (window.radius == 0) {
     for (int t = 0; t < range_count; ++t) identity_filter(fb, images, out + t * count, count);
     return;
   }
   float inv_range2[kMaxRanges];
   for (int t = 0; t < range_count; ++t)
     inv_range2[t] = ranges[t] > 0.f ? 1.f / (ranges[t] * ranges[t]) : 0.f;
-  parallel_rows(H, [&](int y0, int y1) {
+  int squared_from[kMaxRanges];
+  for (int t = 0; t < range_count; ++t) {
+    squared_from[t] = -1;
+    for (int u = 0; u < range_count; ++u)
+      if (inv_range2[u] > 0.f &&
+          std::abs(inv_range2[t] - 16.f * inv_range2[u]) <= 1e-6f * inv_range2[t])
+        squared_from[t] = u;
+  }
+  for (int t = 0; t < range_count; ++t)  // from a weight computed directly only
+    if (squared_from[t] >= 0 && squared_from[squared_from[t]] >= 0) squared_from[t] = -1;
+  const FilterJob job{fb,          window.radius, window.stride, inv_range2, squared_from,
+                      range_count, images,        count,         out};
+  parallel_rows(fb.height, [&](int y0, int y1) {
+    const ChunkPlanes planes = chunk_planes(job, y0, y1);
+    BlockSums sums;
     for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < W; ++x) {
-        const size_t i = size_t(y) * W + x;
-        const bool centre_features = fb.valid[i] & kFeaturesValid;
-        // A missing centre has no colour to compare with: features alone weigh its neighbours.
-        const bool centre_colour = fb.valid[i] & kImagesValid;
-        float num[kMaxRanges][kMaxImages][3] = {}, den[kMaxRanges][kMaxImages] = {};
-        float scale[kMaxImages];
-        for (int k = 0; k < count; ++k) {
-          const float* p = images[k] + 3 * i;
-          const float lum = std::max(0.f, (p[0] + p[1] + p[2]) * (1.f / 3.f)) + kRangeFloor;
-          scale[k] = centre_colour ? 1.f / (3.f * lum * lum) : 0.f;
-        }
-        for (int dy = -r; dy <= r; dy += step) {
-          const int yy = y + dy;
-          if (yy < 0 || yy >= H) continue;
-          for (int dx = -r; dx <= r; dx += step) {
-            const int xx = x + dx;
-            if (xx < 0 || xx >= W) continue;
-            const size_t j = size_t(yy) * W + xx;
-            if (!(fb.valid[j] & kImagesValid)) continue;
-            if (!centre_features && j != i) continue;
-            float df = 0.f;
-            if (centre_features) {
-              if (!(fb.valid[j] & kFeaturesValid)) continue;
-              df = feature_distance(fb, i, j);
-              if (df > kNegligibleDistance) continue;
-            }
-            const float wf = std::exp(-0.5f * df);
-            for (int k = 0; k < count; ++k) {
-              const float *p = images[k] + 3 * i, *q = images[k] + 3 * j;
-              const float d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2];
-              const float dc = (d0 * d0 + d1 * d1 + d2 * d2) * scale[k];
-              for (int t = 0; t < range_count; ++t) {
-                const float w =
-                    inv_range2[t] > 0.f ? wf * std::exp(-0.5f * dc * inv_range2[t]) : wf;
-                for (int c = 0; c < 3; ++c) num[t][k][c] += w * q[c];
-                den[t][k] += w;
-              }
-            }
-          }
-        }
-        for (int t = 0; t < range_count; ++t)
-          for (int k = 0; k < count; ++k)
-            for (int c = 0; c < 3; ++c)
-              out[t * count + k][3 * i + c] =
-                  den[t][k] > 0.f ? num[t][k][c] / den[t][k] : images[k][3 * i + c];
-      }
+      for (int xb = 0; xb < fb.width; xb += kBlock)
+        filter_block(job, planes, y, xb, std::min(fb.width, xb + kBlock), sums);
   });
 }
 

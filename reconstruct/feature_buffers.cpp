@@ -15,13 +15,14 @@ bool finite_n(const float* v, int n) {
   return true;
 }
 
-// Copies `n`-channel values and variances into the interleaved feature buffers at `offset`;
+// Copies `n`-channel values and variances into the feature planes from plane `offset`;
 // clears kFeaturesValid where a value or variance is not finite.
 void copy_feature(const float* values, const float* variance, int n, int offset,
                   FeatureBuffers& fb) {
   if (!values) return;
   fb.features += n;
   const int W = fb.width;
+  const size_t pixels = size_t(W) * fb.height;
   parallel_rows(fb.height, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
       const float* v = values + size_t(n) * i;
@@ -31,8 +32,8 @@ void copy_feature(const float* values, const float* variance, int n, int offset,
         continue;
       }
       for (int c = 0; c < n; ++c) {
-        fb.feature[kFeatureChannels * i + offset + c] = v[c];
-        fb.feature_var[kFeatureChannels * i + offset + c] = var ? std::max(0.f, var[c]) : 0.f;
+        fb.feature[size_t(offset + c) * pixels + i] = v[c];
+        fb.feature_var[size_t(offset + c) * pixels + i] = var ? std::max(0.f, var[c]) : 0.f;
       }
     }
   });

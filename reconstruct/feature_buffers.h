@@ -19,8 +19,9 @@ struct FeatureBuffers {
   int features = 0;              // feature channels present (albedo 3, normal 3, depth 1)
   std::vector<float> a, b, all;  // RGB: the halves and the image of all samples, 0 where missing
   std::vector<float> half_var;   // RGB (Var A + Var B) / 2, unbiased per pixel
-  // Feature values and variances, interleaved per pixel: albedo RGB, normal XYZ, depth (zeros
-  // for an absent feature, which then adds nothing to a distance).
+  // Feature values and variances, one plane (width x height) per channel, so that the filters'
+  // loops over pixels read contiguous floats: albedo RGB, normal XYZ, depth (zeros for an absent
+  // feature, which then adds nothing to a distance).
   std::vector<float> feature, feature_var;
   std::vector<uint8_t> valid;  // FeatureValidity bits per pixel
   int missing = 0;             // pixels with some non-finite input

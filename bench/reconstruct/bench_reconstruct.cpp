@@ -16,8 +16,9 @@
 // --l2-only stops after the DCT pair and the L2 solve (for quick runs while tuning L2).
 //   - Feature (--norm feature): total time with the L1 guide and with the L2 guide, split into the
 //     guide solve, preparation, the cross-filtered candidates and the choice, on the synthetic
-//     room of testing/feature_scene.h (half noise 0.2, gradient noise 0.1), relMSE against L1;
-//     --feature-only runs just this case.
+//     room of testing/feature_scene.h (half noise 0.2, gradient noise 0.1), relMSE against L1,
+//     CPU time (the time on idle cores on a loaded machine) of the whole and of the filters and
+//     choice alone; --feature-only runs just this case.
 // --admm compares an ADMM L1 probe (l1_admm_probe.h) with the library's IRLS (see bench_admm).
 // --pcg counts PCG steps of the IRLS systems with DCT preconditioners (l1_pcg_probe.h).
 // --warm measures L1 warm-started from another alpha's output (ReconstructionInput::initial);
@@ -195,8 +196,11 @@ void bench_feature(int width, int height, int threads) {
     // The filters and the choice alone, on the primal halves (the same work per candidate).
     gdpt::FeatureReconstruction fr;
     tbb::task_arena arena(threads);
+    const auto t2 = Clock::now();
+    const double c2 = cpu_seconds();
     arena.execute(
         [&] { fr = gdpt::feature_filter(in, sc.a.data(), sc.b.data(), sc.primal.data()); });
+    const double filter_wall = seconds_since(t2), filter_cpu = cpu_seconds() - c2;
     const double rel = gdpt::test::relative_mse(img, sc.truth);
     std::printf(
         "Feature (guide %s): %8.1f ms = solves %.1f ms + filters %.1f ms (prepare %.1f, %zu "
@@ -208,6 +212,8 @@ void bench_feature(int width, int height, int threads) {
     // Wall time depends on what else runs; CPU time (all threads) / threads is the time on
     // otherwise idle cores.
     std::printf("  CPU time: total %.2f s (%.2f s per thread)\n", cpu_total, cpu_total / threads);
+    std::printf("  filters and choice alone: %.1f ms, CPU %.2f s (%.2f s per thread)\n",
+                1e3 * filter_wall, filter_cpu, filter_cpu / threads);
   }
 }
 
