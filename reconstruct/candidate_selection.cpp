@@ -4,43 +4,57 @@
 
 namespace gdpt::detail {
 
-void candidate_error(const FeatureBuffers& fb, const float* fa, const float* fb_half,
-                     float* error) {
+void candidate_error(const FeatureBuffers& fb, const float* fa, const float* fb_half, float* error,
+                     const float* weight, float* relative) {
   const int W = fb.width;
   parallel_rows(fb.height, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
-      if (!(fb.valid[i] & kImagesValid)) {
-        error[i] = 0.f;
-        continue;
-      }
-      float e = 0.f;
-      for (int c = 0; c < 3; ++c) {
-        const size_t k = 3 * i + c;
-        const float da = fa[k] - fb.b[k], db = fb_half[k] - fb.a[k], dd = fa[k] - fb_half[k];
-        e += 0.5f * (da * da + db * db) - fb.half_var[k] - 0.25f * dd * dd;
+      float e = 0.f, r = 0.f;
+      if (fb.valid[i] & kImagesValid) {
+        for (int c = 0; c < 3; ++c) {
+          const size_t k = 3 * i + c;
+          const float da = fa[k] - fb.b[k], db = fb_half[k] - fb.a[k], dd = fa[k] - fb_half[k];
+          const float ec = 0.5f * (da * da + db * db) - fb.half_var[k] - 0.25f * dd * dd;
+          e += ec;
+          if (weight) r += weight[k] * ec;
+        }
       }
       error[i] = e * (1.f / 3.f);
+      if (relative) relative[i] = r * (1.f / 3.f);
     }
   });
+}
+
+void set_relative_weights(const FeatureBuffers& fb, const float* guide, CandidateChoice& choice) {
+  const size_t n3 = 3 * size_t(fb.width) * fb.height;
+  choice.weight.resize(n3);
+  for (size_t k = 0; k < n3; ++k)
+    choice.weight[k] = 1.f / (guide[k] * guide[k] + kRelativeErrorEpsilon);
 }
 
 void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const float* fb_half,
                      const float* filtered, CandidateChoice& choice) {
   const int W = fb.width, H = fb.height;
   const size_t n = size_t(W) * H;
-  std::vector<float> raw(n), smooth(n);
-  candidate_error(fb, fa, fb_half, raw.data());
+  const bool weighted = !choice.weight.empty();
+  std::vector<float> raw(2 * n), smooth(2 * n);
+  candidate_error(fb, fa, fb_half, raw.data(), weighted ? choice.weight.data() : nullptr,
+                  raw.data() + n);
   box_filter(raw.data(), 1, W, H, kErrorSmoothingRadius, smooth.data());
+  if (weighted) box_filter(raw.data() + n, 1, W, H, kErrorSmoothingRadius, smooth.data() + n);
+  const float* key = weighted ? smooth.data() + n : smooth.data();
   const bool first = choice.image.empty();
   if (first) {
     choice.image.resize(3 * n);
     choice.error.resize(n);
+    choice.relative.resize(n);
     choice.index.resize(n);
   }
   parallel_rows(H, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
-      if (!first && !(smooth[i] < choice.error[i])) continue;
+      if (!first && !(key[i] < choice.relative[i])) continue;
       choice.error[i] = smooth[i];
+      choice.relative[i] = key[i];
       choice.index[i] = uint8_t(index);
       for (int c = 0; c < 3; ++c) choice.image[3 * i + c] = filtered[3 * i + c];
     }

@@ -1,7 +1,9 @@
 #include "reconstruct/feature_reconstruct.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
@@ -14,6 +16,9 @@
 namespace gdpt {
 
 namespace {
+
+// Relative to the centre's brightness, as the candidates' tolerances.
+constexpr float kGuideColourTolerance = 1.f;
 
 double since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -99,6 +104,21 @@ FeatureBase base_images(const ReconstructionInput& in, const ReconstructionSetti
   return base;
 }
 
+// The candidate-independent colour the relative errors are taken against: per channel the smaller
+// of all samples under the widest window with a loose colour tolerance (a bright spot stays off
+// its dark neighbours) and without one (a firefly is spread thin). Wide, so the weights carry
+// little of the noise they weigh.
+std::vector<float> relative_error_guide(const detail::FeatureBuffers& fb) {
+  const size_t n3 = fb.all.size();
+  std::vector<float> tolerant(n3), plain(n3);
+  const float* const all = fb.all.data();
+  float* const out[2] = {tolerant.data(), plain.data()};
+  const float tolerances[2] = {kGuideColourTolerance, 0.f};
+  detail::bilateral_filter(fb, std::end(detail::kWindows)[-1], tolerances, 2, &all, 1, out);
+  for (size_t k = 0; k < n3; ++k) tolerant[k] = std::min(tolerant[k], plain[k]);
+  return tolerant;
+}
+
 }  // namespace
 
 FeatureReconstruction feature_filter(const ReconstructionInput& input, const float* a,
@@ -120,6 +140,9 @@ FeatureReconstruction feature_filter(const ReconstructionInput& input, const flo
   for (int k = 0; k < kTol * 3; ++k) out[k] = filtered.data() + size_t(k) * n3;
   const float* const images[3] = {fb.a.data(), fb.b.data(), fb.all.data()};
   detail::CandidateChoice choice;
+  t = std::chrono::steady_clock::now();
+  detail::set_relative_weights(fb, relative_error_guide(fb).data(), choice);
+  r.filter_seconds += since(t);
   int index = 0;
   auto offer = [&](int tolerances) {
     t = std::chrono::steady_clock::now();

@@ -7,13 +7,14 @@
 //      its halves and their mean;
 //   2. per candidate filter (feature_bilateral.h): each half filtered alone and the solution of
 //      all samples filtered alike;
-//   3. per pixel the candidate with the smallest smoothed error estimate of the halves
-//      (candidate_selection.h); output = that candidate applied to all samples (+ emission).
+//   3. per pixel the candidate with the smallest smoothed relative error estimate of the halves
+//      (candidate_selection.h; relative to a guide colour from two more filters of all samples);
+//      output = that candidate applied to all samples (+ emission).
 //
-// Memory beyond the inputs: about 280 bytes per pixel, 280 MB per megapixel (feature buffers
+// Memory beyond the inputs: about 300 bytes per pixel, 300 MB per megapixel (feature buffers
 // 105, the solved halves and image 36, their copies filtered with the three colour tolerances
-// 108, the choice 17, error scratch 12), plus the gradient-domain solves' own buffers while they
-// run.
+// 108, the choice and its weights 33, error scratch 16; the guide's two filtered copies, 24,
+// before the candidates run), plus the gradient-domain solves' own buffers while they run.
 #pragma once
 
 #include <vector>
