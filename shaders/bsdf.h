@@ -115,6 +115,12 @@ class ClosureSet {
     return single_lambert() ? lambert::sample(closures_[0], wi, u_lobe, u)
                             : sample_mixture(wi, u_lobe, u);
   }
+  // The delta lobes' discrete event `event` (kLobeReflection or kLobeTransmission) from wi as
+  // one event: the direction they send wi in, the sum of their values and of their selection
+  // times event probabilities, as sample() returns it for any of them. Invalid when no delta lobe
+  // has that event or when the lobes that have it send wi in different directions. G-PT's shift
+  // of a delta event evaluates it at the offset vertex (no lobe number: integrators/gpt).
+  BsdfSample delta_event(Vec3f wi, uint8_t event) const;
   // Whether sample() reads u_lobe at all: only to pick among several lobes or, for a single
   // dielectric, reflection against refraction. Integrators skip drawing it otherwise.
   bool uses_lobe_choice() const {
@@ -154,6 +160,14 @@ class ClosureSet {
   BsdfSample sample_single_t(Vec3f wi, float u_lobe, Vec2f u) const;  // count_ == 1
   template <bool kFramed>
   BsdfSample sample_several_t(Vec3f wi, float u_lobe, Vec2f u) const;  // count_ > 1
+  template <bool kFramed>
+  BsdfSample delta_event_t(Vec3f wi, uint8_t event) const;
+  // Adds to `s`, the delta event of lobe k, the other delta lobes that send wi the same way
+  // (selection weights w, their sum total).
+  template <bool kFramed>
+  void add_same_delta_events(int k, Vec3f wi, const float* w, float total, BsdfSample& s) const;
+  template <bool kFramed>
+  BsdfSample lobe_delta_event(int i, Vec3f wi, uint8_t event) const;
   // Any set (the same values as the fast path for a single Lambert lobe).
   Spectrum eval_mixture(Vec3f wi, Vec3f wo) const;
   float pdf_mixture(Vec3f wi, Vec3f wo) const;

@@ -3,7 +3,8 @@
 // Sampling is one-sample MIS over lobes: a lobe k is chosen with probability s_k proportional
 // to luminance(weight_k) * albedo_hint_k(wi), it samples wo, and the returned value and pdf are
 // those of the whole mixture, sum_j eval_j and sum_j s_j pdf_j, so that value / pdf agrees with
-// eval() / pdf() (delta lobes excepted: they return their own value and s_k * probability).
+// eval() / pdf(). A delta lobe's event is summed alike over the delta lobes that send wi the
+// same way (value sum_j value_j, pdf sum_j s_j probability_j; delta_event()).
 #include <algorithm>
 
 #include "core/frame.h"
@@ -153,6 +154,12 @@ bool lobe_is_diffuse(const Closure& c) {
   return c.type == ClosureType::Lambert || c.type == ClosureType::OrenNayar ||
          c.type == ClosureType::PrincipledDiffuse || c.type == ClosureType::PrincipledSheen ||
          c.type == ClosureType::Translucent || c.type == ClosureType::Velvet;
+}
+
+// Whether two delta events send wi the same way: lobes about one normal compute the direction
+// alike, and an index-matched interface's pass-through bends it by less than 1e-4.
+bool same_delta_direction(Vec3f a, Vec3f b) {
+  return dot(a, b) > 1.0f - 1e-6f;
 }
 
 // Unnormalised selection weights; returns their sum.
@@ -339,7 +346,11 @@ BsdfSample ClosureSet::sample_several_t(Vec3f wi, float u_lobe, Vec2f u) const {
 
   const float sel_k = w[k] / total;
   if (s.is_delta()) {
+    // Delta lobes sending wi the same way (mirrors mixed by a factor, a mirror and a glass's
+    // reflection) make one event, whose value and probability are their sums, as for the
+    // non-delta lobes below: the same numbers as delta_event() of that event.
     s.pdf *= sel_k;
+    add_same_delta_events<kFramed>(k, wi, w, total, s);
     return s;
   }
 
@@ -359,6 +370,62 @@ BsdfSample ClosureSet::sample_several_t(Vec3f wi, float u_lobe, Vec2f u) const {
   s.pdf = pdf / total;
   s.valid = s.pdf > 0.0f;
   return s;
+}
+
+template <bool kFramed>
+BsdfSample ClosureSet::lobe_delta_event(int i, Vec3f wi, uint8_t event) const {
+  const Closure& c = closures_[i];
+  if (!lobe_is_delta(c)) return {};
+  // A delta lobe's only random choice is reflection against transmission: force it.
+  const float u_choice = (event & kLobeReflection) ? 0.0f : 0.99999994f;
+  BsdfSample s = lobe_sample<kFramed>(c, interpolated_, wi, u_choice, Vec2f(0.5f, 0.5f));
+  if (!s.valid || !s.is_delta() || (s.lobe & event) == 0) return {};
+  if constexpr (kFramed)
+    if (!lobe_side_ok(c, wi, s.wo)) return {};
+  return s;
+}
+
+template <bool kFramed>
+void ClosureSet::add_same_delta_events(int k, Vec3f wi, const float* w, float total,
+                                       BsdfSample& s) const {
+  const uint8_t event = s.lobe & (kLobeReflection | kLobeTransmission);
+  for (int i = 0; i < count_; ++i) {
+    if (i == k || !(w[i] > 0.0f)) continue;
+    const BsdfSample e = lobe_delta_event<kFramed>(i, wi, event);
+    if (e.valid && same_delta_direction(e.wo, s.wo)) {
+      s.value += e.value;
+      s.pdf += w[i] / total * e.pdf;
+    }
+  }
+}
+
+BsdfSample ClosureSet::delta_event(Vec3f wi, uint8_t event) const {
+  return own_frames_ ? delta_event_t<true>(wi, event) : delta_event_t<false>(wi, event);
+}
+
+template <bool kFramed>
+BsdfSample ClosureSet::delta_event_t(Vec3f wi, uint8_t event) const {
+  float w[kMaxClosures] = {1.0f};
+  float total = 1.0f;
+  if (count_ > 1) total = selection_weights<kFramed>(closures_, count_, interpolated_, wi, w);
+  BsdfSample sum;
+  if (!(total > 0.0f)) return sum;
+  for (int i = 0; i < count_; ++i) {
+    if (!(w[i] > 0.0f)) continue;
+    const BsdfSample e = lobe_delta_event<kFramed>(i, wi, event);
+    if (!e.valid) continue;
+    if (!sum.valid) {
+      sum = e;
+      sum.pdf *= w[i] / total;
+    } else if (same_delta_direction(e.wo, sum.wo)) {
+      sum.value += e.value;
+      sum.pdf += w[i] / total * e.pdf;
+    } else {
+      return BsdfSample{};  // two directions: the event names none
+    }
+  }
+  sum.valid = sum.valid && sum.pdf > 0.0f;
+  return sum;
 }
 
 float ClosureSet::roughness() const {

@@ -192,13 +192,11 @@ class GradientPathTracer final : public Integrator {
       }
 
       // --- BSDF sampling: extend the base ---
-      // The lobe number is drawn when the base's closures read it, or below when a delta shift
-      // samples an offset's closures that do.
-      bool lobe_drawn = bc.uses_lobe_choice();
-      const float u_lobe =
-          lobe_drawn ? sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe)) : 0.0f;
-      const Vec2f u_dir = u.dir;
-      const BsdfSample bs = bc.sample(base.wi, u_lobe, u_dir);
+      // The lobe number is drawn when the base's closures read it (the offsets never do).
+      const float u_lobe = bc.uses_lobe_choice()
+                               ? sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe))
+                               : 0.0f;
+      const BsdfSample bs = bc.sample(base.wi, u_lobe, u.dir);
       if (!bs.valid || !(bs.pdf > 0.0f) || is_black(bs.value)) break;
       const Vec3f wo_world = base.frame.to_world(bs.wo);
       const float cos_ng = dot(wo_world, base.ng);
@@ -253,17 +251,10 @@ class GradientPathTracer final : public Integrator {
       const VertexType xd_type = delta ? VertexType::Specular : base_type;
       if (open_mask != 0) {
         BaseStep& st = scratch.step;
-        prepare_step(base, bs, xd_type, next_type, wo_world, found, next, u_lobe, u_dir, ray.kind,
-                     holdout_ends, bp.state, st);
-        for (unsigned m = open_mask; m != 0; m &= m - 1) {
-          Offset& o = off[std::countr_zero(m)];
-          if (!lobe_drawn && delta && o.link == Link::NotConnected &&
-              o.v.closures->uses_lobe_choice()) {
-            st.u_lobe = sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kBsdfLobe));
-            lobe_drawn = true;
-          }
-          shift_segment(g_, o, st, out.rays);
-        }
+        prepare_step(base, bs, xd_type, next_type, wo_world, found, next, ray.kind, holdout_ends,
+                     bp.state, st);
+        for (unsigned m = open_mask; m != 0; m &= m - 1)
+          shift_segment(g_, off[std::countr_zero(m)], st, out.rays);
       }
 
       // --- Emission events at the end of the segment (emission_events.h) ---
@@ -415,8 +406,7 @@ class GradientPathTracer final : public Integrator {
   // across them (failed store-to-load forwarding).
   static void prepare_step(const Vertex& base, const BsdfSample& bs, VertexType xd_type,
                            VertexType next_type, Vec3f wo_world, bool found, const SurfaceHit& next,
-                           float u_lobe, Vec2f u_dir, uint32_t kind, bool holdout_ends,
-                           const PathState& state, BaseStep& st) {
+                           uint32_t kind, bool holdout_ends, const PathState& state, BaseStep& st) {
     st.base = &base;
     st.bs = &bs;
     st.xd_type = xd_type;
@@ -424,8 +414,7 @@ class GradientPathTracer final : public Integrator {
     st.wo_world = wo_world;
     st.found = found;
     st.next = &next;
-    st.u_lobe = u_lobe;
-    st.u_dir = u_dir;
+    st.base_delta_unique = delta_event_unique(base, bs);
     st.kind = kind;
     st.holdout_ends = holdout_ends;
     st.state = &state;

@@ -104,18 +104,15 @@ void half_vector_copy(const GptContext& g, Offset& o, const BaseStep& st, Vertex
   const Vertex& y = o.v;
   const VertexType xd_type = st.xd_type;
   const bool found = st.found;
-  const float u_lobe = st.u_lobe;
-  const Vec2f u_dir = st.u_dir;
   Vec3f wo;
   if (bs.is_delta()) {
-    // Delta lobe: the same discrete event (reflection / transmission) at y_d, J = 1. The
-    // offset samples its own closures; when its random choice differs, the choice is forced
-    // for a single-lobe closure set (the lobe's event is driven by u_lobe alone).
-    const uint8_t want = bs.lobe & (kLobeReflection | kLobeTransmission);
-    BsdfSample so = y.closures->sample(y.wi, u_lobe, u_dir);
-    if (so.valid && (!so.is_delta() || (so.lobe & want) == 0) && y.closures->count() == 1)
-      so = y.closures->sample(y.wi, (want & kLobeReflection) ? 0.0f : 0.99999994f, u_dir);
-    if (!so.valid || !so.is_delta() || (so.lobe & want) == 0 || !(so.pdf > 0.0f)) {
+    // Delta event: the same discrete event (reflection / transmission) at y_d, J = 1, valued over
+    // all of y_d's delta lobes that make it, as sample() sums them at x_d; a lobe re-drawn with
+    // the base's lobe number would make the shift depend on that number. An event sending wi two
+    // ways names no single path: fail on either side, so that the reverse shift fails alike.
+    const uint8_t event = bs.lobe & (kLobeReflection | kLobeTransmission);
+    const BsdfSample so = y.closures->delta_event(y.wi, event);
+    if (!so.valid || !st.base_delta_unique) {
       o.shift = Shift::Failed;
       return;
     }

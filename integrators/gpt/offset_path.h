@@ -56,8 +56,9 @@ struct BaseStep {
   Vec3f wo_world;
   bool found;
   const SurfaceHit* next;
-  float u_lobe;
-  Vec2f u_dir;
+  // A delta event at x_d: whether x_d's delta lobes make it in one direction
+  // (ClosureSet::delta_event valid), as the half-vector copy requires of both vertices.
+  bool base_delta_unique;
   uint32_t kind;      // RayKind of the base's segment: the offsets' segments see what it sees
   bool holdout_ends;  // a holdout at the segment's end ends the path (the camera path's)
   // The base's path state past this step: the offsets shade their next vertices by its
@@ -67,6 +68,12 @@ struct BaseStep {
   shift::ReconnectionBase target;
   bool base_front;
 };
+
+// BaseStep::base_delta_unique of the base's sample `bs` at `base`.
+inline bool delta_event_unique(const Vertex& base, const BsdfSample& bs) {
+  return bs.is_delta() &&
+         base.closures->delta_event(base.wi, bs.lobe & (kLobeReflection | kLobeTransmission)).valid;
+}
 
 // Decides and evaluates the offset's version of the base segment x_d -> x_{d+1}: T_ij for one
 // segment, its Jacobian, and the visibility or own hit it needs.

@@ -553,6 +553,50 @@ TEST(GradientUnbiased, ViewDependentMaterials) {
   expect_unbiased("view-dependent", scene, 4096, 1024, 0.1f);
 }
 
+// Two mirror lobes (Glossy roughness 0 and 0.01: both below the delta width) in different
+// colours, mixed by a Noise Texture of the world position, on the ball and the back wall: the
+// mix weights, and with them each lobe's selection probability, differ between a base vertex and
+// its offset's. Both lobes reflect into the same direction, so the offset's delta event is the
+// base's whichever lobe the base's lobe number picked; a lobe re-drawn at the offset with that
+// number (another lobe where the weights differ) makes the shift depend on the number and biases
+// the gradients.
+TEST(GradientUnbiased, MixOfTwoMirrorsBySmoothlyVaryingFactor) {
+  InputNode noise;  // Noise Texture, Fac, at the world position
+  noise.kind = InputNodeKind::Noise;
+  noise.vector.source = TexCoordSource::Position;
+  noise.value_a = FloatInput(2.5f);  // scale
+  noise.value_b = FloatInput(2.0f);  // detail
+  noise.value_c = FloatInput(0.5f);  // roughness
+  noise.fac_output = true;
+  InputNode contrast;  // 3 (noise - 0.5) + 0.5, clamped: the factor spans [0, 1]
+  contrast.kind = InputNodeKind::Math;
+  contrast.math = MathOp::MultiplyAdd;
+  contrast.value_a.node = 1;
+  contrast.value_b = FloatInput(3.0f);
+  contrast.value_c = FloatInput(-1.0f);
+  contrast.clamp_result = true;
+  MaterialDesc mirrors =
+      view_mix(glossy({0.95f, 0.95f, 0.95f}, 0.0f), glossy({0.9f, 0.25f, 0.05f}, 0.01f), contrast);
+  mirrors.inputs.push_back(noise);
+  Scene scene = make_scene(SceneKind::CornellDiffuse, 16);
+  scene.materials[3] = mirrors;
+  scene.materials.push_back(mirrors);      // 4
+  scene.instances[2].slot_material = {4};  // the back wall
+  expect_unbiased("mix-two-mirrors-noise", scene, 4096, 1024, 0.39f);
+  // Under a constant sky the mirrors' reflections are nearly noiseless: the sphere and the floor.
+  Scene sky = make_scene(SceneKind::Environment, 16);
+  sky.materials[3] = mirrors;
+  sky.materials[0] = mirrors;
+  expect_unbiased("mix-two-mirrors-sky", sky, 4096, 1024, 0.16f);
+  // A mirror and a near-mirror Glossy (roughness 0.02: alpha 4e-4, above the delta width and
+  // below the shift threshold): the base's delta events and its half-vector copies alternate.
+  MaterialDesc near = mirrors;
+  near.nodes[1].roughness = FloatInput(0.02f);
+  sky.materials[3] = near;
+  sky.materials[0] = near;
+  expect_unbiased("mix-mirror-near-mirror-sky", sky, 4096, 1024, 0.16f);
+}
+
 // The Geometry node's mesh attributes (Pointiness, Parametric, Random Per Island) vary over the
 // surface like a texture: an offset path that hits its own point must read its own values. The
 // white surfaces mix by Parametric (the quads' two triangles), the red wall by Random Per Island

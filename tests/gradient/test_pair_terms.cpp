@@ -199,8 +199,10 @@ void run_segment(Pair& p, Segment& s, bool events = true) {
   static const PathState kFirstBounce;  // the test's materials follow no light-path rule
   const VertexType next_type = s.found ? g.classify_hit(s.next, kFirstBounce) : VertexType::Diffuse;
   BaseStep& st = p.scratch->step;
-  st = BaseStep{&base, &s.bs, base_type,  next_type, wo_world,      s.found, &s.next,
-                0.0f,  {},    s.ray.kind, false,     &kFirstBounce, {},      false};
+  st = BaseStep{&base,      &s.bs,   base_type,     next_type,
+                wo_world,   s.found, &s.next,       delta_event_unique(base, s.bs),
+                s.ray.kind, false,   &kFirstBounce, {},
+                false};
   if (s.found && base_type == VertexType::Diffuse && next_type == VertexType::Diffuse) {
     st.target =
         shift::reconnection_base(base.hit.position, s.next.position, s.next.geometric_normal);

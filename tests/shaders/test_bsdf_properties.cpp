@@ -345,6 +345,47 @@ TEST(ClosureSet, SampleReportsLobeFlagsEtaAndRoughness) {
   EXPECT_NEAR(t.weight().x, 0.5f, 1e-7f);
 }
 
+// Delta lobes that send wi the same way are one discrete event: sample() returns the sum of
+// their values and of their selection times event probabilities whichever of them the lobe number
+// picks, and delta_event() returns the same without a lobe number (G-PT's shift of a delta
+// event). Two mirrors in one set are one mirror of their summed colour, probability 1.
+TEST(ClosureSet, DeltaLobesOfOneDirectionAreOneEvent) {
+  const Vec3f wi = incident(0.6f);
+  const ClosureSet mirrors =
+      set_of({ggx(0.0f, Spectrum(0.9f, 0.2f, 0.1f)), ggx(1e-4f, Spectrum(0.1f, 0.3f, 0.8f))});
+  const BsdfSample event = mirrors.delta_event(wi, kLobeReflection);
+  ASSERT_TRUE(event.valid && event.is_delta());
+  EXPECT_NEAR(event.pdf, 1.0f, 1e-6f);
+  EXPECT_NEAR(event.value.x, 1.0f, 1e-6f);
+  EXPECT_NEAR(event.value.y, 0.5f, 1e-6f);
+  EXPECT_NEAR(event.value.z, 0.9f, 1e-6f);
+  EXPECT_FALSE(mirrors.delta_event(wi, kLobeTransmission).valid);
+  // A mirror and smooth glass: their reflections are one event, the refraction another.
+  const ClosureSet mirror_glass = set_of({ggx(0.0f, Spectrum(0.5f)), glass(0.0f, 1.5f)});
+  const float f = fresnel_dielectric(0.6f, 1.5f);
+  const BsdfSample reflection = mirror_glass.delta_event(wi, kLobeReflection);
+  const BsdfSample refraction = mirror_glass.delta_event(wi, kLobeTransmission);
+  ASSERT_TRUE(reflection.valid && refraction.valid);
+  EXPECT_NEAR(reflection.value.y, 0.5f + f, 1e-6f);
+  EXPECT_NEAR(refraction.value.y, 1.0f - f, 1e-6f);
+  EXPECT_NEAR(reflection.pdf + refraction.pdf, 1.0f, 1e-6f);
+  for (const ClosureSet* set : {&mirrors, &mirror_glass})
+    for (float u_lobe : {0.01f, 0.3f, 0.6f, 0.99f}) {
+      const BsdfSample s = set->sample(wi, u_lobe, Vec2f(0.5f, 0.5f));
+      ASSERT_TRUE(s.valid && s.is_delta());
+      const BsdfSample e = set->delta_event(wi, s.lobe & (kLobeReflection | kLobeTransmission));
+      EXPECT_EQ(s.wo, e.wo);
+      EXPECT_NEAR(s.pdf, e.pdf, 1e-6f) << u_lobe;
+      EXPECT_NEAR(s.value.y, e.value.y, 1e-6f) << u_lobe;
+    }
+  // Straight through and refracted: two transmissions, so the event names no direction.
+  EXPECT_FALSE(set_of({transparent(), glass(0.0f, 1.5f)}).delta_event(wi, kLobeTransmission).valid);
+  // Mirrors about two normals (one lobe keeps a tilted interpolated normal): two reflections.
+  const ClosureSet tilted = set_of({ggx(0.0f), kept(ggx(0.0f))}, Vec3f(0.2f, 0.0f, 1.0f));
+  EXPECT_FALSE(tilted.delta_event(wi, kLobeReflection).valid);
+  EXPECT_TRUE(set_of({ggx(0.0f)}, Vec3f(0.2f, 0.0f, 1.0f)).delta_event(wi, kLobeReflection).valid);
+}
+
 // Bump shadowing scales the diffuse lobes' values by Cycles' term of g = cos(n0, wo) / (cos(n,
 // wo) cos(n0, n)) (n = +z) and leaves glossy lobes and all densities alone; sampling returns the
 // same values as evaluation.
