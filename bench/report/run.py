@@ -192,10 +192,11 @@ def kept_curves(name, args):
         return {}
     with open(os.path.join(args.results, f"{name}.json")) as f:
         old = json.load(f)
-    if old["budgets"] != args.budgets or old["resolution"] != args.res:
-        sys.exit(f"run.py: --keep needs the previous run's budgets and resolution for {name}")
+    if not set(args.budgets) <= set(old["budgets"]) or old["resolution"] != args.res:
+        sys.exit(f"run.py: --keep needs budgets among the previous run's and its resolution "
+                 f"for {name} ({old['budgets']}, {old['resolution']})")
     args.kept_from = old["meta"].get("kept_from") or {k: old["meta"][k] for k in ("commit", "date")}
-    return {m: old["curves"][m] for m in args.keep}
+    return {m: [p for p in old["curves"][m] if p["budget"] in args.budgets] for m in args.keep}
 
 
 def summarise(result):
@@ -432,6 +433,16 @@ def rewrite_doc(args, fig_dir, doc_dir):
     print(f"rewrote {args.out_doc} from {len(results)} result files in {args.results}")
 
 
+def command_line(args, quick):
+    """How the page says it was made: `make bench` unless budgets or scenes were chosen by hand."""
+    if args.budgets_given or args.scenes_given:
+        return ("bench/report/run.py" + (f" --scenes {','.join(args.scenes)}" if args.scenes_given else "")
+                + f" --budgets {','.join(map(str, args.budgets))}"
+                + (f" --keep {','.join(args.keep)}" if args.keep else ""))
+    return ("make bench" + (" QUICK=1" if quick else "")
+            + (f" KEEP={','.join(args.keep)}" if args.keep else ""))
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--build", default=os.path.join(ROOT, "build"))
@@ -452,6 +463,7 @@ def main():
     args = p.parse_args()
     args.build = os.path.abspath(args.build)
     quick = args.quick
+    args.budgets_given, args.scenes_given = bool(args.budgets), bool(args.scenes)
     args.keep = args.keep.split(",") if args.keep else []
     if any(m not in ("cycles_default", "cycles_unbiased") for m in args.keep):
         sys.exit("run.py: --keep takes only cycles_default and cycles_unbiased")
@@ -472,8 +484,7 @@ def main():
                                                                             "--untracked-files=no") else ""),
             "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
             "machine": f"{platform.machine()}, {os.cpu_count()} cores",
-            "command": "make bench" + (" QUICK=1" if quick else "")
-            + (f" KEEP={','.join(args.keep)}" if args.keep else ""), "crop_budget": args.crop_budget}
+            "command": command_line(args, quick), "crop_budget": args.crop_budget}
     if args.doc_only:
         return rewrite_doc(args, fig_dir, doc_dir)
     blender = Blender(args.build)
