@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/shadow_terminator.h"
 #include "scene/generated_mapping.h"
 
 namespace gdpt {
@@ -119,6 +120,9 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     if (id >= instances_.size()) instances_.resize(id + 1);
     InstanceData& d = instances_[id];
     d.index = uint32_t(i);
+    if (top_ids_.size() <= i) top_ids_.resize(i + 1, 0);
+    top_ids_[i] = id;
+    d.terminator_cutoff = inst.terminator_geometry_offset;
     d.shading = &shading_instances_[i];
     d.world_space = world_positions != nullptr;
     d.winding = det < 0.0f ? -1.0f : 1.0f;
@@ -354,6 +358,7 @@ void EmbreeScene::complete_hit(uint32_t top_id, uint32_t primitive, float u, flo
   const float w = 1.0f - u - v;
   hit.instance = d.index;
   hit.primitive = primitive;
+  hit.bary = Vec2f(u, v);
   hit.shading_instance = d.shading;
   const __m128 W = _mm_set1_ps(w), U = _mm_set1_ps(u), V = _mm_set1_ps(v);
 
@@ -445,6 +450,45 @@ Vec3f world_direction(const float (*cols)[4], Vec3f v) {
   for (int r = 0; r < 3; ++r) w[r] = cols[0][r] * v.x + cols[1][r] * v.y + cols[2][r] * v.z;
   return w;
 }
+
+}  // namespace
+
+bool EmbreeScene::world_smooth_triangle(const InstanceData& d, uint32_t prim, SmoothTriangle& t) {
+  const bool corner = prim < d.corner_normal_tris;
+  if (!corner && !d.vertex_normals) return false;
+  const uint32_t* idx = d.indices + size_t(prim) * 3;
+  for (int i = 0; i < 3; ++i) {
+    const Vec3f p = d.positions[idx[i]];
+    t.p[i] = d.world_space
+                 ? p
+                 : world_direction(d.to_world_cols, p) +
+                       Vec3f(d.to_world_cols[3][0], d.to_world_cols[3][1], d.to_world_cols[3][2]);
+    const Vec3f n = corner ? d.corner_normals[size_t(prim) * 3 + i] : d.vertex_normals[idx[i]];
+    t.n[i] = normalize(world_direction(d.normal_cols, n));
+  }
+  return true;
+}
+
+bool EmbreeScene::lifts_shadow_rays(const SurfaceHit& hit) const {
+  const InstanceData& d = instances_[top_ids_[hit.instance]];
+  return d.terminator_cutoff > 0.0f &&
+         (hit.primitive < d.corner_normal_tris || d.vertex_normals != nullptr);
+}
+
+Vec3f EmbreeScene::shadow_ray_start(const SurfaceHit& hit, Vec3f l) const {
+  const InstanceData& d = instances_[top_ids_[hit.instance]];
+  const float side = hit.front_facing ? 1.0f : -1.0f;
+  const Vec3f ns = (hit.perturbed ? hit.unperturbed_normal : hit.shading_normal) * side;
+  Vec3f ng_side;
+  const float amount =
+      terminator_lift_amount(d.terminator_cutoff, ns, hit.geometric_normal * side, l, ng_side);
+  SmoothTriangle t;
+  if (amount == 0.0f || !world_smooth_triangle(d, hit.primitive, t)) return hit.position;
+  const Vec3f b(1.0f - hit.bary.x - hit.bary.y, hit.bary.x, hit.bary.y);
+  return hit.position + smooth_surface_lift(t, b, ng_side) * amount;
+}
+
+namespace {
 
 // out = v / |v| when that is finite and non-zero (else out keeps its value); whether it was set.
 bool set_unit(Vec3f v, Vec3f& out) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/huge_pages.h"
+#include "core/shadow_terminator.h"
 #include "core/transform.h"
 #include "core/vec.h"
 #include "render/camera.h"
@@ -40,6 +41,7 @@ struct SurfaceHit {
   bool perturbed = false;
   Vec3f unperturbed_normal;
   uint32_t instance = 0, primitive = 0;  // index in Scene::instances, triangle in its mesh
+  Vec2f bary;  // Embree's (u, v): the weights of the triangle's second and third corners
   const ShadingInstance* shading_instance = nullptr;  // the instance as shading nodes see it
   int32_t material = -1;     // index into SceneContext::materials() (always valid after hit())
   bool front_facing = true;  // the ray came from the side geometric_normal points to
@@ -173,6 +175,15 @@ class EmbreeScene {
   // (some material reads them); other hits skip all three. Unset: none.
   void set_materials(std::span<const Material> materials);
 
+  // Where a shadow ray from `hit` towards the unit direction `l` starts, before
+  // offset_ray_origin(): the hit's position, or on smooth-shaded triangles near the shadow
+  // terminator that position lifted towards the curved surface the corner normals describe, by
+  // the instance's Instance::terminator_geometry_offset (core/shadow_terminator.h).
+  Vec3f shadow_ray_start(const SurfaceHit& hit, Vec3f l) const;
+  // Whether shadow rays from `hit` may start lifted: a smooth-shaded triangle of an instance
+  // with a Geometry Offset.
+  bool lifts_shadow_rays(const SurfaceHit& hit) const;
+
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
   size_t instanced_triangle_count() const { return instanced_triangles_; }
   // Fills the rest of a hit from (top-level geometry id, primitive, barycentrics).
@@ -254,6 +265,7 @@ class EmbreeScene {
     alignas(16) float to_world_cols[4][4] = {};
     alignas(16) float normal_cols[3][4] = {};
     const ShadingInstance* shading = nullptr;  // SurfaceHit::shading_instance
+    float terminator_cutoff = 0.0f;            // Instance::terminator_geometry_offset
   };
   RTCDevice device_ = nullptr;
   RTCScene top_ = nullptr;
@@ -261,6 +273,7 @@ class EmbreeScene {
   std::vector<RTCScene> mesh_scenes_;
   std::vector<HugePageVector<UnitNormal>> unit_normals_;  // InstanceData::unit_normals' storage
   std::vector<InstanceData> instances_;                   // indexed by top-level Embree geometry id
+  std::vector<uint32_t> top_ids_;                         // Scene::instances index -> geometry id
   std::vector<ShadingInstance> shading_instances_;        // indexed as Scene::instances
   // Replaces hit.shading_normal by what the material's normal chain (displacement, normal map,
   // bumps: MaterialDesc::bumps) makes of it (out of line: rare).
@@ -280,6 +293,9 @@ class EmbreeScene {
     return ctx;
   }
   static void set_generated_mapping(InstanceData& d, const Mesh& mesh);
+  // A smooth triangle's corners and unit shading normals in world space (Cycles lifts objects
+  // with their transform applied); false for a flat triangle.
+  static bool world_smooth_triangle(const InstanceData& d, uint32_t prim, SmoothTriangle& t);
   // The mesh attributes (SurfaceAttributes) at barycentrics (u, v) of triangle `primitive`.
   static SurfaceAttributes attributes_at(const InstanceData& d, uint32_t primitive,
                                          const uint32_t* idx, float u, float v);

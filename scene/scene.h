@@ -69,6 +69,10 @@ struct Instance {
   // Blender's Object > Visibility > Mask > Holdout: where the camera path meets it, the path
   // ends with nothing added, and with Film > Transparent the pixel's coverage drops (Cycles).
   bool holdout = false;
+  // Object > Shading > Shadow Terminator > Geometry Offset (Cycles' object setting, default 0.1):
+  // shadow rays from smooth-shaded triangles near the terminator start from the curved surface
+  // (core/shadow_terminator.h); 0 turns it off.
+  float terminator_geometry_offset = 0.1f;
 };
 
 // Blender camera. Looks down its local -Z with +Y up, like Blender.

@@ -128,7 +128,8 @@ PYBIND11_MODULE(_gdpt, m) {
            py::arg("loop_colors").noconvert() = py::none())
       .def("add_instance", &SceneBuilder::add_instance, py::arg("mesh"), py::arg("matrix"),
            py::arg("slot_material"), py::arg("pass_index") = 0,
-           py::arg("visibility") = uint32_t(kRayAll), py::arg("holdout") = false)
+           py::arg("visibility") = uint32_t(kRayAll), py::arg("holdout") = false,
+           py::arg("terminator_geometry_offset") = 0.1f)
       .def("add_material", &SceneBuilder::add_material)
       .def("add_image", &SceneBuilder::add_image, py::arg("name"), py::arg("width"),
            py::arg("height"), py::arg("rgba").noconvert(), py::arg("colorspace"))

@@ -556,15 +556,21 @@ py::dict SceneBuilder::mesh_arrays(int index) const {
 }
 
 void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
-                                int pass_index, uint32_t visibility, bool holdout) {
+                                int pass_index, uint32_t visibility, bool holdout,
+                                float terminator_geometry_offset) {
   if (mesh < 0 || size_t(mesh) >= scene_.meshes.size())
     throw std::invalid_argument("add_instance: mesh index out of range");
+  if (!(terminator_geometry_offset >= 0.0f && terminator_geometry_offset <= 1.0f))
+    throw std::invalid_argument("add_instance: terminator_geometry_offset is " +
+                                std::to_string(terminator_geometry_offset) +
+                                ", outside [0, 1] (Cycles' Shadow Terminator Geometry Offset)");
   Instance inst;
   inst.mesh = uint32_t(mesh);
   inst.object_to_world = to_transform(matrix, "instance");
   inst.pass_index = float(pass_index);
   inst.visibility = visibility;
   inst.holdout = holdout;
+  inst.terminator_geometry_offset = terminator_geometry_offset;
   inst.slot_material.reserve(py::len(slot_material));
   for (const auto& m : slot_material) {
     const int32_t index = m.cast<int32_t>();

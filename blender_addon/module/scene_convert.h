@@ -83,8 +83,11 @@ class SceneBuilder {
   // pass_index: the object's Pass Index (IndexOB pass).
   // visibility: RayKind bits of the rays that see the instance (Object > Visibility > Ray
   // Visibility).
+  // terminator_geometry_offset: Object > Shading > Shadow Terminator > Geometry Offset, in
+  // [0, 1] (Instance::terminator_geometry_offset).
   void add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
-                    int pass_index = 0, uint32_t visibility = kRayAll, bool holdout = false);
+                    int pass_index = 0, uint32_t visibility = kRayAll, bool holdout = false,
+                    float terminator_geometry_offset = 0.1f);
   int add_material(const py::dict& material);
   // rgba: (h, w, 4) or flat, row 0 at the bottom; converted to scene linear from `colorspace`
   // unless it is empty (already scene linear).

@@ -85,7 +85,7 @@ void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, cons
   float pdf_fs = 0.0f;
   bool visible = false;
   Spectrum le = ls.radiance;  // arriving: times the transmittance of delta lamps' rays
-  if (local_dir(base, ls.direction, wo)) {
+  if (light_dir(g.ctx.bvh(), base, ls.direction, wo)) {
     fs = bc.eval_pdf(base.wi, wo, pdf_fs);
     if (!is_black(fs) && !is_black(ls.radiance))
       visible = lamp_visible(g, base, ls, ls, scratch.shadow_closures, le, out.rays);
@@ -147,7 +147,7 @@ void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, cons
                ? 1.0
                : shift::light_reconnection_jacobian(light_base, o.v.hit.position);
     fo[k] = Spectrum(0.0f);
-    if (local_dir(o.v, lo[k].direction, wo_o[k])) {
+    if (light_dir(g.ctx.bvh(), o.v, lo[k].direction, wo_o[k])) {
       fo[k] = o.v.closures->eval_pdf(o.v.wi, wo_o[k], pdf_fo[k]);
       if (!is_black(fo[k]) && !is_black(lo[k].radiance)) {
         test[k] = true;

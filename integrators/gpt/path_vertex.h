@@ -8,6 +8,7 @@
 #include "core/frame.h"
 #include "integrators/common/light_path_filters.h"
 #include "integrators/common/path_state.h"
+#include "integrators/common/shadow_ray.h"
 #include "render/embree_scene.h"
 #include "render/scene_context.h"
 #include "shaders/bsdf.h"
@@ -56,6 +57,12 @@ inline bool same_side(const Vertex& v, Vec3f wi_a, Vec3f wi_b, Vec3f wo) {
 inline bool local_dir(const Vertex& v, Vec3f dir, Vec3f& wo) {
   wo = v.frame.to_local(dir);
   return v.closures->side_ok(wo, dot(dir, v.ng));
+}
+
+// The same for a light sample's direction: light_side_ok(), the path tracer's rule.
+inline bool light_dir(const EmbreeScene& bvh, const Vertex& v, Vec3f dir, Vec3f& wo) {
+  wo = v.frame.to_local(dir);
+  return light_side_ok(bvh, v.hit, *v.closures, wo, dot(dir, v.ng));
 }
 
 // What a vertex needs of a material side whose closures do not vary over the surface

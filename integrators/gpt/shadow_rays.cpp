@@ -5,8 +5,7 @@ namespace gdpt {
 bool lamp_visible(const GptContext& g, const Vertex& v, const LightSample& ls,
                   const LightSample& seen, ClosureSet& scratch, Spectrum& le, uint32_t& rays) {
   if (!ls.cast_shadow) return true;  // Light::cast_shadow off: no shadow ray
-  const Ray ray = seen.is_infinite ? shadow_ray_along(v, seen.direction, kRayShadow)
-                                   : shadow_ray_to(v, seen.direction, seen.position, kRayShadow);
+  const Ray ray = light_ray_from(g.ctx.bvh(), v, seen.direction, seen.position, seen.is_infinite);
   if (ls.is_delta && g.transparent_shadows) {
     const Spectrum tr = g.ctx.transmittance(ray, scratch, rays);
     le *= tr;

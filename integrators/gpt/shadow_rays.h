@@ -24,6 +24,16 @@ inline Ray shadow_ray_along(const Vertex& v, Vec3f dir, uint32_t kind) {
   return shadow_ray_to_infinity(ray_origin(v, dot(dir, v.ng) > 0.0f), dir, kind);
 }
 
+// From vertex `v` towards a light sample in the unit direction `dir`, to the point `target`
+// or, for `infinite`, to infinity: the path tracer's rule (light_ray_origin) at v's own hit.
+inline Ray light_ray_from(const EmbreeScene& bvh, const Vertex& v, Vec3f dir, Vec3f target,
+                          bool infinite) {
+  const Vec3f origin =
+      light_ray_origin(bvh, v.hit, v.ng, dir, ray_origin(v, dot(dir, v.ng) > 0.0f));
+  return infinite ? shadow_ray_to_infinity(origin, dir, kRayShadow)
+                  : shadow_ray_to_point(origin, target, kRayShadow);
+}
+
 // An occlusion query. `kind` of the ray: kRayShadow for light samples; a reconnected segment is
 // the kind of the base's segment it replaces (RayKind, Instance::visibility).
 inline bool occluded(const GptContext& g, const Ray& ray, uint32_t& rays) {

@@ -307,12 +307,14 @@ class PathTracer final : public Integrator {
     const Vec3f wo = frame.to_local(ls.direction);
     const float cos_ng = dot(ls.direction, ng);
     // The geometric and shading hemispheres must agree, or light leaks through the surface.
-    if (!closures.side_ok(wo, cos_ng)) return nee;
+    if (!light_side_ok(ctx_.bvh(), hit, closures, wo, cos_ng)) return nee;
     float bsdf_pdf;
     const Spectrum f = closures.eval_pdf(wi, wo, bsdf_pdf);
     if (is_black(f)) return nee;
-    const Vec3f origin =
-        offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng, ctx_.bvh().offset_scale());
+    const EmbreeScene& bvh = ctx_.bvh();
+    const Vec3f plain =
+        offset_ray_origin(hit.position, cos_ng > 0.0f ? ng : -ng, bvh.offset_scale());
+    const Vec3f origin = light_ray_origin(bvh, hit, ng, ls.direction, plain);
     nee.ray = ls.is_infinite ? shadow_ray_to_infinity(origin, ls.direction, kRayShadow)
                              : shadow_ray_to_point(origin, ls.position, kRayShadow);
     nee.pending = true;

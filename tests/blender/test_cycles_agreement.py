@@ -1142,6 +1142,27 @@ def case_smooth_silhouettes(scene):
     return 1
 
 
+def case_shadow_terminator(scene):
+    # Object > Shading > Shadow Terminator > Geometry Offset: two smooth-shaded 8x6-segment UV
+    # spheres side by side under a high sun, the terminator running across each below its
+    # middle. There the light is below a facet but above its smooth shading; Cycles starts those
+    # shadow rays from the curved surface and lights them (Cycles' default offset 0.1 on the
+    # left sphere, 0.5 on the right one). A strong sun keeps the terminator's pixels well above
+    # relMSE's epsilon.
+    S.camera((0, -4, 0), (0, 0, 0), lens=45)
+    m = S.diffuse("matte", (0.8, 0.8, 0.8))
+    for x, offset in ((-0.75, 0.1), (0.75, 0.5)):
+        bpy.ops.mesh.primitive_uv_sphere_add(segments=8, ring_count=6, radius=0.7,
+                                             location=(x, 0, 0))
+        bpy.ops.object.shade_smooth()
+        ball = bpy.context.active_object
+        ball.data.materials.append(m)
+        ball.cycles.shadow_terminator_geometry_offset = offset
+    S.light('SUN', (1, 0.5, 5), 10.0, target=(0, 0, 0))
+    scene.world.color = (0.02, 0.02, 0.02)
+    return 1
+
+
 def case_dof(scene):
     lit_room(scene)
     area_ceiling()
@@ -1940,6 +1961,7 @@ FLOORS = {
     "world_hdri/GPT": (1.5e-4, 6.7e-4), "subsurface/GPT": (5.4e-4, 1.3e-3),
     "refractive_caustics_off/GPT": (3.5e-3, 1.1e-2), "object_nodes/GPT": (2.0e-3, 3.4e-3),
     "beckmann_glossy/GPT": (3.9e-3, 7.3e-3), "beckmann_glass/GPT": (6.0e-3, 3.3e-2),
+    "shadow_terminator/GPT": (2.0e-4, 1.3e-3),
 }
 FLOOR_FACTOR = 3.0
 DEFAULT_COUNTS = (GDPT_SAMPLES, CYCLES_SAMPLES) == (128, 256)

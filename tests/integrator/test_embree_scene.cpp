@@ -299,6 +299,61 @@ TEST(EmbreeScene, ManyInstancesShareOneMesh) {
   }
 }
 
+// The right triangle of test_shadow_terminator.cpp (x, y in [0, 1], z = 0) with its tilted
+// vertex normals: at the centroid the lift towards the curved surface is 0.28 times the
+// interpolated normal (0.04, 0.08, 0.8), taken whole by a light along +x (at the terminator).
+Mesh tilted_triangle() {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  m.indices = {0, 1, 2};
+  m.vertex_normals = {{-0.48f, -0.36f, 0.8f}, {0.6f, 0, 0.8f}, {0, 0.6f, 0.8f}};
+  return m;
+}
+
+TEST(EmbreeScene, ShadowRaysStartOnTheCurvedSurfaceOfSmoothTriangles) {
+  // One placement (flattened to world space) and two of another copy (two-level instancing),
+  // scaled by 2: the lift scales with the object, as Cycles' object-space lift does.
+  Scene scene;
+  scene.meshes = {tilted_triangle(), tilted_triangle(), tilted_triangle()};
+  Instance flat_placed;
+  flat_placed.mesh = 0;
+  flat_placed.object_to_world = translate_scale({5, 0, 0}, {1, 1, 1});
+  scene.instances.push_back(flat_placed);
+  for (float y : {10.0f, 20.0f}) {
+    Instance inst;
+    inst.mesh = 1;
+    inst.object_to_world = translate_scale({0, y, 0}, {2, 2, 2});
+    scene.instances.push_back(inst);
+  }
+  Instance off = flat_placed;  // Geometry Offset 0: no lift
+  off.mesh = 2;
+  off.object_to_world = translate_scale({-5, 0, 0}, {1, 1, 1});
+  off.terminator_geometry_offset = 0.0f;
+  scene.instances.push_back(off);
+  EmbreeScene bvh(scene, 0);
+  const Vec3f lift = Vec3f(0.04f, 0.08f, 0.8f) * 0.28f, light(1, 0, 0);
+  const float third = 1.0f / 3.0f;
+  struct Case {
+    Vec3f at;
+    float scale;
+  };
+  for (const Case& c :
+       {Case{{5 + third, third, 0}, 1.0f}, Case{{2 * third, 10 + 2 * third, 0}, 2.0f},
+        Case{{2 * third, 20 + 2 * third, 0}, 2.0f}}) {
+    SurfaceHit hit;
+    ASSERT_TRUE(bvh.intersect(down(c.at.x, c.at.y), hit));
+    EXPECT_TRUE(bvh.lifts_shadow_rays(hit));
+    const Vec3f start = bvh.shadow_ray_start(hit, light);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(start[k], c.at[k] + c.scale * lift[k], 2e-5f) << k;
+    // Well above the terminator (light straight up): no lift.
+    EXPECT_EQ(bvh.shadow_ray_start(hit, Vec3f(0, 0, 1)), hit.position);
+  }
+  SurfaceHit hit;
+  ASSERT_TRUE(bvh.intersect(down(-5 + third, third), hit));
+  EXPECT_FALSE(bvh.lifts_shadow_rays(hit));
+  EXPECT_EQ(bvh.shadow_ray_start(hit, light), hit.position);
+}
+
 TEST(EmbreeScene, MirroringTransformsKeepTheObjectSpaceFrontFace) {
   // The quad faces +z in object space; mirrored in x its inverse-transpose normal still faces +z
   // (Cycles keeps the object's orientation for negatively scaled objects), although the world
