@@ -4,6 +4,9 @@
 # cached GDPT PT reference (bench/results/cache/<scene>_320x240/ref_pt_{1,2}_40s.exr, made by
 # `make bench`). Sample counts default to what G-PT reached in 40 s in the committed report.
 #   /usr/bin/python3 bench/reconstruct/feature_vs_l1.py --build build [--scenes a,b] [--cache DIR]
+#                                                         [--resolve]
+# --resolve: no rendering; the renders already in --out are solved again with both norms (for a
+# change to the reconstruction alone).
 # Prints one line per scene and writes bench/results/feature_vs_l1.json.
 import argparse
 import json
@@ -33,9 +36,11 @@ def main():
     p.add_argument("--scenes", default=",".join(SCENES))
     p.add_argument("--cache", default=os.path.join(ROOT, "bench", "results", "cache"))
     p.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "feature_vs_l1"))
+    p.add_argument("--resolve", action="store_true",
+                   help="solve the renders already in --out again instead of rendering")
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
-    blender = R.Blender(args.build)
+    blender = None if args.resolve else R.Blender(args.build)
     rows = []
     try:
         for scene in args.scenes.split(","):
@@ -43,15 +48,18 @@ def main():
             refs = [R.rgb(os.path.join(cache, f"ref_pt_{i}_40s.exr")) for i in (1, 2)]
             spp = samples_at_40s(scene)
             path = os.path.join(args.out, f"{scene}.exr")
-            info = R.render(blender, os.path.join(cache, f"{scene}.blend"), "gpt_feature", path,
-                            samples=spp, seed=7)
-            feature = R.rgb(path)
+            if args.resolve:
+                info = {"samples": spp}
+            else:
+                info = R.render(blender, os.path.join(cache, f"{scene}.blend"), "gpt_feature",
+                                path, samples=spp, seed=7)
             t0 = time.perf_counter()
             l1, _ = R.solve(args.build, path, "l1", path[:-4] + "_l1.exr")
             t_l1 = time.perf_counter() - t0
             t0 = time.perf_counter()
-            R.solve(args.build, path, "feature", path[:-4] + "_feature.exr")
+            solved, _ = R.solve(args.build, path, "feature", path[:-4] + "_feature.exr")
             t_feature = time.perf_counter() - t0
+            feature = solved if args.resolve else R.rgb(path)
             row = {"scene": scene, "samples": info["samples"],
                    "relmse_l1": M.rel_mse_denoised(l1, *refs),
                    "relmse_feature": M.rel_mse_denoised(feature, *refs),
@@ -62,7 +70,8 @@ def main():
                   f"Feature {row['relmse_feature']:.3e}  L1 / Feature {row['l1_over_feature']:.2f}x"
                   f"  (gdpt-reconstruct {t_l1:.1f} s / {t_feature:.1f} s)", flush=True)
     finally:
-        blender.close()
+        if blender:
+            blender.close()
     with open(os.path.join(ROOT, "bench", "results", "feature_vs_l1.json"), "w") as f:
         json.dump(rows, f, indent=1)
 

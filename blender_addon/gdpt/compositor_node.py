@@ -629,7 +629,7 @@ class GDPTReconstructNode(bpy.types.CompositorNodeCustomGroup):
         items=[('L1', "L1", "Robust iteratively reweighted solve (fewer outliers, slightly "
                 "biased)"),
                ('L2', "L2", "Unbiased screened Poisson solve (exact DCT)"),
-               ('FEATURE', "Feature", "Per-pixel regression on the feature passes, guided by L1 "
+               ('FEATURE', "Feature", "L1 filtered by feature-guided filters, chosen per pixel "
                 "(Render Layers of a render with the Feature reconstruction)")],
         default='L1', update=_update_setting)
 

@@ -64,9 +64,9 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
         items=[('L1', "L1", "Robust iteratively reweighted solve (fewer outliers, slightly biased)"),
                ('L2', "L2", "Unbiased screened Poisson solve (exact DCT)"),
                ('WEIGHTED', "Variance Weighted", "Each term weighted by its per-pixel variance"),
-               ('FEATURE', "Feature", "Per-pixel regression on the Denoising Albedo, Normal and "
-                "Depth passes and the L1 solution, from two halves of the samples (renders "
-                "those passes too)"),
+               ('FEATURE', "Feature", "The L1 solution filtered by filters guided by the Denoising "
+                "Albedo, Normal and Depth passes, chosen per pixel by an error estimate from two "
+                "halves of the samples (renders those passes too)"),
                ('NONE', "None", "Combined = Primal + Emission")],
         default='L1')
     alpha: FloatProperty(
