@@ -214,9 +214,10 @@ struct InputNode {
 };
 
 enum class ShaderNodeKind : uint8_t {
-  Diffuse,      // Blender Diffuse BSDF: Lambert (roughness 0) or Oren-Nayar (roughness > 0)
-  Glossy,       // Blender Glossy BSDF, GGX or Beckmann (no Fresnel; colour scales), alpha = r^2
-  Glass,        // Blender Glass BSDF, GGX or Beckmann dielectric; roughness 0 = smooth (delta)
+  Diffuse,  // Blender Diffuse BSDF: Lambert (roughness 0) or Oren-Nayar (roughness > 0)
+  Glossy,   // Blender Glossy BSDF, GGX, Beckmann or Ashikhmin-Shirley (no Fresnel; colour scales),
+            // alpha = r^2
+  Glass,    // Blender Glass BSDF, GGX or Beckmann dielectric; roughness 0 = smooth (delta)
   Principled,   // Blender 3.4 Principled BSDF v1
   Emission,     // colour * strength (radiance, W/m^2/sr per unit strength as in Cycles)
   Transparent,  // straight-through transmission, colour scales
@@ -248,9 +249,10 @@ struct ShaderNode {
   ColorInput color;       // base colour for every BSDF, emission colour for Emission
   FloatInput roughness;   // Diffuse, Glossy, Glass, Principled
   FloatInput ior{1.45f};  // Glass, Principled
-  MicrofacetDistribution distribution = MicrofacetDistribution::GGX;  // Glossy, Glass, Refraction
-  FloatInput strength{1.0f};                                          // Emission
-  FloatInput fac{0.5f};                                               // Mix
+  MicrofacetDistribution distribution =
+      MicrofacetDistribution::GGX;  // Glossy, Glass, Refraction, Anisotropic
+  FloatInput strength{1.0f};        // Emission
+  FloatInput fac{0.5f};             // Mix
   // Mix / Add children (indices into Material::nodes); -1: an unlinked shader input, no closure
   // (black, as Cycles).
   int32_t a = -1, b = -1;

@@ -115,8 +115,9 @@ struct VectorTransformDesc {
 };
 
 // The microfacet distribution of Blender's Glossy, Glass and Refraction BSDFs
-// (shaders/microfacet.h).
-enum class MicrofacetDistribution : uint8_t { GGX, Beckmann };
+// (shaders/microfacet.h); AshikhminShirley: Glossy and Anisotropic only
+// (shaders/ashikhmin_shirley.h).
+enum class MicrofacetDistribution : uint8_t { GGX, Beckmann, AshikhminShirley };
 
 struct BrickDesc {
   float offset = 0.5f;

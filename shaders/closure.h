@@ -53,15 +53,17 @@ struct Closure {
   ClosureType type = ClosureType::Lambert;
   FresnelMode fresnel = FresnelMode::None;
   // GGXReflection, GGXDielectric: the microfacet distribution (Blender's Glossy, Glass and
-  // Refraction BSDFs offer Beckmann; Principled is GGX).
+  // Refraction BSDFs offer Beckmann; Principled is GGX; GGXReflection alone may be
+  // Ashikhmin-Shirley, isotropic or anisotropic).
   MicrofacetDistribution distribution = MicrofacetDistribution::GGX;
   Spectrum weight{1.0f, 1.0f, 1.0f};  // colour * mix weight
   float alpha = 0.0f;                 // microfacet alpha (= Blender roughness^2); diffuse roughness
-  // Anisotropic GGX (GGXReflection, distribution GGX): alpha is the width along the lobe's tangent,
-  // alpha_y along its bitangent; alpha_y < 0: isotropic. The lobe's tangent is local (rotation.x,
-  // rotation.y, 0): the shading frame's x axis follows `tangent` (world; the material's Tangent
-  // input, neither projected nor rotated: shading_frame() in integrators/common/surface_frame.h),
-  // and `rotation` is (cos, sin) of the Anisotropic Rotation about the normal from there.
+  // Anisotropic GGX (GGXReflection, distribution GGX or AshikhminShirley): alpha is the width along
+  // the lobe's tangent, alpha_y along its bitangent; alpha_y < 0: isotropic. The lobe's tangent is
+  // local (rotation.x, rotation.y, 0): the shading frame's x axis follows `tangent` (world; the
+  // material's Tangent input, neither projected nor rotated: shading_frame() in
+  // integrators/common/surface_frame.h), and `rotation` is (cos, sin) of the Anisotropic Rotation
+  // about the normal from there.
   float alpha_y = -1.0f;
   Vec2f rotation{1.0f, 0.0f};
   Vec3f tangent{0.0f, 0.0f, 0.0f};
@@ -90,9 +92,13 @@ inline bool is_anisotropic(const Closure& c) {
 inline float min_alpha(const Closure& c) {
   return is_anisotropic(c) ? std::min(c.alpha, c.alpha_y) : c.alpha;
 }
-// The width tested for a perfect mirror: Cycles' alpha_x alpha_y <= 1e-7.
+// The width tested for a perfect mirror: Cycles' alpha_x alpha_y <= 1e-7 (Ashikhmin-Shirley: the
+// wider of the two, as Cycles tests max(alpha_x, alpha_y)).
 inline float mirror_test_alpha(const Closure& c) {
-  return is_anisotropic(c) ? std::sqrt(c.alpha * c.alpha_y) : c.alpha;
+  if (!is_anisotropic(c)) return c.alpha;
+  if (c.distribution == MicrofacetDistribution::AshikhminShirley)
+    return std::max(c.alpha, c.alpha_y);
+  return std::sqrt(c.alpha * c.alpha_y);
 }
 
 enum LobeFlags : uint8_t {

@@ -613,6 +613,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       const float r = saturate(in.scalar(n.roughness));
       c.type = ClosureType::GGXReflection;
       c.fresnel = FresnelMode::None;
+      c.distribution = n.distribution;
       set_anisotropy(c, r * r, std::clamp(in.scalar(n.anisotropy), -0.99f, 0.99f));
       if (is_anisotropic(c)) orient(c, in.tangent(n.tangent), in.scalar(n.rotation));
       c.weight = in.color(n.color) * w;

@@ -42,7 +42,10 @@ _NO_TRANSPORT = "subsurface scattering, rendered as diffuse (no subsurface trans
 _GGX_LIKE = {'GGX', 'SHARP'}
 # The Glossy, Glass and Refraction BSDFs' distributions the core renders as Cycles does (Sharp is
 # GGX at roughness 0); the others (Multiscatter GGX, Ashikhmin-Shirley) render as GGX, reported.
-_MICROFACET = {'GGX': 'GGX', 'SHARP': 'GGX', 'BECKMANN': 'BECKMANN'}
+_MICROFACET = {'GGX': 'GGX', 'SHARP': 'GGX', 'BECKMANN': 'BECKMANN',
+               'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY'}
+# The Anisotropic BSDF's distributions rendered as Cycles does (its Beckmann is rendered as GGX).
+_ANISOTROPIC = {'GGX': 'GGX', 'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',
@@ -243,10 +246,11 @@ class _Translator:
                           "normal_linked": linked})
 
     def _bsdf_anisotropic(self, n):
-        if n.distribution != 'GGX':
+        if n.distribution not in _ANISOTROPIC:
             self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
         linked = self.normal(n.inputs["Normal"])
         return self._add({"kind": "ANISOTROPIC", "color": self.color(n.inputs["Color"]),
+                          "distribution": _ANISOTROPIC.get(n.distribution, 'GGX'),
                           "roughness": self.value(n.inputs["Roughness"]),
                           "anisotropy": self.value(n.inputs["Anisotropy"]),
                           "rotation": self.value(n.inputs["Rotation"]),

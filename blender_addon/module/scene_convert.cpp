@@ -617,9 +617,16 @@ int SceneBuilder::add_material(const py::dict& material) {
       read_float(d, "roughness", node.roughness);
       read_float(d, "ior", node.ior);
       static const std::pair<const char*, MicrofacetDistribution> kDistributions[] = {
-          {"GGX", MicrofacetDistribution::GGX}, {"BECKMANN", MicrofacetDistribution::Beckmann}};
+          {"GGX", MicrofacetDistribution::GGX},
+          {"BECKMANN", MicrofacetDistribution::Beckmann},
+          {"ASHIKHMIN_SHIRLEY", MicrofacetDistribution::AshikhminShirley}};
       node.distribution =
           get_enum(d, "distribution", "GGX", kDistributions, "microfacet distribution");
+      // Blender offers Ashikhmin-Shirley on the Glossy and Anisotropic BSDFs only.
+      if (node.distribution == MicrofacetDistribution::AshikhminShirley &&
+          node.kind != ShaderNodeKind::Glossy && node.kind != ShaderNodeKind::Anisotropic)
+        throw std::invalid_argument("microfacet distribution 'ASHIKHMIN_SHIRLEY' on a " +
+                                    get_str(d, "kind", "DIFFUSE") + " node");
       read_float(d, "strength", node.strength);
       read_float(d, "fac", node.fac);
       get(d, "a", node.a);

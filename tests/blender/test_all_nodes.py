@@ -154,9 +154,9 @@ def main():
     geometry_outputs_translate(builder, images, export_materials)
     print(f"{len(materials)} materials, {reported} with warnings", flush=True)
 
-    # Microfacet distributions: Beckmann is rendered as Cycles does, silently; Multiscatter GGX
-    # and Ashikhmin-Shirley are rendered as GGX, reported. The Anisotropic BSDF is GGX only (no
-    # distribution exported): its Beckmann is reported.
+    # Microfacet distributions: Beckmann and Ashikhmin-Shirley are rendered as Cycles does,
+    # silently; Multiscatter GGX is rendered as GGX, reported. The Anisotropic BSDF exports GGX or
+    # Ashikhmin-Shirley; its Beckmann and Multiscatter GGX are rendered as GGX, reported.
     for node_type, distribution, exported, warned in (
             ("ShaderNodeBsdfGlossy", 'BECKMANN', 'BECKMANN', False),
             ("ShaderNodeBsdfGlass", 'BECKMANN', 'BECKMANN', False),
@@ -164,9 +164,11 @@ def main():
             ("ShaderNodeBsdfGlossy", 'GGX', 'GGX', False),
             ("ShaderNodeBsdfGlass", 'SHARP', 'GGX', False),
             ("ShaderNodeBsdfGlass", 'MULTI_GGX', 'GGX', True),
-            ("ShaderNodeBsdfGlossy", 'ASHIKHMIN_SHIRLEY', 'GGX', True),
-            ("ShaderNodeBsdfAnisotropic", 'GGX', None, False),
-            ("ShaderNodeBsdfAnisotropic", 'BECKMANN', None, True)):
+            ("ShaderNodeBsdfGlossy", 'MULTI_GGX', 'GGX', True),
+            ("ShaderNodeBsdfGlossy", 'ASHIKHMIN_SHIRLEY', 'ASHIKHMIN_SHIRLEY', False),
+            ("ShaderNodeBsdfAnisotropic", 'GGX', 'GGX', False),
+            ("ShaderNodeBsdfAnisotropic", 'ASHIKHMIN_SHIRLEY', 'ASHIKHMIN_SHIRLEY', False),
+            ("ShaderNodeBsdfAnisotropic", 'BECKMANN', 'GGX', True)):
         m = S.shader_material(f"{node_type}:{distribution}", node_type, distribution=distribution)
         warnings = []
         d = export_materials.translate_material(m, images, warnings.append)

@@ -250,6 +250,18 @@ TEST(GradientUnbiased, BeckmannGlossyReconnectedAndHalfVector) {
   }
 }
 
+// Ashikhmin-Shirley lobes take the same shifts: its own value and density at the reconnected
+// vertex (roughness 0.3) and at the half-vector copy's offset (0.02, a lobe of exponent 1.2e7).
+TEST(GradientUnbiased, AshikhminShirleyGlossyReconnectedAndHalfVector) {
+  for (float roughness : {0.3f, 0.02f}) {
+    Scene scene = make_scene(SceneKind::CornellGlossy, 16, roughness);
+    scene.materials[3].nodes[0].distribution = MicrofacetDistribution::AshikhminShirley;
+    const bool rough = roughness > 0.1f;
+    expect_unbiased(rough ? "ashikhmin-rough" : "ashikhmin-smooth", scene, 4096, 1024,
+                    rough ? 0.25f : 0.29f);
+  }
+}
+
 // Anisotropic GGX on the ball with Cycles' default tangent, radial about the ball's Z axis (which
 // faces the camera): alpha 0.0005 across the tangent makes its vertices specular (half-vector
 // copy) while alpha 0.2 along it spreads the reflection. Each path's vertex has its own tangent

@@ -74,6 +74,11 @@ inline Closure glass(float alpha, float ior, Spectrum c = Spectrum(1.0f)) {
   k.ior = ior;
   return k;
 }
+// A Glossy or Anisotropic lobe (ggx, aniso_ggx) with Blender's Ashikhmin-Shirley distribution.
+inline Closure ashikhmin_shirley(Closure k) {
+  k.distribution = MicrofacetDistribution::AshikhminShirley;
+  return k;
+}
 // A Glossy, Glass or Refraction lobe with Blender's Beckmann distribution instead of GGX.
 inline Closure beckmann(Closure k) {
   k.distribution = MicrofacetDistribution::Beckmann;

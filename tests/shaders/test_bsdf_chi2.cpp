@@ -44,7 +44,13 @@ std::vector<Case> lobe_cases() {
     cases.push_back({"Clearcoat" + s, set_of({clearcoat(a)})});
     cases.push_back({"Beckmann" + s, set_of({beckmann(ggx(a))})});
     cases.push_back({"BeckmannGlass" + s, set_of({beckmann(glass(a, 1.5f))})});
+    cases.push_back({"AshikhminShirley" + s, set_of({ashikhmin_shirley(ggx(a))})});
   }
+  // Ashikhmin-Shirley anisotropic: the quadrant-wise azimuth sampler, either width the wider.
+  cases.push_back(
+      {"AshikhminShirley05x40", set_of({ashikhmin_shirley(aniso_ggx(0.05f, 0.4f, 0.3f))})});
+  cases.push_back(
+      {"AshikhminShirley50x10", set_of({ashikhmin_shirley(aniso_ggx(0.5f, 0.1f, 2.0f))})});
   // Glass with one part dropped (Cycles' caustics toggles): the other part alone.
   for (const bool reflection : {true, false}) {
     Closure g = glass(0.2f, 1.5f);

@@ -61,6 +61,9 @@ TEST(BsdfEnergy, SampleWeightsIntegrateEval) {
       set_of({beckmann(ggx(1.0f))}),
       set_of({beckmann(glass(0.3f, 1.5f))}),
       set_of({aniso_ggx(0.05f, 0.6f, 0.4f)}),
+      set_of({ashikhmin_shirley(ggx(0.3f))}),
+      set_of({ashikhmin_shirley(ggx(1.0f))}),
+      set_of({ashikhmin_shirley(aniso_ggx(0.05f, 0.6f, 0.4f))}),
   };
   for (size_t i = 0; i < std::size(sets); ++i) {
     for (float c : {0.9f, 0.4f, -0.5f}) {
@@ -94,7 +97,9 @@ TEST(BsdfReciprocity, ReflectionLobesAreSymmetric) {
                            ggx_principled(0.15f, 1.6f, Spectrum(0.7f, 0.4f, 0.2f)),
                            clearcoat(0.1f),
                            beckmann(ggx(0.3f)),
-                           aniso_ggx(0.08f, 0.5f, 1.2f)};
+                           aniso_ggx(0.08f, 0.5f, 1.2f),
+                           ashikhmin_shirley(ggx(0.3f)),
+                           ashikhmin_shirley(aniso_ggx(0.08f, 0.5f, 1.2f))};
   Pcg32 rng(3);
   for (const Closure& c : lobes) {
     const ClosureSet set = set_of({c});
@@ -535,6 +540,8 @@ TEST(BsdfRobustness, NoNaNOrInfInDegenerateConfigurations) {
     lobes.push_back(beckmann(ggx(a)));
     lobes.push_back(beckmann(glass(a, 1.5f)));
     lobes.push_back(beckmann(refraction(a, 1.5f)));
+    lobes.push_back(ashikhmin_shirley(ggx(a)));
+    lobes.push_back(ashikhmin_shirley(aniso_ggx(a, 0.3f)));
     lobes.push_back(clearcoat(a));
     lobes.push_back(kept(clearcoat(a)));
   }
