@@ -3,6 +3,7 @@
 // Sampling against the density is in test_bsdf_chi2 (MultiscatterLobe*, MultiscatterGGX*).
 #include <gtest/gtest.h>
 
+#include "shaders/material.h"
 #include "testing/chi2.h"
 #include "tests/shaders/lobe_factory.h"
 
@@ -69,6 +70,51 @@ TEST(GgxMultiscatter, FresnelColourFactor) {
   EXPECT_NEAR(f.y, 0.25f * e_avg / (1.0f - 0.5f * (1.0f - e_avg)), 1e-6f);
   EXPECT_LT(f.y, 0.5f);
   EXPECT_EQ(f.z, 0.0f);
+}
+
+// A one-node material with the Multiscatter GGX distribution, roughness r, colour c.
+ClosureSet multiscatter_material(ShaderNodeKind kind, float r, Spectrum c) {
+  ShaderNode n;
+  n.kind = kind;
+  n.color = ColorInput(c);
+  n.roughness = FloatInput(r);
+  n.metallic = FloatInput(1.0f);
+  n.distribution = MicrofacetDistribution::MultiscatterGGX;
+  MaterialDesc d;
+  d.nodes = {n};
+  d.root = 0;
+  ClosureSet s;
+  Material(d, {}).evaluate(ShadingContext{{0.25f, 0.25f}, true}, s);
+  return s;
+}
+
+// The Glossy BSDF: its GGX lobe, coloured, and the compensation of Kulla-Conty's colour for
+// F_avg = the colour; white, the pair reflects all light.
+TEST(GgxMultiscatter, GlossyNodeAddsTheLobe) {
+  const Spectrum c(1.0f, 0.5f, 0.2f);
+  const ClosureSet s = multiscatter_material(ShaderNodeKind::Glossy, 0.6f, c);
+  ASSERT_EQ(s.count(), 2);
+  EXPECT_EQ(s[0].type, ClosureType::GGXReflection);
+  EXPECT_EQ(s[0].distribution, MicrofacetDistribution::GGX);
+  EXPECT_EQ(s[1].type, ClosureType::GGXMultiscatter);
+  EXPECT_NEAR(s[1].alpha, 0.36f, 1e-6f);
+  const Spectrum f = ggx_multiscatter::multiscatter_fresnel(c, ggx_average_albedo(0.36f));
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[1].weight[k], f[k], 1e-6f);
+  for (float mu : kIncidentCos)
+    EXPECT_NEAR(albedo(multiscatter_material(ShaderNodeKind::Glossy, 0.6f, Spectrum(1.0f)),
+                       incident(mu)),
+                1.0, 0.02);
+}
+
+// Principled, white metal: Fresnel 1 at every angle, so the specular pair reflects all light.
+TEST(GgxMultiscatter, PrincipledWhiteMetalPassesTheFurnace) {
+  for (float r : kRoughness)
+    for (float mu : kIncidentCos) {
+      const ClosureSet s = multiscatter_material(ShaderNodeKind::Principled, r, Spectrum(1.0f));
+      ASSERT_EQ(s.count(), 2);
+      EXPECT_EQ(s[1].type, ClosureType::GGXMultiscatter);
+      EXPECT_NEAR(albedo(s, incident(mu)), 1.0, 0.02) << "roughness " << r << " cos_i " << mu;
+    }
 }
 
 }  // namespace
