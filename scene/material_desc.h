@@ -250,7 +250,7 @@ struct ShaderNode {
   FloatInput roughness;   // Diffuse, Glossy, Glass, Principled
   FloatInput ior{1.45f};  // Glass, Principled
   MicrofacetDistribution distribution =
-      MicrofacetDistribution::GGX;  // Glossy, Glass, Refraction, Anisotropic
+      MicrofacetDistribution::GGX;  // Glossy, Glass, Refraction, Anisotropic, Principled
   FloatInput strength{1.0f};        // Emission
   FloatInput fac{0.5f};             // Mix
   // Mix / Add children (indices into Material::nodes); -1: an unlinked shader input, no closure

@@ -31,6 +31,9 @@ enum class ClosureType : uint8_t {
   // Microfacet reflection (GGX or Closure::distribution) with the Fresnel mode below (Glossy:
   // none; Principled specular: Schlick mix)
   GGXReflection,
+  // The light a GGX reflection lobe (of the same alpha) loses to multiple scattering, returned as
+  // a smooth lobe (bsdf_ggx_multiscatter.h): Blender's Multiscatter GGX, reflection
+  GGXMultiscatter,
   // Microfacet glass (GGX or Closure::distribution): reflection + refraction by dielectric
   // Fresnel; alpha 0 = smooth
   GGXDielectric,

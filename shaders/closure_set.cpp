@@ -11,6 +11,7 @@
 #include "shaders/bsdf.h"
 #include "shaders/bsdf_clearcoat.h"
 #include "shaders/bsdf_ggx_dielectric.h"
+#include "shaders/bsdf_ggx_multiscatter.h"
 #include "shaders/bsdf_ggx_reflection.h"
 #include "shaders/bsdf_lambert.h"
 #include "shaders/bsdf_oren_nayar.h"
@@ -37,6 +38,8 @@ namespace {
       return principled_sheen::call;     \
     case ClosureType::GGXReflection:     \
       return ggx_reflection::call;       \
+    case ClosureType::GGXMultiscatter:   \
+      return ggx_multiscatter::call;     \
     case ClosureType::GGXDielectric:     \
       return ggx_dielectric::call;       \
     case ClosureType::Clearcoat:         \
@@ -434,7 +437,9 @@ float ClosureSet::roughness() const {
     const Closure& c = closures_[i];
     if (lobe_is_delta(c) && !(c.type == ClosureType::GGXDielectric && !is_delta_alpha(c.alpha)))
       continue;
-    r = std::min(r, lobe_is_diffuse(c) ? 1.0f : std::clamp(min_alpha(c), 0.0f, 1.0f));
+    // The multiple-scattering lobe is as smooth as a diffuse one.
+    const bool smooth = lobe_is_diffuse(c) || c.type == ClosureType::GGXMultiscatter;
+    r = std::min(r, smooth ? 1.0f : std::clamp(min_alpha(c), 0.0f, 1.0f));
   }
   return r > 1.0f ? (count_ > 0 && has_delta() ? 0.0f : 1.0f) : r;
 }

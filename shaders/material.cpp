@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "shaders/bsdf_ggx_multiscatter.h"
 #include "shaders/curves_node.h"
 #include "shaders/math_node.h"
 #include "shaders/microfacet.h"
@@ -605,7 +606,17 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       c.fresnel = FresnelMode::None;
       c.distribution = n.distribution;
       c.alpha = r * r;
-      c.weight = in.color(n.color) * w;
+      const Spectrum color = in.color(n.color);
+      c.weight = color * w;
+      if (n.distribution != MicrofacetDistribution::MultiscatterGGX) {
+        out.add(c);
+        return;
+      }
+      c.distribution = MicrofacetDistribution::GGX;
+      out.add(c);
+      c.type = ClosureType::GGXMultiscatter;
+      // No Fresnel: the colour is the lobe's average reflectance.
+      c.weight = ggx_multiscatter::multiscatter_fresnel(color, ggx_average_albedo(c.alpha)) * w;
       out.add(c);
       return;
     }
@@ -680,6 +691,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       p.front_facing = in.front_facing();
       p.interpolated_normal = !n.normal_linked;
       p.clearcoat_interpolated_normal = !n.clearcoat_normal_linked;
+      p.multiscatter = n.distribution == MicrofacetDistribution::MultiscatterGGX;
       p.anisotropic = in.scalar(n.anisotropy);
       if (p.anisotropic != 0.0f) {
         Closure oriented;

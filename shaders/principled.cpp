@@ -3,11 +3,35 @@
 #include <algorithm>
 #include <cmath>
 
+#include "shaders/bsdf_ggx_multiscatter.h"
+#include "shaders/fresnel.h"
+
 namespace gdpt {
 
 namespace {
 // Cycles drops closures lighter than this (CLOSURE_WEIGHT_CUTOFF).
 constexpr float kWeightCutoff = 1e-5f;
+
+// The specular lobe's multiple-scattering lobe, coloured by the cosine average of its Fresnel
+// colour: cspec0 (1 - fh_avg) + fh_avg, fh_avg that of the normalised dielectric Fresnel. An
+// anisotropic lobe is compensated as the isotropic one of the same area, sqrt(alpha_x alpha_y).
+Closure principled_multiscatter(const Closure& s) {
+  constexpr int kSteps = 32;
+  const PrincipledFresnel white(s.ior, Spectrum(0.0f));
+  float fh = 0.0f;
+  for (int i = 0; i < kSteps; ++i) {
+    const float mu = (float(i) + 0.5f) / float(kSteps);
+    fh += white(mu).x * mu;
+  }
+  fh *= 2.0f / float(kSteps);
+  Closure m;
+  m.type = ClosureType::GGXMultiscatter;
+  m.alpha = is_anisotropic(s) ? std::sqrt(s.alpha * s.alpha_y) : s.alpha;
+  const Spectrum f_avg = s.f0 * (1.0f - fh) + Spectrum(fh);
+  m.weight = s.weight * ggx_multiscatter::multiscatter_fresnel(f_avg, ggx_average_albedo(m.alpha));
+  m.interpolated_normal = s.interpolated_normal;
+  return m;
+}
 
 }  // namespace
 
@@ -88,6 +112,7 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
     s.f0 = saturate(tint * (specular * 0.08f * (1.0f - metallic)) + base * metallic);
     s.interpolated_normal = p.interpolated_normal;
     out.add(s);
+    if (p.multiscatter) out.add(principled_multiscatter(s));
   }
 
   // --- Transmission (GGX glass; reflection part Fresnel-blended, refraction tinted by base).

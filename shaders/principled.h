@@ -54,6 +54,8 @@ struct PrincipledParams {
   // Closure::interpolated_normal of the base lobes and of the clearcoat.
   bool interpolated_normal = false;
   bool clearcoat_interpolated_normal = false;
+  // Blender's Multiscatter GGX: the specular lobe gets its multiple-scattering lobe.
+  bool multiscatter = false;
 };
 
 void add_principled_closures(const PrincipledParams& p, float mix_weight, ClosureSet& out);

@@ -39,11 +39,14 @@ _SHADERS = {
 # Cycles turns a BSSRDF channel of a smaller radius into a diffuse BSDF (BSSRDF_MIN_RADIUS).
 _BSSRDF_MIN_RADIUS = 1e-8
 _NO_TRANSPORT = "subsurface scattering, rendered as diffuse (no subsurface transport), of"
-_GGX_LIKE = {'GGX', 'SHARP'}
-# The Glossy, Glass and Refraction BSDFs' distributions the core renders as Cycles does (Sharp is
-# GGX at roughness 0); the others (Multiscatter GGX, Ashikhmin-Shirley) render as GGX, reported.
+# The Principled BSDF's distributions: Multiscatter GGX as GGX with an energy-compensating lobe.
+_PRINCIPLED = {'GGX': 'GGX', 'MULTI_GGX': 'MULTI_GGX'}
+# The Glass and Refraction BSDFs' distributions the core renders as Cycles does (Sharp is GGX at
+# roughness 0); the others (Multiscatter GGX) render as GGX, reported.
 _MICROFACET = {'GGX': 'GGX', 'SHARP': 'GGX', 'BECKMANN': 'BECKMANN',
                'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY'}
+# The Glossy BSDF's: those, and Multiscatter GGX as GGX with an energy-compensating lobe.
+_GLOSSY = dict(_MICROFACET, MULTI_GGX='MULTI_GGX')
 # The Anisotropic BSDF's distributions rendered as Cycles does (its Beckmann is rendered as GGX).
 _ANISOTROPIC = {'GGX': 'GGX', 'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
@@ -166,8 +169,8 @@ class _Translator:
 
     def _bsdf_principled(self, n):
         i = n.inputs
-        if n.distribution not in _GGX_LIKE:
-            self.warn(n, f"distribution {n.distribution} of")
+        if n.distribution not in _PRINCIPLED:
+            self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
         subsurface = i["Subsurface"]
         has_subsurface = subsurface.is_linked or subsurface.default_value != 0.0
         if has_subsurface:
@@ -196,6 +199,7 @@ class _Translator:
             "anisotropy": self.value(i["Anisotropic"]),
             "rotation": self.value(i["Anisotropic Rotation"]),
             "tangent": self.tangent(i["Tangent"]),
+            "distribution": _PRINCIPLED.get(n.distribution, 'GGX'),
         }
         if has_subsurface:
             d["subsurface"] = self.value(subsurface)
@@ -230,13 +234,13 @@ class _Translator:
                           "roughness": self.value(n.inputs["Roughness"]),
                           "normal_linked": linked})
 
-    def _distribution(self, n):
-        if n.distribution not in _MICROFACET:
+    def _distribution(self, n, supported=_MICROFACET):
+        if n.distribution not in supported:
             self.warn(n, f"distribution {n.distribution} (rendered as GGX) of")
-        return _MICROFACET.get(n.distribution, 'GGX')
+        return supported.get(n.distribution, 'GGX')
 
     def _bsdf_glossy(self, n):
-        distribution = self._distribution(n)
+        distribution = self._distribution(n, _GLOSSY)
         linked = self.normal(n.inputs["Normal"])
         roughness = self.value(n.inputs["Roughness"])
         if n.distribution == 'SHARP':

@@ -619,13 +619,20 @@ int SceneBuilder::add_material(const py::dict& material) {
       static const std::pair<const char*, MicrofacetDistribution> kDistributions[] = {
           {"GGX", MicrofacetDistribution::GGX},
           {"BECKMANN", MicrofacetDistribution::Beckmann},
-          {"ASHIKHMIN_SHIRLEY", MicrofacetDistribution::AshikhminShirley}};
+          {"ASHIKHMIN_SHIRLEY", MicrofacetDistribution::AshikhminShirley},
+          {"MULTI_GGX", MicrofacetDistribution::MultiscatterGGX}};
       node.distribution =
           get_enum(d, "distribution", "GGX", kDistributions, "microfacet distribution");
       // Blender offers Ashikhmin-Shirley on the Glossy and Anisotropic BSDFs only.
       if (node.distribution == MicrofacetDistribution::AshikhminShirley &&
           node.kind != ShaderNodeKind::Glossy && node.kind != ShaderNodeKind::Anisotropic)
         throw std::invalid_argument("microfacet distribution 'ASHIKHMIN_SHIRLEY' on a " +
+                                    get_str(d, "kind", "DIFFUSE") + " node");
+      // The core compensates Multiscatter GGX on reflection only: the add-on exports the
+      // Glass, Refraction and Anisotropic BSDFs' as GGX.
+      if (node.distribution == MicrofacetDistribution::MultiscatterGGX &&
+          node.kind != ShaderNodeKind::Glossy && node.kind != ShaderNodeKind::Principled)
+        throw std::invalid_argument("microfacet distribution 'MULTI_GGX' on a " +
                                     get_str(d, "kind", "DIFFUSE") + " node");
       read_float(d, "strength", node.strength);
       read_float(d, "fac", node.fac);

@@ -75,6 +75,7 @@ class LightPathFilters {
   static Kind kind_of(const Closure& c) {
     switch (c.type) {
       case ClosureType::GGXReflection:
+      case ClosureType::GGXMultiscatter:
       case ClosureType::Clearcoat:
         return Kind::Reflection;
       case ClosureType::GGXDielectric:

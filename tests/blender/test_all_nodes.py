@@ -155,7 +155,8 @@ def main():
     print(f"{len(materials)} materials, {reported} with warnings", flush=True)
 
     # Microfacet distributions: Beckmann and Ashikhmin-Shirley are rendered as Cycles does,
-    # silently; Multiscatter GGX is rendered as GGX, reported. The Anisotropic BSDF exports GGX or
+    # silently; Multiscatter GGX too on the Glossy and Principled BSDFs (energy-compensated GGX),
+    # the Glass BSDF's as GGX, reported. The Anisotropic BSDF exports GGX or
     # Ashikhmin-Shirley; its Beckmann and Multiscatter GGX are rendered as GGX, reported.
     for node_type, distribution, exported, warned in (
             ("ShaderNodeBsdfGlossy", 'BECKMANN', 'BECKMANN', False),
@@ -164,7 +165,9 @@ def main():
             ("ShaderNodeBsdfGlossy", 'GGX', 'GGX', False),
             ("ShaderNodeBsdfGlass", 'SHARP', 'GGX', False),
             ("ShaderNodeBsdfGlass", 'MULTI_GGX', 'GGX', True),
-            ("ShaderNodeBsdfGlossy", 'MULTI_GGX', 'GGX', True),
+            ("ShaderNodeBsdfGlossy", 'MULTI_GGX', 'MULTI_GGX', False),
+            ("ShaderNodeBsdfPrincipled", 'MULTI_GGX', 'MULTI_GGX', False),
+            ("ShaderNodeBsdfPrincipled", 'GGX', 'GGX', False),
             ("ShaderNodeBsdfGlossy", 'ASHIKHMIN_SHIRLEY', 'ASHIKHMIN_SHIRLEY', False),
             ("ShaderNodeBsdfAnisotropic", 'GGX', 'GGX', False),
             ("ShaderNodeBsdfAnisotropic", 'ASHIKHMIN_SHIRLEY', 'ASHIKHMIN_SHIRLEY', False),

@@ -6,6 +6,7 @@
 
 #include "core/vec.h"
 #include "shaders/bsdf.h"
+#include "shaders/bsdf_ggx_multiscatter.h"
 
 namespace gdpt::test {
 
@@ -57,6 +58,15 @@ inline Closure ggx_principled(float alpha, float ior, Spectrum cspec0) {
   k.ior = ior;
   k.f0 = cspec0;
   return k;
+}
+// Blender's Multiscatter GGX reflection: the GGX lobe `k` and its multiple-scattering lobe,
+// whose colour is the Kulla-Conty factor of `f_avg` (the Glossy colour: no Fresnel).
+inline Closure multiscatter_of(const Closure& k, Spectrum f_avg = Spectrum(1.0f)) {
+  Closure m;
+  m.type = ClosureType::GGXMultiscatter;
+  m.alpha = k.alpha;
+  m.weight = ggx_multiscatter::multiscatter_fresnel(f_avg, ggx_average_albedo(k.alpha));
+  return m;
 }
 inline Closure clearcoat(float alpha, Spectrum c = Spectrum(1.0f)) {
   Closure k;

@@ -45,6 +45,9 @@ std::vector<Case> lobe_cases() {
     cases.push_back({"Beckmann" + s, set_of({beckmann(ggx(a))})});
     cases.push_back({"BeckmannGlass" + s, set_of({beckmann(glass(a, 1.5f))})});
     cases.push_back({"AshikhminShirley" + s, set_of({ashikhmin_shirley(ggx(a))})});
+    cases.push_back({"MultiscatterLobe" + s, set_of({multiscatter_of(ggx(a))})});
+    const Spectrum tint(0.9f, 0.6f, 0.2f);
+    cases.push_back({"MultiscatterGGX" + s, set_of({ggx(a, tint), multiscatter_of(ggx(a), tint)})});
   }
   // Ashikhmin-Shirley anisotropic: the quadrant-wise azimuth sampler, either width the wider.
   cases.push_back(

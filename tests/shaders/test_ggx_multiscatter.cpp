@@ -1,0 +1,121 @@
+// Multiscatter GGX reflection (bsdf_ggx_multiscatter.h, ggx_albedo.h): a white lobe with its
+// multiple-scattering lobe passes the white furnace, which plain GGX fails at high roughness.
+// Sampling against the density is in test_bsdf_chi2 (MultiscatterLobe*, MultiscatterGGX*).
+#include <gtest/gtest.h>
+
+#include "shaders/material.h"
+#include "testing/chi2.h"
+#include "tests/shaders/lobe_factory.h"
+
+namespace gdpt::test {
+namespace {
+
+// Directional albedo of `set` from wi: the mean of the sampled value / pdf (fixed seed).
+double albedo(const ClosureSet& set, Vec3f wi, int samples = 400000) {
+  Pcg32 rng(77);
+  double sum = 0.0;
+  for (int i = 0; i < samples; ++i) {
+    const float ul = rng.uniform();
+    const Vec2f u(rng.uniform(), rng.uniform());
+    const BsdfSample s = set.sample(wi, ul, u);
+    if (s.valid && s.pdf > 0.0f) sum += double(s.value.y) / double(s.pdf);
+  }
+  return sum / samples;
+}
+
+const float kRoughness[] = {0.3f, 0.6f, 1.0f};
+const float kIncidentCos[] = {1.0f, 0.7f, 0.4f, 0.15f, -0.5f};
+
+TEST(GgxMultiscatter, WhiteFurnaceReflectsAllLight) {
+  for (float r : kRoughness)
+    for (float mu : kIncidentCos) {
+      const Closure g = ggx(r * r);
+      const double e = albedo(set_of({g, multiscatter_of(g)}), incident(mu));
+      EXPECT_NEAR(e, 1.0, 0.02) << "roughness " << r << " cos_i " << mu;
+    }
+}
+
+// What the compensation is for: plain GGX loses light at roughness 1 from every angle (about
+// two thirds at normal incidence).
+TEST(GgxMultiscatter, PlainGgxFailsTheFurnaceAtRoughnessOne) {
+  for (float mu : kIncidentCos) {
+    const double e = albedo(set_of({ggx(1.0f)}), incident(mu));
+    EXPECT_LT(e, 0.95) << "cos_i " << mu;
+    EXPECT_GT(e, 0.2) << "cos_i " << mu;
+  }
+}
+
+// The multiple-scattering lobe alone reflects what the tabulated single-scattering lobe lacks:
+// 1 - E(cos_i), so the table agrees with the lobe's albedo.
+TEST(GgxMultiscatter, TableMatchesTheSingleScatteringAlbedo) {
+  for (float r : kRoughness)
+    for (float mu : kIncidentCos) {
+      const Closure g = ggx(r * r);
+      const double single = albedo(set_of({g}), incident(mu));
+      EXPECT_NEAR(ggx_albedo(std::fabs(mu), r * r), single, 0.01)
+          << "roughness " << r << " cos_i " << mu;
+      const double multiple = albedo(set_of({multiscatter_of(g)}), incident(mu));
+      EXPECT_NEAR(multiple, 1.0 - single, 0.01) << "roughness " << r << " cos_i " << mu;
+    }
+}
+
+// Kulla-Conty's colour: white stays white, a colour c < 1 scatters c^2 E_avg / (1 - c (1 -
+// E_avg)) of the compensated light, less than c, and nothing when black.
+TEST(GgxMultiscatter, FresnelColourFactor) {
+  const float e_avg = ggx_average_albedo(0.36f);
+  EXPECT_GT(e_avg, 0.7f);
+  EXPECT_LT(e_avg, 0.9f);
+  const Spectrum f = ggx_multiscatter::multiscatter_fresnel(Spectrum(1.0f, 0.5f, 0.0f), e_avg);
+  EXPECT_NEAR(f.x, 1.0f, 1e-6f);
+  EXPECT_NEAR(f.y, 0.25f * e_avg / (1.0f - 0.5f * (1.0f - e_avg)), 1e-6f);
+  EXPECT_LT(f.y, 0.5f);
+  EXPECT_EQ(f.z, 0.0f);
+}
+
+// A one-node material with the Multiscatter GGX distribution, roughness r, colour c.
+ClosureSet multiscatter_material(ShaderNodeKind kind, float r, Spectrum c) {
+  ShaderNode n;
+  n.kind = kind;
+  n.color = ColorInput(c);
+  n.roughness = FloatInput(r);
+  n.metallic = FloatInput(1.0f);
+  n.distribution = MicrofacetDistribution::MultiscatterGGX;
+  MaterialDesc d;
+  d.nodes = {n};
+  d.root = 0;
+  ClosureSet s;
+  Material(d, {}).evaluate(ShadingContext{{0.25f, 0.25f}, true}, s);
+  return s;
+}
+
+// The Glossy BSDF: its GGX lobe, coloured, and the compensation of Kulla-Conty's colour for
+// F_avg = the colour; white, the pair reflects all light.
+TEST(GgxMultiscatter, GlossyNodeAddsTheLobe) {
+  const Spectrum c(1.0f, 0.5f, 0.2f);
+  const ClosureSet s = multiscatter_material(ShaderNodeKind::Glossy, 0.6f, c);
+  ASSERT_EQ(s.count(), 2);
+  EXPECT_EQ(s[0].type, ClosureType::GGXReflection);
+  EXPECT_EQ(s[0].distribution, MicrofacetDistribution::GGX);
+  EXPECT_EQ(s[1].type, ClosureType::GGXMultiscatter);
+  EXPECT_NEAR(s[1].alpha, 0.36f, 1e-6f);
+  const Spectrum f = ggx_multiscatter::multiscatter_fresnel(c, ggx_average_albedo(0.36f));
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[1].weight[k], f[k], 1e-6f);
+  for (float mu : kIncidentCos)
+    EXPECT_NEAR(albedo(multiscatter_material(ShaderNodeKind::Glossy, 0.6f, Spectrum(1.0f)),
+                       incident(mu)),
+                1.0, 0.02);
+}
+
+// Principled, white metal: Fresnel 1 at every angle, so the specular pair reflects all light.
+TEST(GgxMultiscatter, PrincipledWhiteMetalPassesTheFurnace) {
+  for (float r : kRoughness)
+    for (float mu : kIncidentCos) {
+      const ClosureSet s = multiscatter_material(ShaderNodeKind::Principled, r, Spectrum(1.0f));
+      ASSERT_EQ(s.count(), 2);
+      EXPECT_EQ(s[1].type, ClosureType::GGXMultiscatter);
+      EXPECT_NEAR(albedo(s, incident(mu)), 1.0, 0.02) << "roughness " << r << " cos_i " << mu;
+    }
+}
+
+}  // namespace
+}  // namespace gdpt::test
