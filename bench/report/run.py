@@ -205,9 +205,10 @@ def summarise(result):
         pts = result["curves"].get(curve, [])
         e = M.at_time([(p["seconds"], p["relmse_denoised"]) for p in pts], t)
         # A render that ended well before its budget (Cycles' adaptive sampling at its noise
-        # threshold) gives the same image at any later time.
+        # threshold) gives the same image at any later time; so does one whose budget was t.
         last = max(pts, key=lambda p: p["seconds"], default=None)
-        if e is None and last and t > last["seconds"] and last["seconds"] < 0.9 * last["budget"]:
+        if e is None and last and t > last["seconds"] and (last["seconds"] < 0.9 * last["budget"]
+                                                           or last["budget"] >= t):
             e = last["relmse_denoised"] if last["relmse_denoised"] > 0 else None
         return e
 
