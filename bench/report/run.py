@@ -331,7 +331,8 @@ def write_doc(results, meta, path, figures):
         "run; rerun the command to regenerate this page."
         + (f" Curves of {', '.join(meta['kept'])} are those of the run at commit "
            f"{meta['kept_from']['commit']} on {meta['kept_from']['date']} (same machine, Blender "
-           "and budgets; `run.py --keep`): Cycles does not depend on GDPT's code."
+           "and budgets; `run.py --keep`): Cycles does not depend on GDPT's code, but the host's "
+           "speed may differ between the two runs and that enters the equal-time ratios."
            if meta.get("kept") else ""),
         "",
         "relMSE is measured against each method's own converged reference (two independent "
