@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,6 +83,20 @@ class Integrator2D {
   }
   std::function<double(double, double)> f_;
 };
+
+// Integral over the upper hemisphere of f(direction) d omega, by adaptive quadrature; the polar
+// range is split finely near the pole, where narrow lobes peak.
+inline double hemisphere_integral(const std::function<double(Vec3f)>& f) {
+  Integrator2D integ([&](double theta, double phi) {
+    return f(direction(std::cos(theta), phi)) * std::sin(theta);
+  });
+  const double edges[] = {0.0, 0.002, 0.01, 0.03, 0.1, 0.3, 0.7, 1.1, M_PI / 2};
+  double sum = 0.0;
+  for (size_t i = 0; i + 1 < std::size(edges); ++i)
+    for (int k = 0; k < 8; ++k)
+      sum += integ.integrate(edges[i], edges[i + 1], k * M_PI / 4, (k + 1) * M_PI / 4, 1e-9, 3, 10);
+  return sum;
+}
 
 struct Chi2Result {
   double p_value = 0.0;

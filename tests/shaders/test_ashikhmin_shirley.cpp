@@ -13,18 +13,6 @@
 namespace gdpt::test {
 namespace {
 
-double hemisphere_integral(const std::function<double(Vec3f)>& f) {
-  Integrator2D integ([&](double theta, double phi) {
-    return f(direction(std::cos(theta), phi)) * std::sin(theta);
-  });
-  const double edges[] = {0.0, 0.002, 0.01, 0.03, 0.1, 0.3, 0.7, 1.1, M_PI / 2};
-  double sum = 0.0;
-  for (size_t i = 0; i + 1 < std::size(edges); ++i)
-    for (int k = 0; k < 8; ++k)
-      sum += integ.integrate(edges[i], edges[i + 1], k * M_PI / 4, (k + 1) * M_PI / 4, 1e-9, 3, 10);
-  return sum;
-}
-
 struct D3 {
   double x, y, z;
 };

@@ -15,20 +15,6 @@ namespace {
 
 const float kAlphas[] = {0.01f, 0.05f, 0.2f, 0.5f, 1.0f};
 
-// Integral over the upper hemisphere of f(direction) d omega, by adaptive quadrature; the polar
-// range is split finely near the pole, where narrow lobes peak.
-double hemisphere_integral(const std::function<double(Vec3f)>& f) {
-  Integrator2D integ([&](double theta, double phi) {
-    return f(direction(std::cos(theta), phi)) * std::sin(theta);
-  });
-  const double edges[] = {0.0, 0.002, 0.01, 0.03, 0.1, 0.3, 0.7, 1.1, M_PI / 2};
-  double sum = 0.0;
-  for (size_t i = 0; i + 1 < std::size(edges); ++i)
-    for (int k = 0; k < 8; ++k)
-      sum += integ.integrate(edges[i], edges[i + 1], k * M_PI / 4, (k + 1) * M_PI / 4, 1e-9, 3, 10);
-  return sum;
-}
-
 // Cycles 3.4's isotropic Beckmann D and G1 (bsdf_microfacet.h), in double, from the cosines.
 double cycles_d(double cos_m, double alpha) {
   const double c2 = cos_m * cos_m, a2 = alpha * alpha;

@@ -101,9 +101,9 @@ TEST(GgxMultiscatter, GlossyNodeAddsTheLobe) {
   const Spectrum f = ggx_multiscatter::multiscatter_fresnel(c, ggx_average_albedo(0.36f));
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(s[1].weight[k], f[k], 1e-6f);
   for (float mu : kIncidentCos)
-    EXPECT_NEAR(albedo(multiscatter_material(ShaderNodeKind::Glossy, 0.6f, Spectrum(1.0f)),
-                       incident(mu)),
-                1.0, 0.02);
+    EXPECT_NEAR(
+        albedo(multiscatter_material(ShaderNodeKind::Glossy, 0.6f, Spectrum(1.0f)), incident(mu)),
+        1.0, 0.02);
 }
 
 // Principled, white metal: Fresnel 1 at every angle, so the specular pair reflects all light.
