@@ -199,6 +199,38 @@ TEST(Feature, MissingFeaturesAndNonFiniteInputs) {
   EXPECT_NO_THROW(reconstruct(no_gradients, settings));
 }
 
+// Small bright spots whose features match their dark, flat surroundings (a light seen in a
+// mirror, a caustic): away from them the widest filter wins, and the blend of the neighbourhood's
+// choices must not bring that filter onto the spots, which it would spread and dim.
+TEST(Feature, BlendKeepsBrightSpotsWhereTheyAre) {
+  const int w = 120, h = 80;
+  FeatureScene s;
+  s.w = w, s.h = h;
+  const size_t n = size_t(w) * h;
+  s.truth.assign(3 * n, 0.1f);
+  s.albedo.assign(3 * n, 0.5f);
+  s.normal.assign(3 * n, 0.f);
+  s.depth.assign(n, 1.f);
+  for (size_t i = 0; i < n; ++i) s.normal[3 * i + 2] = 1.f;
+  for (int cy : {20, 40, 60})
+    for (int cx : {20, 60, 100})
+      for (int y = cy - 1; y <= cy + 1; ++y)
+        for (int x = cx - 1; x <= cx + 1; ++x)
+          for (int c = 0; c < 3; ++c) s.truth[3 * (size_t(y) * w + x) + c] = 20.f;
+  std::mt19937 rng(3);
+  std::normal_distribution<float> noise(0.f, 0.05f);
+  s.a.resize(3 * n), s.b.resize(3 * n), s.primal.resize(3 * n);
+  for (size_t i = 0; i < 3 * n; ++i) {
+    s.a[i] = s.truth[i] * (1.f + noise(rng));
+    s.b[i] = s.truth[i] * (1.f + noise(rng));
+    s.primal[i] = 0.5f * (s.a[i] + s.b[i]);
+  }
+  const FeatureReconstruction r = filter_primal(s);
+  const double before = relative_mse(s.primal, s.truth), after = relative_mse(r.image, s.truth);
+  std::printf("bright spots: relMSE %.3g -> %.3g\n", before, after);
+  EXPECT_LT(after, before / 4.0);
+}
+
 TEST(Feature, SameResultOnOneAndTwoThreads) {
   const FeatureScene s = make_feature_scene(150, 70, 0.15f, 0.02f, 51);
   ReconstructionSettings settings;
