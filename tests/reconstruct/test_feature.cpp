@@ -3,6 +3,7 @@
 // data, determinism, gain over L1.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -33,6 +34,32 @@ std::vector<float> box_of_mean(const FeatureScene& s, int r) {
   std::vector<float> out(s.primal.size());
   detail::box_filter(s.primal.data(), 3, s.w, s.h, r, out.data());
   return out;
+}
+
+// box_filter against the direct mean over the clipped window: several channels, a height that is
+// not a whole number of row chunks, and a window taller than the image.
+TEST(Feature, BoxFilterIsTheMeanOverTheClippedWindow) {
+  const int w = 23, h = 19, channels = 2;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-1.f, 4.f);
+  std::vector<float> src(size_t(w) * h * channels), dst(src.size());
+  for (float& v : src) v = u(rng);
+  for (int r : {0, 1, 3, 25}) {
+    detail::box_filter(src.data(), channels, w, h, r, dst.data());
+    double worst = 0.0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < channels; ++c) {
+          double sum = 0.0;
+          int count = 0;
+          for (int yy = std::max(0, y - r); yy <= std::min(h - 1, y + r); ++yy)
+            for (int xx = std::max(0, x - r); xx <= std::min(w - 1, x + r); ++xx, ++count)
+              sum += src[(size_t(yy) * w + xx) * channels + c];
+          const double d = dst[(size_t(y) * w + x) * channels + c] - sum / count;
+          worst = std::max(worst, std::fabs(d));
+        }
+    EXPECT_LT(worst, 1e-5) << "radius " << r;
+  }
 }
 
 // The primal halves filtered alone (no gradients), as in PT mode.
