@@ -29,11 +29,13 @@
 namespace gdpt {
 
 struct FeatureReconstruction {
-  std::vector<float> image;     // RGB, without emission
-  std::vector<float> error;     // per pixel: estimated squared error of the halves' mean
-  std::vector<uint8_t> chosen;  // per pixel: index of the candidate filter used
-  int features = 0;             // feature channels used
-  int missing = 0;              // pixels with some non-finite input
+  std::vector<float> image;  // RGB, without emission
+  // Per pixel: the chosen candidate's index and estimated squared error of the halves' mean (the
+  // image blends that candidate with those its neighbours chose).
+  std::vector<float> error;
+  std::vector<uint8_t> chosen;
+  int features = 0;  // feature channels used
+  int missing = 0;   // pixels with some non-finite input
   double prepare_seconds = 0.0, filter_seconds = 0.0, select_seconds = 0.0;
 };
 
