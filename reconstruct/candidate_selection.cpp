@@ -1,5 +1,8 @@
 #include "reconstruct/candidate_selection.h"
 
+#include <cmath>
+#include <stdexcept>
+
 #include "reconstruct/parallel.h"
 
 namespace gdpt::detail {
@@ -43,6 +46,10 @@ void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const
   box_filter(raw.data(), 1, W, H, kErrorSmoothingRadius, smooth.data());
   if (weighted) box_filter(raw.data() + n, 1, W, H, kErrorSmoothingRadius, smooth.data() + n);
   const float* key = weighted ? smooth.data() + n : smooth.data();
+  if (size_t(index) != choice.images.size())
+    throw std::logic_error("offer_candidate: candidates must be offered in index order");
+  choice.images.emplace_back(filtered, filtered + 3 * n);
+  choice.keys.emplace_back(key, key + n);
   const bool first = choice.image.empty();
   if (first) {
     choice.image.resize(3 * n);
@@ -59,6 +66,33 @@ void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const
       for (int c = 0; c < 3; ++c) choice.image[3 * i + c] = filtered[3 * i + c];
     }
   });
+}
+
+void blend_choices(const FeatureBuffers& fb, CandidateChoice& choice) {
+  const int W = fb.width, H = fb.height;
+  const size_t n = size_t(W) * H;
+  std::vector<float> sum(3 * n, 0.f), total(n, 0.f), chose(n), share(n);
+  for (size_t k = 0; k < choice.images.size(); ++k) {
+    for (size_t i = 0; i < n; ++i) chose[i] = choice.index[i] == k ? 1.f : 0.f;
+    box_filter(chose.data(), 1, W, H, kErrorSmoothingRadius, share.data());
+    const float* key = choice.keys[k].data();
+    const float* image = choice.images[k].data();
+    parallel_rows(H, [&](int y0, int y1) {
+      for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
+        const float best = choice.relative[i];
+        if (!(share[i] > 0.f) || !(key[i] <= best + kBlendTolerance * std::fabs(best))) continue;
+        total[i] += share[i];
+        for (int c = 0; c < 3; ++c) sum[3 * i + c] += share[i] * image[3 * i + c];
+      }
+    });
+  }
+  // The chosen candidate always takes part (its share at its own pixel is positive).
+  parallel_rows(H, [&](int y0, int y1) {
+    for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i)
+      for (int c = 0; c < 3; ++c) choice.image[3 * i + c] = sum[3 * i + c] / total[i];
+  });
+  choice.images.clear();
+  choice.keys.clear();
 }
 
 }  // namespace gdpt::detail

@@ -9,6 +9,13 @@
 // the pixel's colour: the error compared is relative, so a few bright pixels (a light seen in a
 // mirror, a noisy highlight edge) cannot choose, for a whole window, a filter that spreads them
 // over their dark neighbours.
+//
+// The per-pixel choice is then smoothed: each pixel blends the candidates in the proportions its
+// (2 kErrorSmoothingRadius + 1)^2 neighbourhood chose them (neighbouring choices are noisy picks
+// among near-equal candidates; their mean has less error than any one of them). The neighbourhood
+// is no wider than the estimate's window, so every neighbour's choice weighed this pixel's error,
+// and a candidate whose own estimate here is far above the best is left out (a neighbour's choice
+// must not bring a wide filter onto a bright spot it would spread).
 #pragma once
 
 #include <cstdint>
@@ -20,6 +27,8 @@ namespace gdpt::detail {
 
 inline constexpr int kErrorSmoothingRadius = 10;
 inline constexpr float kRelativeErrorEpsilon = 1e-2f;
+// A candidate enters a pixel's blend while its estimate is at most best + tolerance * |best|.
+inline constexpr float kBlendTolerance = 16.f;
 
 struct CandidateChoice {
   std::vector<float> image;     // RGB: the chosen candidate's filter applied to all samples
@@ -27,6 +36,8 @@ struct CandidateChoice {
   std::vector<float> relative;  // per pixel, its smoothed relative error estimate (the key)
   std::vector<float> weight;    // RGB: 1 / (guide^2 + eps); empty: absolute errors compared
   std::vector<uint8_t> index;   // per pixel, the chosen candidate
+  // Every candidate offered: its image of all samples (RGB) and its key, for blend_choices.
+  std::vector<std::vector<float>> images, keys;
 };
 
 // Per pixel e (mean over RGB) of the candidate with filtered halves fa, fb_half; 0 where the
@@ -39,8 +50,13 @@ void set_relative_weights(const FeatureBuffers& fb, const float* guide, Candidat
 
 // Offers candidate `index` (halves filtered to fa, fb_half; the image of all samples to
 // `filtered`): pixels whose smoothed relative error beats the current choice take `filtered` (the
-// first candidate offered is taken everywhere; ties keep the earlier one).
+// first candidate offered is taken everywhere; ties keep the earlier one). Candidates are offered
+// with index 0, 1, 2, ... in turn.
 void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const float* fb_half,
                      const float* filtered, CandidateChoice& choice);
+
+// After the last offer: choice.image becomes the blend of the candidates in the proportions the
+// neighbourhood chose them (see above); the offered images and keys are released.
+void blend_choices(const FeatureBuffers& fb, CandidateChoice& choice);
 
 }  // namespace gdpt::detail

@@ -43,36 +43,47 @@ void copy_feature(const float* values, const float* variance, int n, int offset,
 
 void box_filter(const float* src, int channels, int width, int height, int radius, float* dst) {
   const int W = width, C = channels;
-  std::vector<float> rows(size_t(W) * height * C);
+  const size_t row = size_t(W) * C;
+  // Rows: window sums from prefix sums; the mean's divisions are applied once, at the end.
+  std::vector<float> rows(row * height);
+  std::vector<double> inv_x(W);
+  for (int x = 0; x < W; ++x)
+    inv_x[x] = 1.0 / double(std::min(W, x + radius + 1) - std::max(0, x - radius));
   parallel_rows(height, [&](int y0, int y1) {
     std::vector<double> prefix(size_t(W + 1) * C);
     for (int y = y0; y < y1; ++y) {
-      const float* s = src + size_t(y) * W * C;
+      const float* s = src + size_t(y) * row;
       for (int c = 0; c < C; ++c) prefix[c] = 0.0;
-      for (int x = 0; x < W; ++x)
-        for (int c = 0; c < C; ++c)
-          prefix[size_t(x + 1) * C + c] = prefix[size_t(x) * C + c] + s[x * C + c];
-      float* d = rows.data() + size_t(y) * W * C;
+      for (size_t i = 0; i < row; ++i) prefix[i + C] = prefix[i] + s[i];
+      float* d = rows.data() + size_t(y) * row;
       for (int x = 0; x < W; ++x) {
-        const int lo = std::max(0, x - radius), hi = std::min(W, x + radius + 1);
-        const double inv = 1.0 / (hi - lo);
-        for (int c = 0; c < C; ++c)
-          d[x * C + c] = float((prefix[size_t(hi) * C + c] - prefix[size_t(lo) * C + c]) * inv);
+        const size_t lo = size_t(std::max(0, x - radius)) * C,
+                     hi = size_t(std::min(W, x + radius + 1)) * C;
+        for (int c = 0; c < C; ++c) d[size_t(x) * C + c] = float(prefix[hi + c] - prefix[lo + c]);
       }
     }
   });
+  // Columns: a running sum down each chunk (in double, so that adding and removing rows leaves
+  // no drift); chunks start afresh, so the result does not depend on the thread count.
   parallel_rows(height, [&](int y0, int y1) {
-    std::vector<float> sum(size_t(W) * C);
+    std::vector<double> sum(row, 0.0);
+    auto add = [&](int yy, double sign) {
+      const float* r = rows.data() + size_t(yy) * row;
+      for (size_t i = 0; i < row; ++i) sum[i] += sign * r[i];
+    };
+    int lo = std::max(0, y0 - radius), hi = std::min(height, y0 + radius + 1);
+    for (int yy = lo; yy < hi; ++yy) add(yy, 1.0);
     for (int y = y0; y < y1; ++y) {
-      const int lo = std::max(0, y - radius), hi = std::min(height, y + radius + 1);
-      std::fill(sum.begin(), sum.end(), 0.f);
-      for (int yy = lo; yy < hi; ++yy) {
-        const float* r = rows.data() + size_t(yy) * W * C;
-        for (size_t i = 0; i < size_t(W) * C; ++i) sum[i] += r[i];
-      }
-      const float inv = 1.f / float(hi - lo);
-      float* d = dst + size_t(y) * W * C;
-      for (size_t i = 0; i < size_t(W) * C; ++i) d[i] = sum[i] * inv;
+      const int nlo = std::max(0, y - radius), nhi = std::min(height, y + radius + 1);
+      for (; lo < nlo; ++lo) add(lo, -1.0);
+      for (; hi < nhi; ++hi) add(hi, 1.0);
+      const double inv_y = 1.0 / double(hi - lo);
+      float* d = dst + size_t(y) * row;
+      for (int x = 0; x < W; ++x)
+        for (int c = 0; c < C; ++c) {
+          const size_t i = size_t(x) * C + c;
+          d[i] = float(sum[i] * (inv_y * inv_x[x]));
+        }
     }
   });
 }

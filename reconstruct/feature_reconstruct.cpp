@@ -19,6 +19,8 @@ namespace {
 
 // Relative to the centre's brightness, as the candidates' tolerances.
 constexpr float kGuideColourTolerance = 1.f;
+// Added to the albedo the images are divided by: keeps black surfaces finite.
+constexpr float kDemodulationFloor = 0.02f;
 
 double since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -119,6 +121,40 @@ std::vector<float> relative_error_guide(const detail::FeatureBuffers& fb) {
   return tolerant;
 }
 
+// Per pixel and channel, the albedo the filters' images are divided by and their outputs
+// multiplied by: filtering the illumination instead of the colour, textures stay sharp and the
+// colour tolerances compare light, not paint. Empty without an albedo feature; 1 where a pixel has
+// no valid features.
+std::vector<float> demodulation(const ReconstructionInput& in, const detail::FeatureBuffers& fb) {
+  if (!in.albedo) return {};
+  const size_t n = size_t(fb.width) * fb.height;
+  std::vector<float> d(3 * n);
+  detail::parallel_rows(fb.height, [&](int y0, int y1) {
+    for (size_t i = size_t(y0) * fb.width; i < size_t(y1) * fb.width; ++i)
+      for (int c = 0; c < 3; ++c)
+        d[3 * i + c] = (fb.valid[i] & detail::kFeaturesValid)
+                           ? std::max(0.f, fb.feature[size_t(c) * n + i]) + kDemodulationFloor
+                           : 1.f;
+  });
+  return d;
+}
+
+// images[k] (RGB, width x height) divided or multiplied by `factor` (a no-op when it is empty).
+void scale_images(const std::vector<float>& factor, bool divide, int width, int height,
+                  float* const* images, int count) {
+  if (factor.empty()) return;
+  detail::parallel_rows(height, [&](int y0, int y1) {
+    const size_t i0 = 3 * size_t(y0) * width, i1 = 3 * size_t(y1) * width;
+    for (int k = 0; k < count; ++k) {
+      float* im = images[k];
+      if (divide)
+        for (size_t i = i0; i < i1; ++i) im[i] /= factor[i];
+      else
+        for (size_t i = i0; i < i1; ++i) im[i] *= factor[i];
+    }
+  });
+}
+
 }  // namespace
 
 FeatureReconstruction feature_filter(const ReconstructionInput& input, const float* a,
@@ -138,13 +174,21 @@ FeatureReconstruction feature_filter(const ReconstructionInput& input, const flo
   std::vector<float> filtered(size_t(kTol) * 3 * n3);
   float* out[kTol * 3];
   for (int k = 0; k < kTol * 3; ++k) out[k] = filtered.data() + size_t(k) * n3;
-  const float* const images[3] = {fb.a.data(), fb.b.data(), fb.all.data()};
   detail::CandidateChoice choice;
   t = std::chrono::steady_clock::now();
   detail::set_relative_weights(fb, relative_error_guide(fb).data(), choice);
+  const std::vector<float> albedo = demodulation(input, fb);
+  std::vector<float> illumination[3] = {fb.a, fb.b, fb.all};
+  float* const divided[3] = {illumination[0].data(), illumination[1].data(),
+                             illumination[2].data()};
+  scale_images(albedo, true, input.width, input.height, divided, 3);
+  const float* const images[3] = {divided[0], divided[1], divided[2]};
   r.filter_seconds += since(t);
   int index = 0;
   auto offer = [&](int tolerances) {
+    t = std::chrono::steady_clock::now();
+    scale_images(albedo, false, input.width, input.height, out, 3 * tolerances);
+    r.filter_seconds += since(t);
     t = std::chrono::steady_clock::now();
     for (int k = 0; k < tolerances; ++k, ++index)
       detail::offer_candidate(fb, index, out[3 * k], out[3 * k + 1], out[3 * k + 2], choice);
@@ -159,6 +203,9 @@ FeatureReconstruction feature_filter(const ReconstructionInput& input, const flo
     r.filter_seconds += since(t);
     offer(kTol);
   }
+  t = std::chrono::steady_clock::now();
+  detail::blend_choices(fb, choice);
+  r.select_seconds += since(t);
   r.image = std::move(choice.image);
   r.error = std::move(choice.error);
   r.chosen = std::move(choice.index);

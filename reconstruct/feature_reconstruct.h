@@ -6,15 +6,19 @@
 //      estimate errors). Without gradient halves, or with the guide None, the base is the primal:
 //      its halves and their mean;
 //   2. per candidate filter (feature_bilateral.h): each half filtered alone and the solution of
-//      all samples filtered alike;
+//      all samples filtered alike, all three divided by the albedo before and multiplied by it
+//      after (the filters smooth the illumination; textures stay sharp);
 //   3. per pixel the candidate with the smallest smoothed relative error estimate of the halves
-//      (candidate_selection.h; relative to a guide colour from two more filters of all samples);
-//      output = that candidate applied to all samples (+ emission).
+//      (candidate_selection.h; relative to a guide colour from two more filters of all samples),
+//      then the choices blended over the estimate's window (blend_choices); output = the blend
+//      of the candidates applied to all samples (+ emission).
 //
-// Memory beyond the inputs: about 300 bytes per pixel, 300 MB per megapixel (feature buffers
-// 105, the solved halves and image 36, their copies filtered with the three colour tolerances
-// 108, the choice and its weights 33, error scratch 16; the guide's two filtered copies, 24,
-// before the candidates run), plus the gradient-domain solves' own buffers while they run.
+// Memory beyond the inputs: about 580 bytes per pixel, 580 MB per megapixel (feature buffers
+// 105, the solved halves and image 36, their albedo-divided copies and the albedo 48, their
+// copies filtered with the three colour tolerances 108, the choice and its weights 33, error
+// scratch 16, every candidate's image and estimate for the blend 208, the blend's scratch 24; the
+// guide's two filtered copies, 24, before the candidates run), plus the gradient-domain solves'
+// own buffers while they run.
 #pragma once
 
 #include <vector>
@@ -25,11 +29,13 @@
 namespace gdpt {
 
 struct FeatureReconstruction {
-  std::vector<float> image;     // RGB, without emission
-  std::vector<float> error;     // per pixel: estimated squared error of the halves' mean
-  std::vector<uint8_t> chosen;  // per pixel: index of the candidate filter used
-  int features = 0;             // feature channels used
-  int missing = 0;              // pixels with some non-finite input
+  std::vector<float> image;  // RGB, without emission
+  // Per pixel: the chosen candidate's index and estimated squared error of the halves' mean (the
+  // image blends that candidate with those its neighbours chose).
+  std::vector<float> error;
+  std::vector<uint8_t> chosen;
+  int features = 0;  // feature channels used
+  int missing = 0;   // pixels with some non-finite input
   double prepare_seconds = 0.0, filter_seconds = 0.0, select_seconds = 0.0;
 };
 

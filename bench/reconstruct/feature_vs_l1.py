@@ -48,8 +48,9 @@ def main():
             refs = [R.rgb(os.path.join(cache, f"ref_pt_{i}_40s.exr")) for i in (1, 2)]
             spp = samples_at_40s(scene)
             path = os.path.join(args.out, f"{scene}.exr")
-            if args.resolve:
-                info = {"samples": spp}
+            if args.resolve:  # the samples the render was made with
+                attrs = R.exr.read_string_attributes(path)
+                info = {"samples": int(attrs.get("gdpt.ViewLayer.samples", spp))}
             else:
                 info = R.render(blender, os.path.join(cache, f"{scene}.blend"), "gpt_feature",
                                 path, samples=spp, seed=7)

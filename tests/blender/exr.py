@@ -103,3 +103,11 @@ def read_exr(path):
 def rgb(channels, prefix):
     """(height, width, 3) from `prefix` + R/G/B (prefix e.g. 'ViewLayer.Primal.' or '')."""
     return np.stack([channels[prefix + c] for c in "RGB"], axis=-1)
+
+
+def read_string_attributes(path):
+    """The header's string attributes, e.g. {"gdpt.ViewLayer.samples": "687", ...}."""
+    with open(path, "rb") as f:
+        data = f.read(1 << 20)
+    header, _ = _read_header(data, 8)
+    return {k: v.decode(errors="replace") for k, (kind, v) in header.items() if kind == "string"}

@@ -3,6 +3,7 @@
 // data, determinism, gain over L1.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -33,6 +34,32 @@ std::vector<float> box_of_mean(const FeatureScene& s, int r) {
   std::vector<float> out(s.primal.size());
   detail::box_filter(s.primal.data(), 3, s.w, s.h, r, out.data());
   return out;
+}
+
+// box_filter against the direct mean over the clipped window: several channels, a height that is
+// not a whole number of row chunks, and a window taller than the image.
+TEST(Feature, BoxFilterIsTheMeanOverTheClippedWindow) {
+  const int w = 23, h = 19, channels = 2;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-1.f, 4.f);
+  std::vector<float> src(size_t(w) * h * channels), dst(src.size());
+  for (float& v : src) v = u(rng);
+  for (int r : {0, 1, 3, 25}) {
+    detail::box_filter(src.data(), channels, w, h, r, dst.data());
+    double worst = 0.0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < channels; ++c) {
+          double sum = 0.0;
+          int count = 0;
+          for (int yy = std::max(0, y - r); yy <= std::min(h - 1, y + r); ++yy)
+            for (int xx = std::max(0, x - r); xx <= std::min(w - 1, x + r); ++xx, ++count)
+              sum += src[(size_t(yy) * w + xx) * channels + c];
+          const double d = dst[(size_t(y) * w + x) * channels + c] - sum / count;
+          worst = std::max(worst, std::fabs(d));
+        }
+    EXPECT_LT(worst, 1e-5) << "radius " << r;
+  }
 }
 
 // The primal halves filtered alone (no gradients), as in PT mode.
@@ -197,6 +224,38 @@ TEST(Feature, MissingFeaturesAndNonFiniteInputs) {
   EXPECT_THROW(reconstruct(three_halves, settings), std::invalid_argument);
   settings.feature_guide = ReconstructionNorm::None;
   EXPECT_NO_THROW(reconstruct(no_gradients, settings));
+}
+
+// Small bright spots whose features match their dark, flat surroundings (a light seen in a
+// mirror, a caustic): away from them the widest filter wins, and the blend of the neighbourhood's
+// choices must not bring that filter onto the spots, which it would spread and dim.
+TEST(Feature, BlendKeepsBrightSpotsWhereTheyAre) {
+  const int w = 120, h = 80;
+  FeatureScene s;
+  s.w = w, s.h = h;
+  const size_t n = size_t(w) * h;
+  s.truth.assign(3 * n, 0.1f);
+  s.albedo.assign(3 * n, 0.5f);
+  s.normal.assign(3 * n, 0.f);
+  s.depth.assign(n, 1.f);
+  for (size_t i = 0; i < n; ++i) s.normal[3 * i + 2] = 1.f;
+  for (int cy : {20, 40, 60})
+    for (int cx : {20, 60, 100})
+      for (int y = cy - 1; y <= cy + 1; ++y)
+        for (int x = cx - 1; x <= cx + 1; ++x)
+          for (int c = 0; c < 3; ++c) s.truth[3 * (size_t(y) * w + x) + c] = 20.f;
+  std::mt19937 rng(3);
+  std::normal_distribution<float> noise(0.f, 0.05f);
+  s.a.resize(3 * n), s.b.resize(3 * n), s.primal.resize(3 * n);
+  for (size_t i = 0; i < 3 * n; ++i) {
+    s.a[i] = s.truth[i] * (1.f + noise(rng));
+    s.b[i] = s.truth[i] * (1.f + noise(rng));
+    s.primal[i] = 0.5f * (s.a[i] + s.b[i]);
+  }
+  const FeatureReconstruction r = filter_primal(s);
+  const double before = relative_mse(s.primal, s.truth), after = relative_mse(r.image, s.truth);
+  std::printf("bright spots: relMSE %.3g -> %.3g\n", before, after);
+  EXPECT_LT(after, before / 4.0);
 }
 
 TEST(Feature, SameResultOnOneAndTwoThreads) {
