@@ -84,10 +84,12 @@ KEEP ?=
 bench: build install-addon
 	QUICK=$(QUICK) KEEP=$(KEEP) bash scripts/bench.sh $(BUILD)
 
-# Per-material agreement with Cycles over a library of material scripts (not in CI):
-#   make materials LIB=/path/to/scripts [ONLY=Name,Name]
+# Per-material agreement with Cycles over a library of material scripts and .blend files (not in
+# CI), written to bench/results/$(RESULTS).{json,md}:
+#   make materials LIB=/path/to/library [ONLY=Name,Name] [RESULTS=materials] [SOURCE='owner/repo@commit (licence)']
+RESULTS ?= materials
 materials: build
-	bash bench/materials/run.sh $(BUILD) "$(LIB)" $(if $(ONLY),--only $(ONLY))
+	RESULTS=$(RESULTS) bash bench/materials/run.sh $(BUILD) "$(LIB)" $(if $(ONLY),--only "$(ONLY)") $(if $(SOURCE),--source "$(SOURCE)")
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')

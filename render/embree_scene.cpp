@@ -14,6 +14,7 @@
 
 #include "core/shadow_terminator.h"
 #include "scene/generated_mapping.h"
+#include "shaders/object_nodes.h"
 
 namespace gdpt {
 
@@ -534,12 +535,16 @@ void EmbreeScene::normal_map_normal(const InstanceData& d, uint32_t primitive, f
   set_unit(t * c.x + b * c.y + n * c.z, hit.shading_normal);
 }
 
-// Cycles' bump (svm_node_set_bump) tilts N against the surface gradient of the height, which it
-// takes from heights at the ray differentials' offsets: to first order N' = normalize(N -
-// distance grad h). Here grad h comes from forward differences of the height along two
-// directions a0, a1 of the triangle's plane, through their dual basis (g_i . a_j = delta_ij):
-// along dP/du and dP/dv with a step in UV when the mesh has UVs, else along the triangle's edges
-// with a step in barycentrics. Every coordinate moves with the step (UV, and object-space
+// Cycles' bump (svm_node_set_bump) tilts N against the surface gradient of the height, from
+// heights at the hit and at two offsets of one pixel footprint (its compact ray differential)
+// along the tangents make_orthonormals(Ng) gives: N' = normalize(|det| N - distance sign(det)
+// surfgrad). The step matters: a height with detail finer than a pixel (a fractal noise of many
+// octaves) differs over a footprint by far less than its true slope says, so a differential step
+// would tilt the normal much more than Cycles does. Where no camera gives a footprint, the
+// gradient comes from forward differences of a small step (the derivative). Heights are read at
+// an offset through the dual basis (g_i . a_j = delta_ij) of two directions a0, a1 of the
+// triangle's plane: dP/du and dP/dv (a step in UV) when the mesh has UVs, else the triangle's
+// edges (a step in barycentrics). Every coordinate moves with the step (UV, and object-space
 // coordinates along the object-space image of the direction), so image and procedural heights
 // both differentiate.
 void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
@@ -582,44 +587,65 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
   const float jac = dot(ng, cross(a[0], a[1]));
   if (!(std::fabs(jac) > 0.0f) || !std::isfinite(jac)) return;
   const Vec3f g0 = cross(a[1], ng) / jac, g1 = cross(ng, a[0]) / jac;
-  // In UV: about a quarter texel of a 256 image; in barycentrics: a 1024th of the triangle.
-  constexpr float kStep = 1.0f / 1024.0f;
-  float h[3];
   ShadingContext at = shading_context(d, hit);
-  h[0] = material.bump_height(bump, at);
+  const float h0 = material.bump_height(bump, at);
   const TexCoords base = hit.coords;
-  for (int k = 0; k < 2; ++k) {
-    at.uv = hit.uv + duv[k] * kStep;
+  // The height at the hit moved by c0 a0 + c1 a1.
+  auto height_at = [&](float c0, float c1) {
+    at.uv = hit.uv + duv[0] * c0 + duv[1] * c1;
     TexCoords shifted = base;
     if (d.writes_coords) {
-      shifted.object = base.object + o[k] * kStep;
-      shifted.position = base.position + a[k] * kStep;
+      const Vec3f object = o[0] * c0 + o[1] * c1;
+      shifted.object = base.object + object;
+      shifted.position = base.position + a[0] * c0 + a[1] * c1;
       for (int c = 0; c < 3; ++c)
-        shifted.generated[c] = base.generated[c] + o[k][c] * kStep * d.generated_scale[c];
+        shifted.generated[c] = base.generated[c] + object[c] * d.generated_scale[c];
     }
     at.coords = d.writes_coords ? &shifted : nullptr;
     // Mesh attributes (Pointiness, Parametric) move with the step too, as Cycles differentiates
     // them for bump.
     SurfaceAttributes moved;
     if (d.writes_attributes) {
-      const Vec2f b = hit.attributes.barycentric + dbary[k] * kStep;
+      const Vec2f b = hit.attributes.barycentric + dbary[0] * c0 + dbary[1] * c1;
       moved = attributes_at(d, primitive, idx, b.x, b.y);
     }
     at.attributes = d.writes_attributes ? &moved : nullptr;
-    h[k + 1] = material.bump_height(bump, at);
-  }
-  Vec3f grad = (g0 * (h[1] - h[0]) + g1 * (h[2] - h[0])) / kStep;
+    return material.bump_height(bump, at);
+  };
   const BumpDesc& b = material.bumps()[bump];
   // The tilt belongs to the surface, not to the side it is seen from: a back face shows the
   // same bumped normal, flipped (as Cycles 3.4 renders inside-out meshes).
   const float distance = b.invert ? -b.distance : b.distance;
   const Vec3f n = hit.shading_normal;
-  // The same directional derivatives, in the plane normal to n (Cycles' surface gradient): moves
-  // grad along the face normal; it matters where n is tilted, by smoothing or an earlier bump.
-  const float ng_n = dot(ng, n);
-  if (std::fabs(ng_n) > 1e-3f * length(ng)) grad = grad - ng * (dot(grad, n) / ng_n);
   Vec3f bumped;
-  if (!set_unit(n - grad * distance, bumped)) return;
+  const float footprint = pixel_footprint(material.camera(), hit.position);
+  if (footprint > 0.0f && std::isfinite(footprint)) {
+    // Cycles' tangents belong to the geometric normal of the side the ray sees.
+    const Vec3f ng_seen = normalize(hit.front_facing ? ng : -ng);
+    Vec3f tx = ng_seen.x != ng_seen.y || ng_seen.x != ng_seen.z
+                   ? Vec3f(ng_seen.z - ng_seen.y, ng_seen.x - ng_seen.z, ng_seen.y - ng_seen.x)
+                   : Vec3f(ng_seen.z - ng_seen.y, ng_seen.x + ng_seen.z, -ng_seen.y - ng_seen.x);
+    tx = normalize(tx) * footprint;
+    const Vec3f ty = cross(ng_seen, tx);
+    const float hx = height_at(dot(g0, tx), dot(g1, tx));
+    const float hy = height_at(dot(g0, ty), dot(g1, ty));
+    const Vec3f rx = cross(ty, n), ry = cross(n, tx);
+    const float det = dot(tx, rx);
+    const Vec3f surfgrad = rx * (hx - h0) + ry * (hy - h0);
+    if (!set_unit(n * std::fabs(det) - surfgrad * (distance * (det < 0.0f ? -1.0f : 1.0f)), bumped))
+      return;
+  } else {
+    // In UV: about a quarter texel of a 256 image; in barycentrics: a 1024th of the triangle.
+    constexpr float kStep = 1.0f / 1024.0f;
+    const float h1 = height_at(kStep, 0.0f), h2 = height_at(0.0f, kStep);
+    Vec3f grad = (g0 * (h1 - h0) + g1 * (h2 - h0)) / kStep;
+    // The same directional derivatives, in the plane normal to n (Cycles' surface gradient):
+    // moves grad along the face normal; it matters where n is tilted, by smoothing or an
+    // earlier bump.
+    const float ng_n = dot(ng, n);
+    if (std::fabs(ng_n) > 1e-3f * length(ng)) grad = grad - ng * (dot(grad, n) / ng_n);
+    if (!set_unit(n - grad * distance, bumped)) return;
+  }
   const float strength = std::max(b.strength, 0.0f);
   set_unit(bumped * strength + n * (1.0f - strength), hit.shading_normal);
   // Displacement as bump: the tilted normal is the surface's own (not a perturbation of it).

@@ -65,6 +65,8 @@ class Material {
   // The camera Vector Transform's Camera space and Wireframe's pixel size read (set by the
   // scene's owner before rendering; default: at the origin, looking down world +z).
   void set_camera(const ShadingCamera& camera) { camera_ = camera; }
+  // The camera it was given: Bump nodes' finite differences step one pixel footprint of it.
+  const ShadingCamera& camera() const { return camera_; }
 
  private:
   void cache_if_constant();

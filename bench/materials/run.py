@@ -1,6 +1,7 @@
-# Renders every material of a library of Blender material scripts (one .txt/.py per material, as
-# the Node-To-Python add-on writes them) on a sphere over a ground plane, with Gradient PT and with
-# Cycles set up as the agreement suite's oracle, and compares them per material.
+# Renders every material of a library on a sphere over a ground plane, with Gradient PT and with
+# Cycles set up as the agreement suite's oracle, and compares them per material. A library is a
+# folder of material scripts (one .txt/.py per material, as the Node-To-Python add-on writes them)
+# and of .blend files (every material in each, appended one at a time).
 #   blender -b --factory-startup --addons gdpt --python-exit-code 1 --python run.py --
 #           --lib DIR --out DIR [--json FILE] [--md FILE] [--only NAME,...] [--reuse 1]
 #           [--source TEXT] (where the library comes from, for the report's header)
@@ -74,19 +75,55 @@ def verdict(err, err_blocks, ratio, warnings):
     return "REPORTED" if warnings else "FAIL"
 
 
-def run_material(path, out_dir, reuse):
-    name = os.path.splitext(os.path.basename(path))[0]
-    row = {"file": os.path.basename(path), "name": name}
+def load_script(path):
+    """(materials the script made, settings lost loading it)."""
+    with open(path, encoding="utf-8") as f:
+        return adapt.load(bpy, f.read(), path)
+
+
+def load_from_blend(path, material):
+    """([the material appended from the .blend], its image textures whose files are missing)."""
+    with bpy.data.libraries.load(path, link=False) as (source, target):
+        target.materials = [material]
+    loaded = [m for m in target.materials if m is not None]
+    missing = sorted({f"image '{n.image.name}' ({n.image.filepath}) missing" for m in loaded
+                      for n in m.node_tree.nodes if n.type == 'TEX_IMAGE' and n.image
+                      and n.image.packed_file is None and not n.image.has_data
+                      and not os.path.exists(bpy.path.abspath(n.image.filepath))})
+    return loaded, missing
+
+
+def library_entries(lib):
+    """(row name, file, loader) per material: one per script, one per material of each .blend
+    (named 'material [file]' when two files hold materials of the same name)."""
+    entries = []
+    for f in sorted(os.listdir(lib)):
+        path = os.path.join(lib, f)
+        if f.endswith((".txt", ".py")):
+            entries.append((os.path.splitext(f)[0], f, lambda p=path: load_script(p)))
+        elif f.endswith(".blend"):
+            with bpy.data.libraries.load(path) as (source, _):
+                names = list(source.materials)
+            entries += [(m, f, lambda p=path, m=m: load_from_blend(p, m)) for m in names]
+    counts = {}
+    for name, _, _ in entries:
+        counts[name] = counts.get(name, 0) + 1
+    return [(f"{n} [{os.path.splitext(f)[0]}]" if counts[n] > 1 else n, f, load)
+            for n, f, load in entries]
+
+
+def run_material(entry, out_dir, reuse):
+    name, file, load = entry
+    row = {"file": file, "name": name}
     scene = S.clear()
     try:
-        with open(path, encoding="utf-8") as f:
-            materials, skipped = adapt.load(bpy, f.read(), path)
-    except Exception as e:  # a script that does not run is a row of the table, not the end
-        row.update(verdict="FAIL", reason=f"script does not load in Blender 3.4: "
+        materials, skipped = load()
+    except Exception as e:  # a material that does not load is a row of the table, not the end
+        row.update(verdict="FAIL", reason=f"material does not load in Blender 3.4: "
                    f"{type(e).__name__}: {e}".splitlines()[0])
         return row
     if not materials:
-        row.update(verdict="FAIL", reason="the script made no material")
+        row.update(verdict="FAIL", reason="no material loaded")
         return row
     material = materials[0]
     row.update(material=material.name, skipped_on_load=skipped,
@@ -131,15 +168,15 @@ def main():
     a = S.args()
     lib, out_dir = a.get("lib"), a.get("out")
     if not lib or not os.path.isdir(lib) or not out_dir:
-        raise SystemExit("usage: run.py -- --lib DIR (material scripts) --out DIR "
+        raise SystemExit("usage: run.py -- --lib DIR (material scripts, .blend files) --out DIR "
                          "[--json F] [--md F]")
     os.makedirs(out_dir, exist_ok=True)
-    files = sorted(f for f in os.listdir(lib) if f.endswith((".txt", ".py")))
     only = set(a["only"].split(",")) if "only" in a else None
-    rows = [run_material(os.path.join(lib, f), out_dir, a.get("reuse") == "1") for f in files
-            if only is None or os.path.splitext(f)[0] in only]
+    rows = [run_material(e, out_dir, a.get("reuse") == "1") for e in library_entries(lib)
+            if only is None or e[0] in only]
     if not rows:
-        raise SystemExit(f"no material scripts (.txt/.py) in {lib}")
+        raise SystemExit(f"no material scripts (.txt/.py) or .blend materials in {lib}"
+                         + (f" named {sorted(only)}" if only else ""))
     json_path = a.get("json", os.path.join(out_dir, "materials.json"))
     with open(json_path, "w") as f:
         json.dump({"library": a.get("source", lib), "samples": SAMPLES, "size": SIZE, "materials": rows}, f,
