@@ -94,6 +94,8 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     if (mesh.triangle_count() == 0 || mesh.positions.empty()) continue;
     const Transform& T = inst.object_to_world;
     shading_instances_[i] = {T, T.inverse(), mesh.positions.data(), mesh.indices.data()};
+    shading_instances_[i].terminator_frequency =
+        terminator_frequency(inst.terminator_shading_offset);
     const float det = T.m[0][0] * (T.m[1][1] * T.m[2][2] - T.m[1][2] * T.m[2][1]) -
                       T.m[0][1] * (T.m[1][0] * T.m[2][2] - T.m[1][2] * T.m[2][0]) +
                       T.m[0][2] * (T.m[1][0] * T.m[2][1] - T.m[1][1] * T.m[2][0]);
@@ -534,6 +536,34 @@ void EmbreeScene::normal_map_normal(const InstanceData& d, uint32_t primitive, f
   set_unit(t * c.x + b * c.y + n * c.z, hit.shading_normal);
 }
 
+// A vector displacement's height is dot(M V, n) for the frame M of its space and the interpolated
+// normal n (world), i.e. dot(V, M^T n): this returns M^T n. Tangent space (Cycles'
+// svm_node_vector_displacement): x along the corner tangent t, y along the object-space normal
+// n_o = normalize(O^T n) (O: the object's linear part), z along n_o x t, so M = O [t n_o b] and,
+// b being normal to n_o, M^T n = |O^T n| (t . n_o, 1, 0). Without a tangent here (no UV map) the
+// x term is dropped (Cycles then takes dP/du, which lies nearly in the surface too).
+Vec3f EmbreeScene::displacement_along(const InstanceData& d, uint32_t primitive,
+                                      const SurfaceHit& hit, const BumpDesc& bump) {
+  const Vec3f n = hit.shading_normal;
+  if (bump.vector_space == BumpDesc::VectorSpace::World) return n;
+  if (bump.vector_space == BumpDesc::VectorSpace::None) return Vec3f(0.0f);
+  const auto& cols = d.to_world_cols;
+  const Vec3f on(dot(Vec3f(cols[0][0], cols[0][1], cols[0][2]), n),
+                 dot(Vec3f(cols[1][0], cols[1][1], cols[1][2]), n),
+                 dot(Vec3f(cols[2][0], cols[2][1], cols[2][2]), n));  // O^T n
+  if (bump.vector_space == BumpDesc::VectorSpace::Object) return on;
+  const float len = length(on);
+  if (!(len > 0.0f)) return Vec3f(0.0f);
+  float t_n = 0.0f;
+  if (primitive < d.corner_tangent_tris) {
+    const Vec3f* T = d.corner_tangents + size_t(primitive) * 3;
+    const Vec2f b = hit.bary;
+    const Vec3f t = T[0] * (1.0f - b.x - b.y) + T[1] * b.x + T[2] * b.y;
+    t_n = dot(t, on) / len;
+  }
+  return Vec3f(len * t_n, len, 0.0f);
+}
+
 // Cycles' bump (svm_node_set_bump) tilts N against the surface gradient of the height, which it
 // takes from heights at the ray differentials' offsets: to first order N' = normalize(N -
 // distance grad h). Here grad h comes from forward differences of the height along two
@@ -579,6 +609,7 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
     }
   }
   const Vec3f ng = cross(e1, e2);
+  const Vec3f along = displacement_along(d, primitive, hit, material.bumps()[bump]);
   const float jac = dot(ng, cross(a[0], a[1]));
   if (!(std::fabs(jac) > 0.0f) || !std::isfinite(jac)) return;
   const Vec3f g0 = cross(a[1], ng) / jac, g1 = cross(ng, a[0]) / jac;
@@ -586,7 +617,7 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
   constexpr float kStep = 1.0f / 1024.0f;
   float h[3];
   ShadingContext at = shading_context(d, hit);
-  h[0] = material.bump_height(bump, at);
+  h[0] = material.bump_height(bump, at, along);
   const TexCoords base = hit.coords;
   for (int k = 0; k < 2; ++k) {
     at.uv = hit.uv + duv[k] * kStep;
@@ -606,7 +637,7 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
       moved = attributes_at(d, primitive, idx, b.x, b.y);
     }
     at.attributes = d.writes_attributes ? &moved : nullptr;
-    h[k + 1] = material.bump_height(bump, at);
+    h[k + 1] = material.bump_height(bump, at, along);
   }
   Vec3f grad = (g0 * (h[1] - h[0]) + g1 * (h[2] - h[0])) / kStep;
   const BumpDesc& b = material.bumps()[bump];
