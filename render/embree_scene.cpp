@@ -537,14 +537,16 @@ void EmbreeScene::normal_map_normal(const InstanceData& d, uint32_t primitive, f
 }
 
 // A vector displacement's height is dot(M V, n) for the frame M of its space and the interpolated
-// normal n (world), i.e. dot(V, M^T n): this returns M^T n. Tangent space (Cycles'
+// normal n (world, facing the ray), i.e. dot(V, M^T n): this returns M^T n. Tangent space (Cycles'
 // svm_node_vector_displacement): x along the corner tangent t, y along the object-space normal
 // n_o = normalize(O^T n) (O: the object's linear part), z along n_o x t, so M = O [t n_o b] and,
 // b being normal to n_o, M^T n = |O^T n| (t . n_o, 1, 0). Without a tangent here (no UV map) the
 // x term is dropped (Cycles then takes dP/du, which lies nearly in the surface too).
 Vec3f EmbreeScene::displacement_along(const InstanceData& d, uint32_t primitive,
                                       const SurfaceHit& hit, const BumpDesc& bump) {
-  const Vec3f n = hit.shading_normal;
+  // Cycles dots with sd->N, which faces the incoming ray: on a back face the height changes sign
+  // (bump_normal then tilts the surface's own normal, flipped, by it).
+  const Vec3f n = hit.front_facing ? hit.shading_normal : -hit.shading_normal;
   if (bump.vector_space == BumpDesc::VectorSpace::World) return n;
   if (bump.vector_space == BumpDesc::VectorSpace::None) return Vec3f(0.0f);
   const auto& cols = d.to_world_cols;

@@ -453,7 +453,9 @@ TEST(Render, TerminatorShadingOffsetShiftsTheCosine) {
 // red does only through the tangent's component along the normal (Cycles reads the interpolated
 // tangent as it is): with t = (1, 0, 0.5) half the tilt. World space: blue tilts, green does not.
 // Object space reads the object's transform: blue under a z scale of 2 tilts twice as much
-// (O^T n = 2 z). PT and G-PT.
+// (O^T n = 2 z). Seen from its back (the quad wound the other way, n = -z), the height is the
+// component along the normal facing the ray (Cycles' sd->N, +z): the surface's own normal tilts
+// by it, flipped, so world-space blue tilts the other way (-0.2). PT and G-PT.
 TEST(Render, VectorDisplacementTiltsByItsComponentAlongTheNormal) {
   using Space = BumpDesc::VectorSpace;
   constexpr float kTheta = 0.5f;
@@ -462,13 +464,15 @@ TEST(Render, VectorDisplacementTiltsByItsComponentAlongTheNormal) {
     Spectrum channel;
     float tangent_z, scale_z;
     double tilt;
+    bool back = false;
   };
   const Spectrum red(1, 0, 0), green(0, 1, 0), blue(0, 0, 1);
   for (const Case& c :
        {Case{Space::Tangent, green, 0.0f, 1.0f, 0.2}, Case{Space::Tangent, blue, 0.0f, 1.0f, 0.0},
         Case{Space::Tangent, red, 0.0f, 1.0f, 0.0}, Case{Space::Tangent, red, 0.5f, 1.0f, 0.1},
         Case{Space::World, blue, 0.0f, 1.0f, 0.2}, Case{Space::World, green, 0.0f, 1.0f, 0.0},
-        Case{Space::Object, blue, 0.0f, 2.0f, 0.4}}) {
+        Case{Space::Object, blue, 0.0f, 2.0f, 0.4},
+        Case{Space::World, blue, 0.0f, 1.0f, -0.2, true}}) {
     MaterialDesc m = ramp_bumped();
     m.bumps[0].replaces_normal = true;
     m.bumps[0].vector_space = c.space;
@@ -476,6 +480,10 @@ TEST(Render, VectorDisplacementTiltsByItsComponentAlongTheNormal) {
     Mesh plane = uv_quad();
     plane.corner_tangents.assign(6, Vec3f(1.0f, 0.0f, c.tangent_z));
     plane.corner_tangent_signs.assign(6, 1.0f);
+    if (c.back) {
+      plane.indices = {0, 2, 1, 0, 3, 2};
+      plane.corner_uvs = {{0, 0}, {1, 1}, {1, 0}, {0, 0}, {0, 1}, {1, 1}};
+    }
     Transform placement;
     placement.m[2][2] = c.scale_z;
     Scene scene = sunlit_plane(plane, m, kTheta, placement);
