@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/vec.h"
 
@@ -56,6 +57,23 @@ inline float terminator_lift_amount(float cutoff, Vec3f ns, Vec3f ng, Vec3f l, V
   const float cos_s = std::fabs(cos_n), cos_g = dot(ng_side, l);
   const float ramp = cos_s < cutoff ? 2.0f - (cos_g + cos_s) / cutoff : 1.0f - cos_g / cutoff;
   return std::clamp(ramp, 0.0f, 1.0f);
+}
+
+// Cycles' shadow terminator shading offset (Object > Shading > Shadow Terminator > Shading
+// Offset, after appleseed): the BSDF value of a reflected direction at angle a from the lobe's
+// normal is scaled by max(cos(k a), 0) / cos(a), which darkens towards the terminator and moves
+// it towards the light. k is the frequency multiplier of the setting `offset` in [0, 1]
+// (Cycles' object.cpp: 1 / (1 - offset / 2)).
+inline float terminator_frequency(float offset) {
+  return 1.0f / (1.0f - 0.5f * offset);
+}
+
+// The factor for a direction of cosine `cos_wo` with the lobe's normal: 1 for k <= 1 and for
+// directions at or below the lobe's horizon (transmission: Cycles leaves those alone).
+inline float terminator_shading_factor(float cos_wo, float k) {
+  if (!(k > 1.0f) || !(cos_wo > 0.0f)) return 1.0f;
+  const float c = std::min(cos_wo, 1.0f);
+  return std::max(std::cos(std::acos(c) * k), 0.0f) / c;
 }
 
 }  // namespace gdpt

@@ -95,6 +95,8 @@ EmbreeScene::EmbreeScene(const Scene& scene, int32_t default_material)
     if (mesh.triangle_count() == 0 || mesh.positions.empty()) continue;
     const Transform& T = inst.object_to_world;
     shading_instances_[i] = {T, T.inverse(), mesh.positions.data(), mesh.indices.data()};
+    shading_instances_[i].terminator_frequency =
+        terminator_frequency(inst.terminator_shading_offset);
     const float det = T.m[0][0] * (T.m[1][1] * T.m[2][2] - T.m[1][2] * T.m[2][1]) -
                       T.m[0][1] * (T.m[1][0] * T.m[2][2] - T.m[1][2] * T.m[2][0]) +
                       T.m[0][2] * (T.m[1][0] * T.m[2][1] - T.m[1][1] * T.m[2][0]);
@@ -535,6 +537,36 @@ void EmbreeScene::normal_map_normal(const InstanceData& d, uint32_t primitive, f
   set_unit(t * c.x + b * c.y + n * c.z, hit.shading_normal);
 }
 
+// A vector displacement's height is dot(M V, n) for the frame M of its space and the interpolated
+// normal n (world, facing the ray), i.e. dot(V, M^T n): this returns M^T n. Tangent space (Cycles'
+// svm_node_vector_displacement): x along the corner tangent t, y along the object-space normal
+// n_o = normalize(O^T n) (O: the object's linear part), z along n_o x t, so M = O [t n_o b] and,
+// b being normal to n_o, M^T n = |O^T n| (t . n_o, 1, 0). Without a tangent here (no UV map) the
+// x term is dropped (Cycles then takes dP/du, which lies nearly in the surface too).
+Vec3f EmbreeScene::displacement_along(const InstanceData& d, uint32_t primitive,
+                                      const SurfaceHit& hit, const BumpDesc& bump) {
+  // Cycles dots with sd->N, which faces the incoming ray: on a back face the height changes sign
+  // (bump_normal then tilts the surface's own normal, flipped, by it).
+  const Vec3f n = hit.front_facing ? hit.shading_normal : -hit.shading_normal;
+  if (bump.vector_space == BumpDesc::VectorSpace::World) return n;
+  if (bump.vector_space == BumpDesc::VectorSpace::None) return Vec3f(0.0f);
+  const auto& cols = d.to_world_cols;
+  const Vec3f on(dot(Vec3f(cols[0][0], cols[0][1], cols[0][2]), n),
+                 dot(Vec3f(cols[1][0], cols[1][1], cols[1][2]), n),
+                 dot(Vec3f(cols[2][0], cols[2][1], cols[2][2]), n));  // O^T n
+  if (bump.vector_space == BumpDesc::VectorSpace::Object) return on;
+  const float len = length(on);
+  if (!(len > 0.0f)) return Vec3f(0.0f);
+  float t_n = 0.0f;
+  if (primitive < d.corner_tangent_tris) {
+    const Vec3f* T = d.corner_tangents + size_t(primitive) * 3;
+    const Vec2f b = hit.bary;
+    const Vec3f t = T[0] * (1.0f - b.x - b.y) + T[1] * b.x + T[2] * b.y;
+    t_n = dot(t, on) / len;
+  }
+  return Vec3f(len * t_n, len, 0.0f);
+}
+
 // Cycles' bump (svm_node_set_bump) tilts N against the surface gradient of the height, from
 // heights at the hit and at two offsets of one pixel footprint (its compact ray differential)
 // along the tangents make_orthonormals(Ng) gives: N' = normalize(|det| N - distance sign(det)
@@ -584,11 +616,12 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
     }
   }
   const Vec3f ng = cross(e1, e2);
+  const Vec3f along = displacement_along(d, primitive, hit, material.bumps()[bump]);
   const float jac = dot(ng, cross(a[0], a[1]));
   if (!(std::fabs(jac) > 0.0f) || !std::isfinite(jac)) return;
   const Vec3f g0 = cross(a[1], ng) / jac, g1 = cross(ng, a[0]) / jac;
   ShadingContext at = shading_context(d, hit);
-  const float h0 = material.bump_height(bump, at);
+  const float h0 = material.bump_height(bump, at, along);
   const TexCoords base = hit.coords;
   // The height at the hit moved by c0 a0 + c1 a1.
   auto height_at = [&](float c0, float c1) {
@@ -610,7 +643,7 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
       moved = attributes_at(d, primitive, idx, b.x, b.y);
     }
     at.attributes = d.writes_attributes ? &moved : nullptr;
-    return material.bump_height(bump, at);
+    return material.bump_height(bump, at, along);
   };
   const BumpDesc& b = material.bumps()[bump];
   // The tilt belongs to the surface, not to the side it is seen from: a back face shows the

@@ -283,6 +283,9 @@ class EmbreeScene {
                          SurfaceHit& hit, const Material& material) const;
   void bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
                    const Material& material, size_t bump) const;
+  // What a vector displacement's vector is dotted with for its height (Material::bump_height).
+  static Vec3f displacement_along(const InstanceData& d, uint32_t primitive, const SurfaceHit& hit,
+                                  const BumpDesc& bump);
   // The shading context of a completed hit (its colour and coordinates where it has them).
   static ShadingContext shading_context(const InstanceData& d, const SurfaceHit& hit) {
     ShadingContext ctx{hit.uv, true, d.writes_color ? &hit.color : nullptr,

@@ -306,6 +306,13 @@ struct NormalMapDesc {
 // bump shadowing follows and every lobe and Geometry Normal reads it. The gradient is taken in
 // world units, where Cycles takes an object-space displacement's in object units: the two agree
 // for objects of unit scale only.
+// A Vector Displacement node on the Displacement output (vector_space not None) gives the height
+// from `vector`, its (Vector - Midlevel) Scale in that space: the height is the displacement's
+// component along the interpolated normal, as Cycles' bump_from_displacement dots the
+// displacement with the normal. The frame that takes the vector to world space (tangent: x along
+// the UV map's tangent, y along the normal, z along the bitangent; object: the object's transform)
+// is the shading point's for every sample of the gradient, as Cycles evaluates the node's frame
+// at the centre only.
 // A Bump node whose Normal input is another Bump (or a Normal Map) tilts that node's normal: the
 // gradient is taken in the plane normal to it (Cycles' surface gradient against its N).
 struct BumpDesc {
@@ -314,6 +321,13 @@ struct BumpDesc {
   float distance = 1.0f;
   bool invert = false;
   bool replaces_normal = false;
+  enum class VectorSpace : uint8_t {
+    None,
+    Tangent,
+    Object,
+    World
+  } vector_space = VectorSpace::None;
+  ColorInput vector{Spectrum(0.0f)};  // with vector_space: replaces height
 };
 
 struct MaterialDesc {

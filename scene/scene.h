@@ -73,6 +73,9 @@ struct Instance {
   // shadow rays from smooth-shaded triangles near the terminator start from the curved surface
   // (core/shadow_terminator.h); 0 turns it off.
   float terminator_geometry_offset = 0.1f;
+  // Object > Shading > Shadow Terminator > Shading Offset (Cycles' object setting, in [0, 1],
+  // default 0): the BSDFs' values darken towards the terminator (core/shadow_terminator.h).
+  float terminator_shading_offset = 0.0f;
 };
 
 // Blender camera. Looks down its local -Z with +Y up, like Blender.

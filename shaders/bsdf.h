@@ -22,6 +22,7 @@ class ClosureSet {
     emission_ = Spectrum(0.0f);
     shadowing_ = false;
     own_frames_ = false;
+    terminator_k_ = 1.0f;
   }
   // Becomes a copy of `other` (only its live lobes are copied: cheaper than assignment).
   void assign(const ClosureSet& other) {
@@ -33,6 +34,7 @@ class ClosureSet {
     own_frames_ = other.own_frames_;
     interpolated_ = other.interpolated_;
     ng_ = other.ng_;
+    terminator_k_ = other.terminator_k_;
   }
   // Cycles' bump shadowing (Conty Estevez et al. 2019, Cycles 3.4's bump_shadowing_term): at a
   // point whose shading normal a normal map or bump replaced, the diffuse lobes' values (not
@@ -42,6 +44,14 @@ class ClosureSet {
   void set_bump_shadowing(Vec3f unperturbed) {
     shadowing_ = true;
     unperturbed_ = unperturbed;
+  }
+  // Cycles' shadow terminator shading offset of the object (core/shadow_terminator.h): every
+  // lobe's value (not its density) towards a direction above the lobe's normal is scaled by
+  // terminator_shading_factor of frequency k. k <= 1 leaves the set as it is.
+  void set_terminator_shift(float k) {
+    if (!(k > 1.0f)) return;
+    terminator_k_ = k;
+    shadowing_ = true;  // off the single-Lambert fast path
   }
   // Whether a lobe keeps the interpolated normal under a normal map or bump
   // (Closure::interpolated_normal).
@@ -100,6 +110,13 @@ class ClosureSet {
   }
   // The bump shadowing factor of direction wo (1 without set_bump_shadowing).
   float diffuse_shadowing(Vec3f wo) const;
+  // The factors the lobes' values take towards wo (bump shadowing, terminator shift).
+  struct Attenuation {
+    float diffuse = 1.0f;    // bump shadowing, diffuse lobes about the shading normal
+    float shift = 1.0f;      // terminator shift about the shading normal (+z)
+    float shift_own = 1.0f;  // terminator shift about the interpolated normal (own frames)
+  };
+  Attenuation attenuation(Vec3f wo) const;
   float pdf(Vec3f wi, Vec3f wo) const {
     return single_lambert() ? lambert::pdf(closures_[0], wi, wo) : pdf_mixture(wi, wo);
   }
@@ -168,6 +185,9 @@ class ClosureSet {
   void add_same_delta_events(int k, Vec3f wi, const float* w, float total, BsdfSample& s) const;
   template <bool kFramed>
   BsdfSample lobe_delta_event(int i, Vec3f wi, uint8_t event) const;
+  // A delta lobe's value towards wo with the terminator shift about the lobe's normal.
+  template <bool kFramed>
+  Spectrum delta_shifted(const Closure& c, Spectrum value, Vec3f wo) const;
   // Any set (the same values as the fast path for a single Lambert lobe).
   Spectrum eval_mixture(Vec3f wi, Vec3f wo) const;
   float pdf_mixture(Vec3f wi, Vec3f wo) const;
@@ -183,6 +203,7 @@ class ClosureSet {
   bool own_frames_ = false;
   Vec3f interpolated_{0.0f, 0.0f, 1.0f};
   Vec3f ng_{0.0f, 0.0f, 1.0f};
+  float terminator_k_ = 1.0f;  // set_terminator_shift
 };
 
 }  // namespace gdpt

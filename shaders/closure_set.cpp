@@ -8,6 +8,7 @@
 #include <algorithm>
 
 #include "core/frame.h"
+#include "core/shadow_terminator.h"
 #include "shaders/bsdf.h"
 #include "shaders/bsdf_clearcoat.h"
 #include "shaders/bsdf_ggx_dielectric.h"
@@ -205,14 +206,35 @@ float ClosureSet::diffuse_shadowing(Vec3f wo) const {
   return -g2 * g + g2 + g;
 }
 
-// A lobe's value with the bump shadowing of diffuse lobes applied (`shadowing` = its factor).
-// Lobes about their own (interpolated) normal are not shadowed: Cycles shadows the closures whose
-// normal is not the interpolated one.
+ClosureSet::Attenuation ClosureSet::attenuation(Vec3f wo) const {
+  Attenuation a;
+  if (!shadowing_) return a;
+  a.diffuse = diffuse_shadowing(wo);
+  if (terminator_k_ > 1.0f) {
+    a.shift = terminator_shading_factor(wo.z, terminator_k_);
+    if (own_frames_) a.shift_own = terminator_shading_factor(dot(interpolated_, wo), terminator_k_);
+  }
+  return a;
+}
+
+// A lobe's value with the bump shadowing of diffuse lobes and the terminator shift applied.
+// Lobes about their own (interpolated) normal are not bump-shadowed: Cycles shadows the closures
+// whose normal is not the interpolated one.
 template <bool kFramed>
-Spectrum shadowed(const Closure& c, Spectrum value, float shadowing) {
+Spectrum shadowed(const Closure& c, Spectrum value, const ClosureSet::Attenuation& a) {
   if constexpr (kFramed)
-    if (c.interpolated_normal) return value;
-  return shadowing != 1.0f && lobe_is_diffuse(c) ? value * shadowing : value;
+    if (c.interpolated_normal) return a.shift_own != 1.0f ? value * a.shift_own : value;
+  const float f = lobe_is_diffuse(c) ? a.diffuse * a.shift : a.shift;
+  return f != 1.0f ? value * f : value;
+}
+
+template <bool kFramed>
+Spectrum ClosureSet::delta_shifted(const Closure& c, Spectrum value, Vec3f wo) const {
+  if (!(terminator_k_ > 1.0f)) return value;
+  float cos_wo = wo.z;
+  if constexpr (kFramed)
+    if (c.interpolated_normal) cos_wo = dot(interpolated_, wo);
+  return value * terminator_shading_factor(cos_wo, terminator_k_);
 }
 
 bool ClosureSet::lobe_side_ok(const Closure& c, Vec3f wi, Vec3f wo) const {
@@ -242,7 +264,7 @@ BsdfSample ClosureSet::sample_mixture(Vec3f wi, float u_lobe, Vec2f u) const {
 
 template <bool kFramed>
 Spectrum ClosureSet::eval_mixture_t(Vec3f wi, Vec3f wo) const {
-  const float sh = diffuse_shadowing(wo);
+  const Attenuation sh = attenuation(wo);
   Spectrum f(0.0f);
   for (int i = 0; i < count_; ++i) {
     if constexpr (kFramed)
@@ -274,7 +296,7 @@ float ClosureSet::pdf_mixture_t(Vec3f wi, Vec3f wo) const {
 
 template <bool kFramed>
 Spectrum ClosureSet::eval_pdf_mixture_t(Vec3f wi, Vec3f wo, float& pdf_out) const {
-  const float sh = diffuse_shadowing(wo);
+  const Attenuation sh = attenuation(wo);
   if (count_ == 1) {
     if constexpr (kFramed)
       if (!lobe_side_ok(closures_[0], wi, wo)) {
@@ -317,7 +339,8 @@ BsdfSample ClosureSet::sample_single_t(Vec3f wi, float u_lobe, Vec2f u) const {
   if constexpr (kFramed)
     if (s.valid && !lobe_side_ok(closures_[0], wi, s.wo)) s = BsdfSample{};
   if (s.valid && shadowing_)
-    s.value = shadowed<kFramed>(closures_[0], s.value, diffuse_shadowing(s.wo));
+    s.value = s.is_delta() ? delta_shifted<kFramed>(closures_[0], s.value, s.wo)
+                           : shadowed<kFramed>(closures_[0], s.value, attenuation(s.wo));
   return s;
 }
 
@@ -353,12 +376,13 @@ BsdfSample ClosureSet::sample_several_t(Vec3f wi, float u_lobe, Vec2f u) const {
     // reflection) make one event, whose value and probability are their sums, as for the
     // non-delta lobes below: the same numbers as delta_event() of that event.
     s.pdf *= sel_k;
+    s.value = delta_shifted<kFramed>(closures_[k], s.value, s.wo);
     add_same_delta_events<kFramed>(k, wi, w, total, s);
     return s;
   }
 
   // --- One-sample MIS: the mixture's value and density at the sampled direction.
-  const float sh = diffuse_shadowing(s.wo);
+  const Attenuation sh = attenuation(s.wo);
   Spectrum value = shadowed<kFramed>(closures_[k], s.value, sh);
   float pdf = w[k] * s.pdf;
   for (int i = 0; i < count_; ++i) {
@@ -385,6 +409,7 @@ BsdfSample ClosureSet::lobe_delta_event(int i, Vec3f wi, uint8_t event) const {
   if (!s.valid || !s.is_delta() || (s.lobe & event) == 0) return {};
   if constexpr (kFramed)
     if (!lobe_side_ok(c, wi, s.wo)) return {};
+  s.value = delta_shifted<kFramed>(c, s.value, s.wo);
   return s;
 }
 

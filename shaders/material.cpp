@@ -1009,7 +1009,10 @@ Material::Material(const MaterialDesc& desc, std::span<const Texture> textures)
   };
   visit(visit, root_, 0);
   if (normal_map_.enabled) note(normal_map_.color);
-  for (const BumpDesc& b : bumps_) note(b.height);
+  for (const BumpDesc& b : bumps_) {
+    note(b.height);
+    if (b.vector_space != BumpDesc::VectorSpace::None) note(b.vector);
+  }
 
   // --- Mean of every texture the tree uses, for average_emission().
   std::vector<Rgba> means(textures.size());
@@ -1056,8 +1059,12 @@ Vec3f Material::normal_map_direction(const ShadingContext& at) const {
           1.0f + (2.0f * (c.z - 0.5f) - 1.0f) * std::clamp(s, 0.0f, 1.0f)};
 }
 
-float Material::bump_height(size_t bump, const ShadingContext& at) const {
-  return PointInputs{textures_, inputs_, at, &camera_}.scalar(bumps_[bump].height);
+float Material::bump_height(size_t bump, const ShadingContext& at, Vec3f along) const {
+  const BumpDesc& b = bumps_[bump];
+  const PointInputs inputs{textures_, inputs_, at, &camera_};
+  if (b.vector_space == BumpDesc::VectorSpace::None) return inputs.scalar(b.height);
+  const Spectrum v = inputs.color(b.vector);
+  return v.x * along.x + v.y * along.y + v.z * along.z;
 }
 
 }  // namespace gdpt

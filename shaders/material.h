@@ -46,9 +46,10 @@ class Material {
   bool has_normal_map() const { return normal_map_.enabled; }
   Vec3f normal_map_direction(const ShadingContext& at) const;
   // Bump nodes (MaterialDesc::bumps, in their order): the height of one at a point (the caller
-  // differentiates).
+  // differentiates); a vector displacement's (BumpDesc::vector_space) is its vector dotted with
+  // `along`, the normal taken into the vector's space.
   const std::vector<BumpDesc>& bumps() const { return bumps_; }
-  float bump_height(size_t bump, const ShadingContext& at) const;
+  float bump_height(size_t bump, const ShadingContext& at, Vec3f along = Vec3f(0.0f)) const;
   // Some input reads the mesh's colour attribute (ShadingContext::color).
   bool reads_color_attribute() const { return reads_color_attribute_; }
   // Some texture reads Generated or Object coordinates (ShadingContext::coords).

@@ -60,6 +60,9 @@ struct ShadingInstance {
   const uint32_t* indices = nullptr;  // 3 per triangle
   // Generated = object * generated_scale + generated_offset (coords_at; hits carry their own).
   Vec3f generated_scale{0.0f}, generated_offset{0.0f};
+  // The frequency multiplier of the object's shadow terminator shading offset (1: none;
+  // core/shadow_terminator.h), applied by the integrators' shading_closures().
+  float terminator_frequency = 1.0f;
   // Corner k of triangle `primitive`, in world space.
   Vec3f corner(uint32_t primitive, int k) const {
     return object_to_world.point(positions[indices[3 * size_t(primitive) + size_t(k)]]);

@@ -413,6 +413,9 @@ class _Translator:
         method = getattr(cycles, "displacement_method", 'BUMP')
         if method != 'BUMP':
             self.warn(node, f"displacement method {method} (rendered as Bump Only) with")
+        if node.type == 'VECTOR_DISPLACEMENT':
+            self._vector_displacement(node)
+            return
         if node.type != 'DISPLACEMENT':
             self.warn(node, "displacement node (the displacement is ignored)")
             return
@@ -428,6 +431,35 @@ class _Translator:
         height = math("MULTIPLY", offset, self.value(i["Scale"]))
         self.displacement_bump = {"height": height, "strength": 1.0, "distance": 1.0,
                                   "invert": False, "replaces_normal": True}
+
+    def _vector_displacement(self, node):
+        """A Vector Displacement node as Cycles' Bump Only method renders it: the height is the
+        displacement's component along the normal, with the vector (Vector - Midlevel) Scale
+        taken to world space by the node's space (BumpDesc::vector_space; tangent space reads the
+        active render UV map's tangents)."""
+        i = node.inputs
+
+        def vector_math(op, a, b=None, scale=None):
+            d = {"kind": "VECTOR_MATH", "op": op, "a": a}
+            if b is not None:
+                d["b"] = b
+            if scale is not None:
+                d["value_a"] = scale
+            return {"value": (0.0, 0.0, 0.0), "node": self._push_input(d)["node"]}
+
+        mid = self.value(i["Midlevel"])
+        if set(mid) != {"value"}:  # linked: the same value on each axis
+            mid_rgb = {"value": (0.0, 0.0, 0.0), "node": self._push_input(
+                {"kind": "COMBINE_XYZ", "value_a": mid, "value_b": mid, "value_c": mid})["node"]}
+        else:
+            mid_rgb = {"value": (mid["value"],) * 3}
+        offset = vector_math("SUBTRACT", self.color(i["Vector"]), mid_rgb)
+        vector = vector_math("SCALE", offset, scale=self.value(i["Scale"]))
+        if node.space == 'TANGENT':
+            self.uv_tangents = True
+        self.displacement_bump = {"strength": 1.0, "distance": 1.0, "invert": False,
+                                  "replaces_normal": True, "vector": vector,
+                                  "vector_space": node.space}
 
     def color(self, socket):
         d = {"value": self._default_rgb(socket)}

@@ -242,6 +242,11 @@ def terminator_geometry_offset(obj):
     return _cycles_object_setting(obj, "shadow_terminator_geometry_offset", 0.1)
 
 
+def terminator_shading_offset(obj):
+    """Object > Shading > Shadow Terminator > Shading Offset (Cycles' default 0)."""
+    return _cycles_object_setting(obj, "shadow_terminator_offset", 0.0)
+
+
 def _matrix12(m):
     a = np.array(m, dtype=np.float32)  # 4x4 rows
     return np.ascontiguousarray(a[:3, :4]).ravel()
@@ -341,9 +346,7 @@ class GeometryExporter:
         mesh = self._mesh_for(obj, tangents, colors, attributes)
         if mesh < 0:
             return
-        if _cycles_object_setting(obj, "shadow_terminator_offset", 0.0) > 0.0:
-            self.warn(f"Shadow Terminator Shading Offset of '{obj.name}' is not supported by "
-                      "Gradient PT (ignored)")
         self.builder.add_instance(mesh, _matrix12(matrix), slots, obj.pass_index,
                                   ray_visibility(obj), bool(obj.is_holdout),
-                                  terminator_geometry_offset(obj))
+                                  terminator_geometry_offset(obj),
+                                  terminator_shading_offset(obj))

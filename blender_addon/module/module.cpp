@@ -129,7 +129,8 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("add_instance", &SceneBuilder::add_instance, py::arg("mesh"), py::arg("matrix"),
            py::arg("slot_material"), py::arg("pass_index") = 0,
            py::arg("visibility") = uint32_t(kRayAll), py::arg("holdout") = false,
-           py::arg("terminator_geometry_offset") = 0.1f)
+           py::arg("terminator_geometry_offset") = 0.1f,
+           py::arg("terminator_shading_offset") = 0.0f)
       .def("add_material", &SceneBuilder::add_material)
       .def("add_image", &SceneBuilder::add_image, py::arg("name"), py::arg("width"),
            py::arg("height"), py::arg("rgba").noconvert(), py::arg("colorspace"))

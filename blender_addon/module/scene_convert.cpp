@@ -557,13 +557,17 @@ py::dict SceneBuilder::mesh_arrays(int index) const {
 
 void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
                                 int pass_index, uint32_t visibility, bool holdout,
-                                float terminator_geometry_offset) {
+                                float terminator_geometry_offset, float terminator_shading_offset) {
   if (mesh < 0 || size_t(mesh) >= scene_.meshes.size())
     throw std::invalid_argument("add_instance: mesh index out of range");
   if (!(terminator_geometry_offset >= 0.0f && terminator_geometry_offset <= 1.0f))
     throw std::invalid_argument("add_instance: terminator_geometry_offset is " +
                                 std::to_string(terminator_geometry_offset) +
                                 ", outside [0, 1] (Cycles' Shadow Terminator Geometry Offset)");
+  if (!(terminator_shading_offset >= 0.0f && terminator_shading_offset <= 1.0f))
+    throw std::invalid_argument("add_instance: terminator_shading_offset is " +
+                                std::to_string(terminator_shading_offset) +
+                                ", outside [0, 1] (Cycles' Shadow Terminator Shading Offset)");
   Instance inst;
   inst.mesh = uint32_t(mesh);
   inst.object_to_world = to_transform(matrix, "instance");
@@ -571,6 +575,7 @@ void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::li
   inst.visibility = visibility;
   inst.holdout = holdout;
   inst.terminator_geometry_offset = terminator_geometry_offset;
+  inst.terminator_shading_offset = terminator_shading_offset;
   inst.slot_material.reserve(py::len(slot_material));
   for (const auto& m : slot_material) {
     const int32_t index = m.cast<int32_t>();
@@ -663,7 +668,8 @@ int SceneBuilder::add_material(const py::dict& material) {
     for (const auto& item : material["inputs"].cast<py::list>())
       desc.inputs.push_back(read_input_node(item.cast<py::dict>()));
   // Bump nodes, in MaterialDesc::bumps' order: [{"height": float input, "strength", "distance":
-  // float, "invert": bool, "replaces_normal": bool (the Displacement output, first only)}].
+  // float, "invert": bool, "replaces_normal": bool (the Displacement output, first only)}, and
+  // for a vector displacement "vector" and "vector_space" (BumpDesc)].
   if (material.contains("bumps"))
     for (const auto& item : material["bumps"].cast<py::list>()) {
       const auto d = item.cast<py::dict>();
@@ -673,10 +679,23 @@ int SceneBuilder::add_material(const py::dict& material) {
       get(d, "distance", bump.distance);
       get(d, "invert", bump.invert);
       get(d, "replaces_normal", bump.replaces_normal);
+      // A vector displacement: "vector": colour input, "vector_space": TANGENT, OBJECT or WORLD.
+      if (d.contains("vector_space")) {
+        static const std::pair<const char*, BumpDesc::VectorSpace> kSpaces[] = {
+            {"TANGENT", BumpDesc::VectorSpace::Tangent},
+            {"OBJECT", BumpDesc::VectorSpace::Object},
+            {"WORLD", BumpDesc::VectorSpace::World}};
+        bump.vector_space = get_enum(d, "vector_space", "", kSpaces, "vector displacement space");
+        read_color(d, "vector", bump.vector);
+        if (!bump.replaces_normal)
+          throw std::invalid_argument("material '" + desc.name +
+                                      "': a vector displacement must replace the normal");
+      }
       if (bump.replaces_normal && desc.bumps.size() > 1)
         throw std::invalid_argument("material '" + desc.name +
                                     "': only the first bump may replace the normal");
-      if (bump.height.texture.image >= int32_t(scene_.images.size()))
+      if (bump.height.texture.image >= int32_t(scene_.images.size()) ||
+          bump.vector.texture.image >= int32_t(scene_.images.size()))
         throw std::invalid_argument("material '" + desc.name + "': image index out of range");
     }
   // Normal Map node (tangent space): {"color": colour input, "strength": float}.

@@ -85,10 +85,12 @@ class SceneBuilder {
   // visibility: RayKind bits of the rays that see the instance (Object > Visibility > Ray
   // Visibility).
   // terminator_geometry_offset: Object > Shading > Shadow Terminator > Geometry Offset, in
-  // [0, 1] (Instance::terminator_geometry_offset).
+  // [0, 1] (Instance::terminator_geometry_offset); terminator_shading_offset: its Shading
+  // Offset, in [0, 1] (Instance::terminator_shading_offset).
   void add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
                     int pass_index = 0, uint32_t visibility = kRayAll, bool holdout = false,
-                    float terminator_geometry_offset = 0.1f);
+                    float terminator_geometry_offset = 0.1f,
+                    float terminator_shading_offset = 0.0f);
   int add_material(const py::dict& material);
   // rgba: (h, w, 4) or flat, row 0 at the bottom; converted to scene linear from `colorspace`
   // unless it is empty (already scene linear).

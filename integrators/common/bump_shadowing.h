@@ -2,7 +2,8 @@
 // diffuse lobes of every closure whose normal differs from the interpolated one (a normal map or
 // bump replaced it, or its reflection check rotated it: `sc->N != sd->N`). Such points get a copy
 // of their closures marked with the interpolated normal (ClosureSet::set_bump_shadowing); all
-// others keep theirs untouched, at the cost of one comparison.
+// others keep theirs untouched, at the cost of one comparison. Objects with a shadow terminator
+// shading offset get a copy too (ClosureSet::set_terminator_shift).
 #pragma once
 
 #include "core/frame.h"
@@ -19,12 +20,18 @@ namespace gdpt {
 inline const ClosureSet& shading_closures(const ClosureSet& closures, ClosureSet& scratch,
                                           const SurfaceHit& hit, const Frame& frame, Vec3f ng,
                                           Vec3f wi, bool rotated) {
-  if (!hit.perturbed && !rotated) [[likely]]
+  const float k = hit.shading_instance ? hit.shading_instance->terminator_frequency : 1.0f;
+  if (!hit.perturbed && !rotated && !(k > 1.0f)) [[likely]]
     return closures;
   const Vec3f interpolated = hit.perturbed ? hit.unperturbed_normal : hit.shading_normal;
   const Vec3f n0 = hit.front_facing ? interpolated : -interpolated;
-  if (frame.n == n0) return closures;
+  const bool shadowed = frame.n != n0;
+  if (!shadowed && !(k > 1.0f)) return closures;
   if (&closures != &scratch) scratch.assign(closures);
+  // The object's terminator shading offset, which PT and G-PT's shifted paths both evaluate
+  // through the set, each with its own directions.
+  scratch.set_terminator_shift(k);
+  if (!shadowed) return scratch;
   scratch.set_bump_shadowing(frame.to_local(n0));
   // Lobes that keep the interpolated normal under the perturbation get it, with Cycles'
   // reflection check of their own.

@@ -429,6 +429,80 @@ TEST(Render, DisplacementAsBumpReplacesTheNormalWithoutBumpShadowing) {
   }
 }
 
+// The object's shadow terminator shading offset darkens a sunlit plane by Cycles' shifted cosine:
+// offset 0.5 (k = 4/3) under a sun at t from the normal scales L = 0.5 E cos(t) / pi to
+// 0.5 E max(cos(k t), 0) / pi; at t = 1.2 (k t past 90 degrees) the plane goes black. PT and
+// G-PT (both take it through shading_closures).
+TEST(Render, TerminatorShadingOffsetShiftsTheCosine) {
+  for (const float theta : {0.6f, 1.0f, 1.2f})
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      Scene scene = sunlit_plane(quad(50.0f), diffuse(Spectrum(0.5f)), theta);
+      scene.instances[0].terminator_shading_offset = 0.5f;
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      const double expect = lambert_radiance(std::max(std::cos(4.0 / 3.0 * theta), 0.0));
+      EXPECT_NEAR(mean_direct(scene, s), expect, 1e-3 * expect + 1e-6)
+          << "theta " << theta << " G-PT " << (mode == RenderSettings::Mode::GPT);
+    }
+}
+
+// A vector displacement's height is the displacement's component along the normal (Cycles'
+// bump_from_displacement), its vector taken to world space by the node's space. The image ramps
+// along v in one channel only, as the scalar test above (tilt 0.2 along -y when it is the height).
+// Tangent space is Cycles' x tangent, y normal, z bitangent: the green ramp tilts, blue does not;
+// red does only through the tangent's component along the normal (Cycles reads the interpolated
+// tangent as it is): with t = (1, 0, 0.5) half the tilt. World space: blue tilts, green does not.
+// Object space reads the object's transform: blue under a z scale of 2 tilts twice as much
+// (O^T n = 2 z). Seen from its back (the quad wound the other way, n = -z), the height is the
+// component along the normal facing the ray (Cycles' sd->N, +z): the surface's own normal tilts
+// by it, flipped, so world-space blue tilts the other way (-0.2). PT and G-PT.
+TEST(Render, VectorDisplacementTiltsByItsComponentAlongTheNormal) {
+  using Space = BumpDesc::VectorSpace;
+  constexpr float kTheta = 0.5f;
+  struct Case {
+    Space space;
+    Spectrum channel;
+    float tangent_z, scale_z;
+    double tilt;
+    bool back = false;
+  };
+  const Spectrum red(1, 0, 0), green(0, 1, 0), blue(0, 0, 1);
+  for (const Case& c :
+       {Case{Space::Tangent, green, 0.0f, 1.0f, 0.2}, Case{Space::Tangent, blue, 0.0f, 1.0f, 0.0},
+        Case{Space::Tangent, red, 0.0f, 1.0f, 0.0}, Case{Space::Tangent, red, 0.5f, 1.0f, 0.1},
+        Case{Space::World, blue, 0.0f, 1.0f, 0.2}, Case{Space::World, green, 0.0f, 1.0f, 0.0},
+        Case{Space::Object, blue, 0.0f, 2.0f, 0.4},
+        Case{Space::World, blue, 0.0f, 1.0f, -0.2, true}}) {
+    MaterialDesc m = ramp_bumped();
+    m.bumps[0].replaces_normal = true;
+    m.bumps[0].vector_space = c.space;
+    m.bumps[0].vector.texture = m.bumps[0].height.texture;
+    Mesh plane = uv_quad();
+    plane.corner_tangents.assign(6, Vec3f(1.0f, 0.0f, c.tangent_z));
+    plane.corner_tangent_signs.assign(6, 1.0f);
+    if (c.back) {
+      plane.indices = {0, 2, 1, 0, 3, 2};
+      plane.corner_uvs = {{0, 0}, {1, 1}, {1, 0}, {0, 0}, {0, 1}, {1, 1}};
+    }
+    Transform placement;
+    placement.m[2][2] = c.scale_z;
+    Scene scene = sunlit_plane(plane, m, kTheta, placement);
+    ImageDesc ramp = ramp_image(1, 2);
+    for (int k = 0; k < 3; ++k) ramp.rgba[size_t(4 + k)] = c.channel[k];
+    scene.images.push_back(ramp);
+    const double cosine =
+        (c.tilt * std::sin(kTheta) + std::cos(kTheta)) / std::sqrt(1.0 + c.tilt * c.tilt);
+    const double expect = lambert_radiance(cosine);
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      EXPECT_NEAR(mean_direct(scene, s), expect, 2e-3 * expect)
+          << "space " << int(c.space) << " tilt " << c.tilt << " G-PT "
+          << (mode == RenderSettings::Mode::GPT);
+    }
+  }
+}
+
 // Lobes whose normal input is not linked to the material's bump keep the interpolated normal
 // (Cycles gives an unlinked input sd->N), seen from straight above under a sun from
 // (0, -sin t, cos t):

@@ -102,3 +102,23 @@ TEST(ShadowTerminator, TransmissionTakesTheOtherSide) {
   EXPECT_NEAR(terminator_lift_amount(0.1f, kUp, kUp, under, side), 1.0f, 1e-5f);
   expect_vec(side, -kUp);
 }
+
+// The shading offset's frequency multiplier, Cycles' 1 / (1 - offset / 2): 1 (off), 4/3, 2.
+TEST(ShadowTerminator, ShadingOffsetFrequency) {
+  EXPECT_FLOAT_EQ(terminator_frequency(0.0f), 1.0f);
+  EXPECT_FLOAT_EQ(terminator_frequency(0.5f), 4.0f / 3.0f);
+  EXPECT_FLOAT_EQ(terminator_frequency(1.0f), 2.0f);
+}
+
+// max(cos(k a), 0) / cos(a) by hand: k = 4/3 at a = 60 degrees gives cos(80) / cos(60) =
+// 0.173648 / 0.5; k = 2 at 30 degrees cos(60) / cos(30) = 0.57735; at 70 degrees k = 4/3 turns
+// past 90 (0); the normal itself keeps its value; below the horizon and with k = 1 nothing moves.
+TEST(ShadowTerminator, ShadingFactorShiftsTheCosine) {
+  const float k = 4.0f / 3.0f, deg = float(M_PI) / 180.0f;
+  EXPECT_NEAR(terminator_shading_factor(0.5f, k), 0.3472964f, 1e-5f);
+  EXPECT_NEAR(terminator_shading_factor(std::cos(30 * deg), 2.0f), 0.5773503f, 1e-5f);
+  EXPECT_EQ(terminator_shading_factor(std::cos(70 * deg), k), 0.0f);
+  EXPECT_NEAR(terminator_shading_factor(1.0f, k), 1.0f, 1e-6f);
+  EXPECT_EQ(terminator_shading_factor(-0.5f, k), 1.0f);
+  EXPECT_EQ(terminator_shading_factor(0.5f, 1.0f), 1.0f);
+}

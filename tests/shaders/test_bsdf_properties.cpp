@@ -430,6 +430,57 @@ TEST(ClosureSet, BumpShadowingScalesDiffuseValuesOnly) {
   }
 }
 
+// The terminator shading offset (set_terminator_shift, k = 4/3: Cycles' Shading Offset 0.5) scales
+// every lobe's value towards a direction above the normal by max(cos(k a), 0) / cos(a), glossy as
+// diffuse, and no density; directions past a = 67.5 degrees get nothing; a mirror's sampled
+// value too; sampling returns the same values as evaluation.
+TEST(ClosureSet, TerminatorShiftScalesEveryLobeAboveTheNormal) {
+  const float k = 4.0f / 3.0f;
+  auto factor = [&](Vec3f wo) {
+    return wo.z > 0.0f ? std::max(std::cos(std::acos(std::min(wo.z, 1.0f)) * k), 0.0f) / wo.z
+                       : 1.0f;
+  };
+  for (const bool single : {true, false}) {
+    const ClosureSet plain =
+        single ? set_of({lambert(Spectrum(0.7f))}) : set_of({lambert(Spectrum(0.7f)), ggx(0.3f)});
+    ClosureSet shifted = plain;
+    shifted.set_terminator_shift(k);
+    Pcg32 rng(5);
+    int zeroed = 0;
+    for (int i = 0; i < 500; ++i) {
+      const Vec3f wi = incident(0.2f + 0.8f * rng.uniform());
+      const Vec3f wo = direction(rng.uniform(), 2 * M_PI * rng.uniform());
+      float pdf_plain, pdf_shifted;
+      const Spectrum f = plain.eval_pdf(wi, wo, pdf_plain);
+      const Spectrum fs = shifted.eval_pdf(wi, wo, pdf_shifted);
+      EXPECT_NEAR(fs.x, f.x * factor(wo), 1e-5f * (1 + f.x));
+      EXPECT_FLOAT_EQ(pdf_shifted, pdf_plain);
+      zeroed += f.x > 0.0f && fs.x == 0.0f;
+      const BsdfSample s = shifted.sample(wi, rng.uniform(), Vec2f(rng.uniform(), rng.uniform()));
+      if (!s.valid) continue;
+      float pdf;
+      const Spectrum e = shifted.eval_pdf(wi, s.wo, pdf);
+      EXPECT_NEAR(s.value.x, e.x, 1e-4f * (1 + e.x));
+      EXPECT_NEAR(s.pdf, pdf, 1e-4f * (1 + pdf));
+    }
+    EXPECT_GT(zeroed, 50);  // cos(a) < cos(67.5 degrees) = 0.383: about 38% of wo
+  }
+  // A mirror: the sampled (delta) value and the delta event take the factor at the reflection.
+  const Vec3f wi = incident(0.6f);
+  ClosureSet mirror = set_of({ggx(0.0f)});
+  const BsdfSample m = mirror.sample(wi, 0.5f, Vec2f(0.5f, 0.5f));
+  mirror.set_terminator_shift(k);
+  const BsdfSample ms = mirror.sample(wi, 0.5f, Vec2f(0.5f, 0.5f));
+  ASSERT_TRUE(m.valid && ms.valid && m.is_delta());
+  EXPECT_NEAR(ms.value.y, m.value.y * factor(m.wo), 1e-5f * m.value.y);
+  EXPECT_NEAR(mirror.delta_event(wi, kLobeReflection).value.y, ms.value.y, 1e-5f * m.value.y);
+  // k <= 1 (no offset) leaves the set on its fast path, untouched.
+  ClosureSet off = set_of({lambert(Spectrum(0.7f))});
+  off.set_terminator_shift(1.0f);
+  const Vec3f wo = direction(0.3f, 1.0f);
+  EXPECT_EQ(off.eval(wi, wo).x, set_of({lambert(Spectrum(0.7f))}).eval(wi, wo).x);
+}
+
 // A lobe about its own normal n (ClosureSet::set_interpolated_normal) is the same lobe seen in a
 // rotated frame: for isotropic lobes any rotation taking n to +z gives the same value and
 // density. The rotation here is built independently of Frame (Rodrigues' formula, then a turn
