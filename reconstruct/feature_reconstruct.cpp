@@ -70,6 +70,7 @@ std::vector<float> solve(const ReconstructionInput& in, const ReconstructionSett
   gs.norm = norm;
   gs.compute_objective = false;
   gs.progress = nullptr;
+  gs.l1_reweightings = s.feature_guide_l1_reweightings;
   return reconstruct(gi, gs);
 }
 

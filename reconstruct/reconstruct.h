@@ -59,6 +59,10 @@ struct ReconstructionSettings {
   // Feature: the gradient-domain solution that is filtered (L1, L2, Weighted at `alpha`, or None:
   // the primal is filtered).
   ReconstructionNorm feature_guide = ReconstructionNorm::L1;
+  // Feature with the L1 guide: its reweightings (Jacobi-PCG steps as l1_cg_steps_*). The filters
+  // need no fully converged L1: 12 instead of 36 gave a lower relMSE on six of the seven benchmark
+  // scenes for a third of the solve (bench/reconstruct/feature_vs_l1.py --resolve).
+  int feature_guide_l1_reweightings = 12;
   // Called with the completed fraction in [0, 1] (from the calling thread).
   std::function<void(float)> progress;
 };

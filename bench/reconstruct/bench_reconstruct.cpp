@@ -1,7 +1,7 @@
 // bench_reconstruct: cost of the reconstruction solvers at 1920x1080 RGB on 1 and 2 threads.
 //
 //   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] [--l2-only] [--feature-only]
-//                     [--memory] [--admm] [--pcg] [--warm]
+//                     [--memory] [--admm] [--pcg] [--warm] [--schedules K,F,L ...]
 //
 // Reports, per thread count:
 //   - one bare FFTW forward + inverse 2-D DCT of the 3 planes (double, the same cached plans the
@@ -14,7 +14,8 @@
 //   - Weighted time, iterations, exit residual and objective.
 // --sweep also prints the L1 objective and time for a grid of (reweightings, CG steps);
 // --l2-only stops after the DCT pair and the L2 solve (for quick runs while tuning L2).
-//   - Feature (--norm feature): total time with the L1 guide and with the L2 guide, split into the
+//   - Feature (--norm feature): total time with the L1 guide (at its own reweightings and at the
+//     L1 norm's) and with the L2 guide, split into the
 //     guide solve, preparation, the cross-filtered candidates and the choice, on the synthetic
 //     room of testing/feature_scene.h (half noise 0.2, gradient noise 0.1), relMSE against L1,
 //     CPU time (the time on idle cores on a loaded machine) of the whole and of the filters and
@@ -23,6 +24,7 @@
 // --pcg counts PCG steps of the IRLS systems with DCT preconditioners (l1_pcg_probe.h).
 // --warm measures L1 warm-started from another alpha's output (ReconstructionInput::initial);
 // --warm --sweep also a grid of warm schedules.
+// --schedules K,F,L ...: cold L1 schedules against the default, alternated (time, objective).
 // --memory only measures the peak resident memory (getrusage) after one solve of each norm, in the
 // order L2, Weighted, L1: each figure is the process's peak so far, inputs included.
 // Synthetic data: a smooth image with edges; primal noise sigma 0.2 (0.05 in the right half),
@@ -175,6 +177,52 @@ int measure_memory(const Data& d, int threads) {
 
 }  // namespace
 
+// --schedules K,F,L ...: each cold L1 schedule (K reweightings, F -> L Jacobi-PCG steps) against
+// the default, alternated default / schedule in one run: wall and process CPU time, inner steps,
+// objective relative to the default's.
+int bench_schedules(const Data& d, int threads, const std::vector<std::string>& specs) {
+  gdpt::ReconstructionInput in{d.w,         d.h,     d.primal.data(), d.gx.data(),
+                               d.gy.data(), nullptr, nullptr};
+  gdpt::ReconstructionSettings base;
+  base.threads = threads;
+  base.fft_measure = true;
+  base.norm = gdpt::ReconstructionNorm::L1;
+  auto run = [&](const gdpt::ReconstructionSettings& s, double& wall, double& cpu, int& steps) {
+    gdpt::ReconstructionReport r;
+    const auto t0 = Clock::now();
+    const double c0 = cpu_seconds();
+    const auto x = gdpt::reconstruct(in, s, &r);
+    wall = seconds_since(t0);
+    cpu = cpu_seconds() - c0;
+    steps = r.iterations;
+    return gdpt::reconstruction_objective(in, gdpt::ReconstructionNorm::L1, s.alpha, x.data());
+  };
+  double w0, c0;
+  int n0;
+  run(base, w0, c0, n0);  // warm-up: plans, huge pages
+  std::printf("L1 schedules against the default (%d x %d -> %d), %dx%d, %d threads, alternated\n",
+              base.l1_reweightings, base.l1_cg_steps_first, base.l1_cg_steps_last, d.w, d.h,
+              threads);
+  for (const std::string& spec : specs) {
+    gdpt::ReconstructionSettings s = base;
+    if (std::sscanf(spec.c_str(), "%d,%d,%d", &s.l1_reweightings, &s.l1_cg_steps_first,
+                    &s.l1_cg_steps_last) != 3) {
+      std::fprintf(stderr, "bench_reconstruct: bad schedule '%s' (want K,F,L)\n", spec.c_str());
+      return 2;
+    }
+    double w1, c1;
+    int n1;
+    const double o0 = run(base, w0, c0, n0);
+    const double o1 = run(s, w1, c1, n1);
+    std::printf(
+        "  %2d x %2d -> %2d: %4d steps, wall %6.2f s (default %6.2f s), CPU %6.2f s (default "
+        "%6.2f s): CPU ratio %.3f, objective %+.4f%% vs default\n",
+        s.l1_reweightings, s.l1_cg_steps_first, s.l1_cg_steps_last, n1, w1, w0, c1, c0, c1 / c0,
+        100.0 * (o1 / o0 - 1.0));
+  }
+  return 0;
+}
+
 // The Feature reconstruction on the synthetic room: total time per guide and its split.
 void bench_feature(int width, int height, int threads) {
   const gdpt::test::FeatureScene sc = gdpt::test::make_feature_scene(width, height, 0.2f, 0.1f, 7);
@@ -186,8 +234,13 @@ void bench_feature(int width, int height, int threads) {
   const double rel_l1 = gdpt::test::relative_mse(gdpt::reconstruct(in, s), sc.truth);
   const double t_l1 = seconds_since(t0);
   s.norm = gdpt::ReconstructionNorm::Feature;
-  for (auto guide : {gdpt::ReconstructionNorm::L1, gdpt::ReconstructionNorm::L2}) {
+  const int guide_k = s.feature_guide_l1_reweightings;
+  // The L1 guide at its own reweightings, at the L1 norm's (a fully converged guide), and L2.
+  for (auto [guide, k] : {std::pair{gdpt::ReconstructionNorm::L1, guide_k},
+                          std::pair{gdpt::ReconstructionNorm::L1, s.l1_reweightings},
+                          std::pair{gdpt::ReconstructionNorm::L2, guide_k}}) {
     s.feature_guide = guide;
+    s.feature_guide_l1_reweightings = k;
     gdpt::ReconstructionReport r;
     const auto t1 = Clock::now();
     const double c1 = cpu_seconds();
@@ -203,9 +256,10 @@ void bench_feature(int width, int height, int threads) {
     const double filter_wall = seconds_since(t2), filter_cpu = cpu_seconds() - c2;
     const double rel = gdpt::test::relative_mse(img, sc.truth);
     std::printf(
-        "Feature (guide %s): %8.1f ms = solves %.1f ms + filters %.1f ms (prepare %.1f, %zu "
+        "Feature (guide %s, %d reweightings): %8.1f ms = solves %.1f ms + filters %.1f ms (prepare "
+        "%.1f, %zu "
         "candidates %.1f, choice %.1f); relMSE %.5f vs L1 %.5f (%.1f ms): %.2fx lower\n",
-        guide == gdpt::ReconstructionNorm::L1 ? "L1" : "L2", 1e3 * total, 1e3 * r.guide_seconds,
+        guide == gdpt::ReconstructionNorm::L1 ? "L1" : "L2", k, 1e3 * total, 1e3 * r.guide_seconds,
         1e3 * (total - r.guide_seconds), 1e3 * fr.prepare_seconds,
         gdpt::detail::default_bilateral_candidates().size(), 1e3 * fr.filter_seconds,
         1e3 * fr.select_seconds, rel, rel_l1, 1e3 * t_l1, rel_l1 / rel);
@@ -398,6 +452,7 @@ int main(int argc, char** argv) {
   int width = 1920, height = 1080, only_threads = 0;
   bool sweep = false, l2_only = false, feature_only = false, memory = false, admm = false,
        pcg = false, warm = false;
+  std::vector<std::string> schedules;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--width" && i + 1 < argc)
@@ -420,10 +475,13 @@ int main(int argc, char** argv) {
       pcg = true;
     else if (a == "--warm")
       warm = true;
+    else if (a == "--schedules")
+      while (i + 1 < argc && argv[i + 1][0] != '-') schedules.push_back(argv[++i]);
     else {
       std::fprintf(stderr,
                    "usage: bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] "
-                   "[--l2-only] [--feature-only] [--memory] [--admm] [--pcg] [--warm]\n");
+                   "[--l2-only] [--feature-only] [--memory] [--admm] [--pcg] [--warm] "
+                   "[--schedules K,F,L ...]\n");
       return 2;
     }
   }
@@ -433,6 +491,7 @@ int main(int argc, char** argv) {
   if (admm) return bench_admm(d, only_threads > 0 ? only_threads : 2);
   if (pcg) return bench_pcg(d, only_threads > 0 ? only_threads : 2);
   if (warm) return bench_warm(d, only_threads > 0 ? only_threads : 2, sweep);
+  if (!schedules.empty()) return bench_schedules(d, only_threads > 0 ? only_threads : 2, schedules);
   const size_t px = size_t(width) * height;
   gdpt::ReconstructionInput input{
       width, height, d.primal.data(), d.gx.data(), d.gy.data(), d.variance.data(), nullptr};
