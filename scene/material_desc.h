@@ -217,7 +217,8 @@ enum class ShaderNodeKind : uint8_t {
   Diffuse,  // Blender Diffuse BSDF: Lambert (roughness 0) or Oren-Nayar (roughness > 0)
   Glossy,   // Blender Glossy BSDF, GGX, Beckmann or Ashikhmin-Shirley (no Fresnel; colour scales),
             // alpha = r^2
-  Glass,    // Blender Glass BSDF, GGX or Beckmann dielectric; roughness 0 = smooth (delta)
+  Glass,    // Blender Glass BSDF, GGX, Beckmann or Multiscatter GGX dielectric; roughness 0 =
+            // smooth (delta)
   Principled,   // Blender 3.4 Principled BSDF v1
   Emission,     // colour * strength (radiance, W/m^2/sr per unit strength as in Cycles)
   Transparent,  // straight-through transmission, colour scales

@@ -116,8 +116,9 @@ struct VectorTransformDesc {
 
 // The microfacet distribution of Blender's Glossy, Glass and Refraction BSDFs
 // (shaders/microfacet.h); AshikhminShirley: Glossy and Anisotropic only
-// (shaders/ashikhmin_shirley.h); MultiscatterGGX: Glossy and Principled only, GGX plus its
-// multiple-scattering lobe (shaders/bsdf_ggx_multiscatter.h; never a Closure's distribution).
+// (shaders/ashikhmin_shirley.h); MultiscatterGGX: Glossy, Glass and Principled only, GGX plus its
+// multiple-scattering lobe (shaders/bsdf_ggx_multiscatter.h) or, on glass, GGX scaled to conserve
+// energy (Closure::multiscatter); never a Closure's distribution.
 enum class MicrofacetDistribution : uint8_t { GGX, Beckmann, AshikhminShirley, MultiscatterGGX };
 
 struct BrickDesc {

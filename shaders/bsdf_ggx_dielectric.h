@@ -29,10 +29,20 @@
 // transmission is T D G ... without (1 - F); total internal reflection still loses the sample.
 // drop_reflection / drop_refraction (Cycles' caustics toggles, one of the two closures left out):
 // the dropped part evaluates to 0 and is never sampled; the other keeps its F or (1 - F).
+// Closure::multiscatter (Blender's Multiscatter GGX glass): the rough lobe takes the single-
+// scattering term of Cycles' random walk on the microsurface, which splits by the Fresnel term of
+// the MICROFACET, F(wi.h) (so light also leaves past the critical angle of the shading normal,
+// through tilted microfacets; sampled with that split), and its value is multiplied by
+//   1 + multiscatter_tint (1 / E(cos_i) - 1),
+// E that white lobe's directional albedo from wi's side (ggx_dielectric_albedo.h), so that a
+// white lobe reflects and refracts all the light from every direction, as the random walk does;
+// the shape and the density stay the single-scattering lobe's. Everything is a function of wi,
+// wo, alpha and eta: a shifted path evaluates it for its own directions.
 #pragma once
 
 #include "shaders/closure.h"
 #include "shaders/fresnel.h"
+#include "shaders/ggx_dielectric_albedo.h"
 #include "shaders/lobe_util.h"
 #include "shaders/microfacet.h"
 
@@ -43,8 +53,9 @@ struct Setup {
   float eta;      // n_t / n_i
   float fresnel;  // reflectance at the shading normal
   float p_reflect;
-  bool smooth;        // delta reflection and refraction
-  bool pass_through;  // eta ~ 1: refraction is a straight delta pass-through
+  bool smooth;                              // delta reflection and refraction
+  bool pass_through;                        // eta ~ 1: refraction is a straight delta pass-through
+  Spectrum compensation{1.0f, 1.0f, 1.0f};  // Closure::multiscatter's factor on the rough lobe
 };
 
 inline Spectrum reflection_colour(const Closure& c, float eta, float cos_h) {
@@ -52,22 +63,48 @@ inline Spectrum reflection_colour(const Closure& c, float eta, float cos_h) {
   return c.weight * PrincipledFresnel(eta, c.f0)(cos_h);
 }
 
-inline Setup setup(const Closure& c, float cos_i, bool entering) {
-  Setup s;
-  const float ior = std::max(c.ior, 1e-5f);
-  s.eta = entering ? ior : 1.0f / ior;
-  s.fresnel = c.fresnel == FresnelMode::RefractionOnly ? 0.0f : fresnel_dielectric(cos_i, s.eta);
-  s.smooth = is_delta_alpha(c.alpha);
-  s.pass_through = std::fabs(s.eta - 1.0f) < 1e-4f;
-  const float r = c.drop_reflection
-                      ? 0.0f
-                      : s.fresnel * selection_luminance(reflection_colour(c, s.eta, cos_i));
+// The Fresnel split at a normal of cosine `cos` with wi: reflectance and the probability of
+// sampling the reflection (Fresnel weighted by colour luminances).
+struct Split {
+  float fresnel;
+  float p_reflect;
+};
+
+inline Split split(const Closure& c, float eta, float cos) {
+  Split s;
+  s.fresnel = c.fresnel == FresnelMode::RefractionOnly ? 0.0f : fresnel_dielectric(cos, eta);
+  const float r =
+      c.drop_reflection ? 0.0f : s.fresnel * selection_luminance(reflection_colour(c, eta, cos));
   const float t = c.drop_refraction
                       ? 0.0f
                       : (1.0f - s.fresnel) * selection_luminance(c.weight * c.transmission_tint);
   const float fallback = c.drop_reflection ? 0.0f : c.drop_refraction ? 1.0f : s.fresnel;
   s.p_reflect = (r + t) > 0.0f ? r / (r + t) : fallback;
   return s;
+}
+
+// `compensate` false: the single-scattering lobe (what ggx_dielectric_albedo tabulates).
+inline Setup setup(const Closure& c, float cos_i, bool entering, bool compensate = true) {
+  Setup s;
+  const float ior = std::max(c.ior, 1e-5f);
+  s.eta = entering ? ior : 1.0f / ior;
+  const Split sp = split(c, s.eta, cos_i);
+  s.fresnel = sp.fresnel;
+  s.p_reflect = sp.p_reflect;
+  s.smooth = is_delta_alpha(c.alpha);
+  s.pass_through = std::fabs(s.eta - 1.0f) < 1e-4f;
+  if (compensate && c.multiscatter && !s.smooth && !s.pass_through) {
+    const float e = ggx_dielectric_albedo(cos_i, c.alpha, s.eta);
+    if (e > 1e-4f) s.compensation = Spectrum(1.0f) + c.multiscatter_tint * (1.0f / e - 1.0f);
+  }
+  return s;
+}
+
+// The split of the rough lobe at microfacet normal h: the shading normal's, or (multiscatter)
+// the microfacet's own.
+inline Split rough_split(const Closure& c, const Setup& st, Vec3f wi, Vec3f h) {
+  if (!c.multiscatter) return {st.fresnel, st.p_reflect};
+  return split(c, st.eta, dot(wi, h));
 }
 
 // Non-delta part; wi, wo mirrored so that wi.z > 0. Returns eval, writes the pdf.
@@ -78,13 +115,16 @@ inline Spectrum eval_pdf_upper(const Closure& c, const Setup& st, Vec3f wi, Vec3
   if (wo.z > 0.0f) {
     const Vec3f sum = wi + wo;
     const float len2 = length_squared(sum);
-    if (!(len2 > 0.0f) || st.fresnel <= 0.0f || c.drop_reflection) return Spectrum(0.0f);
+    if (!(len2 > 0.0f) || c.drop_reflection) return Spectrum(0.0f);
     const Vec3f h = sum / std::sqrt(len2);
+    const Split sp = rough_split(c, st, wi, h);
+    if (sp.fresnel <= 0.0f) return Spectrum(0.0f);
     const float common = mf.D(h) / (4.0f * wi.z);
-    pdf = st.p_reflect * common * mf.G1_visible(wi);
-    return reflection_colour(c, st.eta, dot(wo, h)) * (st.fresnel * common * mf.G1(wi) * mf.G1(wo));
+    pdf = sp.p_reflect * common * mf.G1_visible(wi);
+    return reflection_colour(c, st.eta, dot(wo, h)) * st.compensation *
+           (sp.fresnel * common * mf.G1(wi) * mf.G1(wo));
   }
-  if (st.pass_through || st.fresnel >= 1.0f || c.drop_refraction) return Spectrum(0.0f);
+  if (st.pass_through || c.drop_refraction) return Spectrum(0.0f);
   // Generalised half vector of the refraction, oriented to the outside (+z).
   Vec3f ht = wi + wo * st.eta;
   const float len2 = length_squared(ht);
@@ -94,11 +134,14 @@ inline Spectrum eval_pdf_upper(const Closure& c, const Setup& st, Vec3f wi, Vec3
   const float cos_ih = dot(wi, ht), cos_oh = dot(wo, ht);
   // Only microfacets facing wi that refract towards wo contribute.
   if (!(cos_ih > 0.0f && cos_oh < 0.0f)) return Spectrum(0.0f);
+  const Split sp = rough_split(c, st, wi, ht);
+  if (sp.fresnel >= 1.0f) return Spectrum(0.0f);
   const float denom = cos_ih + st.eta * cos_oh;
   const float jacobian = st.eta * st.eta * std::fabs(cos_oh) / (denom * denom);  // dwh / dwo
   const float common = cos_ih * mf.D(ht) / wi.z * jacobian;
-  pdf = (1.0f - st.p_reflect) * common * mf.G1_visible(wi);
-  return c.weight * c.transmission_tint * ((1.0f - st.fresnel) * common * mf.G1(wi) * mf.G1(wo));
+  pdf = (1.0f - sp.p_reflect) * common * mf.G1_visible(wi);
+  return c.weight * c.transmission_tint * st.compensation *
+         ((1.0f - sp.fresnel) * common * mf.G1(wi) * mf.G1(wo));
 }
 
 inline Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo) {
@@ -124,7 +167,7 @@ inline BsdfSample sample(const Closure& c, Vec3f wi_, float u_choice, Vec2f u) {
   const float sign = wi_.z < 0.0f ? -1.0f : 1.0f;
   const Vec3f wi = flip_z(wi_, sign);
   const Setup st = setup(c, wi.z, wi_.z > 0.0f);
-  const bool pick_reflection = u_choice < st.p_reflect;
+  bool pick_reflection = u_choice < st.p_reflect;
 
   // Delta cases: smooth glass, or the straight pass-through of an index-matched interface.
   if (st.smooth || (!pick_reflection && st.pass_through)) {
@@ -150,6 +193,7 @@ inline BsdfSample sample(const Closure& c, Vec3f wi_, float u_choice, Vec2f u) {
 
   const Vec3f m = Microfacet(c.distribution, c.alpha).sample_visible(wi, u);
   Vec3f wo;
+  if (c.multiscatter) pick_reflection = u_choice < rough_split(c, st, wi, m).p_reflect;
   if (pick_reflection) {
     wo = reflect(wi, m);
     if (wo.z <= 0.0f) return s;
@@ -168,6 +212,27 @@ inline BsdfSample sample(const Closure& c, Vec3f wi_, float u_choice, Vec2f u) {
   return s;
 }
 
+// One quadrature point u of the white single-scattering lobe's directional albedo from wi
+// (wi.z > 0, eta = c.ior): both choices at the sampled microfacet, each value over the density of
+// its direction given the choice.
+inline float single_scattering_albedo_sample(const Closure& c, Vec3f wi, Vec2f u) {
+  const Setup st = setup(c, wi.z, true, false);
+  const Vec3f m = Microfacet(c.distribution, c.alpha).sample_visible(wi, u);
+  const Split sp = rough_split(c, st, wi, m);
+  float sum = 0.0f, pdf;
+  const Vec3f wr = reflect(wi, m);
+  if (wr.z > 0.0f) {
+    const Spectrum v = eval_pdf_upper(c, st, wi, wr, pdf);
+    if (pdf > 0.0f) sum += v.x / pdf * sp.p_reflect;
+  }
+  Vec3f wt;
+  if (refract(wi, m, st.eta, wt) && wt.z < 0.0f) {
+    const Spectrum v = eval_pdf_upper(c, st, wi, wt, pdf);
+    if (pdf > 0.0f) sum += v.x / pdf * (1.0f - sp.p_reflect);
+  }
+  return sum;
+}
+
 inline float albedo_hint(const Closure& c, Vec3f wi) {
   if (wi.z == 0.0f) return 0.0f;
   const Setup st = setup(c, std::fabs(wi.z), wi.z > 0.0f);
@@ -180,7 +245,7 @@ inline float albedo_hint(const Closure& c, Vec3f wi) {
   const float t = c.drop_refraction
                       ? 0.0f
                       : (1.0f - st.fresnel) * selection_luminance(c.weight * c.transmission_tint);
-  return (r + t) / lw;
+  return (r + t) / lw * selection_luminance(st.compensation);
 }
 
 }  // namespace gdpt::ggx_dielectric

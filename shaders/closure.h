@@ -86,6 +86,11 @@ struct Closure {
   // GGXDielectric: its reflected or its refracted part dropped, the other keeping its Fresnel
   // weight (Cycles' caustics toggles remove one of the glass BSDF's two closures).
   bool drop_reflection = false, drop_refraction = false;
+  // GGXDielectric, GGX: Blender's Multiscatter GGX, the lobe divided by its white directional
+  // albedo (shaders/ggx_dielectric_albedo.h); the light so added is tinted once more by
+  // multiscatter_tint (Glass: its colour, which Cycles' random walk applies at every bounce).
+  bool multiscatter = false;
+  Spectrum multiscatter_tint{1.0f, 1.0f, 1.0f};
 };
 
 inline bool is_anisotropic(const Closure& c) {

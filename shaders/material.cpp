@@ -644,6 +644,11 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
         c.fresnel = n.kind == ShaderNodeKind::Refraction ? FresnelMode::RefractionOnly
                                                          : FresnelMode::Dielectric;
         c.distribution = n.distribution;
+        if (n.distribution == MicrofacetDistribution::MultiscatterGGX) {
+          c.distribution = MicrofacetDistribution::GGX;
+          c.multiscatter = true;
+          c.multiscatter_tint = saturate(in.color(n.color));
+        }
         c.alpha = r * r;
         // The integrators orient the frame towards the incoming ray (as Cycles flips N for back
         // faces), so the closure's IOR is that of the far side: 1 / ior when leaving the object.

@@ -126,6 +126,8 @@ void add_principled_closures(const PrincipledParams& p, float mix_weight, Closur
     g.ior = p.front_facing ? ior : 1.0f / ior;
     g.f0 = saturate(base * specular_tint + Spectrum(1.0f - specular_tint));
     g.transmission_tint = base;
+    // Cycles keeps the single-scattering glass up to this roughness.
+    g.multiscatter = p.multiscatter && roughness > 0.05f;
     g.interpolated_normal = p.interpolated_normal;
     out.add(g);
   }

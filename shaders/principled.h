@@ -19,8 +19,9 @@
 //                radius 0 (bssrdf_setup) is its retro-reflection plus a Lambert part of that
 //                colour, the whole PrincipledDiffuse; after a diffuse bounce (diffuse_ancestor)
 //                Cycles uses that colour as the base of every lobe
-// Subsurface transport (radius > 0), anisotropy and the multiscatter GGX variant are not
-// modelled.
+// Multiscatter GGX: the specular lobe gets its multiple-scattering lobe, the transmission above
+// roughness 0.05 is energy-compensated (Closure::multiscatter), as Cycles switches there.
+// Subsurface transport (radius > 0) is not modelled.
 // All weights are multiplied by `mix_weight` (the Mix/Add tree weight).
 #pragma once
 
@@ -54,7 +55,8 @@ struct PrincipledParams {
   // Closure::interpolated_normal of the base lobes and of the clearcoat.
   bool interpolated_normal = false;
   bool clearcoat_interpolated_normal = false;
-  // Blender's Multiscatter GGX: the specular lobe gets its multiple-scattering lobe.
+  // Blender's Multiscatter GGX: the specular lobe gets its multiple-scattering lobe, and above
+  // roughness 0.05 the transmission is energy-compensated (Closure::multiscatter).
   bool multiscatter = false;
 };
 

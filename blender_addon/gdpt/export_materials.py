@@ -41,11 +41,13 @@ _BSSRDF_MIN_RADIUS = 1e-8
 _NO_TRANSPORT = "subsurface scattering, rendered as diffuse (no subsurface transport), of"
 # The Principled BSDF's distributions: Multiscatter GGX as GGX with an energy-compensating lobe.
 _PRINCIPLED = {'GGX': 'GGX', 'MULTI_GGX': 'MULTI_GGX'}
-# The Glass and Refraction BSDFs' distributions the core renders as Cycles does (Sharp is GGX at
-# roughness 0); the others (Multiscatter GGX) render as GGX, reported.
+# The microfacet distributions the core renders as Cycles does (Sharp is GGX at roughness 0;
+# Blender offers Ashikhmin-Shirley on the Glossy BSDF only).
 _MICROFACET = {'GGX': 'GGX', 'SHARP': 'GGX', 'BECKMANN': 'BECKMANN',
                'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY'}
-# The Glossy BSDF's: those, and Multiscatter GGX as GGX with an energy-compensating lobe.
+# The Glossy and Glass BSDFs': those, and Multiscatter GGX as energy-compensated GGX (Glossy: an
+# added multiple-scattering lobe; Glass: the lobe scaled to conserve energy). Blender 3.4's
+# Refraction BSDF offers Sharp, Beckmann and GGX only.
 _GLOSSY = dict(_MICROFACET, MULTI_GGX='MULTI_GGX')
 # The Anisotropic BSDF's distributions rendered as Cycles does (its Beckmann is rendered as GGX).
 _ANISOTROPIC = {'GGX': 'GGX', 'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY'}
@@ -261,7 +263,7 @@ class _Translator:
                           "tangent": self.tangent(n.inputs["Tangent"]), "normal_linked": linked})
 
     def _bsdf_glass(self, n):
-        distribution = self._distribution(n)
+        distribution = self._distribution(n, _GLOSSY)
         linked = self.normal(n.inputs["Normal"])
         roughness = self.value(n.inputs["Roughness"])
         if n.distribution == 'SHARP':

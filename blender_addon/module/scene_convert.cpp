@@ -633,10 +633,11 @@ int SceneBuilder::add_material(const py::dict& material) {
           node.kind != ShaderNodeKind::Glossy && node.kind != ShaderNodeKind::Anisotropic)
         throw std::invalid_argument("microfacet distribution 'ASHIKHMIN_SHIRLEY' on a " +
                                     get_str(d, "kind", "DIFFUSE") + " node");
-      // The core compensates Multiscatter GGX on reflection only: the add-on exports the
-      // Glass, Refraction and Anisotropic BSDFs' as GGX.
+      // Blender offers Multiscatter GGX on these (the add-on exports the Anisotropic BSDF's as
+      // GGX).
       if (node.distribution == MicrofacetDistribution::MultiscatterGGX &&
-          node.kind != ShaderNodeKind::Glossy && node.kind != ShaderNodeKind::Principled)
+          node.kind != ShaderNodeKind::Glossy && node.kind != ShaderNodeKind::Principled &&
+          node.kind != ShaderNodeKind::Glass)
         throw std::invalid_argument("microfacet distribution 'MULTI_GGX' on a " +
                                     get_str(d, "kind", "DIFFUSE") + " node");
       read_float(d, "strength", node.strength);

@@ -10,7 +10,8 @@
 //    glossy reflection lobes (reflective) and refraction lobes (refractive) are dropped. A glass
 //    lobe (Glass BSDF, Principled transmission: Cycles' two closures, reflection weighted by F
 //    and refraction by 1 - F, in one lobe) loses its reflected or refracted part, or all of it
-//    when both are off.
+//    when both are off; a Multiscatter GGX glass lobe (Closure::multiscatter: Cycles' single
+//    random-walk closure) is kept whole unless both are off.
 #pragma once
 
 #include <cmath>
@@ -60,7 +61,7 @@ class LightPathFilters {
         set.remove(i);
         continue;
       }
-      if (kind == Kind::Glass) {
+      if (kind == Kind::Glass && !c.multiscatter) {
         c.drop_reflection = no_reflection;
         c.drop_refraction = no_refraction;
       }

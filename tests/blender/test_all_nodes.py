@@ -155,16 +155,16 @@ def main():
     print(f"{len(materials)} materials, {reported} with warnings", flush=True)
 
     # Microfacet distributions: Beckmann and Ashikhmin-Shirley are rendered as Cycles does,
-    # silently; Multiscatter GGX too on the Glossy and Principled BSDFs (energy-compensated GGX),
-    # the Glass BSDF's as GGX, reported. The Anisotropic BSDF exports GGX or
-    # Ashikhmin-Shirley; its Beckmann and Multiscatter GGX are rendered as GGX, reported.
+    # silently; Multiscatter GGX too on the Glossy, Glass and Principled BSDFs (energy-compensated
+    # GGX). The Anisotropic BSDF exports GGX or Ashikhmin-Shirley; its Beckmann and Multiscatter
+    # GGX are rendered as GGX, reported.
     for node_type, distribution, exported, warned in (
             ("ShaderNodeBsdfGlossy", 'BECKMANN', 'BECKMANN', False),
             ("ShaderNodeBsdfGlass", 'BECKMANN', 'BECKMANN', False),
             ("ShaderNodeBsdfRefraction", 'BECKMANN', 'BECKMANN', False),
             ("ShaderNodeBsdfGlossy", 'GGX', 'GGX', False),
             ("ShaderNodeBsdfGlass", 'SHARP', 'GGX', False),
-            ("ShaderNodeBsdfGlass", 'MULTI_GGX', 'GGX', True),
+            ("ShaderNodeBsdfGlass", 'MULTI_GGX', 'MULTI_GGX', False),
             ("ShaderNodeBsdfGlossy", 'MULTI_GGX', 'MULTI_GGX', False),
             ("ShaderNodeBsdfPrincipled", 'MULTI_GGX', 'MULTI_GGX', False),
             ("ShaderNodeBsdfPrincipled", 'GGX', 'GGX', False),

@@ -299,6 +299,21 @@ TEST(GradientUnbiased, SmoothGlass) {
   expect_unbiased("glass", make_scene(SceneKind::CornellGlass, 16, 0.0f), 4096, 1024, 0.27f);
 }
 
+// Multiscatter GGX glass (Closure::multiscatter): rough balls, whose vertices reconnect; each
+// path's value at a vertex is the compensated lobe evaluated for its own incoming direction. A
+// Glass BSDF at roughness 1 and a Principled with transmission 1 at roughness 0.8 (rough, so that
+// the compensation is large: up to 2.4x from inside).
+TEST(GradientUnbiased, MultiscatterGlass) {
+  Scene glass_ball = make_scene(SceneKind::CornellGlass, 16, 1.0f);
+  glass_ball.materials[3].nodes[0].distribution = MicrofacetDistribution::MultiscatterGGX;
+  expect_unbiased("multiscatter-glass", glass_ball, 4096, 1024, 0.24f);
+  Scene principled = make_scene(SceneKind::CornellGlass, 16);
+  principled.materials[3] = single_node(ShaderNodeKind::Principled, {0.9f, 0.9f, 0.8f}, 0.8f);
+  principled.materials[3].nodes[0].transmission = FloatInput(1.0f);
+  principled.materials[3].nodes[0].distribution = MicrofacetDistribution::MultiscatterGGX;
+  expect_unbiased("multiscatter-principled-glass", principled, 4096, 1024, 0.24f);
+}
+
 TEST(GradientUnbiased, EnvironmentLight) {
   expect_unbiased("environment", make_scene(SceneKind::Environment, 16), 4096, 1024, 0.12f);
 }

@@ -132,6 +132,17 @@ TEST(LightPathFilters, CausticsTogglesDropLobesAfterADiffuseBounce) {
         EXPECT_EQ(set[i].drop_refraction, !k.refractive);
       }
     EXPECT_EQ(set[0].type, ClosureType::Lambert);  // order kept
+    // Multiscatter GGX glass: Cycles' one closure, kept whole unless both toggles are off.
+    ClosureSet multiscatter;
+    Closure g = lobe(ClosureType::GGXDielectric, 0.3f, FresnelMode::Dielectric);
+    g.multiscatter = true;
+    multiscatter.add(g);
+    f.apply(after_diffuse, multiscatter);
+    ASSERT_EQ(multiscatter.count(), int(k.reflective || k.refractive));
+    if (multiscatter.count() == 1) {
+      EXPECT_FALSE(multiscatter[0].drop_reflection);
+      EXPECT_FALSE(multiscatter[0].drop_refraction);
+    }
     ClosureSet untouched = mixed_set();
     f.apply(after_glossy, untouched);
     EXPECT_EQ(untouched.count(), 6);

@@ -84,6 +84,13 @@ inline Closure glass(float alpha, float ior, Spectrum c = Spectrum(1.0f)) {
   k.ior = ior;
   return k;
 }
+// A Glass lobe (glass) with Blender's Multiscatter GGX: energy-compensated, the added light
+// tinted by `tint`.
+inline Closure multiscatter_glass(Closure k, Spectrum tint = Spectrum(1.0f)) {
+  k.multiscatter = true;
+  k.multiscatter_tint = tint;
+  return k;
+}
 // A Glossy or Anisotropic lobe (ggx, aniso_ggx) with Blender's Ashikhmin-Shirley distribution.
 inline Closure ashikhmin_shirley(Closure k) {
   k.distribution = MicrofacetDistribution::AshikhminShirley;

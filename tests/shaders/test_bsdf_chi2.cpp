@@ -48,6 +48,8 @@ std::vector<Case> lobe_cases() {
     cases.push_back({"MultiscatterLobe" + s, set_of({multiscatter_of(ggx(a))})});
     const Spectrum tint(0.9f, 0.6f, 0.2f);
     cases.push_back({"MultiscatterGGX" + s, set_of({ggx(a, tint), multiscatter_of(ggx(a), tint)})});
+    cases.push_back(
+        {"MultiscatterGlass" + s, set_of({multiscatter_glass(glass(a, 1.5f, tint), tint)})});
   }
   // Ashikhmin-Shirley anisotropic: the quadrant-wise azimuth sampler, either width the wider.
   cases.push_back(
