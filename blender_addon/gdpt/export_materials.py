@@ -2,7 +2,7 @@
 #
 # Walks from the active Material Output's Surface input over the tree with its node groups
 # flattened (export_node_groups.py). Supported shader nodes: Principled BSDF, Diffuse, Glossy,
-# Anisotropic (GGX; its Tangent: Cycles' default radial tangent, a Tangent node, Radial or UV Map,
+# Anisotropic (GGX, Beckmann, Ashikhmin-Shirley; its Tangent: Cycles' default radial tangent, a Tangent node, Radial or UV Map,
 # or a vector), Glass, Emission (and, reported, Background: Cycles shows it as one on a surface),
 # Transparent, Mix Shader, Add Shader, Subsurface Scattering and Principled's subsurface (the
 # diffuse Cycles falls back to at radius 0; a larger radius renders the same, reported); a colour
@@ -47,8 +47,8 @@ _MICROFACET = {'GGX': 'GGX', 'SHARP': 'GGX', 'BECKMANN': 'BECKMANN',
                'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY'}
 # The Glossy BSDF's: those, and Multiscatter GGX as GGX with an energy-compensating lobe.
 _GLOSSY = dict(_MICROFACET, MULTI_GGX='MULTI_GGX')
-# The Anisotropic BSDF's distributions rendered as Cycles does (its Beckmann is rendered as GGX).
-_ANISOTROPIC = {'GGX': 'GGX', 'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY'}
+# The Anisotropic BSDF's distributions rendered as Cycles does (Multiscatter GGX as GGX, reported).
+_ANISOTROPIC = {'GGX': 'GGX', 'BECKMANN': 'BECKMANN', 'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',

@@ -156,8 +156,8 @@ def main():
 
     # Microfacet distributions: Beckmann and Ashikhmin-Shirley are rendered as Cycles does,
     # silently; Multiscatter GGX too on the Glossy and Principled BSDFs (energy-compensated GGX),
-    # the Glass BSDF's as GGX, reported. The Anisotropic BSDF exports GGX or
-    # Ashikhmin-Shirley; its Beckmann and Multiscatter GGX are rendered as GGX, reported.
+    # the Glass BSDF's as GGX, reported. The Anisotropic BSDF exports GGX, Beckmann or
+    # Ashikhmin-Shirley; its Multiscatter GGX is rendered as GGX, reported.
     for node_type, distribution, exported, warned in (
             ("ShaderNodeBsdfGlossy", 'BECKMANN', 'BECKMANN', False),
             ("ShaderNodeBsdfGlass", 'BECKMANN', 'BECKMANN', False),
@@ -171,7 +171,8 @@ def main():
             ("ShaderNodeBsdfGlossy", 'ASHIKHMIN_SHIRLEY', 'ASHIKHMIN_SHIRLEY', False),
             ("ShaderNodeBsdfAnisotropic", 'GGX', 'GGX', False),
             ("ShaderNodeBsdfAnisotropic", 'ASHIKHMIN_SHIRLEY', 'ASHIKHMIN_SHIRLEY', False),
-            ("ShaderNodeBsdfAnisotropic", 'BECKMANN', 'GGX', True)):
+            ("ShaderNodeBsdfAnisotropic", 'BECKMANN', 'BECKMANN', False),
+            ("ShaderNodeBsdfAnisotropic", 'MULTI_GGX', 'GGX', True)):
         m = S.shader_material(f"{node_type}:{distribution}", node_type, distribution=distribution)
         warnings = []
         d = export_materials.translate_material(m, images, warnings.append)
