@@ -629,9 +629,10 @@ int SceneBuilder::add_material(const py::dict& material) {
         throw std::invalid_argument("microfacet distribution 'ASHIKHMIN_SHIRLEY' on a " +
                                     get_str(d, "kind", "DIFFUSE") + " node");
       // The core compensates Multiscatter GGX on reflection only: the add-on exports the
-      // Glass, Refraction and Anisotropic BSDFs' as GGX.
+      // Glass and Refraction BSDFs' as GGX.
       if (node.distribution == MicrofacetDistribution::MultiscatterGGX &&
-          node.kind != ShaderNodeKind::Glossy && node.kind != ShaderNodeKind::Principled)
+          node.kind != ShaderNodeKind::Glossy && node.kind != ShaderNodeKind::Principled &&
+          node.kind != ShaderNodeKind::Anisotropic)
         throw std::invalid_argument("microfacet distribution 'MULTI_GGX' on a " +
                                     get_str(d, "kind", "DIFFUSE") + " node");
       read_float(d, "strength", node.strength);

@@ -156,8 +156,7 @@ def main():
 
     # Microfacet distributions: Beckmann and Ashikhmin-Shirley are rendered as Cycles does,
     # silently; Multiscatter GGX too on the Glossy and Principled BSDFs (energy-compensated GGX),
-    # the Glass BSDF's as GGX, reported. The Anisotropic BSDF exports GGX, Beckmann or
-    # Ashikhmin-Shirley; its Multiscatter GGX is rendered as GGX, reported.
+    # the Glass BSDF's as GGX, reported. The Anisotropic BSDF exports each of its distributions.
     for node_type, distribution, exported, warned in (
             ("ShaderNodeBsdfGlossy", 'BECKMANN', 'BECKMANN', False),
             ("ShaderNodeBsdfGlass", 'BECKMANN', 'BECKMANN', False),
@@ -172,7 +171,7 @@ def main():
             ("ShaderNodeBsdfAnisotropic", 'GGX', 'GGX', False),
             ("ShaderNodeBsdfAnisotropic", 'ASHIKHMIN_SHIRLEY', 'ASHIKHMIN_SHIRLEY', False),
             ("ShaderNodeBsdfAnisotropic", 'BECKMANN', 'BECKMANN', False),
-            ("ShaderNodeBsdfAnisotropic", 'MULTI_GGX', 'GGX', True)):
+            ("ShaderNodeBsdfAnisotropic", 'MULTI_GGX', 'MULTI_GGX', False)):
         m = S.shader_material(f"{node_type}:{distribution}", node_type, distribution=distribution)
         warnings = []
         d = export_materials.translate_material(m, images, warnings.append)
