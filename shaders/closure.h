@@ -66,7 +66,8 @@ struct Closure {
   // local (rotation.x, rotation.y, 0): the shading frame's x axis follows `tangent` (world; the
   // material's Tangent input, neither projected nor rotated: shading_frame() in
   // integrators/common/surface_frame.h), and `rotation` is (cos, sin) of the Anisotropic Rotation
-  // about the normal from there.
+  // about the normal from there. The frame follows the set's first anisotropic lobe; the others
+  // are turned to their own tangents per hit (ClosureSet::orient_own_tangents).
   float alpha_y = -1.0f;
   Vec2f rotation{1.0f, 0.0f};
   Vec3f tangent{0.0f, 0.0f, 0.0f};

@@ -293,6 +293,25 @@ TEST(GradientUnbiased, AnisotropicBeckmannHalfVector) {
                   4096, 1024, 0.2f);
 }
 
+// Two anisotropic lobes with their own tangents, radial about the ball's Z and X axes, mixed:
+// every vertex, base or offset, turns the second lobe to its own tangent in its own frame
+// (shading_closures()).
+TEST(GradientUnbiased, AnisotropicOwnTangents) {
+  Scene scene = anisotropic_ball_scene(MicrofacetDistribution::GGX);
+  MaterialDesc& m = scene.materials[3];
+  ShaderNode second = m.nodes[0];
+  second.tangent.axis = 0;
+  second.rotation = FloatInput(0.0f);
+  ShaderNode mix;
+  mix.kind = ShaderNodeKind::Mix;
+  mix.a = 0;
+  mix.b = 1;
+  m.nodes.push_back(second);
+  m.nodes.push_back(mix);
+  m.root = 2;
+  expect_unbiased("anisotropic-own-tangents", scene, 4096, 1024, 0.2f);
+}
+
 // Russian roulette after a glossy bounce takes effect past the emission the next segment finds
 // (path_tracer.cpp, gradient_path_tracer.cpp). Roulette from the first bounce and a dark glossy
 // ball (q = sqrt(0.25) = 0.5 after it) make that rule decide much of the image: G-PT's primal
