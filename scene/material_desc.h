@@ -225,9 +225,10 @@ enum class ShaderNodeKind : uint8_t {
   Translucent,  // Blender Translucent BSDF: Lambertian transmission (diffuse, to the far side)
   Refraction,   // Blender Refraction BSDF: the Glass BSDF's refraction alone, no Fresnel
   Velvet,       // Blender Velvet BSDF: Ashikhmin velvet, sigma = saturated roughness (Sigma)
-  // Blender Anisotropic BSDF, GGX: alpha = r^2 scaled by (1 - anisotropy) along the tangent and
-  // divided by it across (the reverse for negative anisotropy, clamped to +-0.99), the tangent
-  // turned by Rotation * 2 pi about the normal (Cycles 3.4's svm anisotropic closure).
+  // Blender Anisotropic BSDF (GGX, Beckmann, Ashikhmin-Shirley or Multiscatter GGX): alpha =
+  // r^2 scaled by (1 - anisotropy) along the tangent and divided by it across (the reverse for
+  // negative anisotropy, clamped to +-0.99), the tangent turned by Rotation * 2 pi about the
+  // normal (Cycles 3.4's svm anisotropic closure).
   Anisotropic,
   Mix,  // (1 - fac) * a + fac * b
   Add,  // a + b

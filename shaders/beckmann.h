@@ -1,16 +1,21 @@
-// Isotropic Beckmann microfacet distribution, as Cycles 3.4's `microfacet_beckmann` (the Glossy,
-// Glass and Refraction BSDFs' Beckmann option), in the local frame (normal = +z).
+// The Beckmann microfacet distribution, as Cycles 3.4's `microfacet_beckmann` (the Glossy, Glass
+// and Refraction BSDFs' Beckmann option, and the Anisotropic BSDF's), in the local frame
+// (normal = +z, an anisotropic lobe's tangent on +x).
 //
-//  alpha: Beckmann width, Blender roughness^2 (as for GGX).
-//  D(m) = exp(-tan^2 / alpha^2) / (pi alpha^2 cos^4), integrates to 1 over projected area.
+//  ax, ay: Beckmann widths along x and y, Blender roughness^2 (as for GGX); equal: isotropic.
+//  D(m) = exp(-(mx^2 / ax^2 + my^2 / ay^2) / mz^2) / (pi ax ay mz^4), integrates to 1 over
+//         projected area.
 //  G1(w): the masking of the BSDF value, Cycles 3.4's rational fit of the Smith term (Walter et
-//         al. 2007, eq. 27): with b = 1 / (alpha tan), 1 for b >= 1.6, else
-//         (3.535 b + 2.181 b^2) / (1 + 2.276 b + 2.577 b^2).
+//         al. 2007, eq. 27): with b = 1 / (alpha_w tan), alpha_w = sqrt(ax^2 wx^2 + ay^2 wy^2) /
+//         sqrt(wx^2 + wy^2) the width along w's azimuth (bsdf_beckmann_aniso_G1), 1 for
+//         b >= 1.6, else (3.535 b + 2.181 b^2) / (1 + 2.276 b + 2.577 b^2).
 //  smith_G1(w): the exact Smith masking 1 / (1 + Lambda), the normalisation of the visible normals.
 //  sample_visible(wi, u): a normal of the distribution visible from wi (wi.z > 0): the slopes of
-//         the stretched configuration (Heitz and d'Eon 2014) by inverting their CDFs to double
-//         precision, so its density is exactly pdf_visible(wi, m) = smith_G1(wi) max(0, wi.m)
-//         D(m) / wi.z.
+//         the configuration stretched by (ax, ay) (Heitz and d'Eon 2014) by inverting their CDFs
+//         to double precision, so its density is exactly pdf_visible(wi, m) = smith_G1(wi)
+//         max(0, wi.m) D(m) / wi.z. (Cycles 3.4 samples an anisotropic lobe with ax for both
+//         widths while weighting by the anisotropic D, which biases its sampled light; the
+//         BSDF modelled here is the one Cycles evaluates.)
 #pragma once
 
 #include <algorithm>
@@ -60,25 +65,27 @@ inline double sample_visible_slope(double t, double u) {
 }  // namespace beckmann_detail
 
 struct Beckmann {
-  float alpha;
-  float alpha2;
+  float ax, ay;
 
-  explicit Beckmann(float a) : alpha(a), alpha2(a * a) {}
+  explicit Beckmann(float a) : ax(a), ay(a) {}
+  Beckmann(float alpha_x, float alpha_y) : ax(alpha_x), ay(alpha_y) {}
 
   float D(Vec3f m) const {
     if (m.z <= 0.0f) return 0.0f;
     const float z2 = m.z * m.z;
     const float c2 = z2 / length_squared(m);
-    // tan^2 from the horizontal part: (1 - c^2) / c^2 cancels for near-normal m at small alpha.
-    const float tan2 = (m.x * m.x + m.y * m.y) / z2;
-    const float e = std::exp(-tan2 / alpha2);
-    return e > 0.0f ? e / (kPi * alpha2 * c2 * c2) : 0.0f;  // 0, not 0 / 0, at grazing m
+    // tan^2 / alpha^2 from the horizontal part: (1 - c^2) / c^2 cancels for near-normal m at
+    // small widths.
+    const float sx = m.x / ax, sy = m.y / ay;
+    const float e = std::exp(-(sx * sx + sy * sy) / z2);
+    return e > 0.0f ? e / (kPi * ax * ay * c2 * c2) : 0.0f;  // 0, not 0 / 0, at grazing m
   }
 
   float G1(Vec3f w) const {
     const float z = std::fabs(w.z);
     if (z == 0.0f) return 0.0f;
-    const float inv_b = alpha * std::sqrt(w.x * w.x + w.y * w.y) / z;  // alpha tan theta
+    const float px = ax * w.x, py = ay * w.y;
+    const float inv_b = std::sqrt(px * px + py * py) / z;  // alpha_w tan theta
     if (inv_b < 0.625f) return 1.0f;
     // The fit multiplied through by inv_b^2, so grazing directions (inv_b -> inf) give 0.
     return (2.181f + 3.535f * inv_b) / (2.577f + (2.276f + inv_b) * inv_b);
@@ -99,24 +106,26 @@ struct Beckmann {
   }
 
   Vec3f sample_visible(Vec3f wi, Vec2f u) const {
-    const double r = std::sqrt(double(wi.x) * wi.x + double(wi.y) * wi.y);
-    const double cos_phi = r > 0.0 ? wi.x / r : 1.0, sin_phi = r > 0.0 ? wi.y / r : 0.0;
+    // wi stretched to the configuration of unit widths, where the distribution is isotropic.
+    const double px = double(ax) * wi.x, py = double(ay) * wi.y;
+    const double r = std::sqrt(px * px + py * py);
+    const double cos_phi = r > 0.0 ? px / r : 1.0, sin_phi = r > 0.0 ? py / r : 0.0;
     const double t = stretched_tan(wi);
     // Slopes of the stretched configuration with wi in the x-z plane, rotated to wi's azimuth
-    // and scaled back by alpha.
+    // and scaled back by the widths.
     const double sx = beckmann_detail::sample_visible_slope(t, u.x);
     const double sy = beckmann_detail::sample_visible_slope(0.0, u.y);
-    const double x = alpha * (cos_phi * sx - sin_phi * sy);
-    const double y = alpha * (sin_phi * sx + cos_phi * sy);
+    const double x = ax * (cos_phi * sx - sin_phi * sy);
+    const double y = ay * (sin_phi * sx + cos_phi * sy);
     const double inv_len = 1.0 / std::sqrt(1.0 + x * x + y * y);
     return Vec3f(float(-x * inv_len), float(-y * inv_len), float(inv_len));
   }
 
  private:
-  // alpha tan theta of w: its tangent in the configuration stretched to alpha = 1.
+  // alpha_w tan theta of w: its tangent in the configuration stretched to unit widths.
   double stretched_tan(Vec3f w) const {
-    const double r = std::sqrt(double(w.x) * w.x + double(w.y) * w.y);
-    return alpha * r / std::fabs(double(w.z));
+    const double px = double(ax) * w.x, py = double(ay) * w.y;
+    return std::sqrt(px * px + py * py) / std::fabs(double(w.z));
   }
 };
 

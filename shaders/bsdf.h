@@ -153,6 +153,13 @@ class ClosureSet {
       }
     return false;
   }
+  // Whether an anisotropic lobe has a tangent other than the first one's.
+  bool has_own_tangents() const;
+  // Turns each anisotropic lobe whose tangent is not the first one's by the angle from the
+  // shading frame's x axis to its own tangent projected onto the frame's tangent plane (Cycles'
+  // make_orthonormals_tangent per closure), and gives it the first one's tangent: the lobes then
+  // hold their orientation relative to `frame`, and a second call changes nothing.
+  void orient_own_tangents(const Frame& frame);
   // Minimum roughness over non-delta lobes (1 for pure diffuse); 0 if only delta lobes.
   float roughness() const;
   bool has_delta() const;

@@ -28,6 +28,26 @@ inline Spectrum multiscatter_fresnel(Spectrum f_avg, float e_avg) {
   return {channel(f_avg.x), channel(f_avg.y), channel(f_avg.z)};
 }
 
+// The width whose albedo table compensates GGX reflection lobe `single`: an anisotropic lobe's
+// is the root mean square of its widths, which loses about as much light as the lobe does
+// averaged over azimuths (the area's sqrt(alpha_x alpha_y) compensates far too little of a
+// narrow-and-wide lobe; white furnace: test_ggx_multiscatter).
+inline float compensated_alpha(const Closure& single) {
+  if (!is_anisotropic(single)) return single.alpha;
+  return std::sqrt(0.5f * (single.alpha * single.alpha + single.alpha_y * single.alpha_y));
+}
+
+// The multiple-scattering lobe of GGX reflection lobe `single` whose Fresnel colour averages
+// f_avg over the cosine-weighted hemisphere, scaled by `scale`.
+inline Closure lobe_of(const Closure& single, Spectrum f_avg, Spectrum scale) {
+  Closure m;
+  m.type = ClosureType::GGXMultiscatter;
+  m.alpha = compensated_alpha(single);
+  m.weight = scale * multiscatter_fresnel(f_avg, ggx_average_albedo(m.alpha));
+  m.interpolated_normal = single.interpolated_normal;
+  return m;
+}
+
 inline Spectrum eval(const Closure& c, Vec3f wi, Vec3f wo) {
   if (!(wi.z * wo.z > 0.0f)) return Spectrum(0.0f);
   const float lost = 1.0f - ggx_average_albedo(c.alpha);

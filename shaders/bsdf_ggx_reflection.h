@@ -1,5 +1,5 @@
-// Microfacet reflection (GGX, Beckmann or Ashikhmin-Shirley: Closure::distribution; GGX and
-// Ashikhmin-Shirley lobes may be anisotropic about the lobe's tangent), two-sided, as Cycles 3.4's
+// Microfacet reflection (GGX, Beckmann or Ashikhmin-Shirley: Closure::distribution; each may be
+// anisotropic about the lobe's tangent), two-sided, as Cycles 3.4's
 // `microfacet_ggx` / `microfacet_beckmann` / `ashikhmin_shirley` (Glossy and Anisotropic BSDFs)
 // and `microfacet_ggx_fresnel` (Principled v1 specular). Ashikhmin-Shirley has its own value,
 // density and sampler (shaders/ashikhmin_shirley.h); the others are
@@ -47,12 +47,21 @@ inline Spectrum eval_pdf_as(const Closure& c, Vec3f wi, Vec3f wo, Vec3f h, float
   return c.weight * fresnel(c, dot(wo, h)) * v;
 }
 
-// The anisotropic lobe: the same formulas with AnisoGGX in the lobe's frame.
+inline AnisoMicrofacet aniso_microfacet_of(const Closure& c) {
+  return AnisoMicrofacet(c.distribution, c.alpha, c.alpha_y);
+}
+
+// The anisotropic lobe: the same formulas with AnisoMicrofacet in the lobe's frame.
+inline float pdf_aniso(const Closure& c, Vec3f wi, Vec3f h) {
+  const AnisoMicrofacet mf = aniso_microfacet_of(c);
+  return mf.D(to_tangent(c, h)) * mf.G1_visible(to_tangent(c, wi)) / (4.0f * wi.z);
+}
 inline Spectrum eval_pdf_aniso(const Closure& c, Vec3f wi, Vec3f wo, Vec3f h, float& pdf) {
-  const AnisoGGX ggx(c.alpha, c.alpha_y);
-  const float common = ggx.D(to_tangent(c, h)) * ggx.G1(to_tangent(c, wi)) / (4.0f * wi.z);
-  pdf = common;
-  return c.weight * fresnel(c, dot(wo, h)) * (common * ggx.G1(to_tangent(c, wo)));
+  const AnisoMicrofacet mf = aniso_microfacet_of(c);
+  const Vec3f wi_t = to_tangent(c, wi);
+  const float common = mf.D(to_tangent(c, h)) / (4.0f * wi.z);
+  pdf = common * mf.G1_visible(wi_t);
+  return c.weight * fresnel(c, dot(wo, h)) * (common * mf.G1(wi_t) * mf.G1(to_tangent(c, wo)));
 }
 
 // wi, wo already mirrored to wi.z > 0. Returns eval, writes the pdf.
@@ -80,10 +89,7 @@ inline float pdf(const Closure& c, Vec3f wi, Vec3f wo) {
       ashikhmin_shirley_of(k).eval_pdf(to_tangent(k, i), to_tangent(k, o), to_tangent(k, h), p);
       return p;
     }
-    if (is_anisotropic(k)) {
-      const AnisoGGX ggx(k.alpha, k.alpha_y);
-      return ggx.D(to_tangent(k, h)) * ggx.G1(to_tangent(k, i)) / (4.0f * i.z);
-    }
+    if (is_anisotropic(k)) return pdf_aniso(k, i, h);
     const Microfacet mf(k.distribution, k.alpha);
     return mf.D(h) * mf.G1_visible(i) / (4.0f * i.z);
   });
@@ -96,7 +102,7 @@ inline BsdfSample sample(const Closure& c, Vec3f wi, float, Vec2f u) {
         if (is_ashikhmin_shirley(k))
           return from_tangent(k, ashikhmin_shirley_of(k).sample_normal(v));
         if (!is_anisotropic(k)) return Microfacet(k.distribution, k.alpha).sample_visible(i, v);
-        return from_tangent(k, AnisoGGX(k.alpha, k.alpha_y).sample_visible(to_tangent(k, i), v));
+        return from_tangent(k, aniso_microfacet_of(k).sample_visible(to_tangent(k, i), v));
       },
       eval_pdf_upper);
 }

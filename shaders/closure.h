@@ -61,12 +61,13 @@ struct Closure {
   MicrofacetDistribution distribution = MicrofacetDistribution::GGX;
   Spectrum weight{1.0f, 1.0f, 1.0f};  // colour * mix weight
   float alpha = 0.0f;                 // microfacet alpha (= Blender roughness^2); diffuse roughness
-  // Anisotropic GGX (GGXReflection, distribution GGX or AshikhminShirley): alpha is the width along
+  // Anisotropic (GGXReflection, any distribution): alpha is the width along
   // the lobe's tangent, alpha_y along its bitangent; alpha_y < 0: isotropic. The lobe's tangent is
   // local (rotation.x, rotation.y, 0): the shading frame's x axis follows `tangent` (world; the
   // material's Tangent input, neither projected nor rotated: shading_frame() in
   // integrators/common/surface_frame.h), and `rotation` is (cos, sin) of the Anisotropic Rotation
-  // about the normal from there.
+  // about the normal from there. The frame follows the set's first anisotropic lobe; the others
+  // are turned to their own tangents per hit (ClosureSet::orient_own_tangents).
   float alpha_y = -1.0f;
   Vec2f rotation{1.0f, 0.0f};
   Vec3f tangent{0.0f, 0.0f, 0.0f};

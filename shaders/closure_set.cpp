@@ -456,6 +456,30 @@ BsdfSample ClosureSet::delta_event_t(Vec3f wi, uint8_t event) const {
   return sum;
 }
 
+bool ClosureSet::has_own_tangents() const {
+  Vec3f first;
+  if (!anisotropic_tangent(first)) return false;
+  for (int i = 0; i < count_; ++i)
+    if (is_anisotropic(closures_[i]) && !(closures_[i].tangent == first)) return true;
+  return false;
+}
+
+void ClosureSet::orient_own_tangents(const Frame& frame) {
+  Vec3f first;
+  if (!anisotropic_tangent(first)) return;
+  for (int i = 0; i < count_; ++i) {
+    Closure& c = closures_[i];
+    if (!is_anisotropic(c) || c.tangent == first) continue;
+    const Vec3f t = frame.to_local(c.tangent);
+    const float len = std::sqrt(t.x * t.x + t.y * t.y);
+    c.tangent = first;
+    // A tangent along the normal names no direction: the lobe follows the frame's, as there.
+    if (!(len > 1e-10f) || !std::isfinite(len)) continue;
+    const float ct = t.x / len, st = t.y / len, cr = c.rotation.x, sr = c.rotation.y;
+    c.rotation = Vec2f(ct * cr - st * sr, st * cr + ct * sr);
+  }
+}
+
 float ClosureSet::roughness() const {
   float r = 2.0f;
   for (int i = 0; i < count_; ++i) {

@@ -586,6 +586,15 @@ void orient(Closure& c, Vec3f tangent, float turns) {
   c.rotation = turns != 0.0f ? Vec2f(std::cos(angle), std::sin(angle)) : Vec2f(1.0f, 0.0f);
 }
 
+// Blender's Multiscatter GGX of the Glossy and Anisotropic BSDFs: GGX reflection lobe `c` (its
+// distribution set here) and its multiple-scattering lobe, of no Fresnel: the colour is the
+// lobe's average reflectance.
+void add_multiscatter_pair(Closure& c, Spectrum color, float w, ClosureSet& out) {
+  c.distribution = MicrofacetDistribution::GGX;
+  out.add(c);
+  out.add(ggx_multiscatter::lobe_of(c, color, Spectrum(w)));
+}
+
 // Adds the lobes of one BSDF node (weight w) to `out`.
 template <class Inputs>
 void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
@@ -612,12 +621,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
         out.add(c);
         return;
       }
-      c.distribution = MicrofacetDistribution::GGX;
-      out.add(c);
-      c.type = ClosureType::GGXMultiscatter;
-      // No Fresnel: the colour is the lobe's average reflectance.
-      c.weight = ggx_multiscatter::multiscatter_fresnel(color, ggx_average_albedo(c.alpha)) * w;
-      out.add(c);
+      add_multiscatter_pair(c, color, w, out);
       return;
     }
     case ShaderNodeKind::Anisotropic: {
@@ -627,8 +631,13 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       c.distribution = n.distribution;
       set_anisotropy(c, r * r, std::clamp(in.scalar(n.anisotropy), -0.99f, 0.99f));
       if (is_anisotropic(c)) orient(c, in.tangent(n.tangent), in.scalar(n.rotation));
-      c.weight = in.color(n.color) * w;
-      out.add(c);
+      const Spectrum color = in.color(n.color);
+      c.weight = color * w;
+      if (n.distribution != MicrofacetDistribution::MultiscatterGGX) {
+        out.add(c);
+        return;
+      }
+      add_multiscatter_pair(c, color, w, out);
       return;
     }
     case ShaderNodeKind::Glass:

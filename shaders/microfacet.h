@@ -1,5 +1,6 @@
 // The microfacet distributions of the reflection and dielectric lobes: Microfacet, the one a
-// Closure names (GGX or Beckmann, shaders/beckmann.h), the isotropic GGX (Trowbridge-Reitz)
+// Closure names (GGX or Beckmann, shaders/beckmann.h), AnisoMicrofacet, the same of an anisotropic
+// reflection lobe, the isotropic GGX (Trowbridge-Reitz)
 // distribution with the separable Smith masking term, and the anisotropic GGX (AnisoGGX, widths
 // alpha_x along local x, the tangent, and alpha_y along local y), in the local frame
 // (normal = +z), as Cycles 3.4's `microfacet_ggx`.
@@ -133,6 +134,28 @@ struct AnisoGGX {
   }
 
   Vec3f sample_visible(Vec3f wi, Vec2f u) const { return sample_ggx_visible(wi, ax, ay, u); }
+};
+
+// An anisotropic closure's distribution (widths alpha_x along the lobe's tangent, alpha_y across
+// it), with Microfacet's quantities: AnisoGGX, or Beckmann of two widths.
+class AnisoMicrofacet {
+ public:
+  AnisoMicrofacet(MicrofacetDistribution d, float alpha_x, float alpha_y)
+      : beckmann_(d == MicrofacetDistribution::Beckmann),
+        ggx_(alpha_x, alpha_y),
+        bk_(alpha_x, alpha_y) {}
+
+  float D(Vec3f m) const { return beckmann_ ? bk_.D(m) : ggx_.D(m); }
+  float G1(Vec3f w) const { return beckmann_ ? bk_.G1(w) : ggx_.G1(w); }
+  float G1_visible(Vec3f wi) const { return beckmann_ ? bk_.smith_G1(wi) : ggx_.G1(wi); }
+  Vec3f sample_visible(Vec3f wi, Vec2f u) const {
+    return beckmann_ ? bk_.sample_visible(wi, u) : ggx_.sample_visible(wi, u);
+  }
+
+ private:
+  bool beckmann_;
+  AnisoGGX ggx_;
+  Beckmann bk_;
 };
 
 }  // namespace gdpt

@@ -13,8 +13,7 @@ namespace {
 constexpr float kWeightCutoff = 1e-5f;
 
 // The specular lobe's multiple-scattering lobe, coloured by the cosine average of its Fresnel
-// colour: cspec0 (1 - fh_avg) + fh_avg, fh_avg that of the normalised dielectric Fresnel. An
-// anisotropic lobe is compensated as the isotropic one of the same area, sqrt(alpha_x alpha_y).
+// colour: cspec0 (1 - fh_avg) + fh_avg, fh_avg that of the normalised dielectric Fresnel.
 Closure principled_multiscatter(const Closure& s) {
   constexpr int kSteps = 32;
   const PrincipledFresnel white(s.ior, Spectrum(0.0f));
@@ -24,13 +23,7 @@ Closure principled_multiscatter(const Closure& s) {
     fh += white(mu).x * mu;
   }
   fh *= 2.0f / float(kSteps);
-  Closure m;
-  m.type = ClosureType::GGXMultiscatter;
-  m.alpha = is_anisotropic(s) ? std::sqrt(s.alpha * s.alpha_y) : s.alpha;
-  const Spectrum f_avg = s.f0 * (1.0f - fh) + Spectrum(fh);
-  m.weight = s.weight * ggx_multiscatter::multiscatter_fresnel(f_avg, ggx_average_albedo(m.alpha));
-  m.interpolated_normal = s.interpolated_normal;
-  return m;
+  return ggx_multiscatter::lobe_of(s, s.f0 * (1.0f - fh) + Spectrum(fh), s.weight);
 }
 
 }  // namespace

@@ -2,12 +2,12 @@
 #
 # Walks from the active Material Output's Surface input over the tree with its node groups
 # flattened (export_node_groups.py). Supported shader nodes: Principled BSDF, Diffuse, Glossy,
-# Anisotropic (GGX; its Tangent: Cycles' default radial tangent, a Tangent node, Radial or UV Map,
-# or a vector), Glass, Emission (and, reported, Background: Cycles shows it as one on a surface),
-# Transparent, Mix Shader, Add Shader, Subsurface Scattering and Principled's subsurface (the
-# diffuse Cycles falls back to at radius 0; a larger radius renders the same, reported); a colour
-# or float output on a shader socket becomes an Emission, and an unlinked shader input is no
-# closure (black), as in Cycles.
+# Anisotropic (GGX, Beckmann, Ashikhmin-Shirley, Multiscatter GGX; its Tangent: Cycles' default
+# radial tangent, a Tangent node, Radial or UV Map, or a vector), Glass, Emission (and, reported,
+# Background: Cycles shows it as one on a surface), Transparent, Mix Shader, Add Shader, Subsurface
+# Scattering and Principled's subsurface (the diffuse Cycles falls back to at radius 0; a larger
+# radius renders the same, reported); a colour or float output on a shader socket becomes an
+# Emission, and an unlinked shader input is no closure (black), as in Cycles.
 # Inputs may be constants, RGB / Value nodes, colour / math / curve nodes, Blackbody, Fresnel,
 # Layer Weight, Geometry (Normal, True Normal, Incoming, Backfacing, Tangent, Pointiness,
 # Parametric, Random Per Island), Light Path (read per path: its own direction and state), Vector
@@ -49,8 +49,10 @@ _MICROFACET = {'GGX': 'GGX', 'SHARP': 'GGX', 'BECKMANN': 'BECKMANN',
 # added multiple-scattering lobe; Glass: the lobe scaled to conserve energy). Blender 3.4's
 # Refraction BSDF offers Sharp, Beckmann and GGX only.
 _GLOSSY = dict(_MICROFACET, MULTI_GGX='MULTI_GGX')
-# The Anisotropic BSDF's distributions rendered as Cycles does (its Beckmann is rendered as GGX).
-_ANISOTROPIC = {'GGX': 'GGX', 'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY'}
+# The Anisotropic BSDF's: those of the Glossy BSDF (Multiscatter GGX: the energy-compensating lobe
+# of the widths' root mean square).
+_ANISOTROPIC = {'GGX': 'GGX', 'BECKMANN': 'BECKMANN', 'ASHIKHMIN_SHIRLEY': 'ASHIKHMIN_SHIRLEY',
+                'MULTI_GGX': 'MULTI_GGX'}
 # Colour / math nodes between inputs and shaders, and their modes the core models.
 _INPUT_NODES = {'MIX', 'MIX_RGB', 'MATH', 'INVERT', 'VALTORGB', 'SEPRGB', 'SEPARATE_COLOR',
                 'COMBRGB', 'COMBINE_COLOR', 'GAMMA', 'BRIGHTCONTRAST', 'HUE_SAT', 'MAP_RANGE',

@@ -633,11 +633,10 @@ int SceneBuilder::add_material(const py::dict& material) {
           node.kind != ShaderNodeKind::Glossy && node.kind != ShaderNodeKind::Anisotropic)
         throw std::invalid_argument("microfacet distribution 'ASHIKHMIN_SHIRLEY' on a " +
                                     get_str(d, "kind", "DIFFUSE") + " node");
-      // Blender offers Multiscatter GGX on these (the add-on exports the Anisotropic BSDF's as
-      // GGX).
+      // Blender offers Multiscatter GGX on these.
       if (node.distribution == MicrofacetDistribution::MultiscatterGGX &&
           node.kind != ShaderNodeKind::Glossy && node.kind != ShaderNodeKind::Principled &&
-          node.kind != ShaderNodeKind::Glass)
+          node.kind != ShaderNodeKind::Glass && node.kind != ShaderNodeKind::Anisotropic)
         throw std::invalid_argument("microfacet distribution 'MULTI_GGX' on a " +
                                     get_str(d, "kind", "DIFFUSE") + " node");
       read_float(d, "strength", node.strength);

@@ -14,8 +14,8 @@
 //   world:    color (3), strength, image (int), rotation (12 floats)
 //   material: name, root, nodes: list of dicts {kind: 'DIFFUSE'|'GLOSSY'|'GLASS'|'PRINCIPLED'|
 //             'EMISSION'|'TRANSPARENT'|'MIX'|'ADD', a, b, distribution 'GGX'|'BECKMANN' (Glossy,
-//             Glass, Refraction)|'ASHIKHMIN_SHIRLEY' (Glossy, Anisotropic)|'MULTI_GGX' (Glossy,
-//             Glass, Principled), and inputs color, roughness, ior,
+//             Glass, Refraction, Anisotropic)|'ASHIKHMIN_SHIRLEY' (Glossy, Anisotropic)|
+//             'MULTI_GGX' (Glossy, Glass, Anisotropic, Principled), and inputs color, roughness, ior,
 //             strength, fac, metallic, specular, specular_tint, transmission, alpha, emission,
 //             emission_strength, subsurface, subsurface_color}; a colour input is {value: (3),
 //             image, mapping (12), coordinates 'UV'|'GENERATED'|'OBJECT', interpolation

@@ -32,8 +32,9 @@ inline SurfaceFrame facing_frame(const SurfaceHit& hit, Vec3f wi_world) {
 
 // The local frame of a shading point with normal `ns` (unit, world): about the normal alone, or,
 // where a lobe is anisotropic, with its x axis on that lobe's tangent projected onto the tangent
-// plane (Cycles' make_orthonormals_tangent), the frame its Rotation turns from. G-PT's shifts
-// copy local directions, so each path's vertex is in its own tangent frame.
+// plane (Cycles' make_orthonormals_tangent), the frame its Rotation turns from (lobes of other
+// tangents are turned to theirs in shading_closures()). G-PT's shifts copy local directions, so
+// each path's vertex is in its own tangent frame.
 inline Frame shading_frame(Vec3f ns, const ClosureSet& closures) {
   Vec3f t;
   if (!closures.anisotropic_tangent(t)) [[likely]]

@@ -155,9 +155,8 @@ def main():
     print(f"{len(materials)} materials, {reported} with warnings", flush=True)
 
     # Microfacet distributions: Beckmann and Ashikhmin-Shirley are rendered as Cycles does,
-    # silently; Multiscatter GGX too on the Glossy, Glass and Principled BSDFs (energy-compensated
-    # GGX). The Anisotropic BSDF exports GGX or Ashikhmin-Shirley; its Beckmann and Multiscatter
-    # GGX are rendered as GGX, reported.
+    # silently; Multiscatter GGX too on the Glossy, Glass, Anisotropic and Principled BSDFs
+    # (energy-compensated GGX). The Anisotropic BSDF exports each of its distributions.
     for node_type, distribution, exported, warned in (
             ("ShaderNodeBsdfGlossy", 'BECKMANN', 'BECKMANN', False),
             ("ShaderNodeBsdfGlass", 'BECKMANN', 'BECKMANN', False),
@@ -171,7 +170,8 @@ def main():
             ("ShaderNodeBsdfGlossy", 'ASHIKHMIN_SHIRLEY', 'ASHIKHMIN_SHIRLEY', False),
             ("ShaderNodeBsdfAnisotropic", 'GGX', 'GGX', False),
             ("ShaderNodeBsdfAnisotropic", 'ASHIKHMIN_SHIRLEY', 'ASHIKHMIN_SHIRLEY', False),
-            ("ShaderNodeBsdfAnisotropic", 'BECKMANN', 'GGX', True)):
+            ("ShaderNodeBsdfAnisotropic", 'BECKMANN', 'BECKMANN', False),
+            ("ShaderNodeBsdfAnisotropic", 'MULTI_GGX', 'MULTI_GGX', False)):
         m = S.shader_material(f"{node_type}:{distribution}", node_type, distribution=distribution)
         warnings = []
         d = export_materials.translate_material(m, images, warnings.append)

@@ -268,16 +268,48 @@ TEST(GradientUnbiased, AshikhminShirleyGlossyReconnectedAndHalfVector) {
 // frame (shading_frame()), in which the copy is made and the offset's closures are evaluated.
 // Failure rate measured 0.172; building the offset's frame from the base's tangent instead fails
 // here (dx max z 5.58, two outliers).
-TEST(GradientUnbiased, AnisotropicHalfVector) {
+Scene anisotropic_ball_scene(MicrofacetDistribution distribution) {
   Scene scene = make_scene(SceneKind::CornellGlossy, 24, 0.1f, 1.2f);
   // The ball's axis (the tangent's pole, where it turns fastest) towards the lamp's reflection.
   for (Instance& i : scene.instances)
     if (i.mesh == 1) i.object_to_world = transform(-kPi / 4, 0.0f, i.object_to_world.translation());
   ShaderNode& ball = scene.materials[3].nodes[0];
   ball.kind = ShaderNodeKind::Anisotropic;
+  ball.distribution = distribution;
   ball.anisotropy = FloatInput(0.95f);
   ball.rotation = FloatInput(0.1f);
-  expect_unbiased("anisotropic", scene, 4096, 1024, 0.2f);
+  return scene;
+}
+
+TEST(GradientUnbiased, AnisotropicHalfVector) {
+  expect_unbiased("anisotropic", anisotropic_ball_scene(MicrofacetDistribution::GGX), 4096, 1024,
+                  0.2f);
+}
+
+// The same with the Beckmann distribution: the copy's offset density and value are the
+// anisotropic Beckmann lobe's own.
+TEST(GradientUnbiased, AnisotropicBeckmannHalfVector) {
+  expect_unbiased("anisotropic-beckmann", anisotropic_ball_scene(MicrofacetDistribution::Beckmann),
+                  4096, 1024, 0.2f);
+}
+
+// Two anisotropic lobes with their own tangents, radial about the ball's Z and X axes, mixed:
+// every vertex, base or offset, turns the second lobe to its own tangent in its own frame
+// (shading_closures()).
+TEST(GradientUnbiased, AnisotropicOwnTangents) {
+  Scene scene = anisotropic_ball_scene(MicrofacetDistribution::GGX);
+  MaterialDesc& m = scene.materials[3];
+  ShaderNode second = m.nodes[0];
+  second.tangent.axis = 0;
+  second.rotation = FloatInput(0.0f);
+  ShaderNode mix;
+  mix.kind = ShaderNodeKind::Mix;
+  mix.a = 0;
+  mix.b = 1;
+  m.nodes.push_back(second);
+  m.nodes.push_back(mix);
+  m.root = 2;
+  expect_unbiased("anisotropic-own-tangents", scene, 4096, 1024, 0.2f);
 }
 
 // Russian roulette after a glossy bounce takes effect past the emission the next segment finds

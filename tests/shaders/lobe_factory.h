@@ -96,7 +96,8 @@ inline Closure ashikhmin_shirley(Closure k) {
   k.distribution = MicrofacetDistribution::AshikhminShirley;
   return k;
 }
-// A Glossy, Glass or Refraction lobe with Blender's Beckmann distribution instead of GGX.
+// A Glossy, Glass, Refraction or Anisotropic lobe with Blender's Beckmann distribution instead of
+// GGX.
 inline Closure beckmann(Closure k) {
   k.distribution = MicrofacetDistribution::Beckmann;
   return k;

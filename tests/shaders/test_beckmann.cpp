@@ -2,7 +2,8 @@
 // D's normalisation by quadrature, the visible-normal density integrating to 1 (so the sampler's
 // pdf carries the exact Smith G1), Cycles 3.4's formulas for D, the G1 fit and the reflection and
 // refraction values (written out here from the Walter et al. 2007 equations Cycles follows), the
-// fit against the exact term, and the white furnace. Sampling against pdf: test_bsdf_chi2.
+// fit against the exact term, and the white furnace; the same of the anisotropic distribution
+// (Cycles 3.4's anisotropic D and bsdf_beckmann_aniso_G1). Sampling against pdf: test_bsdf_chi2.
 #include <gtest/gtest.h>
 
 #include "shaders/beckmann.h"
@@ -124,6 +125,92 @@ TEST(Beckmann, LobeValuesAreCyclesFormulas) {
     }
     EXPECT_GT(checked, 1000);
   }
+}
+
+// Cycles 3.4's anisotropic Beckmann D and G1 (bsdf_microfacet.h), in double: D from the slopes,
+// G1 from the width along w's azimuth, (ax^2 cos^2 phi + ay^2 sin^2 phi).
+double cycles_aniso_d(Vec3f m, double ax, double ay) {
+  const double len = std::sqrt(double(m.x) * m.x + double(m.y) * m.y + double(m.z) * m.z);
+  const double x = m.x / len, y = m.y / len, z = m.z / len;
+  const double sx = -x / (z * ax), sy = -y / (z * ay);
+  return std::exp(-sx * sx - sy * sy) / (M_PI * ax * ay * z * z * z * z);
+}
+double cycles_aniso_g1(Vec3f w, double ax, double ay) {
+  const double len = std::sqrt(double(w.x) * w.x + double(w.y) * w.y + double(w.z) * w.z);
+  const double x = w.x / len, y = w.y / len, c2 = double(w.z) * w.z / (len * len);
+  const double alpha2 = (x * x * ax * ax + y * y * ay * ay) / (x * x + y * y);
+  const double inv_a = std::sqrt(alpha2 * (1.0 - c2) / c2);
+  if (inv_a < 0.625) return 1.0;
+  const double a = 1.0 / inv_a;
+  return (2.181 * a + 3.535) * a / ((2.577 * a + 2.276) * a + 1.0);
+}
+
+const float kWidths[][2] = {{0.05f, 0.4f}, {0.4f, 0.05f}, {0.2f, 0.6f}, {1.0f, 0.3f}};
+
+TEST(Beckmann, AnisotropicDistributionIntegratesToOne) {
+  for (const auto& w : kWidths) {
+    const Beckmann b(w[0], w[1]);
+    const double mass = hemisphere_integral([&](Vec3f m) { return double(b.D(m)) * m.z; });
+    EXPECT_NEAR(mass, 1.0, 1e-4) << w[0] << " x " << w[1];
+    for (float c : {1.0f, 0.7f, 0.3f, 0.05f})
+      for (float phi : {0.0f, 0.8f, 2.0f}) {
+        const Vec3f wi = direction(c, phi);
+        const double visible =
+            hemisphere_integral([&](Vec3f m) { return double(b.pdf_visible(wi, m)); });
+        EXPECT_NEAR(visible, 1.0, 2e-4) << w[0] << " x " << w[1] << " cos " << c << " " << phi;
+      }
+  }
+}
+
+TEST(Beckmann, AnisotropicDAndG1AreCyclesFormulas) {
+  Pcg32 rng(17);
+  for (const auto& w : kWidths)
+    for (int i = 0; i < 300; ++i) {
+      const Beckmann b(w[0], w[1]);
+      const Vec3f m = direction(0.2 + 0.8 * rng.uniform(), 2 * M_PI * rng.uniform());
+      const double d = cycles_aniso_d(m, w[0], w[1]);
+      if (d > 1e-30) {
+        EXPECT_NEAR(b.D(m), d, 2e-4 * d) << w[0] << " x " << w[1];
+      }
+      const Vec3f v = direction(0.005 + 0.995 * rng.uniform(), 2 * M_PI * rng.uniform());
+      EXPECT_NEAR(b.G1(v), cycles_aniso_g1(v, w[0], w[1]), 2e-5) << w[0] << " x " << w[1];
+      // The fit stays close to the exact term here as well.
+      EXPECT_NEAR(b.G1(v), b.smith_G1(v), 5e-3 * b.smith_G1(v) + 1e-6);
+    }
+  // Equal widths: the isotropic distribution.
+  const Vec3f m = direction(0.6, 1.1);
+  EXPECT_NEAR(Beckmann(0.3f, 0.3f).D(m), Beckmann(0.3f).D(m), 1e-5f * Beckmann(0.3f).D(m));
+}
+
+// The Anisotropic BSDF's lobe with Beckmann takes Cycles' value D G1(wi) G1(wo) / (4 cos_i) in
+// the lobe's rotated frame, and differs from the anisotropic GGX lobe of the same widths.
+TEST(Beckmann, AnisotropicLobeValuesAreCyclesFormulas) {
+  const float ax = 0.08f, ay = 0.35f, turns = 0.15f;
+  const Closure lobe = beckmann(aniso_ggx(ax, ay, 2.0f * float(M_PI) * turns));
+  const ClosureSet set = set_of({lobe}),
+                   as_ggx = set_of({aniso_ggx(ax, ay, 2.0f * float(M_PI) * turns)});
+  // Cycles' tangent frame: the lobe's tangent (rotation) on x.
+  const double cr = lobe.rotation.x, sr = lobe.rotation.y;
+  auto to_lobe = [&](Vec3f v) {
+    return Vec3f(float(cr * v.x + sr * v.y), float(cr * v.y - sr * v.x), v.z);
+  };
+  Pcg32 rng(23);
+  int checked = 0;
+  double differ = 0.0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3f wi = direction(0.05 + 0.95 * rng.uniform(), 2 * M_PI * rng.uniform());
+    const BsdfSample s = set.sample(wi, rng.uniform(), Vec2f(rng.uniform(), rng.uniform()));
+    if (!s.valid) continue;
+    const Vec3f h = normalize(wi + s.wo);
+    const double expected = cycles_aniso_d(to_lobe(h), ax, ay) *
+                            cycles_aniso_g1(to_lobe(wi), ax, ay) *
+                            cycles_aniso_g1(to_lobe(s.wo), ax, ay) / (4.0 * wi.z);
+    EXPECT_NEAR(s.value.y, expected, 1e-3 * expected + 1e-7) << i;
+    differ = std::max(differ, std::fabs(as_ggx.eval(wi, s.wo).y - expected) / expected);
+    ++checked;
+  }
+  EXPECT_GT(checked, 1500);
+  EXPECT_GT(differ, 0.5);
 }
 
 TEST(Beckmann, WhiteFurnaceLossIsSmallForSmoothAndLargerForRough) {

@@ -65,6 +65,9 @@ std::vector<Case> lobe_cases() {
   // Anisotropic GGX: narrow across a rotated tangent, wide along it, and the reverse.
   cases.push_back({"AnisoGGX05x40", set_of({aniso_ggx(0.05f, 0.4f, 0.3f)})});
   cases.push_back({"AnisoGGX50x10", set_of({aniso_ggx(0.5f, 0.1f, 2.0f)})});
+  // Anisotropic Beckmann: the visible slopes of the configuration stretched by both widths.
+  cases.push_back({"AnisoBeckmann05x40", set_of({beckmann(aniso_ggx(0.05f, 0.4f, 0.3f))})});
+  cases.push_back({"AnisoBeckmann50x10", set_of({beckmann(aniso_ggx(0.5f, 0.1f, 2.0f))})});
   {
     Closure a = aniso_ggx(0.3f, 0.08f, 1.0f);
     a.fresnel = FresnelMode::PrincipledV1;

@@ -580,6 +580,44 @@ TEST(AnisotropicGgx, QuarterTurnSwapsTheWidths) {
 }
 
 // Degenerate inputs: zero roughness, exactly grazing wi (z = 0), wo = -wi, wo = wi, poles.
+// Two anisotropic lobes with their own tangents: orient_own_tangents turns the second by the
+// angle from the frame's x axis (the first's tangent) to its tangent projected onto the tangent
+// plane, so the set evaluates as if that lobe had been rotated there; a second call changes
+// nothing, and a set whose lobes share a tangent is left alone.
+TEST(AnisotropicGgx, OwnTangentsTurnEachLobe) {
+  Closure a = aniso_ggx(0.05f, 0.4f), b = aniso_ggx(0.02f, 0.3f, 0.5f);
+  a.tangent = Vec3f(1.0f, 0.0f, 0.0f);
+  // 60 degrees from x in the tangent plane, tilted out of it (the projection counts).
+  b.tangent = Vec3f(0.5f, 0.8660254f, 0.7f);
+  ClosureSet set = set_of({a, b});
+  EXPECT_TRUE(set.has_own_tangents());
+  const Frame frame;  // x along a's tangent, normal +z
+  set.orient_own_tangents(frame);
+  EXPECT_FALSE(set.has_own_tangents());
+  Closure turned = b;
+  const float angle = 0.5f + float(M_PI) / 3.0f;
+  turned.rotation = Vec2f(std::cos(angle), std::sin(angle));
+  EXPECT_NEAR(set[1].rotation.x, turned.rotation.x, 1e-5f);
+  EXPECT_NEAR(set[1].rotation.y, turned.rotation.y, 1e-5f);
+  const ClosureSet expected = set_of({a, turned});
+  ClosureSet again = set;
+  again.orient_own_tangents(Frame(Vec3f(0, 1, 0), Vec3f(-1, 0, 0), Vec3f(0, 0, 1)));
+  Pcg32 rng(3);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3f wi = direction(0.1 + 0.9 * rng.uniform(), 2 * M_PI * rng.uniform());
+    const Vec3f wo = direction(0.1 + 0.9 * rng.uniform(), 2 * M_PI * rng.uniform());
+    const float e = expected.eval(wi, wo).y;
+    EXPECT_NEAR(set.eval(wi, wo).y, e, 1e-4f * e + 1e-6f);
+    EXPECT_EQ(again.eval(wi, wo).y, set.eval(wi, wo).y);
+  }
+  // The same tangent: not turned.
+  b.tangent = a.tangent;
+  ClosureSet shared = set_of({a, b});
+  EXPECT_FALSE(shared.has_own_tangents());
+  shared.orient_own_tangents(Frame(Vec3f(0, 1, 0), Vec3f(-1, 0, 0), Vec3f(0, 0, 1)));
+  EXPECT_EQ(shared[1].rotation.x, b.rotation.x);
+}
+
 TEST(BsdfRobustness, NoNaNOrInfInDegenerateConfigurations) {
   std::vector<Closure> lobes = {lambert(), oren_nayar(1.0f), principled_diffuse(1.0f),
                                 principled_sheen(), transparent()};
