@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include "reconstruct/candidate_selection.h"
+#include "reconstruct/half_outliers.h"
 #include "reconstruct/parallel.h"
 
 namespace gdpt {
@@ -163,15 +164,20 @@ FeatureReconstruction feature_filter(const ReconstructionInput& input, const flo
                                      const float* variance_b) {
   FeatureReconstruction r;
   auto t = std::chrono::steady_clock::now();
-  const detail::FeatureBuffers fb =
-      detail::prepare_feature_buffers(input, a, b, all, variance_a, variance_b);
+  const size_t n3 = 3 * size_t(input.width) * input.height;
+  std::vector<float> la(a, a + n3), lb(b, b + n3), lall(all, all + n3);
+  r.limited = detail::limit_half_outliers(
+      input.width, input.height, input.primal_a ? input.primal_a : a,
+      input.primal_b ? input.primal_b : b, la.data(), lb.data(), lall.data());
+  const detail::FeatureBuffers fb = detail::prepare_feature_buffers(
+      input, la.data(), lb.data(), lall.data(), variance_a, variance_b);
+  std::vector<float>().swap(la), std::vector<float>().swap(lb), std::vector<float>().swap(lall);
   r.features = fb.features;
   r.missing = fb.missing;
   r.prepare_seconds = since(t);
 
   // Per colour tolerance: the two halves and the image of all samples, filtered.
   constexpr int kTol = detail::kColourToleranceCount;
-  const size_t n3 = 3 * size_t(input.width) * input.height;
   std::vector<float> filtered(size_t(kTol) * 3 * n3);
   float* out[kTol * 3];
   for (int k = 0; k < kTol * 3; ++k) out[k] = filtered.data() + size_t(k) * n3;

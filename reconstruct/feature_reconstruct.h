@@ -36,6 +36,7 @@ struct FeatureReconstruction {
   std::vector<uint8_t> chosen;
   int features = 0;  // feature channels used
   int missing = 0;   // pixels with some non-finite input
+  int limited = 0;   // pixels where one half was limited as an outlier (half_outliers.h)
   double prepare_seconds = 0.0, filter_seconds = 0.0, select_seconds = 0.0;
 };
 

@@ -13,6 +13,7 @@
 #include "reconstruct/candidate_selection.h"
 #include "reconstruct/feature_buffers.h"
 #include "reconstruct/feature_reconstruct.h"
+#include "reconstruct/half_outliers.h"
 #include "reconstruct/reconstruct.h"
 #include "testing/feature_scene.h"
 
@@ -256,6 +257,87 @@ TEST(Feature, BlendKeepsBrightSpotsWhereTheyAre) {
   const double before = relative_mse(s.primal, s.truth), after = relative_mse(r.image, s.truth);
   std::printf("bright spots: relMSE %.3g -> %.3g\n", before, after);
   EXPECT_LT(after, before / 4.0);
+}
+
+// A flat grey plane (one albedo, normal and depth) with noisy halves: fireflies (1000x the
+// truth) in one half only at isolated pixels, and real one-pixel highlights (25x) in both.
+struct FireflyScene {
+  FeatureScene s;
+  std::vector<size_t> fireflies, highlights;
+};
+
+FireflyScene make_firefly_scene(float noise_sigma) {
+  FireflyScene f;
+  FeatureScene& s = f.s;
+  const int w = 96, h = 64;
+  s.w = w, s.h = h;
+  const size_t n = size_t(w) * h;
+  s.truth.assign(3 * n, 0.2f);
+  s.albedo.assign(3 * n, 0.5f);
+  s.normal.assign(3 * n, 0.f);
+  s.depth.assign(n, 1.f);
+  for (size_t i = 0; i < n; ++i) s.normal[3 * i + 2] = 1.f;
+  for (int y = 8; y < h - 8; y += 16)
+    for (int x = 8; x < w - 8; x += 16) {
+      f.fireflies.push_back(size_t(y) * w + x);
+      f.highlights.push_back(size_t(y + 8) * w + x + 8);
+    }
+  for (size_t i : f.highlights)
+    for (int c = 0; c < 3; ++c) s.truth[3 * i + c] = 5.f;
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.f, noise_sigma);
+  s.a.resize(3 * n), s.b.resize(3 * n), s.primal.resize(3 * n);
+  for (size_t i = 0; i < 3 * n; ++i) {
+    s.a[i] = s.truth[i] * (1.f + noise(rng));
+    s.b[i] = s.truth[i] * (1.f + noise(rng));
+  }
+  for (size_t k = 0; k < f.fireflies.size(); ++k)
+    for (int c = 0; c < 3; ++c) (k % 2 ? s.b : s.a)[3 * f.fireflies[k] + c] = 200.f;
+  for (size_t i = 0; i < 3 * n; ++i) s.primal[i] = 0.5f * (s.a[i] + s.b[i]);
+  return f;
+}
+
+float luminance(const std::vector<float>& rgb, size_t i) {
+  return 0.2126f * rgb[3 * i] + 0.7152f * rgb[3 * i + 1] + 0.0722f * rgb[3 * i + 2];
+}
+
+// The limit fires at a one-half firefly only: not at a highlight both halves see, and never once
+// the halves agree (converged), so the reconstruction stays consistent.
+TEST(Feature, HalfOutliersAreLimitedWhereOneHalfAloneIsBright) {
+  FireflyScene f = make_firefly_scene(0.1f);
+  FeatureScene& s = f.s;
+  std::vector<float> a = s.a, b = s.b, all = s.primal;
+  const int fired =
+      detail::limit_half_outliers(s.w, s.h, s.a.data(), s.b.data(), a.data(), b.data(), all.data());
+  EXPECT_EQ(fired, int(f.fireflies.size()));
+  for (size_t i : f.fireflies) {
+    EXPECT_LT(luminance(all, i), 4.f * 0.2f) << i;
+    EXPECT_LE(std::max(luminance(a, i), luminance(b, i)), 3.f * 1.3f * 0.2f) << i;
+  }
+  for (size_t i : f.highlights) EXPECT_EQ(luminance(all, i), luminance(s.primal, i)) << i;
+  std::vector<float> ta = s.truth, tb = s.truth, tall = s.truth;
+  EXPECT_EQ(detail::limit_half_outliers(s.w, s.h, s.truth.data(), s.truth.data(), ta.data(),
+                                        tb.data(), tall.data()),
+            0);
+  EXPECT_EQ(tall, s.truth);
+}
+
+// Through the whole Feature filter: no pixel of the flat plane ends up more than 4x the truth
+// (an isolated bright speckle), and the real highlights keep most of their light.
+TEST(Feature, NoSpecklesFromOneHalfFireflies) {
+  const FireflyScene f = make_firefly_scene(0.3f);
+  const FeatureScene& s = f.s;
+  const FeatureReconstruction r = filter_primal(s);
+  int speckles = 0;
+  for (size_t i = 0; i < size_t(s.w) * s.h; ++i)
+    if (luminance(s.truth, i) < 1.f && luminance(r.image, i) > 4.f * luminance(s.truth, i))
+      ++speckles;
+  float kept = 1.f;
+  for (size_t i : f.highlights) kept = std::min(kept, luminance(r.image, i) / 5.f);
+  std::printf("one-half fireflies: %d speckles (limited %d pixels), highlights kept >= %.2f\n",
+              speckles, r.limited, kept);
+  EXPECT_EQ(speckles, 0);
+  EXPECT_GT(kept, 0.5f);
 }
 
 TEST(Feature, SameResultOnOneAndTwoThreads) {

@@ -1,0 +1,107 @@
+#include "reconstruct/half_outliers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "reconstruct/parallel.h"
+
+namespace gdpt::detail {
+
+namespace {
+
+float luminance(const float* rgb) {
+  return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2];
+}
+
+// Median of the finite values of `m` over the 8 neighbours of (x, y), clipped to the image.
+float neighbour_median(const std::vector<float>& m, int width, int height, int x, int y) {
+  float v[8];
+  int count = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int nx = x + dx, ny = y + dy;
+      if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+      const float value = m[size_t(ny) * width + nx];
+      if (std::isfinite(value)) v[count++] = value;
+    }
+  if (count == 0) return 0.f;
+  std::nth_element(v, v + count / 2, v + count);
+  return v[count / 2];
+}
+
+// The factor that lowers `value` by `scale`, but not below `floor`; 1 when value is not above it.
+float limited_scale(float scale, float value, float floor) {
+  if (!(value > floor)) return 1.f;
+  return std::max(scale, floor / value);
+}
+
+struct Luminances {
+  std::vector<float> pa, pb, primal_mean, a, b, half_mean, all;
+};
+
+Luminances luminances(int width, int height, const float* primal_a, const float* primal_b,
+                      const float* a, const float* b, const float* all) {
+  const size_t n = size_t(width) * height;
+  Luminances l;
+  for (std::vector<float>* v : {&l.pa, &l.pb, &l.primal_mean, &l.a, &l.b, &l.half_mean, &l.all})
+    v->resize(n);
+  parallel_rows(height, [&](int y0, int y1) {
+    for (size_t i = size_t(y0) * width; i < size_t(y1) * width; ++i) {
+      l.pa[i] = luminance(primal_a + 3 * i), l.pb[i] = luminance(primal_b + 3 * i);
+      l.primal_mean[i] = 0.5f * (l.pa[i] + l.pb[i]);
+      l.a[i] = luminance(a + 3 * i), l.b[i] = luminance(b + 3 * i);
+      l.half_mean[i] = 0.5f * (l.a[i] + l.b[i]);
+      l.all[i] = luminance(all + 3 * i);
+    }
+  });
+  return l;
+}
+
+}  // namespace
+
+int limit_half_outliers(int width, int height, const float* primal_a, const float* primal_b,
+                        float* a, float* b, float* all) {
+  const size_t n = size_t(width) * height;
+  const Luminances l = luminances(width, height, primal_a, primal_b, a, b, all);
+  std::vector<float> scale_a(n, 1.f), scale_b(n, 1.f), scale_all(n, 1.f);
+  std::vector<int> fired(height, 0);
+  parallel_rows(height, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < width; ++x) {
+        const size_t i = size_t(y) * width + x;
+        if (!std::isfinite(l.primal_mean[i]) || !std::isfinite(l.half_mean[i]) ||
+            !std::isfinite(l.all[i]))
+          continue;
+        const bool a_high = l.pa[i] > l.pb[i];
+        const float high = a_high ? l.pa[i] : l.pb[i], low = a_high ? l.pb[i] : l.pa[i];
+        const float around = neighbour_median(l.primal_mean, width, height, x, y);
+        const float bound = kHalfOutlierRatio * std::max({low, around, kHalfOutlierFloor});
+        if (!(high > bound)) continue;
+        const float rest = std::max(low, 0.f);  // high > bound > 0: the ratios are finite
+        const float half_floor =
+            kHalfOutlierRatio *
+            std::max(neighbour_median(l.half_mean, width, height, x, y), kHalfOutlierFloor);
+        const float all_floor =
+            kHalfOutlierRatio *
+            std::max(neighbour_median(l.all, width, height, x, y), kHalfOutlierFloor);
+        (a_high ? scale_a : scale_b)[i] =
+            limited_scale(bound / high, a_high ? l.a[i] : l.b[i], half_floor);
+        scale_all[i] = limited_scale((bound + rest) / (high + rest), l.all[i], all_floor);
+        ++fired[y];
+      }
+  });
+  parallel_rows(height, [&](int y0, int y1) {
+    for (size_t i = size_t(y0) * width; i < size_t(y1) * width; ++i)
+      for (int c = 0; c < 3; ++c) {
+        a[3 * i + c] *= scale_a[i];
+        b[3 * i + c] *= scale_b[i];
+        all[3 * i + c] *= scale_all[i];
+      }
+  });
+  int total = 0;
+  for (int count : fired) total += count;
+  return total;
+}
+
+}  // namespace gdpt::detail
