@@ -1966,8 +1966,9 @@ MUST_DIFFER = {
 # bump: relMSE 0.0013 at 4x; 0.067 with the bumps ignored.
 # displacement: relMSE 0.0013, mean 0.9993 at 4x (0.0041 / 1.0011 with the ball's back-face tilt
 # taken as its front's reversed instead of from Generated read against the step, as Cycles reads
-# it); 0.36 / 1.070 with the displacement ignored; 0.0084 / 0.9857 at the default counts when the displaced
-# normal is treated as a perturbation (bump shadowing on), which the bounds do not separate.
+# it); 0.36 / 1.070 with the displacement ignored; 0.0084 / 0.9857 at the default counts when the
+# displaced normal is treated as a perturbation (bump shadowing on), which the bounds do not
+# separate.
 # beckmann_glossy: relMSE 0.016 at the default counts, 0.0038 at 4x (noise of the balls'
 # reflections).
 # anisotropic: relMSE 0.0132 at the default counts, 0.0037 at 4x, mean 1.0000 (noise: a lobe of
