@@ -578,7 +578,10 @@ Vec3f EmbreeScene::displacement_along(const InstanceData& d, uint32_t primitive,
 // triangle's plane: dP/du and dP/dv (a step in UV) when the mesh has UVs, else the triangle's
 // edges (a step in barycentrics). Every coordinate moves with the step (UV, and object-space
 // coordinates along the object-space image of the direction), so image and procedural heights
-// both differentiate.
+// both differentiate. On a back face Cycles 3.4 negates dP/du and dP/dv before solving for the
+// attributes' differentials (shader_setup_from_ray, differential_dudv_compact), so attribute
+// coordinates (UV, Generated, Pointiness, Parametric) move against the step there while
+// position-based ones (Object, Position, and what derives from them) move with it.
 void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, SurfaceHit& hit,
                               const Material& material, size_t bump) const {
   const uint32_t* idx = d.indices + size_t(primitive) * 3;
@@ -623,38 +626,41 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
   ShadingContext at = shading_context(d, hit);
   const float h0 = material.bump_height(bump, at, along);
   const TexCoords base = hit.coords;
-  // The height at the hit moved by c0 a0 + c1 a1.
+  // The side the ray sees: +1 on a front face, -1 on a back face.
+  const float side = hit.front_facing ? 1.0f : -1.0f;
+  // The height at the hit moved by c0 a0 + c1 a1 (attributes by side times that).
   auto height_at = [&](float c0, float c1) {
-    at.uv = hit.uv + duv[0] * c0 + duv[1] * c1;
+    const float s0 = side * c0, s1 = side * c1;
+    at.uv = hit.uv + duv[0] * s0 + duv[1] * s1;
     TexCoords shifted = base;
     if (d.writes_coords) {
       const Vec3f object = o[0] * c0 + o[1] * c1;
       shifted.object = base.object + object;
       shifted.position = base.position + a[0] * c0 + a[1] * c1;
       for (int c = 0; c < 3; ++c)
-        shifted.generated[c] = base.generated[c] + object[c] * d.generated_scale[c];
+        shifted.generated[c] = base.generated[c] + object[c] * (side * d.generated_scale[c]);
     }
     at.coords = d.writes_coords ? &shifted : nullptr;
-    // Mesh attributes (Pointiness, Parametric) move with the step too, as Cycles differentiates
-    // them for bump.
+    // Mesh attributes (Pointiness, Parametric) move too, as Cycles differentiates them for bump.
     SurfaceAttributes moved;
     if (d.writes_attributes) {
-      const Vec2f b = hit.attributes.barycentric + dbary[0] * c0 + dbary[1] * c1;
+      const Vec2f b = hit.attributes.barycentric + dbary[0] * s0 + dbary[1] * s1;
       moved = attributes_at(d, primitive, idx, b.x, b.y);
     }
     at.attributes = d.writes_attributes ? &moved : nullptr;
     return material.bump_height(bump, at, along);
   };
   const BumpDesc& b = material.bumps()[bump];
-  // The tilt belongs to the surface, not to the side it is seen from: a back face shows the
-  // same bumped normal, flipped (as Cycles 3.4 renders inside-out meshes).
   const float distance = b.invert ? -b.distance : b.distance;
   const Vec3f n = hit.shading_normal;
   Vec3f bumped;
   const float footprint = pixel_footprint(material.camera(), hit.position);
   if (footprint > 0.0f && std::isfinite(footprint)) {
-    // Cycles' tangents belong to the geometric normal of the side the ray sees.
-    const Vec3f ng_seen = normalize(hit.front_facing ? ng : -ng);
+    // Cycles tilts the normals of the side the ray sees (sd->N, sd->Ng flipped on a back face)
+    // and its tangents belong to that geometric normal; the result is turned back to the
+    // surface's side here.
+    const Vec3f ng_seen = normalize(ng * side);
+    const Vec3f n_seen = n * side;
     Vec3f tx = ng_seen.x != ng_seen.y || ng_seen.x != ng_seen.z
                    ? Vec3f(ng_seen.z - ng_seen.y, ng_seen.x - ng_seen.z, ng_seen.y - ng_seen.x)
                    : Vec3f(ng_seen.z - ng_seen.y, ng_seen.x + ng_seen.z, -ng_seen.y - ng_seen.x);
@@ -662,11 +668,12 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
     const Vec3f ty = cross(ng_seen, tx);
     const float hx = height_at(dot(g0, tx), dot(g1, tx));
     const float hy = height_at(dot(g0, ty), dot(g1, ty));
-    const Vec3f rx = cross(ty, n), ry = cross(n, tx);
+    const Vec3f rx = cross(ty, n_seen), ry = cross(n_seen, tx);
     const float det = dot(tx, rx);
     const Vec3f surfgrad = rx * (hx - h0) + ry * (hy - h0);
-    if (!set_unit(n * std::fabs(det) - surfgrad * (distance * (det < 0.0f ? -1.0f : 1.0f)), bumped))
-      return;
+    const float sign = det < 0.0f ? -1.0f : 1.0f;
+    if (!set_unit(n_seen * std::fabs(det) - surfgrad * (distance * sign), bumped)) return;
+    bumped = bumped * side;
   } else {
     // In UV: about a quarter texel of a 256 image; in barycentrics: a 1024th of the triangle.
     constexpr float kStep = 1.0f / 1024.0f;
@@ -677,7 +684,8 @@ void EmbreeScene::bump_normal(const InstanceData& d, uint32_t primitive, Surface
     // earlier bump.
     const float ng_n = dot(ng, n);
     if (std::fabs(ng_n) > 1e-3f * length(ng)) grad = grad - ng * (dot(grad, n) / ng_n);
-    if (!set_unit(n - grad * distance, bumped)) return;
+    // Tilted on the seen side as above (n side - grad distance), turned back.
+    if (!set_unit(n - grad * (side * distance), bumped)) return;
   }
   const float strength = std::max(b.strength, 0.0f);
   set_unit(bumped * strength + n * (1.0f - strength), hit.shading_normal);

@@ -1069,6 +1069,41 @@ def case_fine_bump(scene):
     return 3
 
 
+def case_position_bump(scene):
+    # Strong smooth bumps (Noise detail 2, distance 1) on the back faces Cycles sees of the
+    # inside-out test balls (S.uv_sphere's faces point inwards), the height's Noise read at
+    # Texture Coordinate > Object, at Geometry > Position through a Mapping, and at Generated.
+    # Cycles 3.4 offsets position-based coordinates along its tangents but attributes against
+    # them on a back face (it negates dP/du, dP/dv there), so the three tilt differently.
+    lit_room(scene)
+    area_ceiling(size=2.0, energy=200.0)
+
+    def bumped(name, source):
+        m = S.diffuse(name, (0.8, 0.8, 0.8))
+        nt = m.node_tree
+        noise = nt.nodes.new("ShaderNodeTexNoise")
+        noise.inputs["Detail"].default_value = 2.0
+        if source == "Position":
+            mapping = nt.nodes.new("ShaderNodeMapping")
+            mapping.inputs["Location"].default_value = (0.3, -0.2, 0.1)
+            nt.links.new(nt.nodes.new("ShaderNodeNewGeometry").outputs["Position"],
+                         mapping.inputs["Vector"])
+            nt.links.new(mapping.outputs["Vector"], noise.inputs["Vector"])
+        else:
+            nt.links.new(nt.nodes.new("ShaderNodeTexCoord").outputs[source],
+                         noise.inputs["Vector"])
+        bump = nt.nodes.new("ShaderNodeBump")
+        bump.inputs["Distance"].default_value = 1.0
+        nt.links.new(noise.outputs["Fac"], bump.inputs["Height"])
+        nt.links.new(bump.outputs["Normal"], next(n for n in nt.nodes
+                                                  if n.type == 'BSDF_DIFFUSE').inputs["Normal"])
+        return m
+
+    for x, source in ((-1.25, "Object"), (0.0, "Position"), (1.25, "Generated")):
+        S.uv_sphere(f"ball_{source}", 0.6, (x, 0.3, 0.9), bumped(f"bumped_{source}", source))
+    return 3
+
+
 def case_displacement(scene):
     # The Material Output's Displacement as Cycles' default Bump Only method: a diffuse floor
     # displaced by a height image (Displacement node, object space, midlevel 0.5, scale 0.2), a
@@ -2125,11 +2160,14 @@ MUST_DIFFER = {
 # when only the outermost node of each chain is modelled, as before chains were).
 # fine_bump: relMSE 0.0057, mean 0.998 (0.33 when the Bump's height is differentiated with a
 # step much smaller than Cycles' pixel footprint).
-# bump: relMSE 0.0068 at the default counts, 0.0032 at 4x (a residual above the noise, not
-# isolated; the same with the wall's invert off); 0.067 with the bumps ignored.
-# displacement: relMSE 0.0047, mean 0.9985 at 4x (0.0078 / 0.9961 at the default counts); 0.36 /
-# 1.070 with the displacement ignored; 0.0084 / 0.9857 at the default counts when the displaced
-# normal is treated as a perturbation (bump shadowing on), which the bounds do not separate.
+# position_bump: relMSE 0.0011, mean 0.998 (0.032 when Object and Position coordinates move
+# against the step on a back face, as Cycles moves only attributes).
+# bump: relMSE 0.0013 at 4x; 0.067 with the bumps ignored.
+# displacement: relMSE 0.0013, mean 0.9993 at 4x (0.0041 / 1.0011 with the ball's back-face tilt
+# taken as its front's reversed instead of from Generated read against the step, as Cycles reads
+# it); 0.36 / 1.070 with the displacement ignored; 0.0084 / 0.9857 at the default counts when the
+# displaced normal is treated as a perturbation (bump shadowing on), which the bounds do not
+# separate.
 # vector_displacement: relMSE 0.0044, mean 1.0018 at the default counts; 0.045 with the
 # displacements ignored; 0.0099 when the ball's heights took its outward normal on its back faces
 # (the floor alone: 0.0007 against 0.0071 ignored; the ball alone 0.0011, 0.0068 with the outward

@@ -410,6 +410,48 @@ TEST(Render, BumpOnABackFaceKeepsTheSurfacesTilt) {
   }
 }
 
+// A height linear in a position-based coordinate (Object y) on the same quad seen from its back:
+// Cycles 3.4 steps Object and Position along its tangents on either side (only attributes step
+// against them on a back face), so the back tilts the seen normal towards -y as the front does,
+// and both sides light as the front side of the test above. h = y / 50 (distance 10: tilt 0.2).
+TEST(Render, BumpOfAPositionOnABackFaceTiltsAsOnTheFront) {
+  constexpr float kTheta = 0.5f;
+  const double cosine = (0.2 * std::sin(kTheta) + std::cos(kTheta)) / std::sqrt(1.04);
+  const double g = std::min(std::cos(kTheta) / (cosine / std::sqrt(1.04)), 1.0);
+  const double expect = lambert_radiance(cosine) * (-g * g * g + g * g + g);
+  for (const bool back : {false, true}) {
+    Mesh plane = uv_quad();
+    if (back) {
+      plane.indices = {0, 2, 1, 0, 3, 2};
+      plane.corner_uvs = {{0, 0}, {1, 1}, {1, 0}, {0, 0}, {0, 1}, {1, 1}};
+    }
+    MaterialDesc m = diffuse(Spectrum(0.5f));
+    InputNode coords;
+    coords.kind = InputNodeKind::Coordinates;
+    coords.vector.source = TexCoordSource::Object;
+    InputNode y;
+    y.kind = InputNodeKind::Separate;
+    y.a.node = 0;
+    y.channel = 1;
+    InputNode height;
+    height.kind = InputNodeKind::Math;
+    height.math = MathOp::Multiply;
+    height.value_a.node = 1;
+    height.value_b = FloatInput(0.02f);
+    m.inputs = {coords, y, height};
+    m.bumps.emplace_back();
+    m.bumps[0].height.node = 2;
+    m.bumps[0].distance = 10.0f;
+    const Scene scene = sunlit_plane(plane, m, kTheta);
+    for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
+      RenderSettings s = pt(4);
+      s.mode = mode;
+      EXPECT_NEAR(mean_direct(scene, s), expect, 2e-3 * expect)
+          << "back " << back << " G-PT " << (mode == RenderSettings::Mode::GPT);
+    }
+  }
+}
+
 // The Displacement output as bump (replaces_normal) tilts the surface's own normal, as Cycles'
 // set_normal writes sd->N: the front side of the test above without the bump shadowing factor.
 TEST(Render, DisplacementAsBumpReplacesTheNormalWithoutBumpShadowing) {
