@@ -7,6 +7,7 @@
 #include "core/vec.h"
 #include "shaders/bsdf.h"
 #include "shaders/bsdf_ggx_multiscatter.h"
+#include "testing/chi2.h"
 
 namespace gdpt::test {
 
@@ -151,6 +152,21 @@ inline ClosureSet set_of(std::initializer_list<Closure> cs,
 inline Vec3f incident(float cos_theta) {
   const float sin_theta = std::sqrt(std::max(0.0f, 1.0f - cos_theta * cos_theta));
   return Vec3f(sin_theta * std::cos(0.3f), sin_theta * std::sin(0.3f), cos_theta);
+}
+
+// Directional albedo of `set` from wi in one channel: the mean sample weight (value / pdf) of
+// `samples` draws from a generator seeded with `seed`.
+inline double sampled_albedo(const ClosureSet& set, Vec3f wi, int samples, uint64_t seed,
+                             int channel = 1) {
+  Pcg32 rng(seed);
+  double sum = 0.0;
+  for (int i = 0; i < samples; ++i) {
+    const float ul = rng.uniform();
+    const Vec2f u(rng.uniform(), rng.uniform());
+    const BsdfSample s = set.sample(wi, ul, u);
+    if (s.valid) sum += s.weight()[channel];
+  }
+  return sum / samples;
 }
 
 }  // namespace gdpt::test

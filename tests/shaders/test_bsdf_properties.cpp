@@ -26,15 +26,7 @@ double albedo_quadrature(const ClosureSet& set, Vec3f wi, int channel = 1) {
 
 // Mean sample weight (including delta lobes): the MC estimate of the albedo.
 double albedo_mc(const ClosureSet& set, Vec3f wi, int n, int channel = 1) {
-  Pcg32 rng(7);
-  double sum = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const float ul = rng.uniform();
-    const Vec2f u(rng.uniform(), rng.uniform());
-    const BsdfSample s = set.sample(wi, ul, u);
-    if (s.valid) sum += s.weight()[channel];
-  }
-  return sum / n;
+  return sampled_albedo(set, wi, n, 7, channel);
 }
 
 TEST(BsdfEnergy, WhiteLambertAlbedoIsOne) {

@@ -10,17 +10,8 @@
 namespace gdpt::test {
 namespace {
 
-// Directional albedo of `set` from wi: the mean of the sampled value / pdf (fixed seed).
 double albedo(const ClosureSet& set, Vec3f wi, int samples = 400000) {
-  Pcg32 rng(77);
-  double sum = 0.0;
-  for (int i = 0; i < samples; ++i) {
-    const float ul = rng.uniform();
-    const Vec2f u(rng.uniform(), rng.uniform());
-    const BsdfSample s = set.sample(wi, ul, u);
-    if (s.valid && s.pdf > 0.0f) sum += double(s.value.y) / double(s.pdf);
-  }
-  return sum / samples;
+  return sampled_albedo(set, wi, samples, 77);
 }
 
 const float kRoughness[] = {0.3f, 0.6f, 1.0f};
