@@ -79,31 +79,6 @@ struct GGX {
   Vec3f sample_visible(Vec3f wi, Vec2f u) const { return sample_ggx_visible(wi, alpha, alpha, u); }
 };
 
-// A closure's distribution. The lobes' value is D(h) G1(wi) G1(wo) ..., their sampler draws h
-// from the normals visible from wi, of density pdf_visible(wi, h) = G1_visible(wi) max(0, wi.h)
-// D(h) / wi.z. G1_visible is G1 for GGX; for Beckmann it is the exact Smith term, where the value
-// takes Cycles' rational fit.
-class Microfacet {
- public:
-  Microfacet(MicrofacetDistribution d, float alpha)
-      : beckmann_(d == MicrofacetDistribution::Beckmann), ggx_(alpha), bk_(alpha) {}
-
-  float D(Vec3f m) const { return beckmann_ ? bk_.D(m) : ggx_.D(m); }
-  float G1(Vec3f w) const { return beckmann_ ? bk_.G1(w) : ggx_.G1(w); }
-  float G1_visible(Vec3f wi) const { return beckmann_ ? bk_.smith_G1(wi) : ggx_.G1(wi); }
-  float pdf_visible(Vec3f wi, Vec3f m) const {
-    return beckmann_ ? bk_.pdf_visible(wi, m) : ggx_.pdf_visible(wi, m);
-  }
-  Vec3f sample_visible(Vec3f wi, Vec2f u) const {
-    return beckmann_ ? bk_.sample_visible(wi, u) : ggx_.sample_visible(wi, u);
-  }
-
- private:
-  bool beckmann_;
-  GGX ggx_;
-  Beckmann bk_;
-};
-
 // Anisotropic GGX, the same quantities as GGX with the slope widths alpha_x (x) and alpha_y (y);
 // equal widths give GGX's distribution (GGX keeps its own code for the isotropic lobes).
 struct AnisoGGX {
@@ -136,26 +111,34 @@ struct AnisoGGX {
   Vec3f sample_visible(Vec3f wi, Vec2f u) const { return sample_ggx_visible(wi, ax, ay, u); }
 };
 
-// An anisotropic closure's distribution (widths alpha_x along the lobe's tangent, alpha_y across
-// it), with Microfacet's quantities: AnisoGGX, or Beckmann of two widths.
-class AnisoMicrofacet {
+// A closure's distribution, GGX or Beckmann of one width (Microfacet) or two (AnisoMicrofacet:
+// alpha_x along the lobe's tangent, alpha_y across it). The lobes' value is D(h) G1(wi) G1(wo)
+// ..., their sampler draws h from the normals visible from wi, of density pdf_visible(wi, h) =
+// G1_visible(wi) max(0, wi.h) D(h) / wi.z. G1_visible is G1 for GGX; for Beckmann it is the exact
+// Smith term, where the value takes Cycles' rational fit.
+template <class Ggx>
+class MicrofacetOf {
  public:
-  AnisoMicrofacet(MicrofacetDistribution d, float alpha_x, float alpha_y)
-      : beckmann_(d == MicrofacetDistribution::Beckmann),
-        ggx_(alpha_x, alpha_y),
-        bk_(alpha_x, alpha_y) {}
+  template <class... Widths>
+  explicit MicrofacetOf(MicrofacetDistribution d, Widths... alpha)
+      : beckmann_(d == MicrofacetDistribution::Beckmann), ggx_(alpha...), bk_(alpha...) {}
 
   float D(Vec3f m) const { return beckmann_ ? bk_.D(m) : ggx_.D(m); }
   float G1(Vec3f w) const { return beckmann_ ? bk_.G1(w) : ggx_.G1(w); }
   float G1_visible(Vec3f wi) const { return beckmann_ ? bk_.smith_G1(wi) : ggx_.G1(wi); }
+  float pdf_visible(Vec3f wi, Vec3f m) const {
+    return beckmann_ ? bk_.pdf_visible(wi, m) : ggx_.pdf_visible(wi, m);
+  }
   Vec3f sample_visible(Vec3f wi, Vec2f u) const {
     return beckmann_ ? bk_.sample_visible(wi, u) : ggx_.sample_visible(wi, u);
   }
 
  private:
   bool beckmann_;
-  AnisoGGX ggx_;
+  Ggx ggx_;
   Beckmann bk_;
 };
+using Microfacet = MicrofacetOf<GGX>;
+using AnisoMicrofacet = MicrofacetOf<AnisoGGX>;
 
 }  // namespace gdpt
