@@ -1,5 +1,6 @@
 #include "reconstruct/candidate_selection.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -29,10 +30,12 @@ void candidate_error(const FeatureBuffers& fb, const float* fa, const float* fb_
 }
 
 void set_relative_weights(const FeatureBuffers& fb, const float* guide, CandidateChoice& choice) {
-  const size_t n3 = 3 * size_t(fb.width) * fb.height;
-  choice.weight.resize(n3);
-  for (size_t k = 0; k < n3; ++k)
-    choice.weight[k] = 1.f / (guide[k] * guide[k] + kRelativeErrorEpsilon);
+  const int W = fb.width;
+  choice.weight.resize(3 * size_t(W) * fb.height);
+  parallel_rows(fb.height, [&](int y0, int y1) {
+    for (size_t k = 3 * size_t(y0) * W; k < 3 * size_t(y1) * W; ++k)
+      choice.weight[k] = 1.f / (guide[k] * guide[k] + kRelativeErrorEpsilon);
+  });
 }
 
 void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const float* fb_half,
@@ -40,16 +43,19 @@ void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const
   const int W = fb.width, H = fb.height;
   const size_t n = size_t(W) * H;
   const bool weighted = !choice.weight.empty();
-  std::vector<float> raw(2 * n), smooth(2 * n);
-  candidate_error(fb, fa, fb_half, raw.data(), weighted ? choice.weight.data() : nullptr,
-                  raw.data() + n);
-  box_filter(raw.data(), 1, W, H, kErrorSmoothingRadius, smooth.data());
-  if (weighted) box_filter(raw.data() + n, 1, W, H, kErrorSmoothingRadius, smooth.data() + n);
-  const float* key = weighted ? smooth.data() + n : smooth.data();
   if (size_t(index) != choice.images.size())
     throw std::logic_error("offer_candidate: candidates must be offered in index order");
-  choice.images.emplace_back(filtered, filtered + 3 * n);
-  choice.keys.emplace_back(key, key + n);
+  // Scratch and keys are written in full before they are read: no zeroing of image-sized buffers.
+  if (!choice.scratch) choice.scratch.reset(new float[3 * n]);
+  float* const raw = choice.scratch.get();
+  choice.keys.emplace_back(new float[n]);
+  float* const key = choice.keys.back().get();
+  candidate_error(fb, fa, fb_half, raw, weighted ? choice.weight.data() : nullptr, raw + n);
+  // Without weights the key is the smoothed absolute estimate itself.
+  float* const smooth = weighted ? raw + 2 * n : key;
+  box_filter(raw, 1, W, H, kErrorSmoothingRadius, smooth);
+  if (weighted) box_filter(raw + n, 1, W, H, kErrorSmoothingRadius, key);
+  choice.images.push_back(filtered);
   const bool first = choice.image.empty();
   if (first) {
     choice.image.resize(3 * n);
@@ -72,11 +78,18 @@ void blend_choices(const FeatureBuffers& fb, CandidateChoice& choice) {
   const int W = fb.width, H = fb.height;
   const size_t n = size_t(W) * H;
   std::vector<float> sum(3 * n, 0.f), total(n, 0.f), chose(n), share(n);
+  std::vector<size_t> pixels_chose(choice.images.size(), 0);
+  for (uint8_t k : choice.index) ++pixels_chose[k];
   for (size_t k = 0; k < choice.images.size(); ++k) {
-    for (size_t i = 0; i < n; ++i) chose[i] = choice.index[i] == k ? 1.f : 0.f;
+    // A candidate no pixel chose has a zero share everywhere: it adds nothing.
+    if (pixels_chose[k] == 0) continue;
+    parallel_rows(H, [&](int y0, int y1) {
+      for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i)
+        chose[i] = choice.index[i] == k ? 1.f : 0.f;
+    });
     box_filter(chose.data(), 1, W, H, kErrorSmoothingRadius, share.data());
-    const float* key = choice.keys[k].data();
-    const float* image = choice.images[k].data();
+    const float* key = choice.keys[k].get();
+    const float* image = choice.images[k];
     parallel_rows(H, [&](int y0, int y1) {
       for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
         const float best = choice.relative[i];

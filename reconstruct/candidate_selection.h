@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "reconstruct/feature_buffers.h"
@@ -36,8 +37,11 @@ struct CandidateChoice {
   std::vector<float> relative;  // per pixel, its smoothed relative error estimate (the key)
   std::vector<float> weight;    // RGB: 1 / (guide^2 + eps); empty: absolute errors compared
   std::vector<uint8_t> index;   // per pixel, the chosen candidate
-  // Every candidate offered: its image of all samples (RGB) and its key, for blend_choices.
-  std::vector<std::vector<float>> images, keys;
+  // Every candidate offered: its image of all samples (RGB; the caller's, kept alive until
+  // blend_choices) and its key, for blend_choices.
+  std::vector<const float*> images;
+  std::vector<std::unique_ptr<float[]>> keys;
+  std::unique_ptr<float[]> scratch;  // the raw estimates and the smoothed absolute one
 };
 
 // Per pixel e (mean over RGB) of the candidate with filtered halves fa, fb_half; 0 where the
@@ -51,7 +55,7 @@ void set_relative_weights(const FeatureBuffers& fb, const float* guide, Candidat
 // Offers candidate `index` (halves filtered to fa, fb_half; the image of all samples to
 // `filtered`): pixels whose smoothed relative error beats the current choice take `filtered` (the
 // first candidate offered is taken everywhere; ties keep the earlier one). Candidates are offered
-// with index 0, 1, 2, ... in turn.
+// with index 0, 1, 2, ... in turn; `filtered` must stay alive until blend_choices.
 void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const float* fb_half,
                      const float* filtered, CandidateChoice& choice);
 

@@ -49,10 +49,12 @@ inline float exp_nonpositive(float x) {
 // The identity, except that a missing pixel takes the mean of its valid 3x3 neighbours (its
 // value is 0 in the masked images, which no error estimate can see: it has no halves).
 void identity_filter(const FeatureBuffers& fb, const float* const* images, float* const* out,
-                     int count) {
+                     int count, const float* multiply) {
   const int W = fb.width, H = fb.height;
-  for (int k = 0; k < count; ++k) std::memcpy(out[k], images[k], sizeof(float) * 3 * size_t(W) * H);
   parallel_rows(H, [&](int y0, int y1) {
+    const size_t i0 = 3 * size_t(y0) * W;
+    for (int k = 0; k < count; ++k)
+      std::memcpy(out[k] + i0, images[k] + i0, sizeof(float) * 3 * size_t(y1 - y0) * W);
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < W; ++x) {
         const size_t i = size_t(y) * W + x;
@@ -69,6 +71,9 @@ void identity_filter(const FeatureBuffers& fb, const float* const* images, float
           for (int c = 0; c < 3; ++c) out[k][3 * i + c] = n > 0.f ? sum[c] / n : 0.f;
         }
       }
+    if (multiply)
+      for (int k = 0; k < count; ++k)
+        for (size_t i = i0; i < 3 * size_t(y1) * W; ++i) out[k][i] *= multiply[i];
   });
 }
 
@@ -84,6 +89,7 @@ struct FilterJob {
   const float* const* images;
   int count;
   float* const* out;
+  const float* multiply;  // RGB factor of every output, or null
 };
 
 // The rows [y0 - radius, y1 + radius) of a chunk, clipped to the image, as planes: the images'
@@ -232,10 +238,13 @@ void filter_block(const FilterJob& job, const ChunkPlanes& p, int y, int xb, int
     for (int k = 0; k < job.count; ++k) {
       float* o = job.out[t * job.count + k] + 3 * row;
       const float* in = job.images[k] + 3 * row;
+      const float* m = job.multiply ? job.multiply + 3 * row : nullptr;
       for (int x = xb; x < xe; ++x) {
         const float den = s.den[t][k][x - xb];
-        for (int c = 0; c < 3; ++c)
-          o[3 * x + c] = den > 0.f ? s.num[t][k][c][x - xb] / den : in[3 * x + c];
+        for (int c = 0; c < 3; ++c) {
+          const float v = den > 0.f ? s.num[t][k][c][x - xb] / den : in[3 * x + c];
+          o[3 * x + c] = m ? v * m[3 * x + c] : v;
+        }
       }
     }
 }
@@ -250,9 +259,11 @@ std::vector<BilateralCandidate> default_bilateral_candidates() {
 }
 
 void bilateral_filter(const FeatureBuffers& fb, const BilateralWindow& window, const float* ranges,
-                      int range_count, const float* const* images, int count, float* const* out) {
+                      int range_count, const float* const* images, int count, float* const* out,
+                      const float* multiply) {
   if (window.radius == 0) {
-    for (int t = 0; t < range_count; ++t) identity_filter(fb, images, out + t * count, count);
+    for (int t = 0; t < range_count; ++t)
+      identity_filter(fb, images, out + t * count, count, multiply);
     return;
   }
   float inv_range2[kMaxRanges];
@@ -269,7 +280,7 @@ void bilateral_filter(const FeatureBuffers& fb, const BilateralWindow& window, c
   for (int t = 0; t < range_count; ++t)  // from a weight computed directly only
     if (squared_from[t] >= 0 && squared_from[squared_from[t]] >= 0) squared_from[t] = -1;
   const FilterJob job{fb,          window.radius, window.stride, inv_range2, squared_from,
-                      range_count, images,        count,         out};
+                      range_count, images,        count,         out,        multiply};
   parallel_rows(fb.height, [&](int y0, int y1) {
     const ChunkPlanes planes = chunk_planes(job, y0, y1);
     BlockSums sums;

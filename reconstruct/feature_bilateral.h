@@ -38,9 +38,11 @@ std::vector<BilateralCandidate> default_bilateral_candidates();
 // Filters `images` (count RGB images, each 0 where fb marks it missing) with each of the `ranges`
 // colour tolerances at once into out[r * count + k]: the feature weights are shared, the colour
 // weights come from each image itself (so a filtered half depends on that half alone). Missing
-// pixels get weight 0; a pixel without valid features keeps its value.
+// pixels get weight 0; a pixel without valid features keeps its value. With `multiply` (RGB),
+// every output is multiplied by it as it is written (the same floats as a pass after the filter).
 void bilateral_filter(const FeatureBuffers& fb, const BilateralWindow& window, const float* ranges,
-                      int range_count, const float* const* images, int count, float* const* out);
+                      int range_count, const float* const* images, int count, float* const* out,
+                      const float* multiply = nullptr);
 
 inline void bilateral_filter(const FeatureBuffers& fb, const BilateralCandidate& candidate,
                              const float* const* images, float* const* out, int count) {

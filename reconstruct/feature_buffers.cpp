@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "reconstruct/parallel.h"
 
@@ -45,7 +46,8 @@ void box_filter(const float* src, int channels, int width, int height, int radiu
   const int W = width, C = channels;
   const size_t row = size_t(W) * C;
   // Rows: window sums from prefix sums; the mean's divisions are applied once, at the end.
-  std::vector<float> rows(row * height);
+  // Written in full by the row pass: left uninitialised (zeroing it would cost a full pass).
+  const std::unique_ptr<float[]> rows(new float[row * height]);
   std::vector<double> inv_x(W);
   for (int x = 0; x < W; ++x)
     inv_x[x] = 1.0 / double(std::min(W, x + radius + 1) - std::max(0, x - radius));
@@ -55,7 +57,7 @@ void box_filter(const float* src, int channels, int width, int height, int radiu
       const float* s = src + size_t(y) * row;
       for (int c = 0; c < C; ++c) prefix[c] = 0.0;
       for (size_t i = 0; i < row; ++i) prefix[i + C] = prefix[i] + s[i];
-      float* d = rows.data() + size_t(y) * row;
+      float* d = rows.get() + size_t(y) * row;
       for (int x = 0; x < W; ++x) {
         const size_t lo = size_t(std::max(0, x - radius)) * C,
                      hi = size_t(std::min(W, x + radius + 1)) * C;
@@ -68,7 +70,7 @@ void box_filter(const float* src, int channels, int width, int height, int radiu
   parallel_rows(height, [&](int y0, int y1) {
     std::vector<double> sum(row, 0.0);
     auto add = [&](int yy, double sign) {
-      const float* r = rows.data() + size_t(yy) * row;
+      const float* r = rows.get() + size_t(yy) * row;
       for (size_t i = 0; i < row; ++i) sum[i] += sign * r[i];
     };
     int lo = std::max(0, y0 - radius), hi = std::min(height, y0 + radius + 1);

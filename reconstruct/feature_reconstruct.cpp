@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <iterator>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -119,7 +120,10 @@ std::vector<float> relative_error_guide(const detail::FeatureBuffers& fb) {
   float* const out[2] = {tolerant.data(), plain.data()};
   const float tolerances[2] = {kGuideColourTolerance, 0.f};
   detail::bilateral_filter(fb, std::end(detail::kWindows)[-1], tolerances, 2, &all, 1, out);
-  for (size_t k = 0; k < n3; ++k) tolerant[k] = std::min(tolerant[k], plain[k]);
+  detail::parallel_rows(fb.height, [&](int y0, int y1) {
+    for (size_t k = 3 * size_t(y0) * fb.width; k < 3 * size_t(y1) * fb.width; ++k)
+      tolerant[k] = std::min(tolerant[k], plain[k]);
+  });
   return tolerant;
 }
 
@@ -141,19 +145,12 @@ std::vector<float> demodulation(const ReconstructionInput& in, const detail::Fea
   return d;
 }
 
-// images[k] (RGB, width x height) divided or multiplied by `factor` (a no-op when it is empty).
-void scale_images(const std::vector<float>& factor, bool divide, int width, int height,
-                  float* const* images, int count) {
-  if (factor.empty()) return;
+// out = image / factor (RGB, width x height).
+void divide_image(const std::vector<float>& factor, int width, int height, const float* image,
+                  float* out) {
   detail::parallel_rows(height, [&](int y0, int y1) {
-    const size_t i0 = 3 * size_t(y0) * width, i1 = 3 * size_t(y1) * width;
-    for (int k = 0; k < count; ++k) {
-      float* im = images[k];
-      if (divide)
-        for (size_t i = i0; i < i1; ++i) im[i] /= factor[i];
-      else
-        for (size_t i = i0; i < i1; ++i) im[i] *= factor[i];
-    }
+    for (size_t i = 3 * size_t(y0) * width; i < 3 * size_t(y1) * width; ++i)
+      out[i] = image[i] / factor[i];
   });
 }
 
@@ -176,43 +173,62 @@ FeatureReconstruction feature_filter(const ReconstructionInput& input, const flo
   r.missing = fb.missing;
   r.prepare_seconds = since(t);
 
-  // Per colour tolerance: the two halves and the image of all samples, filtered.
+  // Per colour tolerance: the two halves (scratch, reused per window) and the image of all
+  // samples (kept for the blend), filtered. Every output is written in full by the filter, so
+  // none is zeroed first.
   constexpr int kTol = detail::kColourToleranceCount;
-  std::vector<float> filtered(size_t(kTol) * 3 * n3);
+  constexpr int kCandidates = 1 + int(std::size(detail::kWindows)) * kTol;
+  const std::unique_ptr<float[]> halves(new float[size_t(kTol) * 2 * n3]);
+  std::unique_ptr<float[]> candidates[kCandidates];
+  for (auto& c : candidates) c.reset(new float[n3]);
   float* out[kTol * 3];
-  for (int k = 0; k < kTol * 3; ++k) out[k] = filtered.data() + size_t(k) * n3;
+  auto point_outputs = [&](int first_candidate) {
+    for (int k = 0; k < kTol; ++k) {
+      out[3 * k] = halves.get() + size_t(2 * k) * n3;
+      out[3 * k + 1] = halves.get() + size_t(2 * k + 1) * n3;
+      out[3 * k + 2] =
+          first_candidate + k < kCandidates ? candidates[first_candidate + k].get() : nullptr;
+    }
+  };
   detail::CandidateChoice choice;
   t = std::chrono::steady_clock::now();
   detail::set_relative_weights(fb, relative_error_guide(fb).data(), choice);
   const std::vector<float> albedo = demodulation(input, fb);
-  std::vector<float> illumination[3] = {fb.a, fb.b, fb.all};
-  float* const divided[3] = {illumination[0].data(), illumination[1].data(),
-                             illumination[2].data()};
-  scale_images(albedo, true, input.width, input.height, divided, 3);
-  const float* const images[3] = {divided[0], divided[1], divided[2]};
+  std::unique_ptr<float[]> illumination[3];
+  const float* images[3] = {fb.a.data(), fb.b.data(), fb.all.data()};
+  if (!albedo.empty()) {
+    for (int k = 0; k < 3; ++k) {
+      illumination[k].reset(new float[n3]);
+      divide_image(albedo, input.width, input.height, images[k], illumination[k].get());
+      images[k] = illumination[k].get();
+    }
+  }
   r.filter_seconds += since(t);
   int index = 0;
+  // The filters' outputs, multiplied back by the albedo as they are written.
+  const float* const remodulate = albedo.empty() ? nullptr : albedo.data();
   auto offer = [&](int tolerances) {
-    t = std::chrono::steady_clock::now();
-    scale_images(albedo, false, input.width, input.height, out, 3 * tolerances);
-    r.filter_seconds += since(t);
     t = std::chrono::steady_clock::now();
     for (int k = 0; k < tolerances; ++k, ++index)
       detail::offer_candidate(fb, index, out[3 * k], out[3 * k + 1], out[3 * k + 2], choice);
     r.select_seconds += since(t);
   };
   const float none = 0.f;
-  detail::bilateral_filter(fb, detail::BilateralWindow{0, 1}, &none, 1, images, 3, out);
+  t = std::chrono::steady_clock::now();
+  point_outputs(0);
+  detail::bilateral_filter(fb, detail::BilateralWindow{0, 1}, &none, 1, images, 3, out, remodulate);
+  r.filter_seconds += since(t);
   offer(1);
   for (const detail::BilateralWindow& w : detail::kWindows) {
     t = std::chrono::steady_clock::now();
-    detail::bilateral_filter(fb, w, detail::kColourTolerances, kTol, images, 3, out);
+    point_outputs(index);
+    detail::bilateral_filter(fb, w, detail::kColourTolerances, kTol, images, 3, out, remodulate);
     r.filter_seconds += since(t);
     offer(kTol);
   }
   t = std::chrono::steady_clock::now();
   detail::blend_choices(fb, choice);
-  r.select_seconds += since(t);
+  r.blend_seconds = since(t);
   r.image = std::move(choice.image);
   r.error = std::move(choice.error);
   r.chosen = std::move(choice.index);

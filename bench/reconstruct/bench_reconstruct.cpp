@@ -255,19 +255,23 @@ void bench_feature(int width, int height, int threads) {
         [&] { fr = gdpt::feature_filter(in, sc.a.data(), sc.b.data(), sc.primal.data()); });
     const double filter_wall = seconds_since(t2), filter_cpu = cpu_seconds() - c2;
     const double rel = gdpt::test::relative_mse(img, sc.truth);
+    const double split =
+        fr.prepare_seconds + fr.filter_seconds + fr.select_seconds + fr.blend_seconds;
     std::printf(
-        "Feature (guide %s, %d reweightings): %8.1f ms = solves %.1f ms + filters %.1f ms (prepare "
-        "%.1f, %zu "
-        "candidates %.1f, choice %.1f); relMSE %.5f vs L1 %.5f (%.1f ms): %.2fx lower\n",
+        "Feature (guide %s, %d reweightings): %8.1f ms = solves %.1f ms + filters %.1f ms; "
+        "relMSE %.5f vs L1 %.5f (%.1f ms): %.2fx lower\n",
         guide == gdpt::ReconstructionNorm::L1 ? "L1" : "L2", k, 1e3 * total, 1e3 * r.guide_seconds,
-        1e3 * (total - r.guide_seconds), 1e3 * fr.prepare_seconds,
+        1e3 * (total - r.guide_seconds), rel, rel_l1, 1e3 * t_l1, rel_l1 / rel);
+    std::printf(
+        "  filters alone %.1f ms = prepare %.1f (outlier limit, buffers) + %zu candidates "
+        "%.1f + choice %.1f + blend %.1f + rest %.1f; CPU %.2f s (%.2f s per thread)\n",
+        1e3 * filter_wall, 1e3 * fr.prepare_seconds,
         gdpt::detail::default_bilateral_candidates().size(), 1e3 * fr.filter_seconds,
-        1e3 * fr.select_seconds, rel, rel_l1, 1e3 * t_l1, rel_l1 / rel);
+        1e3 * fr.select_seconds, 1e3 * fr.blend_seconds, 1e3 * (filter_wall - split), filter_cpu,
+        filter_cpu / threads);
     // Wall time depends on what else runs; CPU time (all threads) / threads is the time on
     // otherwise idle cores.
     std::printf("  CPU time: total %.2f s (%.2f s per thread)\n", cpu_total, cpu_total / threads);
-    std::printf("  filters and choice alone: %.1f ms, CPU %.2f s (%.2f s per thread)\n",
-                1e3 * filter_wall, filter_cpu, filter_cpu / threads);
   }
 }
 
