@@ -586,13 +586,15 @@ void orient(Closure& c, Vec3f tangent, float turns) {
   c.rotation = turns != 0.0f ? Vec2f(std::cos(angle), std::sin(angle)) : Vec2f(1.0f, 0.0f);
 }
 
-// Blender's Multiscatter GGX of the Glossy and Anisotropic BSDFs: GGX reflection lobe `c` (its
-// distribution set here) and its multiple-scattering lobe, of no Fresnel: the colour is the
-// lobe's average reflectance.
-void add_multiscatter_pair(Closure& c, Spectrum color, float w, ClosureSet& out) {
-  c.distribution = MicrofacetDistribution::GGX;
+// A Glossy or Anisotropic BSDF's lobe `c` of `color` at weight w. Blender's Multiscatter GGX
+// there is a GGX lobe (its distribution set here) and its multiple-scattering lobe, of no
+// Fresnel: the colour is the lobe's average reflectance.
+void add_reflection_lobe(Closure& c, Spectrum color, float w, ClosureSet& out) {
+  c.weight = color * w;
+  const bool multiscatter = c.distribution == MicrofacetDistribution::MultiscatterGGX;
+  if (multiscatter) c.distribution = MicrofacetDistribution::GGX;
   out.add(c);
-  out.add(ggx_multiscatter::lobe_of(c, color, Spectrum(w)));
+  if (multiscatter) out.add(ggx_multiscatter::lobe_of(c, color, Spectrum(w)));
 }
 
 // Adds the lobes of one BSDF node (weight w) to `out`.
@@ -615,13 +617,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       c.fresnel = FresnelMode::None;
       c.distribution = n.distribution;
       c.alpha = r * r;
-      const Spectrum color = in.color(n.color);
-      c.weight = color * w;
-      if (n.distribution != MicrofacetDistribution::MultiscatterGGX) {
-        out.add(c);
-        return;
-      }
-      add_multiscatter_pair(c, color, w, out);
+      add_reflection_lobe(c, in.color(n.color), w, out);
       return;
     }
     case ShaderNodeKind::Anisotropic: {
@@ -631,13 +627,7 @@ void add_bsdf(const ShaderNode& n, float w, const Inputs& in, ClosureSet& out) {
       c.distribution = n.distribution;
       set_anisotropy(c, r * r, std::clamp(in.scalar(n.anisotropy), -0.99f, 0.99f));
       if (is_anisotropic(c)) orient(c, in.tangent(n.tangent), in.scalar(n.rotation));
-      const Spectrum color = in.color(n.color);
-      c.weight = color * w;
-      if (n.distribution != MicrofacetDistribution::MultiscatterGGX) {
-        out.add(c);
-        return;
-      }
-      add_multiscatter_pair(c, color, w, out);
+      add_reflection_lobe(c, in.color(n.color), w, out);
       return;
     }
     case ShaderNodeKind::Glass:

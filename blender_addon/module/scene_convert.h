@@ -15,8 +15,8 @@
 //   material: name, root, nodes: list of dicts {kind: 'DIFFUSE'|'GLOSSY'|'GLASS'|'PRINCIPLED'|
 //             'EMISSION'|'TRANSPARENT'|'MIX'|'ADD', a, b, distribution 'GGX'|'BECKMANN' (Glossy,
 //             Glass, Refraction, Anisotropic)|'ASHIKHMIN_SHIRLEY' (Glossy, Anisotropic)|
-//             'MULTI_GGX' (Glossy, Glass, Anisotropic, Principled), and inputs color, roughness, ior,
-//             strength, fac, metallic, specular, specular_tint, transmission, alpha, emission,
+//             'MULTI_GGX' (Glossy, Glass, Anisotropic, Principled), and inputs color, roughness,
+//             ior, strength, fac, metallic, specular, specular_tint, transmission, alpha, emission,
 //             emission_strength, subsurface, subsurface_color}; a colour input is {value: (3),
 //             image, mapping (12), coordinates 'UV'|'GENERATED'|'OBJECT', interpolation
 //             'Linear'|'Closest', extension 'REPEAT'|'EXTEND'|'CLIP', node}, a float input the same
