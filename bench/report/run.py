@@ -150,7 +150,10 @@ def measure_scene(name, args, blender, log):
     kept = kept_curves(name, args)
     for curve, points in kept.items():
         result["curves"][curve] = points
-        crops[curve] = rgb(os.path.join(cache, f"{curve}_{args.crop_budget}s.exr"))
+        path = os.path.join(cache, f"{curve}_{args.crop_budget}s.exr")
+        if not os.path.exists(path):  # a new cache: render the kept curve's crop image again
+            render(blender, blend, curve, path, seconds=args.crop_budget, seed=7)
+        crops[curve] = rgb(path)
     for budget in args.budgets:
         for method in RENDERED:  # interleaved: every method once per budget, in turn
             if method in kept:
@@ -437,8 +440,10 @@ def rewrite_doc(args, fig_dir, doc_dir):
 
 def command_line(args, quick):
     """How the page says it was made: `make bench` unless budgets or scenes were chosen by hand."""
-    if args.budgets_given or args.scenes_given:
-        return ("bench/report/run.py" + (f" --scenes {','.join(args.scenes)}" if args.scenes_given else "")
+    build = os.path.relpath(os.path.abspath(args.build), ROOT)
+    if args.budgets_given or args.scenes_given or build != "build":
+        return ("bench/report/run.py" + (f" --build {build}" if build != "build" else "")
+                + (f" --scenes {','.join(args.scenes)}" if args.scenes_given else "")
                 + f" --budgets {','.join(map(str, args.budgets))}"
                 + (f" --keep {','.join(args.keep)}" if args.keep else ""))
     return ("make bench" + (" QUICK=1" if quick else "")
