@@ -7,6 +7,7 @@
 #include "core/vec.h"
 #include "shaders/bsdf.h"
 #include "shaders/bsdf_ggx_multiscatter.h"
+#include "shaders/material.h"
 #include "testing/chi2.h"
 
 namespace gdpt::test {
@@ -167,6 +168,16 @@ inline double sampled_albedo(const ClosureSet& set, Vec3f wi, int samples, uint6
     if (s.valid) sum += s.weight()[channel];
   }
   return sum / samples;
+}
+
+// The closures of a material made of node n alone, at a fixed UV, seen from the front or back.
+inline ClosureSet one_node_closures(const ShaderNode& n, bool front_facing = true) {
+  MaterialDesc d;
+  d.nodes = {n};
+  d.root = 0;
+  ClosureSet s;
+  Material(d, {}).evaluate(ShadingContext{{0.25f, 0.25f}, front_facing}, s);
+  return s;
 }
 
 }  // namespace gdpt::test

@@ -102,12 +102,7 @@ ClosureSet multiscatter_material(ShaderNodeKind kind, float r, Spectrum c, float
   n.tangent.source = TangentInput::Source::Vector;
   n.tangent.vector = ColorInput(Spectrum(1.0f, 0.0f, 0.0f));
   n.distribution = MicrofacetDistribution::MultiscatterGGX;
-  MaterialDesc d;
-  d.nodes = {n};
-  d.root = 0;
-  ClosureSet s;
-  Material(d, {}).evaluate(ShadingContext{{0.25f, 0.25f}, true}, s);
-  return s;
+  return one_node_closures(n);
 }
 
 // The Glossy BSDF: its GGX lobe, coloured, and the compensation of Kulla-Conty's colour for

@@ -86,15 +86,6 @@ TEST(GgxMultiscatterGlass, RefractsPastTheCriticalAngle) {
   EXPECT_GT(set_of({multiscatter_glass(glass(0.36f, 1.5f))}).eval(wi, wo).x, 0.01f);
 }
 
-ClosureSet node_closures(const ShaderNode& n, bool front_facing = true) {
-  MaterialDesc d;
-  d.nodes = {n};
-  d.root = 0;
-  ClosureSet s;
-  Material(d, {}).evaluate(ShadingContext{{0.25f, 0.25f}, front_facing}, s);
-  return s;
-}
-
 TEST(GgxMultiscatterGlass, GlassNodeCompensates) {
   ShaderNode n;
   n.kind = ShaderNodeKind::Glass;
@@ -103,7 +94,7 @@ TEST(GgxMultiscatterGlass, GlassNodeCompensates) {
   n.ior = FloatInput(1.45f);
   n.distribution = MicrofacetDistribution::MultiscatterGGX;
   for (bool front : {true, false}) {
-    const ClosureSet s = node_closures(n, front);
+    const ClosureSet s = one_node_closures(n, front);
     ASSERT_EQ(s.count(), 1);
     EXPECT_EQ(s[0].type, ClosureType::GGXDielectric);
     EXPECT_EQ(s[0].distribution, MicrofacetDistribution::GGX);
@@ -113,10 +104,10 @@ TEST(GgxMultiscatterGlass, GlassNodeCompensates) {
   n.color = ColorInput(Spectrum(1.0f));
   for (bool front : {true, false})
     for (float mu : kIncidentCos)
-      EXPECT_NEAR(albedo(node_closures(n, front), incident(mu)), 1.0, 0.02)
+      EXPECT_NEAR(albedo(one_node_closures(n, front), incident(mu)), 1.0, 0.02)
           << "front " << front << " cos_i " << mu;
   n.distribution = MicrofacetDistribution::GGX;
-  EXPECT_FALSE(node_closures(n)[0].multiscatter);
+  EXPECT_FALSE(one_node_closures(n)[0].multiscatter);
 }
 
 // Principled, transmission 1, white: its glass alone, compensated above roughness 0.05 (where
@@ -129,12 +120,12 @@ TEST(GgxMultiscatterGlass, PrincipledTransmissionCompensates) {
   n.ior = FloatInput(1.45f);
   n.distribution = MicrofacetDistribution::MultiscatterGGX;
   n.roughness = FloatInput(0.04f);
-  ClosureSet s = node_closures(n);
+  ClosureSet s = one_node_closures(n);
   ASSERT_EQ(s.count(), 1);
   EXPECT_FALSE(s[0].multiscatter);
   for (float r : kRoughness) {
     n.roughness = FloatInput(r);
-    s = node_closures(n);
+    s = one_node_closures(n);
     ASSERT_EQ(s.count(), 1);
     EXPECT_EQ(s[0].type, ClosureType::GGXDielectric);
     EXPECT_TRUE(s[0].multiscatter);
