@@ -330,6 +330,10 @@ def write_doc(results, meta, path, figures):
         f"{meta['machine']}"
         + (f" (page and ratios rewritten from its JSON by `run.py --doc-only` at commit "
            f"{meta['page_commit']})" if meta.get("page_commit") else "")
+        + (f"; the Feature curve's images solved again from that run's renders by the Feature "
+           f"reconstruction of commit {meta['feature_resolved_at']} (`run.py --doc-only "
+           "--resolve-feature`: same passes, render times and samples)"
+           if meta.get("feature_resolved_at") else "")
         + ". Every figure below comes from `bench/results/<scene>.json` of that "
         "run; rerun the command to regenerate this page."
         + (f" Curves of {', '.join(meta['kept'])} are those of the run at commit "
@@ -420,12 +424,30 @@ def git(*args):
     return subprocess.run(["git", "-C", ROOT, *args], capture_output=True, text=True).stdout.strip()
 
 
+def resolve_feature(name, args, result):
+    """The Feature curve's images solved again from the run's cached G-PT + Feature renders by
+    this build's `gdpt-reconstruct --norm feature` (the function the render calls, on the same
+    passes); the render's time and samples are kept: the reconstruction's cost is unchanged."""
+    cache = os.path.join(args.cache, f"{name}_{result['resolution']}")
+    refs = tuple(rgb(os.path.join(cache, f"ref_pt_{seed}_{int(result['reference_seconds_per_half'])}s.exr"))
+                 for seed in (1, 2))
+    ref = 0.5 * (refs[0] + refs[1])
+    for point in result["curves"]["gpt_feature"]:
+        path = os.path.join(cache, f"gpt_feature_{point['budget']}s.exr")
+        img, _ = solve(args.build, path, "feature", path[:-4] + "_resolved.exr")
+        point.update(relmse=M.rel_mse(img, ref), relmse_denoised=M.rel_mse_denoised(img, *refs),
+                     ssim=M.ssim(img, ref))
+    result["meta"]["feature_resolved_at"] = git("rev-parse", "--short", "HEAD")
+
+
 def rewrite_doc(args, fig_dir, doc_dir):
     """The page and plots again from a finished run's JSON (its own commit and date kept)."""
     results, figures = [], {}
     for name in args.scenes:
         with open(os.path.join(args.results, f"{name}.json")) as f:
             result = json.load(f)
+        if args.resolve_feature:
+            resolve_feature(name, args, result)
         summarise(result)  # the derived ratios again; the measured points stay as they are
         result["meta"]["page_commit"] = git("rev-parse", "--short", "HEAD")
         with open(os.path.join(args.results, f"{name}.json"), "w") as f:
@@ -457,6 +479,8 @@ def main():
     p.add_argument("--scenes", help="comma-separated subset of " + ",".join(SCENES))
     p.add_argument("--budgets", help="comma-separated seconds (default 5,10,20,40,80)")
     p.add_argument("--ref-seconds", type=float, help="seconds per reference half (default 40)")
+    p.add_argument("--resolve-feature", action="store_true",
+                   help="with --doc-only: solve the Feature curve again from the cached renders")
     p.add_argument("--doc-only", action="store_true",
                    help="rewrite the page and plots from bench/results/<scene>.json, no rendering")
     p.add_argument("--res", help="WIDTHxHEIGHT (default 320x240)")
