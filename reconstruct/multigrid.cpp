@@ -14,6 +14,7 @@ using Grid = MultigridGrid;
 // Per-thread rows of a stencil pass: u above, at and below the current row, and A u of it.
 struct Rows {
   std::vector<float> u[3], au;
+  std::vector<float> zeros;  // the weights above the first row
 };
 
 Rows& rows_for(int width) {
@@ -21,6 +22,7 @@ Rows& rows_for(int width) {
   if (rows.au.size() < size_t(3) * width) {
     for (auto& v : rows.u) v.resize(size_t(3) * width);
     rows.au.resize(size_t(3) * width);
+    rows.zeros.assign(size_t(width), 0.f);
   }
   return rows;
 }
@@ -42,21 +44,33 @@ void smooth_row(const Grid& g, const float* r, float omega, const float* zc, int
 }
 
 // au = A u on row y from u's rows above (uu), at (uc) and below (ud). A neighbour outside the
-// image has zero weight, so any row may stand in for a missing one.
-void apply_row(const Grid& g, int y, const float* uu, const float* uc, const float* ud, float* au) {
+// image has zero weight, so any row may stand in for a missing one; `zeros`: W zero weights.
+void apply_row(const Grid& g, int y, const float* uu, const float* uc, const float* ud,
+               const float* zeros, float* au) {
   const int W = g.width;
   const size_t row = size_t(y) * W;
   const float *w0 = g.w0 + row, *wx = g.wx + row, *wy = g.wy + row;
-  const float* wyu = y > 0 ? g.wy + row - W : nullptr;
-  for (int x = 0; x < W; ++x) {
+  const float* wyu = y > 0 ? g.wy + row - W : zeros;
+  auto border = [&](int x) {
     const int xl = std::max(x - 1, 0), xr = std::min(x + 1, W - 1);
-    const float wxl = x > 0 ? wx[x - 1] : 0.f, wu = wyu ? wyu[x] : 0.f;
+    const float wxl = x > 0 ? wx[x - 1] : 0.f;
     for (int c = 0; c < 3; ++c) {
       const float v = uc[3 * x + c];
       au[3 * x + c] = w0[x] * v + wx[x] * (v - uc[3 * xr + c]) + wxl * (v - uc[3 * xl + c]) +
-                      wy[x] * (v - ud[3 * x + c]) + wu * (v - uu[3 * x + c]);
+                      wy[x] * (v - ud[3 * x + c]) + wyu[x] * (v - uu[3 * x + c]);
+    }
+  };
+  border(0);
+  for (int x = 1; x < W - 1; ++x) {  // interior: no clamps, so the loop vectorises
+    const float a0 = w0[x], ax = wx[x], axl = wx[x - 1], ay = wy[x], ayu = wyu[x];
+    const float* v = uc + 3 * x;
+    for (int c = 0; c < 3; ++c) {
+      const float vc = v[c];
+      au[3 * x + c] = a0 * vc + ax * (vc - v[c + 3]) + axl * (vc - v[c - 3]) +
+                      ay * (vc - ud[3 * x + c]) + ayu * (vc - uu[3 * x + c]);
     }
   }
+  if (W > 1) border(W - 1);
 }
 
 // For each row y of the chunk [y0, y1): u's rows around y made by make(y, row), A u of row y, then
@@ -72,7 +86,8 @@ void stencil_rows(const Grid& g, int y0, int y1, const Make& make, const Body& b
   for (int y = y0; y < y1; ++y) {
     const bool has_down = y + 1 < g.height;
     if (has_down) make(y + 1, down);
-    apply_row(g, y, y > 0 ? up : cur, cur, has_down ? down : cur, rows.au.data());
+    apply_row(g, y, y > 0 ? up : cur, cur, has_down ? down : cur, rows.zeros.data(),
+              rows.au.data());
     body(y, cur, rows.au.data());
     std::swap(up, cur);  // up <- this row, cur <- the row below
     std::swap(cur, down);

@@ -356,8 +356,20 @@ CgResult run_cg(const WeightedProblem& pb, float* x, const CgStart& start, int m
 void restrict_row(int width, int y, const float* v, const float* a, float* rc, int coarse_width) {
   float* cr = rc + 3 * size_t(y / 2) * coarse_width;
   if (y % 2 == 0) std::fill_n(cr, 3 * size_t(coarse_width), 0.f);
-  for (int x = 0; x < width; ++x)
-    for (int c = 0; c < 3; ++c) cr[3 * (x / 2) + c] += v[3 * x + c] - (a ? a[3 * x + c] : 0.f);
+  const int pairs = width / 2;
+  if (a)
+    for (int i = 0; i < 3 * pairs; ++i) {
+      const int k = 2 * i - i % 3;  // channel i % 3 of the pair's first pixel
+      cr[i] += (v[k] - a[k]) + (v[k + 3] - a[k + 3]);
+    }
+  else
+    for (int i = 0; i < 3 * pairs; ++i) {
+      const int k = 2 * i - i % 3;
+      cr[i] += v[k] + v[k + 3];
+    }
+  if (width % 2)  // a last block of one column
+    for (int c = 0; c < 3; ++c)
+      cr[3 * pairs + c] += v[3 * (width - 1) + c] - (a ? a[3 * (width - 1) + c] : 0.f);
 }
 
 std::vector<float> jacobi_inverse_diagonal(const WeightedProblem& pb) {
