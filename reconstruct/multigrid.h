@@ -9,9 +9,9 @@
 // between the two blocks (edges inside a block see a constant and drop out). Every level thus
 // keeps the per-pixel (w0, wx, wy) representation, rebuilt from the finer one by build().
 // A block-constant P makes the Galerkin edges twice too stiff for smooth errors (the edges inside
-// the blocks, in series with the crossing ones, are ignored), so the coarse correction of the
-// Laplacian part falls by 2 per level; edge_scale 0.5 (the crossing edges' mean) corrects that
-// and keeps the coarse operators symmetric positive definite.
+// the blocks, in series with the crossing ones, are ignored); edge_scale 0.5 (the crossing
+// edges' mean) would undo that, but measured worse than Galerkin on the IRLS systems
+// (bench_reconstruct --outlier-data, bench/results/l1_multigrid.txt), so Galerkin is the default.
 //
 // Cycle: V(1,1) with one damped Jacobi sweep (weight omega) before and the same sweep after the
 // coarse correction (scaled by coarse_scale), so M is symmetric positive definite and CG stays
@@ -34,7 +34,7 @@ struct MultigridOptions {
   Form form = kAdditive;
   float omega = 0.8f;        // damping of the Jacobi smoother, in (0, 1]
   float coarse_scale = 1.f;  // scale of the coarse correction, in (0, 2)
-  float edge_scale = 0.5f;   // coarse edge weight / sum of the crossing edges (1 = Galerkin)
+  float edge_scale = 1.f;    // coarse edge weight / sum of the crossing edges (1 = Galerkin)
   int coarsest_sweeps = 8;   // symmetric Gauss-Seidel sweeps on the coarsest level
   int coarsest_pixels = 64;  // coarsening stops at this many pixels
 };

@@ -365,7 +365,9 @@ void solve_l1(const Prepared& pr, const ReconstructionSettings& settings, bool w
   mg_options.coarse_scale = settings.l1_multigrid_coarse_scale;
   mg_options.edge_scale = settings.l1_multigrid_edge_scale;
   detail::WeightedMultigrid multigrid(mg_options);
-  if (settings.l1_preconditioner != L1Preconditioner::Jacobi) pb.preconditioner = &multigrid;
+  const bool mg = settings.l1_preconditioner != L1Preconditioner::Jacobi;
+  const int mg_until = settings.l1_multigrid_reweightings < 0 ? std::numeric_limits<int>::max()
+                                                              : settings.l1_multigrid_reweightings;
   const L1Schedule schedule(settings, warm);
   const int K = schedule.reweightings;
   const double decay = schedule.decay();
@@ -374,6 +376,7 @@ void solve_l1(const Prepared& pr, const ReconstructionSettings& settings, bool w
     // |b| only for the last solve, whose exit residual is reported.
     const detail::CgStart start =
         detail::irls_reweight(data, float(reg), x.data(), out, ws.r.data(), k == K - 1);
+    pb.preconditioner = mg && k < mg_until ? &multigrid : nullptr;
     if (pb.preconditioner) multigrid.build(pb);
     const auto cg =
         detail::solve_weighted_cg_from_residual(pb, x.data(), start, schedule.steps(k), 0.0, ws);

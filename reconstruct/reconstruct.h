@@ -50,7 +50,11 @@ struct ReconstructionSettings {
   // K,F,L,P,S,E).
   L1Preconditioner l1_preconditioner = L1Preconditioner::Jacobi;
   float l1_multigrid_coarse_scale = 1.f;
-  float l1_multigrid_edge_scale = 0.5f;
+  float l1_multigrid_edge_scale = 1.f;
+  // Multigrid only for the first this many reweightings (negative: all), Jacobi after: the late
+  // IRLS weights spread over 4-6 orders of magnitude, where 2x2 aggregation stops paying
+  // (bench_reconstruct --pcg-mg).
+  int l1_multigrid_reweightings = -1;
   // L1 warm start (ReconstructionInput::initial): reweightings and Jacobi-PCG steps per reweighting
   // (bench_reconstruct --warm --sweep). The regulariser falls from l1_warm_regulariser to the cold
   // schedule's last value, so a start near the minimum is not first pulled towards the smoothed

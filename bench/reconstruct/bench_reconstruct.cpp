@@ -182,14 +182,15 @@ int measure_memory(const Data& d, int threads) {
 
 }  // namespace
 
-// Parses a cold L1 schedule "K,F,L[,P[,S[,E]]]" into `s`: K reweightings, F -> L inner steps, P
-// the preconditioner (j Jacobi, a additive multigrid, v multigrid V-cycle), S its coarse scale,
-// E its coarse edge scale.
+// Parses a cold L1 schedule "K,F,L[,P[,S[,E[,U]]]]" into `s`: K reweightings, F -> L inner
+// steps, P the preconditioner (j Jacobi, a additive multigrid, v multigrid V-cycle), S its coarse
+// scale, E its coarse edge scale, U the reweightings that use it (Jacobi after).
 bool parse_schedule(const std::string& spec, gdpt::ReconstructionSettings& s) {
   char p = 'j';
   float scale = 1.f, edges = s.l1_multigrid_edge_scale;
-  const int n = std::sscanf(spec.c_str(), "%d,%d,%d,%c,%f,%f", &s.l1_reweightings,
-                            &s.l1_cg_steps_first, &s.l1_cg_steps_last, &p, &scale, &edges);
+  const int n =
+      std::sscanf(spec.c_str(), "%d,%d,%d,%c,%f,%f,%d", &s.l1_reweightings, &s.l1_cg_steps_first,
+                  &s.l1_cg_steps_last, &p, &scale, &edges, &s.l1_multigrid_reweightings);
   if (n < 3 || (p != 'j' && p != 'a' && p != 'v') || !(scale > 0.f && scale < 2.f) ||
       !(edges > 0.f && edges <= 1.f))
     return false;
@@ -201,9 +202,9 @@ bool parse_schedule(const std::string& spec, gdpt::ReconstructionSettings& s) {
   return true;
 }
 
-// --schedules K,F,L[,P[,S[,E]]] ...: each cold L1 schedule (parse_schedule) against the default,
-// alternated default / schedule in one run, `rounds` times: wall and process CPU time, inner
-// steps, objective relative to the default's and, with `l1d`, to the reference L1D scheme's.
+// --schedules K,F,L[,P[,S[,E[,U]]]] ...: each cold L1 schedule (parse_schedule) against the
+// default, alternated default / schedule in one run, `rounds` times: wall and process CPU time,
+// inner steps, objective relative to the default's and, with `l1d`, to the reference L1D scheme's.
 int bench_schedules(const Data& d, int threads, const std::vector<std::string>& specs, int rounds,
                     bool l1d) {
   gdpt::ReconstructionInput in{d.w,         d.h,     d.primal.data(), d.gx.data(),

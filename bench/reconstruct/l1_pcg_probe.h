@@ -14,9 +14,9 @@
 //   scaled    M^-1 = D^-1/2 (beta^2 + L)^-1 D^-1/2 with D = diag(A) / (beta^2 + 4): the same DCT
 //             solve between two Jacobi scalings, so that M's diagonal matches A's;
 //   mg-add    the library's multigrid (reconstruct/multigrid.h), additive at the finest level,
-//             coarse edges halved (its default);
+//             coarse edges halved (edge scale 0.5);
 //   mg-V      the same, a full V(1,1) from the finest level;
-//   gal-add, gal-V  the same two with Galerkin coarse operators (edge scale 1).
+//   gal-add, gal-V  the same two with Galerkin coarse operators (edge scale 1, the default).
 #pragma once
 
 #include <vector>

@@ -198,7 +198,8 @@ TEST(Multigrid, SolveMatchesJacobiInFewerSteps) {
   }
 }
 
-// L1 with the multigrid preconditioner gives the same bits on one and two threads.
+// L1 with the multigrid preconditioner gives the same bits on one and two threads, also when it
+// hands over to Jacobi after some reweightings; with multigrid for none, L1 is the Jacobi one.
 TEST(Multigrid, L1SameResultOnOneAndTwoThreads) {
   const int w = 150, h = 70;
   const auto truth = test::make_image(w, h);
@@ -214,6 +215,15 @@ TEST(Multigrid, L1SameResultOnOneAndTwoThreads) {
     const auto one = reconstruct(in, s);
     s.threads = 2;
     EXPECT_EQ(one, reconstruct(in, s));
+    s.l1_multigrid_reweightings = 18;
+    const auto part = reconstruct(in, s);
+    EXPECT_NE(part, one);
+    s.threads = 1;
+    EXPECT_EQ(part, reconstruct(in, s));
+    s.l1_multigrid_reweightings = 0;
+    ReconstructionSettings jacobi;
+    jacobi.norm = ReconstructionNorm::L1;
+    EXPECT_EQ(reconstruct(in, s), reconstruct(in, jacobi));
   }
 }
 
