@@ -15,6 +15,7 @@
 #include "reconstruct/dct_solver.h"
 #include "reconstruct/feature_reconstruct.h"
 #include "reconstruct/irls_reweight.h"
+#include "reconstruct/multigrid.h"
 #include "reconstruct/parallel.h"
 #include "reconstruct/weighted_cg.h"
 
@@ -357,6 +358,16 @@ void solve_l1(const Prepared& pr, const ReconstructionSettings& settings, bool w
   const detail::IrlsWeights out{w.w0.data(), w.wx.data(), w.wy.data(), inv_diag.data()};
   auto pb = make_problem(pr, w);
   pb.inv_diagonal = inv_diag.data();
+  detail::MultigridOptions mg_options;
+  mg_options.form = settings.l1_preconditioner == L1Preconditioner::MultigridVCycle
+                        ? detail::MultigridOptions::kVCycle
+                        : detail::MultigridOptions::kAdditive;
+  mg_options.coarse_scale = settings.l1_multigrid_coarse_scale;
+  mg_options.edge_scale = settings.l1_multigrid_edge_scale;
+  detail::WeightedMultigrid multigrid(mg_options);
+  const bool mg = settings.l1_preconditioner != L1Preconditioner::Jacobi;
+  const int mg_until = settings.l1_multigrid_reweightings < 0 ? std::numeric_limits<int>::max()
+                                                              : settings.l1_multigrid_reweightings;
   const L1Schedule schedule(settings, warm);
   const int K = schedule.reweightings;
   const double decay = schedule.decay();
@@ -365,6 +376,8 @@ void solve_l1(const Prepared& pr, const ReconstructionSettings& settings, bool w
     // |b| only for the last solve, whose exit residual is reported.
     const detail::CgStart start =
         detail::irls_reweight(data, float(reg), x.data(), out, ws.r.data(), k == K - 1);
+    pb.preconditioner = mg && k < mg_until ? &multigrid : nullptr;
+    if (pb.preconditioner) multigrid.build(pb);
     const auto cg =
         detail::solve_weighted_cg_from_residual(pb, x.data(), start, schedule.steps(k), 0.0, ws);
     rep.iterations += cg.iterations;

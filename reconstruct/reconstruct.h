@@ -30,6 +30,11 @@ namespace gdpt {
 
 enum class ReconstructionNorm : uint8_t { L2, L1, Weighted, None, Feature };
 
+// Preconditioner of L1's inner solves: Jacobi, or a multigrid V-cycle whose coarse operators
+// follow the IRLS weights (reconstruct/multigrid.h), at the finest level additive (D^-1 plus the
+// coarse correction) or a full V(1,1).
+enum class L1Preconditioner : uint8_t { Jacobi, MultigridAdditive, MultigridVCycle };
+
 struct ReconstructionSettings {
   ReconstructionNorm norm = ReconstructionNorm::L1;
   float alpha = 0.2f;  // must be > 0
@@ -40,6 +45,16 @@ struct ReconstructionSettings {
   int l1_reweightings = 36;
   int l1_cg_steps_first = 12;
   int l1_cg_steps_last = 3;
+  // Preconditioner of the inner solves (cold and warm) and, for multigrid, the scale of its
+  // coarse correction and of its coarse edges (multigrid.h; bench_reconstruct --schedules
+  // K,F,L,P,S,E).
+  L1Preconditioner l1_preconditioner = L1Preconditioner::Jacobi;
+  float l1_multigrid_coarse_scale = 1.f;
+  float l1_multigrid_edge_scale = 1.f;
+  // Multigrid only for the first this many reweightings (negative: all), Jacobi after: the late
+  // IRLS weights spread over 4-6 orders of magnitude, where 2x2 aggregation stops paying
+  // (bench_reconstruct --pcg-mg).
+  int l1_multigrid_reweightings = -1;
   // L1 warm start (ReconstructionInput::initial): reweightings and Jacobi-PCG steps per reweighting
   // (bench_reconstruct --warm --sweep). The regulariser falls from l1_warm_regulariser to the cold
   // schedule's last value, so a start near the minimum is not first pulled towards the smoothed

@@ -74,9 +74,12 @@ constexpr int kGroup = 4, kLanes = 3 * kGroup;
 
 // Search direction v = z + beta p (z = D^-1 r) of the pixels [i0, i0 + W) of one row, into `v`.
 // p == nullptr on the first step (beta = 0): p is not read, so it needs no clearing.
+// With `zc` (the coarse row below this row), s P zc is added: the fused additive two-level
+// preconditioner (CgPreconditioner::Coarse).
 template <bool kPreconditioned>
 inline void direction_row(const float* dg, const float* r, const float* p,
-                          const std::array<float, 3>& beta, size_t i0, int W, float* v) {
+                          const std::array<float, 3>& beta, size_t i0, int W, float* v,
+                          const float* zc = nullptr, float s = 0.f) {
   float b[kLanes];
   for (int k = 0; k < kLanes; ++k) b[k] = p ? beta[k % 3] : 0.f;
   const float* rr = r + 3 * i0;
@@ -91,6 +94,9 @@ inline void direction_row(const float* dg, const float* r, const float* p,
     const float d = precondition<kPreconditioned>(dg, i0 + x);
     for (int c = 0; c < 3; ++c) v[3 * x + c] = d * rr[3 * x + c] + b[c] * pp[3 * x + c];
   }
+  if (zc)
+    for (x = 0; x < W; ++x)
+      for (int c = 0; c < 3; ++c) v[3 * x + c] += s * zc[3 * (x / 2) + c];
 }
 
 // Per-thread rows of v above and below a chunk: those rows belong to the neighbouring chunks,
@@ -118,18 +124,21 @@ HaloRows& halo_rows(int W) {
 // per value, not once per stencil point.
 template <bool kPreconditioned>
 std::array<double, 3> direction_pass(const WeightedProblem& pb, const float* r, const float* p,
-                                     const std::array<float, 3>& beta, float* p_next, float* q) {
+                                     const std::array<float, 3>& beta, float* p_next, float* q,
+                                     const CgPreconditioner::Coarse* coarse = nullptr) {
   const int W = pb.width, H = pb.height;
   const float* dg = pb.inv_diagonal;
+  auto row = [&](int y, float* out) {
+    const float* zc = coarse ? coarse->z + 3 * size_t(y / 2) * coarse->width : nullptr;
+    direction_row<kPreconditioned>(dg, r, p, beta, size_t(y) * W, W, out, zc,
+                                   coarse ? coarse->scale : 0.f);
+  };
   return parallel_rows_sum<3>(H, [&](int y0, int y1, std::array<double, 3>& s) {
     HaloRows& halo = halo_rows(W);
     // --- v for the chunk's rows and the two halo rows.
-    for (int y = y0; y < y1; ++y)
-      direction_row<kPreconditioned>(dg, r, p, beta, size_t(y) * W, W, p_next + 3 * size_t(y) * W);
-    if (y0 > 0)
-      direction_row<kPreconditioned>(dg, r, p, beta, size_t(y0 - 1) * W, W, halo.above.data());
-    if (y1 < H)
-      direction_row<kPreconditioned>(dg, r, p, beta, size_t(y1) * W, W, halo.below.data());
+    for (int y = y0; y < y1; ++y) row(y, p_next + 3 * size_t(y) * W);
+    if (y0 > 0) row(y0 - 1, halo.above.data());
+    if (y1 < H) row(y1, halo.below.data());
 
     // --- q = A v row by row. A missing neighbour (image border) has zero weight; the row itself
     // stands in for it so that every read stays in bounds.
@@ -184,10 +193,12 @@ std::array<double, 3> direction_pass(const WeightedProblem& pb, const float* r, 
   });
 }
 
-// Pass 2 of a CG step: x += a p, r -= a q; returns |r_c|^2 (0..2) and <r_c, z_c> (3..5).
+// Pass 2 of a CG step: x += a p, r -= a q; returns |r_c|^2 (0..2) and <r_c, z_c> (3..5). With
+// `coarse`, also rc = P^T r into coarse->r (the chunk's rows are still in cache).
 template <bool kPreconditioned>
 std::array<double, 6> update_pass(const WeightedProblem& pb, const std::array<float, 3>& a,
-                                  const float* p, const float* q, float* x, float* r) {
+                                  const float* p, const float* q, float* x, float* r,
+                                  const CgPreconditioner::Coarse* coarse = nullptr) {
   const int W = pb.width;
   float a_lane[kLanes];
   for (int k = 0; k < kLanes; ++k) a_lane[k] = a[k % 3];
@@ -225,12 +236,59 @@ std::array<double, 6> update_pass(const WeightedProblem& pb, const std::array<fl
       s[k % 3] += rr[k];
       s[3 + k % 3] += rz[k];
     }
+    if (coarse)
+      for (int y = y0; y < y1; ++y)
+        restrict_row(W, y, r + 3 * size_t(y) * W, nullptr, coarse->r, coarse->width);
   });
+}
+
+// rc = P^T r alone (the start of a fused two-level solve).
+void restrict_pass(const WeightedProblem& pb, const float* r, const CgPreconditioner::Coarse& c) {
+  parallel_rows(pb.height, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y)
+      restrict_row(pb.width, y, r + 3 * size_t(y) * pb.width, nullptr, c.r, c.width);
+  });
+}
+
+// One CG step's two passes: with the Jacobi scaling formed on the fly (kPreconditioned; plus the
+// fused coarse term with `coarse`), with none, or with `pc`, z = M^-1 r read from ws.z. Returns
+// <p, q> (0..2), |r_c|^2 (3..5) and the Jacobi <r_c, z_c> (6..8). `restrict_to`: the update
+// pass's P^T r target (the fused form, unless this is the last step).
+template <bool kPreconditioned, class StepSizes>
+std::array<double, 9> cg_step(const WeightedProblem& pb, const CgPreconditioner* pc,
+                              const CgPreconditioner::Coarse* coarse,
+                              const CgPreconditioner::Coarse* restrict_to, bool first,
+                              const std::array<float, 3>& beta, const StepSizes& step_sizes,
+                              float* x, CgWorkspace& ws) {
+  const float* p = first ? nullptr : ws.p.data();
+  const auto pq =
+      pc ? direction_pass<false>(pb, ws.z.data(), p, beta, ws.p_next.data(), ws.q.data())
+         : direction_pass<kPreconditioned>(pb, ws.r.data(), p, beta, ws.p_next.data(), ws.q.data(),
+                                           coarse);
+  ws.p.swap(ws.p_next);
+  const std::array<float, 3> a = step_sizes(pq);
+  const auto u = pc ? update_pass<false>(pb, a, ws.p.data(), ws.q.data(), x, ws.r.data())
+                    : update_pass<kPreconditioned>(pb, a, ws.p.data(), ws.q.data(), x, ws.r.data(),
+                                                   restrict_to);
+  return {pq[0], pq[1], pq[2], u[0], u[1], u[2], u[3], u[4], u[5]};
+}
+
+// <r_c, z_c> of the fused two-level form: the Jacobi part plus scale <rc_c, zc_c>.
+std::array<double, 3> fused_rz(const std::array<double, 3>& jacobi, CgPreconditioner& pc,
+                               const CgPreconditioner::Coarse& coarse) {
+  const auto c = pc.solve_coarse();
+  std::array<double, 3> rz{};
+  for (int k = 0; k < 3; ++k) rz[k] = jacobi[k] + double(coarse.scale) * c[k];
+  return rz;
 }
 
 template <bool kPreconditioned>
 CgResult run_cg(const WeightedProblem& pb, float* x, const CgStart& start, int max_iterations,
                 double tolerance, CgWorkspace& ws) {
+  // A preconditioner's two-level form is fused into the Jacobi passes; other forms are applied.
+  CgPreconditioner* const given = pb.preconditioner;
+  const CgPreconditioner::Coarse* coarse = given && kPreconditioned ? given->coarse() : nullptr;
+  CgPreconditioner* const pc = coarse ? nullptr : given;
   std::array<double, 3> rr = start.rr, rz = start.rz;
   const double bb_max = std::max({start.bb[0], start.bb[1], start.bb[2]});
   // A channel whose b is zero (a black channel) is measured against the brightest channel.
@@ -245,6 +303,13 @@ CgResult run_cg(const WeightedProblem& pb, float* x, const CgStart& start, int m
     return worst;
   };
   if (bb_max == 0.0 && rr[0] + rr[1] + rr[2] == 0.0) return result;  // x = 0 solves b = 0
+  if (max_iterations > 0 && coarse) {
+    restrict_pass(pb, ws.r.data(), *coarse);
+    rz = fused_rz(start.rz, *given, *coarse);
+  } else if (max_iterations > 0 && pc) {
+    if (ws.z.size() != ws.r.size()) resize_huge(ws.z, ws.r.size());
+    rz = pc->apply(ws.r.data(), ws.z.data());
+  }
 
   std::array<double, 3> rz_prev = rz;
   for (int it = 0; it < max_iterations; ++it) {
@@ -260,18 +325,25 @@ CgResult run_cg(const WeightedProblem& pb, float* x, const CgStart& start, int m
     if (it > 0)
       for (int c = 0; c < 3; ++c)
         beta[c] = active[c] && rz_prev[c] > 0 ? float(rz[c] / rz_prev[c]) : 0.f;
-    const auto pq = direction_pass<kPreconditioned>(pb, ws.r.data(), it > 0 ? ws.p.data() : nullptr,
-                                                    beta, ws.p_next.data(), ws.q.data());
-    ws.p.swap(ws.p_next);
-
-    std::array<float, 3> a{};
-    for (int c = 0; c < 3; ++c) a[c] = active[c] && pq[c] > 0 ? float(rz[c] / pq[c]) : 0.f;
+    auto step_sizes = [&](const std::array<double, 3>& pq) {
+      std::array<float, 3> a{};
+      for (int c = 0; c < 3; ++c) a[c] = active[c] && pq[c] > 0 ? float(rz[c] / pq[c]) : 0.f;
+      return a;
+    };
+    // The preconditioned residual is needed for a next step only.
+    const bool last = it + 1 == max_iterations;
+    const auto s = cg_step<kPreconditioned>(pb, pc, coarse, last ? nullptr : coarse, it == 0, beta,
+                                            step_sizes, x, ws);
     rz_prev = rz;
-    const auto u = update_pass<kPreconditioned>(pb, a, ws.p.data(), ws.q.data(), x, ws.r.data());
+    std::array<double, 3> rz_next{s[6], s[7], s[8]};
+    if (coarse && !last)
+      rz_next = fused_rz(rz_next, *given, *coarse);
+    else if (pc && !last)
+      rz_next = pc->apply(ws.r.data(), ws.z.data());
     for (int c = 0; c < 3; ++c)
       if (active[c]) {
-        rr[c] = u[c];
-        rz[c] = u[3 + c];
+        rr[c] = s[3 + c];
+        rz[c] = rz_next[c];
       }
     ++result.iterations;
   }
@@ -280,6 +352,25 @@ CgResult run_cg(const WeightedProblem& pb, float* x, const CgStart& start, int m
 }
 
 }  // namespace
+
+void restrict_row(int width, int y, const float* v, const float* a, float* rc, int coarse_width) {
+  float* cr = rc + 3 * size_t(y / 2) * coarse_width;
+  if (y % 2 == 0) std::fill_n(cr, 3 * size_t(coarse_width), 0.f);
+  const int pairs = width / 2;
+  if (a)
+    for (int i = 0; i < 3 * pairs; ++i) {
+      const int k = 2 * i - i % 3;  // channel i % 3 of the pair's first pixel
+      cr[i] += (v[k] - a[k]) + (v[k + 3] - a[k + 3]);
+    }
+  else
+    for (int i = 0; i < 3 * pairs; ++i) {
+      const int k = 2 * i - i % 3;
+      cr[i] += v[k] + v[k + 3];
+    }
+  if (width % 2)  // a last block of one column
+    for (int c = 0; c < 3; ++c)
+      cr[3 * pairs + c] += v[3 * (width - 1) + c] - (a ? a[3 * (width - 1) + c] : 0.f);
+}
 
 std::vector<float> jacobi_inverse_diagonal(const WeightedProblem& pb) {
   const int W = pb.width, H = pb.height;

@@ -17,6 +17,34 @@
 
 namespace gdpt::detail {
 
+// A preconditioner other than Jacobi: z = M^-1 r with M symmetric positive definite (so that CG
+// stays valid), e.g. the multigrid V-cycle of multigrid.h.
+class CgPreconditioner {
+ public:
+  virtual ~CgPreconditioner() = default;
+  // z = M^-1 r for RGB vectors of the problem's size; returns <r_c, z_c> per channel.
+  virtual std::array<double, 3> apply(const float* r, float* z) = 0;
+
+  // Optional additive two-level form  z = D^-1 r + scale P zc  (D^-1 the problem's Jacobi
+  // diagonal, P constant on 2x2 pixel blocks), which CG fuses into its own passes instead of
+  // calling apply(): its update pass sums r over the blocks into `r` (rc = P^T r, restrict_row),
+  // solve_coarse() then forms zc = M_c^-1 rc in `z` and returns <rc_c, zc_c>, and its direction
+  // pass adds scale P zc. nullptr: CG calls apply().
+  struct Coarse {
+    float* r = nullptr;
+    const float* z = nullptr;
+    int width = 0;
+    float scale = 1.f;
+  };
+  virtual const Coarse* coarse() const { return nullptr; }
+  virtual std::array<double, 3> solve_coarse() { return {}; }
+};
+
+// P^T of the 2x2 block aggregation, one fine row at a time: adds row y of v - a (a == nullptr: v;
+// RGB, `width` pixels) into row y / 2 of rc (RGB, `coarse_width` = (width + 1) / 2 pixels), which
+// is zeroed first at even y: go through a coarse row's fine rows in order, from an even row.
+void restrict_row(int width, int y, const float* v, const float* a, float* rc, int coarse_width);
+
 struct WeightedProblem {
   int width = 0, height = 0;
   const float* primal = nullptr;      // RGB, finite
@@ -28,6 +56,9 @@ struct WeightedProblem {
   // Optional Jacobi preconditioner: 1 / diag(A) per pixel (0 where the row of A is empty).
   // nullptr runs plain CG.
   const float* inv_diagonal = nullptr;
+  // Optional preconditioner used instead of the Jacobi one (z = M^-1 r is then stored, one more
+  // vector and pass; a fixed-step solve skips it after the last step).
+  CgPreconditioner* preconditioner = nullptr;
 };
 
 // 1 / diag(A) for the problem's weights (0 where diag(A) is 0), `width * height` values.
@@ -35,7 +66,8 @@ std::vector<float> jacobi_inverse_diagonal(const WeightedProblem& problem);
 
 struct CgWorkspace {
   std::vector<float> r, p, p_next, q;
-  void resize(size_t values);  // no-op when already that size
+  std::vector<float> z;        // only with a WeightedProblem::preconditioner
+  void resize(size_t values);  // no-op when already that size (z is sized when first needed)
 };
 
 struct CgResult {

@@ -22,7 +22,8 @@ inline std::vector<float> l1d_reference(int W, int H, const float* primal, const
   const size_t px = size_t(W) * H;
   std::vector<float> x(primal, primal + 3 * px);
   std::vector<float> w0(px), wx(px), wy(px);
-  gdpt::detail::WeightedProblem pb{W, H, primal, gx, gy, w0.data(), wx.data(), wy.data(), nullptr};
+  gdpt::detail::WeightedProblem pb{W,         H,         primal,    gx,      gy,
+                                   w0.data(), wx.data(), wy.data(), nullptr, nullptr};
   gdpt::detail::CgWorkspace ws;
   double reg = 0.05;
   for (int k = 0; k < reweightings; ++k, reg *= 0.5) {

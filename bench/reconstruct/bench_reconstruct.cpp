@@ -1,7 +1,8 @@
 // bench_reconstruct: cost of the reconstruction solvers at 1920x1080 RGB on 1 and 2 threads.
 //
 //   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] [--l2-only] [--feature-only]
-//                     [--memory] [--admm] [--pcg] [--warm] [--schedules K,F,L ...]
+//                     [--memory] [--admm] [--pcg] [--pcg-mg] [--warm]
+//                     [--schedules K,F,L[,P[,S]] ... [--rounds N] [--l1d] [--outlier-data]]
 //
 // Reports, per thread count:
 //   - one bare FFTW forward + inverse 2-D DCT of the 3 planes (double, the same cached plans the
@@ -21,10 +22,14 @@
 //     CPU time (the time on idle cores on a loaded machine) of the whole and of the filters and
 //     choice alone; --feature-only runs just this case.
 // --admm compares an ADMM L1 probe (l1_admm_probe.h) with the library's IRLS (see bench_admm).
-// --pcg counts PCG steps of the IRLS systems with DCT preconditioners (l1_pcg_probe.h).
+// --pcg counts PCG steps of the IRLS systems with DCT and multigrid preconditioners
+// (l1_pcg_probe.h); --pcg-mg only Jacobi and multigrid, at more reweightings.
 // --warm measures L1 warm-started from another alpha's output (ReconstructionInput::initial);
 // --warm --sweep also a grid of warm schedules.
-// --schedules K,F,L ...: cold L1 schedules against the default, alternated (time, objective).
+// --schedules K,F,L[,P[,S]] ...: cold L1 schedules against the default, alternated (time,
+// objective); P the preconditioner (j Jacobi, a / v multigrid additive / V-cycle), S its coarse
+// scale; --rounds N repeats each pair, --l1d adds the objective against the L1D scheme,
+// --outlier-data uses test L1.BeatsL2OnSparseOutlierGradients' data (e.g. --width 96 --height 64).
 // --memory only measures the peak resident memory (getrusage) after one solve of each norm, in the
 // order L2, Weighted, L1: each figure is the process's peak so far, inputs included.
 // Synthetic data: a smooth image with edges; primal noise sigma 0.2 (0.05 in the right half),
@@ -177,10 +182,31 @@ int measure_memory(const Data& d, int threads) {
 
 }  // namespace
 
-// --schedules K,F,L ...: each cold L1 schedule (K reweightings, F -> L Jacobi-PCG steps) against
-// the default, alternated default / schedule in one run: wall and process CPU time, inner steps,
-// objective relative to the default's.
-int bench_schedules(const Data& d, int threads, const std::vector<std::string>& specs) {
+// Parses a cold L1 schedule "K,F,L[,P[,S[,E[,U]]]]" into `s`: K reweightings, F -> L inner
+// steps, P the preconditioner (j Jacobi, a additive multigrid, v multigrid V-cycle), S its coarse
+// scale, E its coarse edge scale, U the reweightings that use it (Jacobi after).
+bool parse_schedule(const std::string& spec, gdpt::ReconstructionSettings& s) {
+  char p = 'j';
+  float scale = 1.f, edges = s.l1_multigrid_edge_scale;
+  const int n =
+      std::sscanf(spec.c_str(), "%d,%d,%d,%c,%f,%f,%d", &s.l1_reweightings, &s.l1_cg_steps_first,
+                  &s.l1_cg_steps_last, &p, &scale, &edges, &s.l1_multigrid_reweightings);
+  if (n < 3 || (p != 'j' && p != 'a' && p != 'v') || !(scale > 0.f && scale < 2.f) ||
+      !(edges > 0.f && edges <= 1.f))
+    return false;
+  s.l1_multigrid_edge_scale = edges;
+  s.l1_preconditioner = p == 'a'   ? gdpt::L1Preconditioner::MultigridAdditive
+                        : p == 'v' ? gdpt::L1Preconditioner::MultigridVCycle
+                                   : gdpt::L1Preconditioner::Jacobi;
+  s.l1_multigrid_coarse_scale = scale;
+  return true;
+}
+
+// --schedules K,F,L[,P[,S[,E[,U]]]] ...: each cold L1 schedule (parse_schedule) against the
+// default, alternated default / schedule in one run, `rounds` times: wall and process CPU time,
+// inner steps, objective relative to the default's and, with `l1d`, to the reference L1D scheme's.
+int bench_schedules(const Data& d, int threads, const std::vector<std::string>& specs, int rounds,
+                    bool l1d) {
   gdpt::ReconstructionInput in{d.w,         d.h,     d.primal.data(), d.gx.data(),
                                d.gy.data(), nullptr, nullptr};
   gdpt::ReconstructionSettings base;
@@ -203,24 +229,60 @@ int bench_schedules(const Data& d, int threads, const std::vector<std::string>& 
   std::printf("L1 schedules against the default (%d x %d -> %d), %dx%d, %d threads, alternated\n",
               base.l1_reweightings, base.l1_cg_steps_first, base.l1_cg_steps_last, d.w, d.h,
               threads);
+  double o_l1d = 0.0;
+  if (l1d) {
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      const auto x = gdpt::test::l1d_reference(d.w, d.h, d.primal.data(), d.gx.data(), d.gy.data(),
+                                               base.alpha);
+      o_l1d =
+          gdpt::reconstruction_objective(in, gdpt::ReconstructionNorm::L1, base.alpha, x.data());
+    });
+  }
   for (const std::string& spec : specs) {
     gdpt::ReconstructionSettings s = base;
-    if (std::sscanf(spec.c_str(), "%d,%d,%d", &s.l1_reweightings, &s.l1_cg_steps_first,
-                    &s.l1_cg_steps_last) != 3) {
-      std::fprintf(stderr, "bench_reconstruct: bad schedule '%s' (want K,F,L)\n", spec.c_str());
+    if (!parse_schedule(spec, s)) {
+      std::fprintf(stderr, "bench_reconstruct: bad schedule '%s' (want K,F,L[,j|a|v[,S]])\n",
+                   spec.c_str());
       return 2;
     }
-    double w1, c1;
-    int n1;
-    const double o0 = run(base, w0, c0, n0);
-    const double o1 = run(s, w1, c1, n1);
-    std::printf(
-        "  %2d x %2d -> %2d: %4d steps, wall %6.2f s (default %6.2f s), CPU %6.2f s (default "
-        "%6.2f s): CPU ratio %.3f, objective %+.4f%% vs default\n",
-        s.l1_reweightings, s.l1_cg_steps_first, s.l1_cg_steps_last, n1, w1, w0, c1, c0, c1 / c0,
-        100.0 * (o1 / o0 - 1.0));
+    for (int round = 0; round < rounds; ++round) {
+      double w1, c1;
+      int n1;
+      const double o0 = run(base, w0, c0, n0);
+      const double o1 = run(s, w1, c1, n1);
+      std::printf(
+          "  %-12s %4d steps, wall %6.2f s (default %6.2f s), CPU %6.2f s (default "
+          "%6.2f s): CPU ratio %.3f, objective %+.4f%% vs default",
+          spec.c_str(), n1, w1, w0, c1, c0, c1 / c0, 100.0 * (o1 / o0 - 1.0));
+      if (l1d)
+        std::printf(", %+.4f%% vs L1D (default %+.4f%%)", 100.0 * (o1 / o_l1d - 1.0),
+                    100.0 * (o0 / o_l1d - 1.0));
+      std::printf("\n");
+    }
   }
   return 0;
+}
+
+// The problem of test L1.BeatsL2OnSparseOutlierGradients (stronger outliers than make_data):
+// gradient noise sigma 0.01 plus 2% outliers of +4 (x) / -4 (y), primal noise sigma 0.2.
+Data make_outlier_data(int w, int h) {
+  using namespace gdpt::test;
+  Data d{w, h, make_image(w, h), {}, {}, {}, {}};
+  const size_t px = size_t(w) * h;
+  exact_gradients(d.truth, w, h, d.gx, d.gy);
+  d.gx = add(d.gx, zero_mean_noise(px, 0.01f, 11));
+  d.gy = add(d.gy, zero_mean_noise(px, 0.01f, 12));
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (size_t i = 0; i < px; ++i) {
+    if (u(rng) < 0.02f)
+      for (int c = 0; c < 3; ++c) d.gx[3 * i + c] += 4.f;
+    if (u(rng) < 0.02f)
+      for (int c = 0; c < 3; ++c) d.gy[3 * i + c] -= 4.f;
+  }
+  d.primal = add(d.truth, zero_mean_noise(px, 0.2f, 14));
+  return d;
 }
 
 // The Feature reconstruction on the synthetic room: total time per guide and its split.
@@ -364,30 +426,39 @@ int bench_admm(const Data& d, int threads) {
 }
 
 // --pcg: the preconditioner probe (l1_pcg_probe.h) on the library's IRLS trajectory: per probed
-// reweighting, the steps Jacobi, scalar-DCT and scaled-DCT PCG need to reach the residual of the
-// library's fixed steps and a relative residual of 1e-3, and their wall time to the latter.
-int bench_pcg(const Data& d, int threads) {
+// reweighting, the steps Jacobi, scalar-DCT, scaled-DCT and the two multigrid PCGs need to reach
+// the residual of the library's fixed steps and a relative residual of 1e-3, and their wall time
+// to the latter (the probe's own unfused passes). --pcg-mg skips the DCT preconditioners and
+// probes more reweightings.
+int bench_pcg(const Data& d, int threads, bool dct) {
   tbb::task_arena arena(threads);
   const float alpha = 0.2f;
   const double tolerance = 1e-3;
   std::vector<gdpt::bench::PcgProbeRow> rows;
+  const std::vector<int> probe_at =
+      dct ? std::vector<int>{0, 12, 35} : std::vector<int>{0, 12, 24, 35};
   arena.execute([&] {
     rows = gdpt::bench::probe_l1_pcg({d.w, d.h, d.primal.data(), d.gx.data(), d.gy.data(), alpha},
-                                     {0, 12, 35}, tolerance, 60);
+                                     probe_at, tolerance, 60, dct);
   });
   std::printf("bench_reconstruct --pcg: %dx%d RGB, alpha %.2f, %d threads, tolerance %.0e\n", d.w,
               d.h, double(alpha), threads, tolerance);
   std::printf(
-      "reweighting  weight p99/p1  library steps  residual after them  | steps to that residual "
-      "(Jacobi scalar scaled) | steps to tolerance (Jacobi scalar scaled) | seconds to tolerance "
-      "(Jacobi scalar scaled)\n");
-  for (const auto& r : rows)
-    std::printf("%11d  %13.3g  %13d  %19.3e  | %6d %6d %6d | %6d %6d %6d | %7.2f %7.2f %7.2f\n",
-                r.reweighting, r.weight_spread, r.library_steps, r.jacobi_residual,
-                r.steps_to_library[0], r.steps_to_library[1], r.steps_to_library[2],
-                r.steps_to_tolerance[0], r.steps_to_tolerance[1], r.steps_to_tolerance[2],
-                r.seconds_to_tolerance[0], r.seconds_to_tolerance[1], r.seconds_to_tolerance[2]);
-  std::printf("(-1: not reached within 60 steps)\n");
+      "reweighting  weight p99/p1  library steps  residual after them  | steps to that "
+      "residual | steps to tolerance | seconds to tolerance; each in the order");
+  for (const char* name : gdpt::bench::PcgProbeRow::kNames) std::printf(" %s", name);
+  std::printf("\n");
+  for (const auto& r : rows) {
+    std::printf("%11d  %13.3g  %13d  %19.3e  |", r.reweighting, r.weight_spread, r.library_steps,
+                r.jacobi_residual);
+    for (const int n : r.steps_to_library) std::printf(" %4d", n);
+    std::printf(" |");
+    for (const int n : r.steps_to_tolerance) std::printf(" %4d", n);
+    std::printf(" |");
+    for (const double t : r.seconds_to_tolerance) std::printf(" %6.2f", t);
+    std::printf("\n");
+  }
+  std::printf("(-1: not run, or not reached within 60 steps)\n");
   return 0;
 }
 
@@ -455,7 +526,9 @@ int bench_warm(const Data& d, int threads, bool sweep) {
 int main(int argc, char** argv) {
   int width = 1920, height = 1080, only_threads = 0;
   bool sweep = false, l2_only = false, feature_only = false, memory = false, admm = false,
-       pcg = false, warm = false;
+       pcg = false, pcg_mg = false, warm = false;
+  bool outlier_data = false, l1d = false;
+  int rounds = 1;
   std::vector<std::string> schedules;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -477,25 +550,34 @@ int main(int argc, char** argv) {
       admm = true;
     else if (a == "--pcg")
       pcg = true;
+    else if (a == "--pcg-mg")
+      pcg = pcg_mg = true;
     else if (a == "--warm")
       warm = true;
+    else if (a == "--outlier-data")
+      outlier_data = true;
+    else if (a == "--l1d")
+      l1d = true;
+    else if (a == "--rounds" && i + 1 < argc)
+      rounds = std::max(1, std::atoi(argv[++i]));
     else if (a == "--schedules")
       while (i + 1 < argc && argv[i + 1][0] != '-') schedules.push_back(argv[++i]);
     else {
       std::fprintf(stderr,
                    "usage: bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] "
-                   "[--l2-only] [--feature-only] [--memory] [--admm] [--pcg] [--warm] "
-                   "[--schedules K,F,L ...]\n");
+                   "[--l2-only] [--feature-only] [--memory] [--admm] [--pcg] [--pcg-mg] [--warm] "
+                   "[--schedules K,F,L[,P[,S]] ... [--rounds N] [--l1d] [--outlier-data]]\n");
       return 2;
     }
   }
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress is visible when piped to a file
-  const Data d = make_data(width, height);
+  const Data d = outlier_data ? make_outlier_data(width, height) : make_data(width, height);
   if (memory) return measure_memory(d, only_threads);
   if (admm) return bench_admm(d, only_threads > 0 ? only_threads : 2);
-  if (pcg) return bench_pcg(d, only_threads > 0 ? only_threads : 2);
+  if (pcg) return bench_pcg(d, only_threads > 0 ? only_threads : 2, !pcg_mg);
   if (warm) return bench_warm(d, only_threads > 0 ? only_threads : 2, sweep);
-  if (!schedules.empty()) return bench_schedules(d, only_threads > 0 ? only_threads : 2, schedules);
+  if (!schedules.empty())
+    return bench_schedules(d, only_threads > 0 ? only_threads : 2, schedules, rounds, l1d);
   const size_t px = size_t(width) * height;
   gdpt::ReconstructionInput input{
       width, height, d.primal.data(), d.gx.data(), d.gy.data(), d.variance.data(), nullptr};

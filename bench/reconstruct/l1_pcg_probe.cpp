@@ -8,6 +8,7 @@
 
 #include "reconstruct/dct_solver.h"
 #include "reconstruct/irls_reweight.h"
+#include "reconstruct/multigrid.h"
 #include "reconstruct/parallel.h"
 #include "reconstruct/reconstruct.h"
 #include "reconstruct/weighted_cg.h"
@@ -159,7 +160,7 @@ double percentile_spread(const Vec& wx, const Vec& wy) {
 
 std::vector<PcgProbeRow> probe_l1_pcg(const PcgProbeProblem& problem,
                                       const std::vector<int>& probe_at, double tolerance,
-                                      int max_steps) {
+                                      int max_steps, bool dct) {
   const int W = problem.width, H = problem.height;
   const size_t px = size_t(W) * H;
   ReconstructionInput in{W,       H,      problem.primal, problem.gradient_x, problem.gradient_y,
@@ -179,7 +180,7 @@ std::vector<PcgProbeRow> probe_l1_pcg(const PcgProbeProblem& problem,
   const detail::IrlsWeights out{w0.data(), wx.data(), wy.data(), inv.data()};
   detail::WeightedProblem pb{
       W,         H,         problem.primal, problem.gradient_x, problem.gradient_y,
-      w0.data(), wx.data(), wy.data(),      inv.data()};
+      w0.data(), wx.data(), wy.data(),      inv.data(),         nullptr};
   // The library's schedule (reconstruct.cpp): 36 reweightings, reg 0.05 -> 0.05 / 2^19,
   // 12 -> 3 steps.
   const int K = 36, first = 12, last = 3;
@@ -220,8 +221,27 @@ std::vector<PcgProbeRow> probe_l1_pcg(const PcgProbeProblem& problem,
     const Preconditioner scaled = [&](const Vec& r, Vec& z) {
       dct_precondition(W, H, beta2, d_half, d_half, r, z);
     };
-    const Preconditioner* all[3] = {&jacobi, &scalar, &scaled};
-    for (int m = 0; m < 3; ++m) {
+    detail::MultigridOptions options[4];
+    for (int v = 0; v < 4; ++v) {
+      options[v].form =
+          v % 2 ? detail::MultigridOptions::kVCycle : detail::MultigridOptions::kAdditive;
+      options[v].edge_scale = v < 2 ? 0.5f : 1.f;
+    }
+    detail::WeightedMultigrid mg[4] = {
+        detail::WeightedMultigrid(options[0]), detail::WeightedMultigrid(options[1]),
+        detail::WeightedMultigrid(options[2]), detail::WeightedMultigrid(options[3])};
+    Preconditioner multigrid[4];
+    for (int v = 0; v < 4; ++v) {
+      mg[v].build(pb);
+      multigrid[v] = [&mg, v](const Vec& r, Vec& z) { mg[v].apply(r.data(), z.data()); };
+    }
+    const Preconditioner* all[PcgProbeRow::kPreconditioners] = {
+        &jacobi, &scalar, &scaled, &multigrid[0], &multigrid[1], &multigrid[2], &multigrid[3]};
+    for (int m = 0; m < PcgProbeRow::kPreconditioners; ++m) {
+      if (!dct && (m == 1 || m == 2)) {
+        row.steps_to_library[m] = row.steps_to_tolerance[m] = -1;
+        continue;
+      }
       const PcgRun run = run_pcg(pb, x0, *all[m], row.jacobi_residual, tolerance, max_steps);
       row.steps_to_library[m] = run.to_first;
       row.steps_to_tolerance[m] = run.to_second;

@@ -12,7 +12,11 @@
 //   scalar    M = s (beta^2 + L), L the Neumann Laplacian, s the mean gradient weight and
 //             beta^2 = mean(W0) / s: one exact DCT solve per step;
 //   scaled    M^-1 = D^-1/2 (beta^2 + L)^-1 D^-1/2 with D = diag(A) / (beta^2 + 4): the same DCT
-//             solve between two Jacobi scalings, so that M's diagonal matches A's.
+//             solve between two Jacobi scalings, so that M's diagonal matches A's;
+//   mg-add    the library's multigrid (reconstruct/multigrid.h), additive at the finest level,
+//             coarse edges halved (edge scale 0.5);
+//   mg-V      the same, a full V(1,1) from the finest level;
+//   gal-add, gal-V  the same two with Galerkin coarse operators (edge scale 1, the default).
 #pragma once
 
 #include <vector>
@@ -33,15 +37,19 @@ struct PcgProbeRow {
   double jacobi_residual = 0.0;  // relative residual after the library's steps
   int library_steps = 0;
   // Steps (capped) and wall seconds of each preconditioner to reach jacobi_residual, then to
-  // reach `tolerance`; index 0 Jacobi, 1 scalar, 2 scaled.
-  int steps_to_library[3] = {}, steps_to_tolerance[3] = {};
-  double seconds_to_tolerance[3] = {};
+  // reach `tolerance`; in the order of kNames (-1: not run or not reached).
+  static constexpr int kPreconditioners = 7;
+  static constexpr const char* kNames[kPreconditioners] = {"Jacobi", "scalar",  "scaled", "mg-add",
+                                                           "mg-V",   "gal-add", "gal-V"};
+  int steps_to_library[kPreconditioners] = {}, steps_to_tolerance[kPreconditioners] = {};
+  double seconds_to_tolerance[kPreconditioners] = {};
 };
 
 // Runs the default IRLS schedule (36 reweightings, 12 -> 3 steps) and probes the reweightings in
-// `probe_at`; `tolerance` is the fixed relative residual, `max_steps` the cap.
+// `probe_at`; `tolerance` is the fixed relative residual, `max_steps` the cap. Without `dct` the
+// two DCT preconditioners are skipped (they cost several Jacobi steps per step).
 std::vector<PcgProbeRow> probe_l1_pcg(const PcgProbeProblem& problem,
                                       const std::vector<int>& probe_at, double tolerance,
-                                      int max_steps);
+                                      int max_steps, bool dct = true);
 
 }  // namespace gdpt::bench
