@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <new>
+#include <utility>
 #include <vector>
 
 #if defined(__linux__)
@@ -69,6 +70,30 @@ struct HugePageAllocator {
 
 template <typename T>
 using HugePageVector = std::vector<T, HugePageAllocator<T>>;
+
+// HugePageAllocator whose resize() leaves new elements default-initialised (for arithmetic types:
+// unwritten): a buffer written in full by a parallel loop is then first touched, and its pages
+// faulted, by the threads that write it, instead of by a serial zero fill.
+template <typename T>
+struct FreshHugePageAllocator : HugePageAllocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = FreshHugePageAllocator<U>;
+  };
+  FreshHugePageAllocator() = default;
+  template <typename U>
+  FreshHugePageAllocator(const FreshHugePageAllocator<U>&) noexcept {}
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    if constexpr (sizeof...(Args) == 0)
+      ::new (static_cast<void*>(p)) U;
+    else
+      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+template <typename T>
+using FreshHugeVector = std::vector<T, FreshHugePageAllocator<T>>;
 
 // For plain std::vectors (APIs that hand them on): an empty vector with room for n elements, its
 // fresh pages advised (filled later without a zero fill); v.resize(n), a new allocation advised

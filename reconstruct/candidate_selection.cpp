@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "reconstruct/parallel.h"
 
@@ -12,20 +13,8 @@ void candidate_error(const FeatureBuffers& fb, const float* fa, const float* fb_
                      const float* weight, float* relative) {
   const int W = fb.width;
   parallel_rows(fb.height, [&](int y0, int y1) {
-    for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
-      float e = 0.f, r = 0.f;
-      if (fb.valid[i] & kImagesValid) {
-        for (int c = 0; c < 3; ++c) {
-          const size_t k = 3 * i + c;
-          const float da = fa[k] - fb.b[k], db = fb_half[k] - fb.a[k], dd = fa[k] - fb_half[k];
-          const float ec = 0.5f * (da * da + db * db) - fb.half_var[k] - 0.25f * dd * dd;
-          e += ec;
-          if (weight) r += weight[k] * ec;
-        }
-      }
-      error[i] = e * (1.f / 3.f);
-      if (relative) relative[i] = r * (1.f / 3.f);
-    }
+    for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i)
+      pixel_error(fb, i, fa + 3 * i, fb_half + 3 * i, weight, error, relative);
   });
 }
 
@@ -40,28 +29,42 @@ void set_relative_weights(const FeatureBuffers& fb, const float* guide, Candidat
 
 void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const float* fb_half,
                      const float* filtered, CandidateChoice& choice) {
+  const size_t n = size_t(fb.width) * fb.height;
+  const bool weighted = !choice.weight.empty();
+  // Written in full before they are read: no zeroing of image-sized buffers.
+  FreshHugeVector<float> error(n), relative(weighted ? n : 0);
+  candidate_error(fb, fa, fb_half, error.data(), weighted ? choice.weight.data() : nullptr,
+                  relative.data());
+  offer_estimates(fb, index, error.data(), std::move(relative), filtered, choice);
+}
+
+void offer_estimates(const FeatureBuffers& fb, int index, float* error,
+                     FreshHugeVector<float> relative, const float* filtered,
+                     CandidateChoice& choice) {
   const int W = fb.width, H = fb.height;
   const size_t n = size_t(W) * H;
-  const bool weighted = !choice.weight.empty();
   if (size_t(index) != choice.images.size())
     throw std::logic_error("offer_candidate: candidates must be offered in index order");
-  // Scratch and keys are written in full before they are read: no zeroing of image-sized buffers.
-  if (!choice.scratch) choice.scratch.reset(new float[3 * n]);
-  float* const raw = choice.scratch.get();
-  choice.keys.emplace_back(new float[n]);
-  float* const key = choice.keys.back().get();
-  candidate_error(fb, fa, fb_half, raw, weighted ? choice.weight.data() : nullptr, raw + n);
-  // Without weights the key is the smoothed absolute estimate itself.
-  float* const smooth = weighted ? raw + 2 * n : key;
-  box_filter(raw, 1, W, H, kErrorSmoothingRadius, smooth);
-  if (weighted) box_filter(raw + n, 1, W, H, kErrorSmoothingRadius, key);
+  // In place: box_filter reads its source in full before it writes.
+  box_filter(error, 1, W, H, kErrorSmoothingRadius, error);
+  const float* const smooth = error;
+  if (choice.weight.empty()) {  // the key is the smoothed absolute estimate itself
+    relative.resize(n);
+    parallel_rows(H, [&](int y0, int y1) {
+      std::copy(error + size_t(y0) * W, error + size_t(y1) * W, relative.begin() + size_t(y0) * W);
+    });
+  } else {
+    box_filter(relative.data(), 1, W, H, kErrorSmoothingRadius, relative.data());
+  }
+  choice.keys.push_back(std::move(relative));
+  const float* const key = choice.keys.back().data();
   choice.images.push_back(filtered);
   const bool first = choice.image.empty();
-  if (first) {
-    choice.image.resize(3 * n);
-    choice.error.resize(n);
+  if (first) {  // all written below (the image, error and index are handed on as std::vectors)
+    resize_huge(choice.image, 3 * n);
+    resize_huge(choice.error, n);
     choice.relative.resize(n);
-    choice.index.resize(n);
+    resize_huge(choice.index, n);
   }
   parallel_rows(H, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
@@ -77,7 +80,11 @@ void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const
 void blend_choices(const FeatureBuffers& fb, CandidateChoice& choice) {
   const int W = fb.width, H = fb.height;
   const size_t n = size_t(W) * H;
-  std::vector<float> sum(3 * n, 0.f), total(n, 0.f), chose(n), share(n);
+  FreshHugeVector<float> sum(3 * n), total(n), chose(n), share(n);
+  parallel_rows(H, [&](int y0, int y1) {
+    std::fill(sum.begin() + 3 * size_t(y0) * W, sum.begin() + 3 * size_t(y1) * W, 0.f);
+    std::fill(total.begin() + size_t(y0) * W, total.begin() + size_t(y1) * W, 0.f);
+  });
   std::vector<size_t> pixels_chose(choice.images.size(), 0);
   for (uint8_t k : choice.index) ++pixels_chose[k];
   for (size_t k = 0; k < choice.images.size(); ++k) {
@@ -88,7 +95,7 @@ void blend_choices(const FeatureBuffers& fb, CandidateChoice& choice) {
         chose[i] = choice.index[i] == k ? 1.f : 0.f;
     });
     box_filter(chose.data(), 1, W, H, kErrorSmoothingRadius, share.data());
-    const float* key = choice.keys[k].get();
+    const float* key = choice.keys[k].data();
     const float* image = choice.images[k];
     parallel_rows(H, [&](int y0, int y1) {
       for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {

@@ -19,7 +19,6 @@
 #pragma once
 
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 #include "reconstruct/feature_buffers.h"
@@ -32,22 +31,38 @@ inline constexpr float kRelativeErrorEpsilon = 1e-2f;
 inline constexpr float kBlendTolerance = 16.f;
 
 struct CandidateChoice {
-  std::vector<float> image;     // RGB: the chosen candidate's filter applied to all samples
-  std::vector<float> error;     // per pixel, its smoothed error estimate (mean over RGB)
-  std::vector<float> relative;  // per pixel, its smoothed relative error estimate (the key)
-  std::vector<float> weight;    // RGB: 1 / (guide^2 + eps); empty: absolute errors compared
-  std::vector<uint8_t> index;   // per pixel, the chosen candidate
+  std::vector<float> image;         // RGB: the chosen candidate's filter applied to all samples
+  std::vector<float> error;         // per pixel, its smoothed error estimate (mean over RGB)
+  FreshHugeVector<float> relative;  // per pixel, its smoothed relative error estimate (the key)
+  FreshHugeVector<float> weight;    // RGB: 1 / (guide^2 + eps); empty: absolute errors compared
+  std::vector<uint8_t> index;       // per pixel, the chosen candidate
   // Every candidate offered: its image of all samples (RGB; the caller's, kept alive until
   // blend_choices) and its key, for blend_choices.
   std::vector<const float*> images;
-  std::vector<std::unique_ptr<float[]>> keys;
-  std::unique_ptr<float[]> scratch;  // the raw estimates and the smoothed absolute one
+  std::vector<FreshHugeVector<float>> keys;
 };
 
 // Per pixel e (mean over RGB) of the candidate with filtered halves fa, fb_half; 0 where the
 // halves are missing. With `weight` (RGB), also the weighted mean to `relative`.
 void candidate_error(const FeatureBuffers& fb, const float* fa, const float* fb_half, float* error,
                      const float* weight = nullptr, float* relative = nullptr);
+
+// candidate_error at pixel i from the filtered halves' colours fa, fb_half (RGB of pixel i).
+inline void pixel_error(const FeatureBuffers& fb, size_t i, const float* fa, const float* fb_half,
+                        const float* weight, float* error, float* relative) {
+  float e = 0.f, r = 0.f;
+  if (fb.valid[i] & kImagesValid) {
+    for (int c = 0; c < 3; ++c) {
+      const size_t k = 3 * i + c;
+      const float da = fa[c] - fb.b[k], db = fb_half[c] - fb.a[k], dd = fa[c] - fb_half[c];
+      const float ec = 0.5f * (da * da + db * db) - fb.half_var[k] - 0.25f * dd * dd;
+      e += ec;
+      if (weight) r += weight[k] * ec;
+    }
+  }
+  error[i] = e * (1.f / 3.f);
+  if (relative) relative[i] = r * (1.f / 3.f);
+}
 
 // choice.weight from `guide` (RGB, candidate-independent): 1 / (guide^2 + eps) per channel.
 void set_relative_weights(const FeatureBuffers& fb, const float* guide, CandidateChoice& choice);
@@ -58,6 +73,13 @@ void set_relative_weights(const FeatureBuffers& fb, const float* guide, Candidat
 // with index 0, 1, 2, ... in turn; `filtered` must stay alive until blend_choices.
 void offer_candidate(const FeatureBuffers& fb, int index, const float* fa, const float* fb_half,
                      const float* filtered, CandidateChoice& choice);
+
+// offer_candidate from the candidate's estimates (candidate_error's, as bilateral_candidates
+// writes them): `error`, smoothed in place (the caller's scratch), and `relative` (with
+// choice.weight; unused without), which becomes the candidate's key.
+void offer_estimates(const FeatureBuffers& fb, int index, float* error,
+                     FreshHugeVector<float> relative, const float* filtered,
+                     CandidateChoice& choice);
 
 // After the last offer: choice.image becomes the blend of the candidates in the proportions the
 // neighbourhood chose them (see above); the offered images and keys are released.

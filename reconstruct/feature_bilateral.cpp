@@ -4,8 +4,14 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <iterator>
+#include <stdexcept>
 
+#include <tbb/enumerable_thread_specific.h>
+
+#include "reconstruct/candidate_selection.h"
 #include "reconstruct/parallel.h"
 
 namespace gdpt::detail {
@@ -14,12 +20,14 @@ namespace {
 
 inline constexpr int kMaxImages = 3;
 inline constexpr int kMaxRanges = kColourToleranceCount;
+inline constexpr int kMaxWindows = int(std::size(kWindows));
 // Feature distances beyond this give weights below 1e-5 of the centre's: skipped.
 inline constexpr float kNegligibleDistance = 23.f;
 // Keeps the relative colour tolerance finite on black pixels.
 inline constexpr float kRangeFloor = 1e-3f;
-// Pixels of a row filtered together: their sums stay in L1 while every tap adds to them.
-inline constexpr int kBlock = 64;
+// Pixels of a row filtered together: their sums (every window, tolerance and image: 18 KB) stay
+// in L1 while every tap adds to them.
+inline constexpr int kBlock = 32;
 
 // v where `keep`, else 0: a select by bit mask, so the loops over pixels stay branch-free.
 inline float masked(bool keep, float v) {
@@ -77,10 +85,12 @@ void identity_filter(const FeatureBuffers& fb, const float* const* images, float
   });
 }
 
-// One filter call's inputs and outputs.
+// One filter call's inputs and outputs: several windows filtered in one pass over their taps.
 struct FilterJob {
   const FeatureBuffers& fb;
-  int radius, stride;
+  int windows;
+  const BilateralWindow* window;
+  int reach;                // the largest radius
   const float* inv_range2;  // per colour tolerance; 0: none
   // Per colour tolerance: the one 4x wider whose colour weight, to the 16th power, is this one's
   // (four squarings instead of an exponential), or -1.
@@ -88,28 +98,31 @@ struct FilterJob {
   int ranges;
   const float* const* images;
   int count;
-  float* const* out;
+  float* const* out;      // [(window * ranges + tolerance) * count + image]; null: not written
   const float* multiply;  // RGB factor of every output, or null
+  // [window * ranges + tolerance]: the error estimates of images 0 and 1 (the halves), or null.
+  const CandidateEstimates* estimates;
+  const float* weight;  // RGB weights of the relative estimate, or null
 };
 
-// The rows [y0 - radius, y1 + radius) of a chunk, clipped to the image, as planes: the images'
+// The rows [y0 - reach, y1 + reach) of a chunk, clipped to the image, as planes: the images'
 // channels and the validity bits, so that the loops over pixels read contiguous floats.
 struct ChunkPlanes {
   int first_row = 0, width = 0;
-  std::vector<float> colour;   // (image * 3 + channel) planes
-  std::vector<int32_t> valid;  // FeatureValidity bits
-  size_t plane = 0;            // floats per plane
+  FreshHugeVector<float> colour;   // (image * 3 + channel) planes
+  FreshHugeVector<int32_t> valid;  // FeatureValidity bits
+  size_t plane = 0;                // floats per plane
   const float* channel(int k, int c, int y) const {
     return colour.data() + size_t(3 * k + c) * plane + size_t(y - first_row) * width;
   }
   const int32_t* valid_row(int y) const { return valid.data() + size_t(y - first_row) * width; }
 };
 
-ChunkPlanes chunk_planes(const FilterJob& job, int y0, int y1) {
+// Fills `p` (a thread's scratch, reused chunk after chunk: every element read is written here).
+void fill_chunk_planes(const FilterJob& job, int y0, int y1, ChunkPlanes& p) {
   const int W = job.fb.width, H = job.fb.height;
-  ChunkPlanes p;
-  p.first_row = std::max(0, y0 - job.radius);
-  const int last = std::min(H, y1 + job.radius);
+  p.first_row = std::max(0, y0 - job.reach);
+  const int last = std::min(H, y1 + job.reach);
   p.width = W;
   p.plane = size_t(last - p.first_row) * W;
   p.colour.resize(3 * job.count * p.plane);
@@ -122,13 +135,12 @@ ChunkPlanes chunk_planes(const FilterJob& job, int y0, int y1) {
       const float* s = job.images[k] + 3 * base + c;
       for (size_t i = 0; i < p.plane; ++i) d[i] = s[3 * i];
     }
-  return p;
 }
 
-// Per pixel of a block: the sums of weighted colours and weights, per tolerance and image.
+// Per pixel of a block: the sums of weighted colours and weights, per window, tolerance, image.
 struct BlockSums {
-  float num[kMaxRanges][kMaxImages][3][kBlock];
-  float den[kMaxRanges][kMaxImages][kBlock];
+  float num[kMaxWindows][kMaxRanges][kMaxImages][3][kBlock];
+  float den[kMaxWindows][kMaxRanges][kMaxImages][kBlock];
 };
 
 // Feature weights of the tap (dx, dy) for the pixels [x0, x1) of row y (0 for a tap left out).
@@ -163,9 +175,32 @@ void feature_weights(const FilterJob& job, const ChunkPlanes& p, int y, int dy, 
   }
 }
 
-// Adds the tap (dx, dy) to the sums of the pixels [x0, x1) of row y (block starting at xb).
+// Adds one tap's colours q (offset by dx) with weights wf (times `colour` unless null) to sums.
+inline void accumulate(const float* wf, const float* colour, const float* const* q, int dx, int x0,
+                       int x1, int xb, float* n0, float* n1, float* n2, float* den) {
+  if (colour) {
+    for (int x = x0; x < x1; ++x) {
+      const float a = wf[x - xb], w = masked(a > 0.f, a * colour[x - xb]);
+      n0[x - xb] += w * q[0][x + dx];
+      n1[x - xb] += w * q[1][x + dx];
+      n2[x - xb] += w * q[2][x + dx];
+      den[x - xb] += w;
+    }
+  } else {
+    for (int x = x0; x < x1; ++x) {
+      const float w = wf[x - xb];
+      n0[x - xb] += w * q[0][x + dx];
+      n1[x - xb] += w * q[1][x + dx];
+      n2[x - xb] += w * q[2][x + dx];
+      den[x - xb] += w;
+    }
+  }
+}
+
+// Adds the tap (dx, dy) to the sums of the pixels [x0, x1) of row y (block starting at xb) of the
+// windows in `windows` (bit w: window w): its weights are computed once for all of them.
 void add_tap(const FilterJob& job, const ChunkPlanes& p, int y, int dy, int dx, int x0, int x1,
-             int xb, const float* scale, BlockSums& s) {
+             int xb, const float* scale, unsigned windows, BlockSums& s) {
   float wf[kBlock], dc[kBlock], colour[kMaxRanges][kBlock];
   feature_weights(job, p, y, dy, dx, x0, x1, xb, wf);
   for (int k = 0; k < job.count; ++k) {
@@ -189,32 +224,60 @@ void add_tap(const FilterJob& job, const ChunkPlanes& p, int y, int dy, int dx, 
         colour[t][x - xb] = e8 * e8;
       }
     }
-    for (int t = 0; t < job.ranges; ++t) {
-      float *n0 = s.num[t][k][0], *n1 = s.num[t][k][1], *n2 = s.num[t][k][2], *den = s.den[t][k];
-      if (job.inv_range2[t] > 0.f) {
-        for (int x = x0; x < x1; ++x) {
-          const float a = wf[x - xb], w = masked(a > 0.f, a * colour[t][x - xb]);
-          n0[x - xb] += w * q[0][x + dx];
-          n1[x - xb] += w * q[1][x + dx];
-          n2[x - xb] += w * q[2][x + dx];
-          den[x - xb] += w;
-        }
-      } else {
-        for (int x = x0; x < x1; ++x) {
-          const float w = wf[x - xb];
-          n0[x - xb] += w * q[0][x + dx];
-          n1[x - xb] += w * q[1][x + dx];
-          n2[x - xb] += w * q[2][x + dx];
-          den[x - xb] += w;
-        }
-      }
+    for (int w = 0; w < job.windows; ++w) {
+      if (!(windows >> w & 1u)) continue;
+      for (int t = 0; t < job.ranges; ++t)
+        accumulate(wf, job.inv_range2[t] > 0.f ? colour[t] : nullptr, q, dx, x0, x1, xb,
+                   s.num[w][t][k][0], s.num[w][t][k][1], s.num[w][t][k][2], s.den[w][t][k]);
     }
   }
 }
 
-// Filters the pixels [xb, xe) of row y: every tap in the order of the window's rows.
+// The windows (bits) with a tap at (dx, dy).
+unsigned windows_with_tap(const FilterJob& job, int dx, int dy) {
+  unsigned m = 0;
+  for (int w = 0; w < job.windows; ++w) {
+    const BilateralWindow& win = job.window[w];
+    if (std::abs(dx) <= win.radius && std::abs(dy) <= win.radius && dx % win.stride == 0 &&
+        dy % win.stride == 0)
+      m |= 1u << w;
+  }
+  return m;
+}
+
+// Writes the pixels [xb, xe) of row y from the sums: the outputs asked for and the estimates.
+void write_block(const FilterJob& job, int y, int xb, int xe, const BlockSums& s) {
+  const size_t row = size_t(y) * job.fb.width;
+  const float* m = job.multiply ? job.multiply + 3 * row : nullptr;
+  for (int w = 0; w < job.windows; ++w)
+    for (int t = 0; t < job.ranges; ++t) {
+      float halves[2][3 * kBlock];
+      for (int k = 0; k < job.count; ++k) {
+        float* o = job.out[(w * job.ranges + t) * job.count + k];
+        const bool estimated = job.estimates && k < 2;
+        if (!o && !estimated) continue;
+        const float* in = job.images[k] + 3 * row;
+        for (int x = xb; x < xe; ++x) {
+          const float den = s.den[w][t][k][x - xb];
+          for (int c = 0; c < 3; ++c) {
+            const float v0 = den > 0.f ? s.num[w][t][k][c][x - xb] / den : in[3 * x + c];
+            const float v = m ? v0 * m[3 * x + c] : v0;
+            if (o) o[3 * (row + x) + c] = v;
+            if (estimated) halves[k][3 * (x - xb) + c] = v;
+          }
+        }
+      }
+      if (!job.estimates) continue;
+      const CandidateEstimates& e = job.estimates[w * job.ranges + t];
+      for (int x = xb; x < xe; ++x)
+        pixel_error(job.fb, row + x, halves[0] + 3 * (x - xb), halves[1] + 3 * (x - xb), job.weight,
+                    e.error, e.relative);
+    }
+}
+
+// Filters the pixels [xb, xe) of row y: every tap of every window, in the order of the rows.
 void filter_block(const FilterJob& job, const ChunkPlanes& p, int y, int xb, int xe, BlockSums& s) {
-  const int W = job.fb.width, H = job.fb.height, r = job.radius;
+  const int W = job.fb.width, H = job.fb.height, r = job.reach;
   float scale[kMaxImages * kBlock];
   const int32_t* vi = p.valid_row(y);
   for (int k = 0; k < job.count; ++k) {
@@ -225,28 +288,45 @@ void filter_block(const FilterJob& job, const ChunkPlanes& p, int y, int xb, int
       scale[kBlock * k + x - xb] = (vi[x] & kImagesValid) ? 1.f / (3.f * lum * lum) : 0.f;
     }
   }
-  std::memset(&s, 0, sizeof(s));
-  for (int dy = -r; dy <= r; dy += job.stride) {
+  std::memset(&s.num, 0, sizeof(s.num[0]) * job.windows);
+  std::memset(&s.den, 0, sizeof(s.den[0]) * job.windows);
+  // Each window sees its own taps in the order of its rows, as if filtered alone.
+  for (int dy = -r; dy <= r; ++dy) {
     if (y + dy < 0 || y + dy >= H) continue;
-    for (int dx = -r; dx <= r; dx += job.stride) {
+    for (int dx = -r; dx <= r; ++dx) {
+      const unsigned windows = windows_with_tap(job, dx, dy);
       const int x0 = std::max(xb, -dx), x1 = std::min(xe, W - dx);
-      if (x0 < x1) add_tap(job, p, y, dy, dx, x0, x1, xb, scale, s);
+      if (windows && x0 < x1) add_tap(job, p, y, dy, dx, x0, x1, xb, scale, windows, s);
     }
   }
-  const size_t row = size_t(y) * W;
-  for (int t = 0; t < job.ranges; ++t)
-    for (int k = 0; k < job.count; ++k) {
-      float* o = job.out[t * job.count + k] + 3 * row;
-      const float* in = job.images[k] + 3 * row;
-      const float* m = job.multiply ? job.multiply + 3 * row : nullptr;
-      for (int x = xb; x < xe; ++x) {
-        const float den = s.den[t][k][x - xb];
-        for (int c = 0; c < 3; ++c) {
-          const float v = den > 0.f ? s.num[t][k][c][x - xb] / den : in[3 * x + c];
-          o[3 * x + c] = m ? v * m[3 * x + c] : v;
-        }
-      }
-    }
+  write_block(job, y, xb, xe, s);
+}
+
+// The inverse squared tolerances and which tolerances' weights are another's to the 16th power.
+void range_setup(const float* ranges, int range_count, float* inv_range2, int* squared_from) {
+  for (int t = 0; t < range_count; ++t)
+    inv_range2[t] = ranges[t] > 0.f ? 1.f / (ranges[t] * ranges[t]) : 0.f;
+  for (int t = 0; t < range_count; ++t) {
+    squared_from[t] = -1;
+    for (int u = 0; u < range_count; ++u)
+      if (inv_range2[u] > 0.f &&
+          std::abs(inv_range2[t] - 16.f * inv_range2[u]) <= 1e-6f * inv_range2[t])
+        squared_from[t] = u;
+  }
+  for (int t = 0; t < range_count; ++t)  // from a weight computed directly only
+    if (squared_from[t] >= 0 && squared_from[squared_from[t]] >= 0) squared_from[t] = -1;
+}
+
+void run(const FilterJob& job) {
+  tbb::enumerable_thread_specific<ChunkPlanes> scratch;
+  parallel_rows(job.fb.height, [&](int y0, int y1) {
+    ChunkPlanes& planes = scratch.local();
+    fill_chunk_planes(job, y0, y1, planes);
+    BlockSums sums;
+    for (int y = y0; y < y1; ++y)
+      for (int xb = 0; xb < job.fb.width; xb += kBlock)
+        filter_block(job, planes, y, xb, std::min(job.fb.width, xb + kBlock), sums);
+  });
 }
 
 }  // namespace
@@ -267,27 +347,32 @@ void bilateral_filter(const FeatureBuffers& fb, const BilateralWindow& window, c
     return;
   }
   float inv_range2[kMaxRanges];
-  for (int t = 0; t < range_count; ++t)
-    inv_range2[t] = ranges[t] > 0.f ? 1.f / (ranges[t] * ranges[t]) : 0.f;
   int squared_from[kMaxRanges];
-  for (int t = 0; t < range_count; ++t) {
-    squared_from[t] = -1;
-    for (int u = 0; u < range_count; ++u)
-      if (inv_range2[u] > 0.f &&
-          std::abs(inv_range2[t] - 16.f * inv_range2[u]) <= 1e-6f * inv_range2[t])
-        squared_from[t] = u;
+  range_setup(ranges, range_count, inv_range2, squared_from);
+  run(FilterJob{fb, 1, &window, window.radius, inv_range2, squared_from, range_count, images, count,
+                out, multiply, nullptr, nullptr});
+}
+
+void bilateral_candidates(const FeatureBuffers& fb, const BilateralWindow* windows,
+                          int window_count, const float* ranges, int range_count,
+                          const float* const* images, float* const* out,
+                          const CandidateEstimates* estimates, const float* weight,
+                          const float* multiply) {
+  if (window_count > kMaxWindows)
+    throw std::invalid_argument("bilateral_candidates: too many windows");
+  float inv_range2[kMaxRanges];
+  int squared_from[kMaxRanges];
+  range_setup(ranges, range_count, inv_range2, squared_from);
+  int reach = 0;
+  for (int w = 0; w < window_count; ++w) {
+    if (windows[w].radius < 1) throw std::invalid_argument("bilateral_candidates: radius 0");
+    reach = std::max(reach, windows[w].radius);
   }
-  for (int t = 0; t < range_count; ++t)  // from a weight computed directly only
-    if (squared_from[t] >= 0 && squared_from[squared_from[t]] >= 0) squared_from[t] = -1;
-  const FilterJob job{fb,          window.radius, window.stride, inv_range2, squared_from,
-                      range_count, images,        count,         out,        multiply};
-  parallel_rows(fb.height, [&](int y0, int y1) {
-    const ChunkPlanes planes = chunk_planes(job, y0, y1);
-    BlockSums sums;
-    for (int y = y0; y < y1; ++y)
-      for (int xb = 0; xb < fb.width; xb += kBlock)
-        filter_block(job, planes, y, xb, std::min(fb.width, xb + kBlock), sums);
-  });
+  // Outputs per (window, tolerance): the halves are not kept, the image of all samples is.
+  std::vector<float*> outs(size_t(window_count) * range_count * 3, nullptr);
+  for (size_t c = 0; c < size_t(window_count) * range_count; ++c) outs[3 * c + 2] = out[c];
+  run(FilterJob{fb, window_count, windows, reach, inv_range2, squared_from, range_count, images, 3,
+                outs.data(), multiply, estimates, weight});
 }
 
 }  // namespace gdpt::detail

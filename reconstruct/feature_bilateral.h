@@ -44,6 +44,25 @@ void bilateral_filter(const FeatureBuffers& fb, const BilateralWindow& window, c
                       int range_count, const float* const* images, int count, float* const* out,
                       const float* multiply = nullptr);
 
+// Where bilateral_candidates writes a candidate's error estimates (candidate_selection.h,
+// candidate_error): per pixel, `error`, and `relative` unless null.
+struct CandidateEstimates {
+  float* error = nullptr;
+  float* relative = nullptr;
+};
+
+// The candidates of `windows` (radius >= 1; at most std::size(kWindows)) x `ranges` in one pass:
+// each tap's weights are computed once for every window that has it. images = {half A, half B,
+// all samples}: per candidate c = window * range_count + range, out[c] gets the image of all
+// samples filtered (times `multiply`) and estimates[c] candidate_error of the filtered halves
+// (with `weight`), which are not kept. Bit-identical to bilateral_filter per window followed by
+// candidate_error.
+void bilateral_candidates(const FeatureBuffers& fb, const BilateralWindow* windows,
+                          int window_count, const float* ranges, int range_count,
+                          const float* const* images, float* const* out,
+                          const CandidateEstimates* estimates, const float* weight,
+                          const float* multiply = nullptr);
+
 inline void bilateral_filter(const FeatureBuffers& fb, const BilateralCandidate& candidate,
                              const float* const* images, float* const* out, int count) {
   bilateral_filter(fb, candidate.window, &candidate.range, 1, images, count, out);

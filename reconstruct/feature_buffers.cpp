@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <memory>
 
 #include "reconstruct/parallel.h"
 
@@ -16,25 +15,22 @@ bool finite_n(const float* v, int n) {
   return true;
 }
 
-// Copies `n`-channel values and variances into the feature planes from plane `offset`;
-// clears kFeaturesValid where a value or variance is not finite.
+// Writes `n`-channel values and variances to the feature planes from plane `offset` (0 for an
+// absent feature); where a value or variance is not finite, 0 and kFeaturesValid cleared.
 void copy_feature(const float* values, const float* variance, int n, int offset,
                   FeatureBuffers& fb) {
-  if (!values) return;
-  fb.features += n;
+  if (values) fb.features += n;
   const int W = fb.width;
   const size_t pixels = size_t(W) * fb.height;
   parallel_rows(fb.height, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
-      const float* v = values + size_t(n) * i;
-      const float* var = variance ? variance + size_t(n) * i : nullptr;
-      if (!finite_n(v, n) || (var && !finite_n(var, n))) {
-        fb.valid[i] &= uint8_t(~kFeaturesValid);
-        continue;
-      }
+      const float* v = values ? values + size_t(n) * i : nullptr;
+      const float* var = variance && values ? variance + size_t(n) * i : nullptr;
+      const bool ok = v && finite_n(v, n) && (!var || finite_n(var, n));
+      if (v && !ok) fb.valid[i] &= uint8_t(~kFeaturesValid);
       for (int c = 0; c < n; ++c) {
-        fb.feature[size_t(offset + c) * pixels + i] = v[c];
-        fb.feature_var[size_t(offset + c) * pixels + i] = var ? std::max(0.f, var[c]) : 0.f;
+        fb.feature[size_t(offset + c) * pixels + i] = ok ? v[c] : 0.f;
+        fb.feature_var[size_t(offset + c) * pixels + i] = ok && var ? std::max(0.f, var[c]) : 0.f;
       }
     }
   });
@@ -47,7 +43,7 @@ void box_filter(const float* src, int channels, int width, int height, int radiu
   const size_t row = size_t(W) * C;
   // Rows: window sums from prefix sums; the mean's divisions are applied once, at the end.
   // Written in full by the row pass: left uninitialised (zeroing it would cost a full pass).
-  const std::unique_ptr<float[]> rows(new float[row * height]);
+  FreshHugeVector<float> rows(row * height);
   std::vector<double> inv_x(W);
   for (int x = 0; x < W; ++x)
     inv_x[x] = 1.0 / double(std::min(W, x + radius + 1) - std::max(0, x - radius));
@@ -57,7 +53,7 @@ void box_filter(const float* src, int channels, int width, int height, int radiu
       const float* s = src + size_t(y) * row;
       for (int c = 0; c < C; ++c) prefix[c] = 0.0;
       for (size_t i = 0; i < row; ++i) prefix[i + C] = prefix[i] + s[i];
-      float* d = rows.get() + size_t(y) * row;
+      float* d = rows.data() + size_t(y) * row;
       for (int x = 0; x < W; ++x) {
         const size_t lo = size_t(std::max(0, x - radius)) * C,
                      hi = size_t(std::min(W, x + radius + 1)) * C;
@@ -70,7 +66,7 @@ void box_filter(const float* src, int channels, int width, int height, int radiu
   parallel_rows(height, [&](int y0, int y1) {
     std::vector<double> sum(row, 0.0);
     auto add = [&](int yy, double sign) {
-      const float* r = rows.get() + size_t(yy) * row;
+      const float* r = rows.data() + size_t(yy) * row;
       for (size_t i = 0; i < row; ++i) sum[i] += sign * r[i];
     };
     int lo = std::max(0, y0 - radius), hi = std::min(height, y0 + radius + 1);
@@ -98,33 +94,31 @@ FeatureBuffers prepare_feature_buffers(const ReconstructionInput& in, const floa
   fb.height = in.height;
   const int W = in.width;
   const size_t n = size_t(W) * in.height;
-  fb.a.assign(3 * n, 0.f);
-  fb.b.assign(3 * n, 0.f);
-  fb.all.assign(3 * n, 0.f);
-  fb.half_var.assign(3 * n, 0.f);
-  fb.valid.assign(n, kFeaturesValid);
+  // Unwritten until the parallel passes below write every element (fresh pages, no zero fill).
+  for (FreshHugeVector<float>* v : {&fb.a, &fb.b, &fb.all, &fb.half_var}) v->resize(3 * n);
+  fb.valid.resize(n);
+  fb.feature.resize(kFeatureChannels * n);
+  fb.feature_var.resize(kFeatureChannels * n);
   const bool given = variance_a && variance_b;
   parallel_rows(in.height, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * W; i < size_t(y1) * W; ++i) {
       const size_t k = 3 * i;
       bool ok = finite_n(a + k, 3) && finite_n(b + k, 3) && finite_n(all + k, 3);
       if (given) ok = ok && finite_n(variance_a + k, 3) && finite_n(variance_b + k, 3);
-      if (!ok) continue;
-      fb.valid[i] |= kImagesValid;
+      fb.valid[i] = ok ? kFeaturesValid | kImagesValid : kFeaturesValid;
       for (int c = 0; c < 3; ++c) {
-        fb.a[k + c] = a[k + c];
-        fb.b[k + c] = b[k + c];
-        fb.all[k + c] = all[k + c];
         const float d = a[k + c] - b[k + c];
         // E[(A - B)^2] = Var A + Var B for independent halves.
-        fb.half_var[k + c] =
+        const float var =
             given ? 0.5f * (std::max(0.f, variance_a[k + c]) + std::max(0.f, variance_b[k + c]))
                   : 0.5f * d * d;
+        fb.a[k + c] = ok ? a[k + c] : 0.f;
+        fb.b[k + c] = ok ? b[k + c] : 0.f;
+        fb.all[k + c] = ok ? all[k + c] : 0.f;
+        fb.half_var[k + c] = ok ? var : 0.f;
       }
     }
   });
-  fb.feature.assign(kFeatureChannels * n, 0.f);
-  fb.feature_var.assign(kFeatureChannels * n, 0.f);
   copy_feature(in.albedo, in.albedo_variance, 3, 0, fb);
   copy_feature(in.normal, in.normal_variance, 3, 3, fb);
   copy_feature(in.depth, in.depth_variance, 1, 6, fb);

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/huge_pages.h"
 #include "reconstruct/reconstruct.h"
 
 namespace gdpt::detail {
@@ -16,15 +17,16 @@ enum FeatureValidity : uint8_t { kImagesValid = 1, kFeaturesValid = 2 };
 
 struct FeatureBuffers {
   int width = 0, height = 0;
-  int features = 0;              // feature channels present (albedo 3, normal 3, depth 1)
-  std::vector<float> a, b, all;  // RGB: the halves and the image of all samples, 0 where missing
-  std::vector<float> half_var;   // RGB (Var A + Var B) / 2, unbiased per pixel
+  int features = 0;  // feature channels present (albedo 3, normal 3, depth 1)
+  FreshHugeVector<float> a, b,
+      all;                          // RGB: the halves and the image of all samples, 0 where missing
+  FreshHugeVector<float> half_var;  // RGB (Var A + Var B) / 2, unbiased per pixel
   // Feature values and variances, one plane (width x height) per channel, so that the filters'
   // loops over pixels read contiguous floats: albedo RGB, normal XYZ, depth (zeros for an absent
   // feature, which then adds nothing to a distance).
-  std::vector<float> feature, feature_var;
-  std::vector<uint8_t> valid;  // FeatureValidity bits per pixel
-  int missing = 0;             // pixels with some non-finite input
+  FreshHugeVector<float> feature, feature_var;
+  FreshHugeVector<uint8_t> valid;  // FeatureValidity bits per pixel
+  int missing = 0;                 // pixels with some non-finite input
 };
 
 inline constexpr int kFeatureChannels = 7;
@@ -37,7 +39,7 @@ FeatureBuffers prepare_feature_buffers(const ReconstructionInput& in, const floa
                                        const float* variance_b);
 
 // Mean of `channels`-channel `src` over the (2 radius + 1)^2 box around each pixel, clipped to
-// the image (the mean of the pixels inside). Row-chunked and deterministic.
+// the image (the mean of the pixels inside). Row-chunked and deterministic; dst may be src.
 void box_filter(const float* src, int channels, int width, int height, int radius, float* dst);
 
 }  // namespace gdpt::detail

@@ -113,9 +113,9 @@ FeatureBase base_images(const ReconstructionInput& in, const ReconstructionSetti
 // of all samples under the widest window with a loose colour tolerance (a bright spot stays off
 // its dark neighbours) and without one (a firefly is spread thin). Wide, so the weights carry
 // little of the noise they weigh.
-std::vector<float> relative_error_guide(const detail::FeatureBuffers& fb) {
+FreshHugeVector<float> relative_error_guide(const detail::FeatureBuffers& fb) {
   const size_t n3 = fb.all.size();
-  std::vector<float> tolerant(n3), plain(n3);
+  FreshHugeVector<float> tolerant(n3), plain(n3);  // written in full by the filter
   const float* const all = fb.all.data();
   float* const out[2] = {tolerant.data(), plain.data()};
   const float tolerances[2] = {kGuideColourTolerance, 0.f};
@@ -131,10 +131,11 @@ std::vector<float> relative_error_guide(const detail::FeatureBuffers& fb) {
 // multiplied by: filtering the illumination instead of the colour, textures stay sharp and the
 // colour tolerances compare light, not paint. Empty without an albedo feature; 1 where a pixel has
 // no valid features.
-std::vector<float> demodulation(const ReconstructionInput& in, const detail::FeatureBuffers& fb) {
+FreshHugeVector<float> demodulation(const ReconstructionInput& in,
+                                    const detail::FeatureBuffers& fb) {
   if (!in.albedo) return {};
   const size_t n = size_t(fb.width) * fb.height;
-  std::vector<float> d(3 * n);
+  FreshHugeVector<float> d(3 * n);
   detail::parallel_rows(fb.height, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * fb.width; i < size_t(y1) * fb.width; ++i)
       for (int c = 0; c < 3; ++c)
@@ -146,8 +147,7 @@ std::vector<float> demodulation(const ReconstructionInput& in, const detail::Fea
 }
 
 // out = image / factor (RGB, width x height).
-void divide_image(const std::vector<float>& factor, int width, int height, const float* image,
-                  float* out) {
+void divide_image(const float* factor, int width, int height, const float* image, float* out) {
   detail::parallel_rows(height, [&](int y0, int y1) {
     for (size_t i = 3 * size_t(y0) * width; i < 3 * size_t(y1) * width; ++i)
       out[i] = image[i] / factor[i];
@@ -162,70 +162,77 @@ FeatureReconstruction feature_filter(const ReconstructionInput& input, const flo
   FeatureReconstruction r;
   auto t = std::chrono::steady_clock::now();
   const size_t n3 = 3 * size_t(input.width) * input.height;
-  std::vector<float> la(a, a + n3), lb(b, b + n3), lall(all, all + n3);
+  FreshHugeVector<float> la(n3), lb(n3), lall(n3);
+  detail::parallel_rows(input.height, [&](int y0, int y1) {
+    const size_t k0 = 3 * size_t(y0) * input.width, k1 = 3 * size_t(y1) * input.width;
+    std::copy(a + k0, a + k1, la.begin() + k0);
+    std::copy(b + k0, b + k1, lb.begin() + k0);
+    std::copy(all + k0, all + k1, lall.begin() + k0);
+  });
   r.limited = detail::limit_half_outliers(
       input.width, input.height, input.primal_a ? input.primal_a : a,
       input.primal_b ? input.primal_b : b, la.data(), lb.data(), lall.data());
   const detail::FeatureBuffers fb = detail::prepare_feature_buffers(
       input, la.data(), lb.data(), lall.data(), variance_a, variance_b);
-  std::vector<float>().swap(la), std::vector<float>().swap(lb), std::vector<float>().swap(lall);
+  FreshHugeVector<float>().swap(la), FreshHugeVector<float>().swap(lb);
+  FreshHugeVector<float>().swap(lall);
   r.features = fb.features;
   r.missing = fb.missing;
   r.prepare_seconds = since(t);
 
-  // Per colour tolerance: the two halves (scratch, reused per window) and the image of all
-  // samples (kept for the blend), filtered. Every output is written in full by the filter, so
-  // none is zeroed first.
+  // Every candidate's image of all samples, kept for the blend (written in full by the filters).
   constexpr int kTol = detail::kColourToleranceCount;
-  constexpr int kCandidates = 1 + int(std::size(detail::kWindows)) * kTol;
-  const std::unique_ptr<float[]> halves(new float[size_t(kTol) * 2 * n3]);
-  std::unique_ptr<float[]> candidates[kCandidates];
-  for (auto& c : candidates) c.reset(new float[n3]);
-  float* out[kTol * 3];
-  auto point_outputs = [&](int first_candidate) {
-    for (int k = 0; k < kTol; ++k) {
-      out[3 * k] = halves.get() + size_t(2 * k) * n3;
-      out[3 * k + 1] = halves.get() + size_t(2 * k + 1) * n3;
-      out[3 * k + 2] =
-          first_candidate + k < kCandidates ? candidates[first_candidate + k].get() : nullptr;
-    }
-  };
+  constexpr int kWindowed = int(std::size(detail::kWindows)) * kTol;
+  FreshHugeVector<float> candidates[1 + kWindowed];
+  for (auto& c : candidates) c.resize(n3);
   detail::CandidateChoice choice;
   t = std::chrono::steady_clock::now();
   detail::set_relative_weights(fb, relative_error_guide(fb).data(), choice);
-  const std::vector<float> albedo = demodulation(input, fb);
-  std::unique_ptr<float[]> illumination[3];
+  const FreshHugeVector<float> albedo = demodulation(input, fb);
+  FreshHugeVector<float> illumination[3];
   const float* images[3] = {fb.a.data(), fb.b.data(), fb.all.data()};
   if (!albedo.empty()) {
     for (int k = 0; k < 3; ++k) {
-      illumination[k].reset(new float[n3]);
-      divide_image(albedo, input.width, input.height, images[k], illumination[k].get());
-      images[k] = illumination[k].get();
+      illumination[k].resize(n3);
+      divide_image(albedo.data(), input.width, input.height, images[k], illumination[k].data());
+      images[k] = illumination[k].data();
     }
   }
-  r.filter_seconds += since(t);
-  int index = 0;
   // The filters' outputs, multiplied back by the albedo as they are written.
   const float* const remodulate = albedo.empty() ? nullptr : albedo.data();
-  auto offer = [&](int tolerances) {
-    t = std::chrono::steady_clock::now();
-    for (int k = 0; k < tolerances; ++k, ++index)
-      detail::offer_candidate(fb, index, out[3 * k], out[3 * k + 1], out[3 * k + 2], choice);
-    r.select_seconds += since(t);
-  };
-  const float none = 0.f;
-  t = std::chrono::steady_clock::now();
-  point_outputs(0);
-  detail::bilateral_filter(fb, detail::BilateralWindow{0, 1}, &none, 1, images, 3, out, remodulate);
-  r.filter_seconds += since(t);
-  offer(1);
-  for (const detail::BilateralWindow& w : detail::kWindows) {
-    t = std::chrono::steady_clock::now();
-    point_outputs(index);
-    detail::bilateral_filter(fb, w, detail::kColourTolerances, kTol, images, 3, out, remodulate);
+  {  // The identity, through its filtered halves.
+    FreshHugeVector<float> halves(2 * n3);
+    float* const out[3] = {halves.data(), halves.data() + n3, candidates[0].data()};
+    const float none = 0.f;
+    detail::bilateral_filter(fb, detail::BilateralWindow{0, 1}, &none, 1, images, 3, out,
+                             remodulate);
     r.filter_seconds += since(t);
-    offer(kTol);
+    t = std::chrono::steady_clock::now();
+    detail::offer_candidate(fb, 0, out[0], out[1], out[2], choice);
+    r.select_seconds += since(t);
   }
+  // The windows in one pass, which writes the halves' error estimates instead of the halves.
+  t = std::chrono::steady_clock::now();
+  const bool weighted = !choice.weight.empty();
+  const size_t n = size_t(input.width) * input.height;
+  FreshHugeVector<float> errors(size_t(kWindowed) * n), keys[kWindowed];
+  detail::CandidateEstimates estimates[kWindowed];
+  float* out[kWindowed];
+  for (int c = 0; c < kWindowed; ++c) {
+    if (weighted) keys[c].resize(n);
+    estimates[c] = {errors.data() + size_t(c) * n, weighted ? keys[c].data() : nullptr};
+    out[c] = candidates[1 + c].data();
+  }
+  detail::bilateral_candidates(fb, detail::kWindows, int(std::size(detail::kWindows)),
+                               detail::kColourTolerances, kTol, images, out, estimates,
+                               weighted ? choice.weight.data() : nullptr, remodulate);
+  r.filter_seconds += since(t);
+  t = std::chrono::steady_clock::now();
+  for (int c = 0; c < kWindowed; ++c)
+    detail::offer_estimates(fb, 1 + c, estimates[c].error, std::move(keys[c]), out[c], choice);
+  FreshHugeVector<float>().swap(errors);  // released before the blend's scratch
+  for (auto& image : illumination) FreshHugeVector<float>().swap(image);
+  r.select_seconds += since(t);
   t = std::chrono::steady_clock::now();
   detail::blend_choices(fb, choice);
   r.blend_seconds = since(t);

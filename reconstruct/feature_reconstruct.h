@@ -13,12 +13,13 @@
 //      then the choices blended over the estimate's window (blend_choices); output = the blend
 //      of the candidates applied to all samples (+ emission).
 //
-// Memory beyond the inputs: about 580 bytes per pixel, 580 MB per megapixel (feature buffers
-// 105, the solved halves and image 36, their albedo-divided copies and the albedo 48, their
-// copies filtered with the three colour tolerances 108, the choice and its weights 33, error
-// scratch 16, every candidate's image and estimate for the blend 208, the blend's scratch 24; the
-// guide's two filtered copies, 24, before the candidates run), plus the gradient-domain solves'
-// own buffers while they run.
+// Memory beyond the inputs: at most about 480 bytes per pixel, 480 MB per megapixel, while the
+// windows are filtered (feature buffers 105, the solved halves and image 36, their albedo-divided
+// copies and the albedo 48, the choice and its weights 33, every candidate's image and key for
+// the blend 208, the windows' raw error estimates 48; the guide's two filtered copies, 24, and the
+// identity's filtered halves and estimates, 32, before; the blend's scratch, 24, after the
+// estimates and the divided copies are released), plus the gradient-domain solves' own buffers
+// while they run.
 #pragma once
 
 #include <vector>

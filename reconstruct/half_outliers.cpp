@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/huge_pages.h"
 #include "reconstruct/parallel.h"
 
 namespace gdpt::detail {
@@ -15,7 +16,7 @@ float luminance(const float* rgb) {
 }
 
 // Median of the finite values of `m` over the 8 neighbours of (x, y), clipped to the image.
-float neighbour_median(const std::vector<float>& m, int width, int height, int x, int y) {
+float neighbour_median(const float* m, int width, int height, int x, int y) {
   float v[8];
   int count = 0;
   for (int dy = -1; dy <= 1; ++dy)
@@ -36,15 +37,16 @@ float limited_scale(float scale, float value, float floor) {
   return std::max(scale, floor / value);
 }
 
+// Written in full by one parallel pass (fresh pages, no zero fill).
 struct Luminances {
-  std::vector<float> pa, pb, primal_mean, a, b, half_mean, all;
+  FreshHugeVector<float> pa, pb, primal_mean, a, b, half_mean, all;
 };
 
 Luminances luminances(int width, int height, const float* primal_a, const float* primal_b,
                       const float* a, const float* b, const float* all) {
   const size_t n = size_t(width) * height;
   Luminances l;
-  for (std::vector<float>* v : {&l.pa, &l.pb, &l.primal_mean, &l.a, &l.b, &l.half_mean, &l.all})
+  for (FreshHugeVector<float>* v : {&l.pa, &l.pb, &l.primal_mean, &l.a, &l.b, &l.half_mean, &l.all})
     v->resize(n);
   parallel_rows(height, [&](int y0, int y1) {
     for (size_t i = size_t(y0) * width; i < size_t(y1) * width; ++i) {
@@ -64,27 +66,28 @@ int limit_half_outliers(int width, int height, const float* primal_a, const floa
                         float* a, float* b, float* all) {
   const size_t n = size_t(width) * height;
   const Luminances l = luminances(width, height, primal_a, primal_b, a, b, all);
-  std::vector<float> scale_a(n, 1.f), scale_b(n, 1.f), scale_all(n, 1.f);
+  FreshHugeVector<float> scale_a(n), scale_b(n), scale_all(n);  // set per pixel below
   std::vector<int> fired(height, 0);
   parallel_rows(height, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < width; ++x) {
         const size_t i = size_t(y) * width + x;
+        scale_a[i] = scale_b[i] = scale_all[i] = 1.f;
         if (!std::isfinite(l.primal_mean[i]) || !std::isfinite(l.half_mean[i]) ||
             !std::isfinite(l.all[i]))
           continue;
         const bool a_high = l.pa[i] > l.pb[i];
         const float high = a_high ? l.pa[i] : l.pb[i], low = a_high ? l.pb[i] : l.pa[i];
-        const float around = neighbour_median(l.primal_mean, width, height, x, y);
+        const float around = neighbour_median(l.primal_mean.data(), width, height, x, y);
         const float bound = kHalfOutlierRatio * std::max({low, around, kHalfOutlierFloor});
         if (!(high > bound)) continue;
         const float rest = std::max(low, 0.f);  // high > bound > 0: the ratios are finite
         const float half_floor =
             kHalfOutlierRatio *
-            std::max(neighbour_median(l.half_mean, width, height, x, y), kHalfOutlierFloor);
+            std::max(neighbour_median(l.half_mean.data(), width, height, x, y), kHalfOutlierFloor);
         const float all_floor =
             kHalfOutlierRatio *
-            std::max(neighbour_median(l.all, width, height, x, y), kHalfOutlierFloor);
+            std::max(neighbour_median(l.all.data(), width, height, x, y), kHalfOutlierFloor);
         (a_high ? scale_a : scale_b)[i] =
             limited_scale(bound / high, a_high ? l.a[i] : l.b[i], half_floor);
         scale_all[i] = limited_scale((bound + rest) / (high + rest), l.all[i], all_floor);

@@ -20,7 +20,8 @@
 //     guide solve, preparation, the cross-filtered candidates and the choice, on the synthetic
 //     room of testing/feature_scene.h (half noise 0.2, gradient noise 0.1), relMSE against L1,
 //     CPU time (the time on idle cores on a loaded machine) of the whole and of the filters and
-//     choice alone; --feature-only runs just this case.
+//     choice alone, and a digest of both outputs (to compare builds bit for bit); --feature-only
+//     runs just this case.
 // --admm compares an ADMM L1 probe (l1_admm_probe.h) with the library's IRLS (see bench_admm).
 // --pcg counts PCG steps of the IRLS systems with DCT and multigrid preconditioners
 // (l1_pcg_probe.h); --pcg-mg only Jacobi and multigrid, at more reweightings.
@@ -38,6 +39,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -73,6 +75,21 @@ double cpu_seconds() {
   timespec ts{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// Minor page faults of the process so far (first touches of fresh memory).
+long minor_faults() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_minflt;
+}
+
+// FNV-1a over the bytes of an image: equal digests of two builds' runs mean bit-identical output.
+uint64_t digest(const std::vector<float>& v) {
+  uint64_t h = 1469598103934665603ull;
+  const auto* p = reinterpret_cast<const unsigned char*>(v.data());
+  for (size_t i = 0; i < v.size() * sizeof(float); ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
 }
 
 // Median wall time of `runs` calls after one warm-up call.
@@ -306,16 +323,20 @@ void bench_feature(int width, int height, int threads) {
     gdpt::ReconstructionReport r;
     const auto t1 = Clock::now();
     const double c1 = cpu_seconds();
+    const long f1 = minor_faults();
     const auto img = gdpt::reconstruct(in, s, &r);
     const double total = seconds_since(t1), cpu_total = cpu_seconds() - c1;
+    const long faults_total = minor_faults() - f1;
     // The filters and the choice alone, on the primal halves (the same work per candidate).
     gdpt::FeatureReconstruction fr;
     tbb::task_arena arena(threads);
     const auto t2 = Clock::now();
     const double c2 = cpu_seconds();
+    const long f2 = minor_faults();
     arena.execute(
         [&] { fr = gdpt::feature_filter(in, sc.a.data(), sc.b.data(), sc.primal.data()); });
     const double filter_wall = seconds_since(t2), filter_cpu = cpu_seconds() - c2;
+    const long faults_filter = minor_faults() - f2;
     const double rel = gdpt::test::relative_mse(img, sc.truth);
     const double split =
         fr.prepare_seconds + fr.filter_seconds + fr.select_seconds + fr.blend_seconds;
@@ -334,6 +355,10 @@ void bench_feature(int width, int height, int threads) {
     // Wall time depends on what else runs; CPU time (all threads) / threads is the time on
     // otherwise idle cores.
     std::printf("  CPU time: total %.2f s (%.2f s per thread)\n", cpu_total, cpu_total / threads);
+    std::printf("  minor page faults: total %ld, filters alone %ld\n", faults_total, faults_filter);
+    std::printf("  digest: whole %016llx, filters alone %016llx\n",
+                static_cast<unsigned long long>(digest(img)),
+                static_cast<unsigned long long>(digest(fr.image)));
   }
 }
 

@@ -5,10 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <vector>
 
+#include "reconstruct/candidate_selection.h"
 #include "reconstruct/feature_bilateral.h"
 #include "reconstruct/feature_buffers.h"
 #include "testing/feature_scene.h"
@@ -68,8 +71,10 @@ std::vector<float> reference_filter(const detail::FeatureBuffers& fb,
   return out;
 }
 
-TEST(FeatureBilateral, EveryCandidateMatchesTheDirectFilter) {
-  test::FeatureScene s = test::make_feature_scene(90, 61, 0.2f, 0.f, 17);
+// The synthetic room with random feature variances and 30 missing pixels (a half, a normal or
+// a depth not finite), its scene kept alive in `s`.
+detail::FeatureBuffers noisy_buffers(test::FeatureScene& s) {
+  s = test::make_feature_scene(90, 61, 0.2f, 0.f, 17);
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(0.f, 1.f);
   std::vector<float> albedo_var(s.albedo.size()), normal_var(s.normal.size()),
@@ -88,8 +93,13 @@ TEST(FeatureBilateral, EveryCandidateMatchesTheDirectFilter) {
   in.albedo_variance = albedo_var.data();
   in.normal_variance = normal_var.data();
   in.depth_variance = depth_var.data();
-  const detail::FeatureBuffers fb = detail::prepare_feature_buffers(
-      in, s.a.data(), s.b.data(), s.primal.data(), nullptr, nullptr);
+  return detail::prepare_feature_buffers(in, s.a.data(), s.b.data(), s.primal.data(), nullptr,
+                                         nullptr);
+}
+
+TEST(FeatureBilateral, EveryCandidateMatchesTheDirectFilter) {
+  test::FeatureScene s;
+  const detail::FeatureBuffers fb = noisy_buffers(s);
   ASSERT_EQ(fb.missing, 30);
   const size_t n3 = 3 * size_t(s.w) * s.h;
   const float* const images[2] = {fb.a.data(), fb.b.data()};
@@ -125,6 +135,54 @@ TEST(FeatureBilateral, EveryCandidateMatchesTheDirectFilter) {
       EXPECT_LT(worst_alone, 1e-5);
       EXPECT_GT(changed, 0.05);  // the filter does filter
     }
+  }
+}
+
+// All windows in one pass (taps shared by several windows weighed once), writing the halves'
+// error estimates: bit for bit what each window filtered alone and candidate_error give, with and
+// without the relative weights and the output factor.
+TEST(FeatureBilateral, CandidatesInOnePassMatchEachWindowBitForBit) {
+  test::FeatureScene s;
+  const detail::FeatureBuffers fb = noisy_buffers(s);
+  const size_t n = size_t(s.w) * s.h, n3 = 3 * n;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.5f, 2.f);
+  std::vector<float> weight(n3), multiply(n3);
+  for (float& x : weight) x = u(rng);
+  for (float& x : multiply) x = u(rng);
+  const float* const images[3] = {fb.a.data(), fb.b.data(), fb.all.data()};
+  constexpr int kTol = detail::kColourToleranceCount;
+  constexpr int kWin = int(std::size(detail::kWindows));
+  for (const bool extras : {false, true}) {
+    const float* w = extras ? weight.data() : nullptr;
+    const float* m = extras ? multiply.data() : nullptr;
+    std::vector<float> fused(kWin * kTol * n3), error(kWin * kTol * n), relative(kWin * kTol * n);
+    float* out[kWin * kTol];
+    detail::CandidateEstimates est[kWin * kTol];
+    for (int c = 0; c < kWin * kTol; ++c) {
+      out[c] = fused.data() + c * n3;
+      est[c] = {error.data() + c * n, extras ? relative.data() + c * n : nullptr};
+    }
+    detail::bilateral_candidates(fb, detail::kWindows, kWin, detail::kColourTolerances, kTol,
+                                 images, out, est, w, m);
+    int differing = 0;
+    for (int win = 0; win < kWin; ++win) {
+      std::vector<float> one(3 * kTol * n3), e(n), r(n);
+      float* one_out[3 * kTol];
+      for (int k = 0; k < 3 * kTol; ++k) one_out[k] = one.data() + k * n3;
+      detail::bilateral_filter(fb, detail::kWindows[win], detail::kColourTolerances, kTol, images,
+                               3, one_out, m);
+      for (int t = 0; t < kTol; ++t) {
+        const int c = win * kTol + t;
+        detail::candidate_error(fb, one_out[3 * t], one_out[3 * t + 1], e.data(), w, r.data());
+        differing += std::memcmp(one_out[3 * t + 2], out[c], sizeof(float) * n3) != 0;
+        differing += std::memcmp(e.data(), est[c].error, sizeof(float) * n) != 0;
+        if (extras) differing += std::memcmp(r.data(), est[c].relative, sizeof(float) * n) != 0;
+        // The estimate is not trivially 0 (a real error, of either sign).
+        EXPECT_GT(*std::max_element(e.begin(), e.end()), 1e-4f);
+      }
+    }
+    EXPECT_EQ(differing, 0) << (extras ? "with" : "without") << " weights and factor";
   }
 }
 
