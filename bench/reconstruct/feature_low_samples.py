@@ -1,0 +1,92 @@
+# Feature against L1 at the benchmark report's lowest budget, over several seeds: one render is
+# one draw of G-PT's image-wide camera jitter (render/sampler.h), and at ~18 samples per half a
+# single draw can decide a scene's ratio. For each scene and seed: a G-PT + Feature render with
+# the samples the report's Feature render reached at the budget, and a plain G-PT render with the
+# samples its L1 render reached, solved with gdpt-reconstruct --norm l1; also L1 on the Feature
+# render's passes (what the independent halves cost the image of all samples). All against the
+# report's cached GDPT PT reference (bench/results/cache, made by `make bench`).
+#   /usr/bin/python3 bench/reconstruct/feature_low_samples.py --build build [--budget 5]
+#                                                             [--seeds 7,1,2,3,4] [--scenes a,b]
+# Prints one line per scene and seed, then per scene the mean relMSE of each and the ratio of the
+# means; writes bench/results/feature_low_samples.json.
+import argparse
+import json
+import os
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "bench", "report"))
+import metrics as M  # noqa: E402
+import run as R  # noqa: E402
+
+SCENES = ["cornell_panel", "interior", "glossy", "glass_caustics", "difficult_light", "outdoor",
+          "instances"]
+
+
+def samples_at(scene, curve, budget):
+    with open(os.path.join(ROOT, "bench", "results", f"{scene}.json")) as f:
+        points = json.load(f)["curves"][curve]
+    return next(p["samples"] for p in points if p["budget"] == budget)
+
+
+def measure(blender, args, scene, seed):
+    cache = os.path.join(args.cache, f"{scene}_320x240")
+    refs = [R.rgb(os.path.join(cache, f"ref_pt_{i}_40s.exr")) for i in (1, 2)]
+    blend = os.path.join(cache, f"{scene}.blend")
+    feat = os.path.join(args.out, f"{scene}_feature_{seed}.exr")
+    plain = os.path.join(args.out, f"{scene}_gpt_{seed}.exr")
+    spp_f = samples_at(scene, "gpt_feature", args.budget)
+    spp_l1 = samples_at(scene, "gpt_l1", args.budget)
+    R.render(blender, blend, "gpt_feature", feat, samples=spp_f, seed=seed)
+    R.render(blender, blend, "gpt", plain, samples=spp_l1, seed=seed)
+    l1, _ = R.solve(args.build, plain, "l1", plain[:-4] + "_l1.exr")
+    l1_halves, _ = R.solve(args.build, feat, "l1", feat[:-4] + "_l1.exr")
+    return {"seed": seed, "samples_feature": spp_f, "samples_l1": spp_l1,
+            "relmse_feature": M.rel_mse_denoised(R.rgb(feat), *refs),
+            "relmse_l1": M.rel_mse_denoised(l1, *refs),
+            "relmse_l1_on_feature_render": M.rel_mse_denoised(l1_halves, *refs)}
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--build", default="build")
+    p.add_argument("--budget", type=int, default=5)
+    p.add_argument("--seeds", default="7,1,2,3,4")
+    p.add_argument("--scenes", default=",".join(SCENES))
+    p.add_argument("--cache", default=os.path.join(ROOT, "bench", "results", "cache"))
+    p.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "feature_low_samples"))
+    args = p.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    blender = R.Blender(args.build)
+    result = {"budget": args.budget, "commit": R.git("rev-parse", "--short", "HEAD"),
+              "scenes": {}}
+    try:
+        for scene in args.scenes.split(","):
+            rows = []
+            for seed in map(int, args.seeds.split(",")):
+                r = measure(blender, args, scene, seed)
+                rows.append(r)
+                print(f"{scene:16s} seed {seed:2d}  Feature {r['relmse_feature']:.3e} "
+                      f"({r['samples_feature']} spp)  L1 {r['relmse_l1']:.3e} ({r['samples_l1']} "
+                      f"spp)  L1 on the Feature render {r['relmse_l1_on_feature_render']:.3e}",
+                      flush=True)
+            mean = {k: float(np.mean([r[k] for r in rows]))
+                    for k in ("relmse_feature", "relmse_l1", "relmse_l1_on_feature_render")}
+            wins = sum(r["relmse_feature"] < r["relmse_l1"] for r in rows)
+            result["scenes"][scene] = {"per_seed": rows, "mean": mean, "feature_lower": wins,
+                                       "l1_over_feature": mean["relmse_l1"] / mean["relmse_feature"]}
+            print(f"{scene:16s} mean  Feature {mean['relmse_feature']:.3e}  L1 {mean['relmse_l1']:.3e}"
+                  f"  L1 / Feature {mean['relmse_l1'] / mean['relmse_feature']:.2f}x  Feature lower "
+                  f"in {wins} of {len(rows)}  (L1 on the Feature render {mean['relmse_l1_on_feature_render']:.3e})",
+                  flush=True)
+    finally:
+        blender.close()
+    with open(os.path.join(ROOT, "bench", "results", "feature_low_samples.json"), "w") as f:
+        json.dump(result, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
