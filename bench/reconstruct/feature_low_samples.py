@@ -7,6 +7,9 @@
 # report's cached GDPT PT reference (bench/results/cache, made by `make bench`).
 #   /usr/bin/python3 bench/reconstruct/feature_low_samples.py --build build [--budget 5]
 #                                                             [--seeds 7,1,2,3,4] [--scenes a,b]
+#                                                             [--resolve]
+# --resolve: no rendering; the Feature renders already in --out are solved again by this build's
+# gdpt-reconstruct --norm feature (for a change to the reconstruction alone).
 # Prints one line per scene and seed, then per scene the mean relMSE of each and the ratio of the
 # means; writes bench/results/feature_low_samples.json.
 import argparse
@@ -40,12 +43,16 @@ def measure(blender, args, scene, seed):
     plain = os.path.join(args.out, f"{scene}_gpt_{seed}.exr")
     spp_f = samples_at(scene, "gpt_feature", args.budget)
     spp_l1 = samples_at(scene, "gpt_l1", args.budget)
-    R.render(blender, blend, "gpt_feature", feat, samples=spp_f, seed=seed)
-    R.render(blender, blend, "gpt", plain, samples=spp_l1, seed=seed)
+    if args.resolve:
+        feature, _ = R.solve(args.build, feat, "feature", feat[:-4] + "_resolved.exr")
+    else:
+        R.render(blender, blend, "gpt_feature", feat, samples=spp_f, seed=seed)
+        R.render(blender, blend, "gpt", plain, samples=spp_l1, seed=seed)
+        feature = R.rgb(feat)
     l1, _ = R.solve(args.build, plain, "l1", plain[:-4] + "_l1.exr")
     l1_halves, _ = R.solve(args.build, feat, "l1", feat[:-4] + "_l1.exr")
     return {"seed": seed, "samples_feature": spp_f, "samples_l1": spp_l1,
-            "relmse_feature": M.rel_mse_denoised(R.rgb(feat), *refs),
+            "relmse_feature": M.rel_mse_denoised(feature, *refs),
             "relmse_l1": M.rel_mse_denoised(l1, *refs),
             "relmse_l1_on_feature_render": M.rel_mse_denoised(l1_halves, *refs)}
 
@@ -58,11 +65,13 @@ def main():
     p.add_argument("--scenes", default=",".join(SCENES))
     p.add_argument("--cache", default=os.path.join(ROOT, "bench", "results", "cache"))
     p.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "feature_low_samples"))
+    p.add_argument("--resolve", action="store_true",
+                   help="solve the renders already in --out again instead of rendering")
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
-    blender = R.Blender(args.build)
+    blender = None if args.resolve else R.Blender(args.build)
     result = {"budget": args.budget, "commit": R.git("rev-parse", "--short", "HEAD"),
-              "scenes": {}}
+              "resolved": args.resolve, "scenes": {}}
     try:
         for scene in args.scenes.split(","):
             rows = []
@@ -83,7 +92,8 @@ def main():
                   f"in {wins} of {len(rows)}  (L1 on the Feature render {mean['relmse_l1_on_feature_render']:.3e})",
                   flush=True)
     finally:
-        blender.close()
+        if blender:
+            blender.close()
     with open(os.path.join(ROOT, "bench", "results", "feature_low_samples.json"), "w") as f:
         json.dump(result, f, indent=1)
 
