@@ -86,7 +86,7 @@ struct ReconstructionSettings {
 };
 
 // The cold L1 schedule that was the default before the multigrid one: 36 reweightings of 12 -> 3
-// Jacobi-PCG steps (270 inner steps; 1.3-1.6x the multigrid default's time at 1920x1080).
+// Jacobi-PCG steps (270 inner steps; 1.6-1.8x the CPU time of the multigrid default at 1080p).
 inline void use_jacobi_l1_schedule(ReconstructionSettings& s) {
   s.l1_reweightings = 36;
   s.l1_cg_steps_first = 12;
