@@ -27,9 +27,11 @@
 // (l1_pcg_probe.h); --pcg-mg only Jacobi and multigrid, at more reweightings.
 // --warm measures L1 warm-started from another alpha's output (ReconstructionInput::initial);
 // --warm --sweep also a grid of warm schedules.
-// --schedules K,F,L[,P[,S]] ...: cold L1 schedules against the default, alternated (time,
-// objective); P the preconditioner (j Jacobi, a / v multigrid additive / V-cycle), S its coarse
-// scale; --rounds N repeats each pair, --l1d adds the objective against the L1D scheme,
+// --schedules K,F,L[,P[,S[,E[,U]]]] ...: cold L1 schedules against the Jacobi schedule 36 x 12 -> 3
+// (the default before multigrid), alternated (time, objective); P the preconditioner (j Jacobi,
+// a / v multigrid additive / V-cycle), S its coarse scale, E its edge scale, U the reweightings
+// using it (none: all; the default is 30,3,1,v,1,1,16); --rounds N repeats each pair, --l1d adds
+// the objective against the L1D scheme,
 // --outlier-data uses test L1.BeatsL2OnSparseOutlierGradients' data (e.g. --width 96 --height 64).
 // --memory only measures the peak resident memory (getrusage) after one solve of each norm, in the
 // order L2, Weighted, L1: each figure is the process's peak so far, inputs included.
