@@ -92,6 +92,14 @@ void vertical_edges(const IrlsData& d, float reg, const float* x, int y, RowBuff
     }
 }
 
+// w[i] = s2 / (s |e[.][i]|_RGB + reg) from planar e; a function of its own so that the loop
+// vectorises (inside the pass's lambda it stayed scalar).
+void norm_weights(const std::vector<float>* e, float s, float s2, float reg, int n, float* w) {
+  const float *e0 = e[0].data(), *e1 = e[1].data(), *e2 = e[2].data();
+  for (int i = 0; i < n; ++i)
+    w[i] = s2 / (s * std::sqrt(e0[i] * e0[i] + e1[i] * e1[i] + e2[i] * e2[i]) + reg);
+}
+
 // Sum of v[i]^2 and of s[i] v[i]^2 over i < n, in double, in four fixed lanes (vectorisable,
 // deterministic).
 inline void add_squares(const float* v, const float* s, int n, double& vv, double& svv) {
@@ -172,14 +180,8 @@ std::array<double, 9> reweight_pass(const IrlsData& d, float reg, const float* x
       float* w0 = out.w0 + row;
       float* wx = out.wx + row;
       float* inv = out.inv_diagonal + row;
-      {
-        const float *a0 = b.e0[0].data(), *a1 = b.e0[1].data(), *a2 = b.e0[2].data();
-        const float *x0 = b.ex[0].data(), *x1 = b.ex[1].data(), *x2 = b.ex[2].data();
-        for (int i = 0; i < W; ++i) {
-          w0[i] = alpha2 / (alpha * std::sqrt(a0[i] * a0[i] + a1[i] * a1[i] + a2[i] * a2[i]) + reg);
-          wx[i] = 1.f / (std::sqrt(x0[i] * x0[i] + x1[i] * x1[i] + x2[i] * x2[i]) + reg);
-        }
-      }
+      norm_weights(b.e0, alpha, alpha2, reg, W, w0);
+      norm_weights(b.ex, 1.f, 1.f, reg, W, wx);
       wx[W - 1] = 0.f;
       drop_missing(d.terms ? d.terms + row : nullptr, kPrimalTerm, W, w0);
       drop_missing(d.terms ? d.terms + row : nullptr, kDxTerm, W, wx);

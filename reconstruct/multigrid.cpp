@@ -11,6 +11,9 @@ namespace {
 
 using Grid = MultigridGrid;
 
+// Pixels per vectorised group; lane k of a group is channel k % 3 of pixel k / 3.
+constexpr int kGroup = 4, kLanes = 3 * kGroup;
+
 // Per-thread rows of a stencil pass: u above, at and below the current row, and A u of it.
 struct Rows {
   std::vector<float> u[3], au;
@@ -33,13 +36,25 @@ void smooth_row(const Grid& g, const float* r, float omega, const float* zc, int
   const size_t row = size_t(y) * g.width;
   const float* rr = r + 3 * row;
   const float* inv = g.inv + row;
-  for (int x = 0; x < g.width; ++x) {
+  const int W = g.width;
+  int x = 0;
+  for (; x + kGroup <= W; x += kGroup) {
+    float d[kLanes];
+    for (int k = 0; k < kLanes; ++k) d[k] = omega * inv[x + k / 3];
+    for (int k = 0; k < kLanes; ++k) u[3 * x + k] = d[k] * rr[3 * x + k];
+  }
+  for (; x < W; ++x) {
     const float d = omega * inv[x];
     for (int c = 0; c < 3; ++c) u[3 * x + c] = d * rr[3 * x + c];
   }
   if (!zc) return;
   const float* zr = zc + 3 * size_t(y / 2) * wc;
-  for (int x = 0; x < g.width; ++x)
+  x = 0;
+  for (; x + kGroup <= W; x += kGroup) {  // pixels x, x + 1 in block x / 2, x + 2, x + 3 next
+    const float* zb = zr + 3 * (x / 2);
+    for (int k = 0; k < kLanes; ++k) u[3 * x + k] += s * zb[k % 3 + 3 * (k / 6)];
+  }
+  for (; x < W; ++x)
     for (int c = 0; c < 3; ++c) u[3 * x + c] += s * zr[3 * (x / 2) + c];
 }
 
@@ -61,7 +76,27 @@ void apply_row(const Grid& g, int y, const float* uu, const float* uc, const flo
     }
   };
   border(0);
-  for (int x = 1; x < W - 1; ++x) {  // interior: no clamps, so the loop vectorises
+  int x = 1;
+  // Interior in groups of kGroup pixels, lane k = channel k % 3 of pixel k / 3: vectorises.
+  for (; x + kGroup <= W - 1; x += kGroup) {
+    float a0[kLanes], ax[kLanes], axl[kLanes], ay[kLanes], ayu[kLanes];
+    for (int k = 0; k < kLanes; ++k) {
+      const int xk = x + k / 3;
+      a0[k] = w0[xk];
+      ax[k] = wx[xk];
+      axl[k] = wx[xk - 1];
+      ay[k] = wy[xk];
+      ayu[k] = wyu[xk];
+    }
+    const float *v = uc + 3 * x, *vd = ud + 3 * x, *vu = uu + 3 * x;
+    float* out = au + 3 * x;
+    for (int k = 0; k < kLanes; ++k) {
+      const float vc = v[k];
+      out[k] = a0[k] * vc + ax[k] * (vc - v[k + 3]) + axl[k] * (vc - v[k - 3]) +
+               ay[k] * (vc - vd[k]) + ayu[k] * (vc - vu[k]);
+    }
+  }
+  for (; x < W - 1; ++x) {
     const float a0 = w0[x], ax = wx[x], axl = wx[x - 1], ay = wy[x], ayu = wyu[x];
     const float* v = uc + 3 * x;
     for (int c = 0; c < 3; ++c) {
@@ -114,28 +149,49 @@ void presmooth_restrict(const Grid& g, const float* r, float omega, float* rc, i
   });
 }
 
+// Row y of the post-smoothing z = u + omega D^-1 (r - A u), with <r, z> into acc (lane k:
+// channel k % 3).
+void postsmooth_row(const Grid& g, const float* r, float omega, int y, const float* u,
+                    const float* au, float* z, double* acc) {
+  const size_t row = size_t(y) * g.width;
+  const float* rr = r + 3 * row;
+  const float* inv = g.inv + row;
+  float* zr = z + 3 * row;
+  const int W = g.width;
+  int x = 0;
+  for (; x + kGroup <= W; x += kGroup) {
+    float d[kLanes];
+    for (int k = 0; k < kLanes; ++k) d[k] = omega * inv[x + k / 3];
+    for (int k = 0; k < kLanes; ++k) {
+      const int i = 3 * x + k;
+      const float zi = u[i] + d[k] * (rr[i] - au[i]);
+      zr[i] = zi;
+      acc[k] += double(rr[i]) * zi;
+    }
+  }
+  for (; x < W; ++x) {
+    const float d = omega * inv[x];
+    for (int c = 0; c < 3; ++c) {
+      const int i = 3 * x + c;
+      const float zi = u[i] + d * (rr[i] - au[i]);
+      zr[i] = zi;
+      acc[c] += double(rr[i]) * zi;
+    }
+  }
+}
+
 // Coarse correction and post-smoothing: u = omega D^-1 r + s P zc, z = u + omega D^-1 (r - A u);
 // returns <r_c, z_c>.
 std::array<double, 3> postsmooth(const Grid& g, const float* r, float omega, const float* zc,
                                  int wc, float s, float* z) {
   return parallel_rows_sum<3>(g.height, [&](int y0, int y1, std::array<double, 3>& sums) {
-    double acc[3] = {};
+    double acc[kLanes] = {};
     stencil_rows(
         g, y0, y1, [&](int y, float* u) { smooth_row(g, r, omega, zc, wc, s, y, u); },
         [&](int y, const float* u, const float* au) {
-          const size_t row = size_t(y) * g.width;
-          const float* rr = r + 3 * row;
-          float* zr = z + 3 * row;
-          for (int x = 0; x < g.width; ++x) {
-            const float d = omega * g.inv[row + x];
-            for (int c = 0; c < 3; ++c) {
-              const float zi = u[3 * x + c] + d * (rr[3 * x + c] - au[3 * x + c]);
-              zr[3 * x + c] = zi;
-              acc[c] += double(rr[3 * x + c]) * zi;
-            }
-          }
+          postsmooth_row(g, r, omega, y, u, au, z, acc);
         });
-    for (int c = 0; c < 3; ++c) sums[c] += acc[c];
+    for (int k = 0; k < kLanes; ++k) sums[k % 3] += acc[k];
   });
 }
 

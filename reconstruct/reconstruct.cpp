@@ -376,7 +376,9 @@ void solve_l1(const Prepared& pr, const ReconstructionSettings& settings, bool w
     // |b| only for the last solve, whose exit residual is reported.
     const detail::CgStart start =
         detail::irls_reweight(data, float(reg), x.data(), out, ws.r.data(), k == K - 1);
-    pb.preconditioner = mg && k < mg_until ? &multigrid : nullptr;
+    // Warm solves stay on Jacobi: their start's weights already spread over orders of magnitude,
+    // where multigrid loses (bench_reconstruct --pcg-mg).
+    pb.preconditioner = mg && !warm && k < mg_until ? &multigrid : nullptr;
     if (pb.preconditioner) multigrid.build(pb);
     const auto cg =
         detail::solve_weighted_cg_from_residual(pb, x.data(), start, schedule.steps(k), 0.0, ws);

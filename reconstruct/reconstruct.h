@@ -40,21 +40,24 @@ struct ReconstructionSettings {
   float alpha = 0.2f;  // must be > 0
   int threads = 0;     // 0 = all cores
 
-  // L1: reweightings, and Jacobi-PCG steps per reweighting, falling linearly from the first to the
-  // last reweighting (chosen with bench_reconstruct --sweep; docs/reconstruct.md).
-  int l1_reweightings = 36;
-  int l1_cg_steps_first = 12;
-  int l1_cg_steps_last = 3;
-  // Preconditioner of the inner solves (cold and warm) and, for multigrid, the scale of its
-  // coarse correction and of its coarse edges (multigrid.h; bench_reconstruct --schedules
-  // K,F,L,P,S,E).
-  L1Preconditioner l1_preconditioner = L1Preconditioner::Jacobi;
+  // L1 (cold): reweightings, and inner PCG steps per reweighting, falling linearly from the first
+  // to the last reweighting; the first l1_multigrid_reweightings are preconditioned by a multigrid
+  // V-cycle, the rest by Jacobi (chosen with bench_reconstruct --schedules on the benchmark and
+  // the outlier data, --l1d; docs/reconstruct.md). use_jacobi_l1_schedule() sets the earlier
+  // Jacobi-only default (36 x 12 -> 3).
+  int l1_reweightings = 30;
+  int l1_cg_steps_first = 3;
+  int l1_cg_steps_last = 1;
+  // Preconditioner of the cold inner solves (warm solves use Jacobi) and, for multigrid, the scale
+  // of its coarse correction and of its coarse edges (multigrid.h; bench_reconstruct --schedules
+  // K,F,L,P,S,E,U).
+  L1Preconditioner l1_preconditioner = L1Preconditioner::MultigridVCycle;
   float l1_multigrid_coarse_scale = 1.f;
   float l1_multigrid_edge_scale = 1.f;
   // Multigrid only for the first this many reweightings (negative: all), Jacobi after: the late
   // IRLS weights spread over 4-6 orders of magnitude, where 2x2 aggregation stops paying
   // (bench_reconstruct --pcg-mg).
-  int l1_multigrid_reweightings = -1;
+  int l1_multigrid_reweightings = 16;
   // L1 warm start (ReconstructionInput::initial): reweightings and Jacobi-PCG steps per reweighting
   // (bench_reconstruct --warm --sweep). The regulariser falls from l1_warm_regulariser to the cold
   // schedule's last value, so a start near the minimum is not first pulled towards the smoothed
@@ -74,13 +77,22 @@ struct ReconstructionSettings {
   // Feature: the gradient-domain solution that is filtered (L1, L2, Weighted at `alpha`, or None:
   // the primal is filtered).
   ReconstructionNorm feature_guide = ReconstructionNorm::L1;
-  // Feature with the L1 guide: its reweightings (Jacobi-PCG steps as l1_cg_steps_*). The filters
-  // need no fully converged L1: 12 instead of 36 gave a lower relMSE on six of the seven benchmark
-  // scenes for a third of the solve (bench/reconstruct/feature_vs_l1.py --resolve).
+  // Feature with the L1 guide: its reweightings (inner steps and preconditioner as L1's). The
+  // filters need no fully converged L1: 12 instead of 36 gave a lower relMSE on six of the seven
+  // benchmark scenes for a third of the solve (bench/reconstruct/feature_vs_l1.py --resolve).
   int feature_guide_l1_reweightings = 12;
   // Called with the completed fraction in [0, 1] (from the calling thread).
   std::function<void(float)> progress;
 };
+
+// The cold L1 schedule that was the default before the multigrid one: 36 reweightings of 12 -> 3
+// Jacobi-PCG steps (270 inner steps; 1.6-1.8x the CPU time of the multigrid default at 1080p).
+inline void use_jacobi_l1_schedule(ReconstructionSettings& s) {
+  s.l1_reweightings = 36;
+  s.l1_cg_steps_first = 12;
+  s.l1_cg_steps_last = 3;
+  s.l1_preconditioner = L1Preconditioner::Jacobi;
+}
 
 struct ReconstructionInput {
   int width = 0, height = 0;

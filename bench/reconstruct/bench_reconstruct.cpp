@@ -27,9 +27,11 @@
 // (l1_pcg_probe.h); --pcg-mg only Jacobi and multigrid, at more reweightings.
 // --warm measures L1 warm-started from another alpha's output (ReconstructionInput::initial);
 // --warm --sweep also a grid of warm schedules.
-// --schedules K,F,L[,P[,S]] ...: cold L1 schedules against the default, alternated (time,
-// objective); P the preconditioner (j Jacobi, a / v multigrid additive / V-cycle), S its coarse
-// scale; --rounds N repeats each pair, --l1d adds the objective against the L1D scheme,
+// --schedules K,F,L[,P[,S[,E[,U]]]] ...: cold L1 schedules against the Jacobi schedule 36 x 12 -> 3
+// (the default before multigrid), alternated (time, objective); P the preconditioner (j Jacobi,
+// a / v multigrid additive / V-cycle), S its coarse scale, E its edge scale, U the reweightings
+// using it (none: all; the default is 30,3,1,v,1,1,16); --rounds N repeats each pair, --l1d adds
+// the objective against the L1D scheme,
 // --outlier-data uses test L1.BeatsL2OnSparseOutlierGradients' data (e.g. --width 96 --height 64).
 // --memory only measures the peak resident memory (getrusage) after one solve of each norm, in the
 // order L2, Weighted, L1: each figure is the process's peak so far, inputs included.
@@ -205,6 +207,7 @@ int measure_memory(const Data& d, int threads) {
 bool parse_schedule(const std::string& spec, gdpt::ReconstructionSettings& s) {
   char p = 'j';
   float scale = 1.f, edges = s.l1_multigrid_edge_scale;
+  s.l1_multigrid_reweightings = -1;  // no U: multigrid for every reweighting
   const int n =
       std::sscanf(spec.c_str(), "%d,%d,%d,%c,%f,%f,%d", &s.l1_reweightings, &s.l1_cg_steps_first,
                   &s.l1_cg_steps_last, &p, &scale, &edges, &s.l1_multigrid_reweightings);
@@ -230,6 +233,7 @@ int bench_schedules(const Data& d, int threads, const std::vector<std::string>& 
   base.threads = threads;
   base.fft_measure = true;
   base.norm = gdpt::ReconstructionNorm::L1;
+  gdpt::use_jacobi_l1_schedule(base);  // the reference: the earlier Jacobi default
   auto run = [&](const gdpt::ReconstructionSettings& s, double& wall, double& cpu, int& steps) {
     gdpt::ReconstructionReport r;
     const auto t0 = Clock::now();
@@ -243,9 +247,9 @@ int bench_schedules(const Data& d, int threads, const std::vector<std::string>& 
   double w0, c0;
   int n0;
   run(base, w0, c0, n0);  // warm-up: plans, huge pages
-  std::printf("L1 schedules against the default (%d x %d -> %d), %dx%d, %d threads, alternated\n",
-              base.l1_reweightings, base.l1_cg_steps_first, base.l1_cg_steps_last, d.w, d.h,
-              threads);
+  std::printf(
+      "L1 schedules against the Jacobi schedule (%d x %d -> %d), %dx%d, %d threads, alternated\n",
+      base.l1_reweightings, base.l1_cg_steps_first, base.l1_cg_steps_last, d.w, d.h, threads);
   double o_l1d = 0.0;
   if (l1d) {
     tbb::task_arena arena(threads);
@@ -489,8 +493,9 @@ int bench_pcg(const Data& d, int threads, bool dct) {
 
 // --warm: L1 warm-started from the L1 output at alpha 0.2 (ReconstructionInput::initial) at a
 // new alpha, against the cold default at that alpha, interleaved in one process; objectives are
-// divided by a tight cold solve (72 reweightings x 24->6 steps) at the new alpha. With --sweep
-// first a grid of warm schedules (reweightings, first regulariser, steps); then the defaults.
+// divided by a tight cold solve (72 reweightings x 24->6 Jacobi-PCG steps) at the new alpha. With
+// --sweep first a grid of warm schedules (reweightings, first regulariser, steps); then the
+// defaults.
 int bench_warm(const Data& d, int threads, bool sweep) {
   using gdpt::ReconstructionNorm;
   gdpt::ReconstructionInput in{d.w,         d.h,     d.primal.data(), d.gx.data(),
@@ -513,6 +518,7 @@ int bench_warm(const Data& d, int threads, bool sweep) {
     tight_s.l1_reweightings = 72;
     tight_s.l1_cg_steps_first = 24;
     tight_s.l1_cg_steps_last = 6;
+    tight_s.l1_preconditioner = gdpt::L1Preconditioner::Jacobi;  // the reference as before
     const double f_tight = objective(gdpt::reconstruct(in, tight_s), alpha);
     auto warm_in = in;
     warm_in.initial = from.data();

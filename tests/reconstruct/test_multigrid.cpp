@@ -223,6 +223,7 @@ TEST(Multigrid, L1SameResultOnOneAndTwoThreads) {
     s.l1_multigrid_reweightings = 0;
     ReconstructionSettings jacobi;
     jacobi.norm = ReconstructionNorm::L1;
+    jacobi.l1_preconditioner = L1Preconditioner::Jacobi;
     EXPECT_EQ(reconstruct(in, s), reconstruct(in, jacobi));
   }
 }

@@ -182,12 +182,20 @@ TEST(L1, BeatsL2OnSparseOutlierGradients) {
                                                    k / (s1.l1_reweightings - 1)));
   EXPECT_EQ(r1.iterations, expected_iterations);
 
-  // The default schedule reaches the objective of the reference L1D scheme (20 x 50 CG).
+  // The default schedule (+0.006%) and the earlier Jacobi-only one (-0.0001%) come within 0.01%
+  // of the objective of the reference L1D scheme (20 x 50 CG).
   const auto l1d = test::l1d_reference(w, h, primal.data(), gx.data(), gy.data(), s1.alpha);
   const double objective_l1d =
       reconstruction_objective(in, ReconstructionNorm::L1, s1.alpha, l1d.data());
   EXPECT_LT(r1.objective, objective_l1d * 1.0001)
       << "default " << r1.objective << " L1D " << objective_l1d;
+  ReconstructionSettings jacobi = s1;
+  use_jacobi_l1_schedule(jacobi);
+  ReconstructionReport rj;
+  reconstruct(in, jacobi, &rj);
+  EXPECT_EQ(rj.iterations, 270);
+  EXPECT_LT(rj.objective, objective_l1d * 1.0001)
+      << "Jacobi " << rj.objective << " L1D " << objective_l1d;
 }
 
 // Noisy primal, noisy gradients with sparse large outliers, and an emission buffer: the L1 case.
@@ -238,6 +246,7 @@ TEST(L1, WarmStartFromAnotherAlphaConvergesInFewerSteps) {
   tight.l1_reweightings = 72;
   tight.l1_cg_steps_first = 24;
   tight.l1_cg_steps_last = 6;
+  tight.l1_preconditioner = L1Preconditioner::Jacobi;
   auto objective = [&](const std::vector<float>& out) {
     return reconstruction_objective(in, ReconstructionNorm::L1, s.alpha,
                                     scene.solution(out).data());
@@ -251,7 +260,8 @@ TEST(L1, WarmStartFromAnotherAlphaConvergesInFewerSteps) {
 
   EXPECT_LT(objective(cold), 1.001 * f_tight);
   EXPECT_LT(objective(warm), 1.001 * f_tight) << "cold " << objective(cold) / f_tight;
-  EXPECT_LT(warm_report.iterations, cold_report.iterations / 4);
+  // The cold default's steps are a third multigrid-preconditioned (each costs a few Jacobi ones).
+  EXPECT_LT(warm_report.iterations, cold_report.iterations / 3);
   const double e_cold = rms_error(scene.solution(cold), scene.truth);
   const double e_warm = rms_error(scene.solution(warm), scene.truth);
   EXPECT_LT(e_warm, 1.01 * e_cold) << "cold rms " << e_cold;
