@@ -56,12 +56,15 @@ struct CandidateEstimates {
 // all samples}: per candidate c = window * range_count + range, out[c] gets the image of all
 // samples filtered (times `multiply`) and estimates[c] candidate_error of the filtered halves
 // (with `weight`), which are not kept. Bit-identical to bilateral_filter per window followed by
-// candidate_error.
+// candidate_error. With `noise` (per image, one plane: each pixel's variance summed over RGB, in
+// the images' units), a colour distance is the squared difference over the tolerance's share of
+// the centre's brightness plus both pixels' noise, so a difference the noise explains (a sample
+// that one pixel happened to draw) does not keep a pixel apart from its neighbours.
 void bilateral_candidates(const FeatureBuffers& fb, const BilateralWindow* windows,
                           int window_count, const float* ranges, int range_count,
                           const float* const* images, float* const* out,
                           const CandidateEstimates* estimates, const float* weight,
-                          const float* multiply = nullptr);
+                          const float* multiply = nullptr, const float* const* noise = nullptr);
 
 inline void bilateral_filter(const FeatureBuffers& fb, const BilateralCandidate& candidate,
                              const float* const* images, float* const* out, int count) {

@@ -157,6 +157,33 @@ void divide_image(const float* factor, int width, int height, const float* image
   });
 }
 
+// Per image (half A, half B, all samples): each pixel's variance summed over RGB, divided by the
+// albedo squared as the images are; all samples' is (Var A + Var B) / 4. Empty without variances.
+std::vector<FreshHugeVector<float>> pixel_noise(const detail::FeatureBuffers& fb,
+                                                const float* variance_a, const float* variance_b,
+                                                const FreshHugeVector<float>& albedo) {
+  std::vector<FreshHugeVector<float>> noise;
+  if (!variance_a || !variance_b) return noise;
+  noise.resize(3);
+  const size_t n = size_t(fb.width) * fb.height;
+  for (auto& v : noise) v.resize(n);  // written in full below
+  detail::parallel_rows(fb.height, [&](int y0, int y1) {
+    for (size_t i = size_t(y0) * fb.width; i < size_t(y1) * fb.width; ++i) {
+      float va = 0.f, vb = 0.f;
+      for (int c = 0; c < 3; ++c) {
+        const float d = albedo.empty() ? 1.f : albedo[3 * i + c];
+        const float a = variance_a[3 * i + c], b = variance_b[3 * i + c];
+        va += std::isfinite(a) ? std::max(0.f, a) / (d * d) : 0.f;
+        vb += std::isfinite(b) ? std::max(0.f, b) / (d * d) : 0.f;
+      }
+      const bool valid = fb.valid[i] & detail::kImagesValid;
+      noise[0][i] = valid ? va : 0.f, noise[1][i] = valid ? vb : 0.f;
+      noise[2][i] = valid ? 0.25f * (va + vb) : 0.f;
+    }
+  });
+  return noise;
+}
+
 }  // namespace
 
 FeatureReconstruction feature_filter(const ReconstructionInput& input, const float* a,
@@ -226,9 +253,15 @@ FeatureReconstruction feature_filter(const ReconstructionInput& input, const flo
     estimates[c] = {errors.data() + size_t(c) * n, weighted ? keys[c].data() : nullptr};
     out[c] = candidates[1 + c].data();
   }
+  // The primal halves' variances, also where the halves are gradient-domain solutions.
+  const auto noise = pixel_noise(fb, variance_a ? variance_a : input.variance_a,
+                                 variance_b ? variance_b : input.variance_b, albedo);
+  const float* noise_planes[3] = {};
+  for (size_t k = 0; k < noise.size(); ++k) noise_planes[k] = noise[k].data();
   detail::bilateral_candidates(fb, detail::kWindows, int(std::size(detail::kWindows)),
                                detail::kColourTolerances, kTol, images, out, estimates,
-                               weighted ? choice.weight.data() : nullptr, remodulate);
+                               weighted ? choice.weight.data() : nullptr, remodulate,
+                               noise.empty() ? nullptr : noise_planes);
   r.filter_seconds += since(t);
   t = std::chrono::steady_clock::now();
   for (int c = 0; c < kWindowed; ++c)

@@ -7,16 +7,18 @@
 //      its halves and their mean;
 //   2. per candidate filter (feature_bilateral.h): each half filtered alone and the solution of
 //      all samples filtered alike, all three divided by the albedo before and multiplied by it
-//      after (the filters smooth the illumination; textures stay sharp);
+//      after (the filters smooth the illumination; textures stay sharp); with the primal halves'
+//      variances, their colour distances count each pixel's noise;
 //   3. per pixel the candidate with the smallest smoothed relative error estimate of the halves
 //      (candidate_selection.h; relative to a guide colour from two more filters of all samples),
 //      then the choices blended over the estimate's window (blend_choices); output = the blend
 //      of the candidates applied to all samples (+ emission).
 //
-// Memory beyond the inputs: at most about 480 bytes per pixel, 480 MB per megapixel, while the
+// Memory beyond the inputs: at most about 492 bytes per pixel, 492 MB per megapixel, while the
 // windows are filtered (feature buffers 105, the solved halves and image 36, their albedo-divided
 // copies and the albedo 48, the choice and its weights 33, every candidate's image and key for
-// the blend 208, the windows' raw error estimates 48; the guide's two filtered copies, 24, and the
+// the blend 208, the windows' raw error estimates 48, the pixels' noise for the colour distances
+// 12, with the halves' variances; the guide's two filtered copies, 24, and the
 // identity's filtered halves and estimates, 32, before; the blend's scratch, 24, after the
 // estimates and the divided copies are released), plus the gradient-domain solves' own buffers
 // while they run.

@@ -85,9 +85,12 @@ int limit_half_outliers(int width, int height, const float* primal_a, const floa
         const float half_floor =
             kHalfOutlierRatio *
             std::max(neighbour_median(l.half_mean.data(), width, height, x, y), kHalfOutlierFloor);
+        // The solve spreads the firefly onto its neighbours: their level is the lower of the
+        // solve's and the primal's.
         const float all_floor =
             kHalfOutlierRatio *
-            std::max(neighbour_median(l.all.data(), width, height, x, y), kHalfOutlierFloor);
+            std::max(std::min(neighbour_median(l.all.data(), width, height, x, y), around),
+                     kHalfOutlierFloor);
         (a_high ? scale_a : scale_b)[i] =
             limited_scale(bound / high, a_high ? l.a[i] : l.b[i], half_floor);
         scale_all[i] = limited_scale((bound + rest) / (high + rest), l.all[i], all_floor);

@@ -8,7 +8,10 @@
 // the 8 neighbours. Where it fires, the outlier half's image and the image of all samples are
 // scaled by the ratio of the halves' limited to their original sum (the brighter half limited to
 // that bound), but each is kept at or above kHalfOutlierRatio times the median of its own 8
-// neighbours (a gradient-domain solve may already have spread or removed the firefly).
+// neighbours (a gradient-domain solve may already have spread or removed the firefly); for the
+// image of all samples, the lower of that median and the primal mean's (the test's): a solve that
+// spread the firefly onto the neighbours raised their median, which alone kept a spread firefly
+// of the demo scene at 4x the reference.
 // Converging halves agree, so the test stops firing as samples grow and the reconstruction stays
 // consistent; a real one-pixel highlight is in both halves and is kept.
 #pragma once

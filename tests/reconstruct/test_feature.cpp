@@ -340,6 +340,30 @@ TEST(Feature, NoSpecklesFromOneHalfFireflies) {
   EXPECT_GT(kept, 0.5f);
 }
 
+// A firefly of one half that the gradient-domain solve of all samples spread onto its 8
+// neighbours (as on the demo scene, where it ended 4x the reference): their raised median must not
+// keep the pixel bright; the neighbours themselves are left as they are.
+TEST(Feature, FireflySpreadByTheSolveIsLimited) {
+  const int w = 16, h = 16;
+  const size_t n = size_t(w) * h, p = size_t(8) * w + 8;
+  std::vector<float> pa(3 * n, 0.2f), pb = pa, all = pa;
+  for (int c = 0; c < 3; ++c) pb[3 * p + c] = 3.f, all[3 * p + c] = 1.2f;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      if (dx || dy)
+        for (int c = 0; c < 3; ++c) all[3 * (p + dy * w + dx) + c] = 0.45f;
+  std::vector<float> a = pa, b = pb, limited = all;
+  EXPECT_EQ(
+      detail::limit_half_outliers(w, h, pa.data(), pb.data(), a.data(), b.data(), limited.data()),
+      1);
+  // Bound 3 x 0.2 on the bright half: all samples scaled to at most 3x the primal's neighbours.
+  EXPECT_NEAR(luminance(limited, p), 0.6f, 1e-5f);
+  for (size_t i = 0; i < n; ++i)
+    if (i != p) {
+      EXPECT_EQ(luminance(limited, i), luminance(all, i)) << i;
+    }
+}
+
 TEST(Feature, SameResultOnOneAndTwoThreads) {
   const FeatureScene s = make_feature_scene(150, 70, 0.15f, 0.02f, 51);
   ReconstructionSettings settings;

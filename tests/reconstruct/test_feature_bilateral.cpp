@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <iterator>
 #include <limits>
@@ -183,6 +184,80 @@ TEST(FeatureBilateral, CandidatesInOnePassMatchEachWindowBitForBit) {
       }
     }
     EXPECT_EQ(differing, 0) << (extras ? "with" : "without") << " weights and factor";
+  }
+}
+
+// Sparse light on a flat plane (x < 32): each half is 16 samples, each lit (6.4) with
+// probability 1/32, so the truth is 0.2 and most pixels are 0 or 0.4 or more, given with the
+// variance of their mean; beside it (x >= 32) a lit floor at 2.0 with 1% noise, a lighting edge no
+// feature shows. With the noise in the colour distance the relative tolerances average the
+// sparse light (without it a lit pixel's neighbours are too far from it and the noise stays), and
+// the lighting edge, far beyond the noise, stays sharp.
+TEST(FeatureBilateral, DifferencesTheNoiseExplainsAreAveraged) {
+  test::FeatureScene s;
+  s.w = 64, s.h = 48;
+  const size_t n = size_t(s.w) * s.h;
+  s.albedo.assign(3 * n, 0.5f), s.normal.assign(3 * n, 0.f), s.depth.assign(n, 1.f);
+  for (size_t i = 0; i < n; ++i) s.normal[3 * i + 2] = 1.f;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  std::normal_distribution<float> gauss(0.f, 0.02f);
+  s.a.resize(3 * n), s.b.resize(3 * n), s.primal.resize(3 * n), s.truth.resize(3 * n);
+  std::vector<float> va(3 * n), vb(3 * n);
+  for (size_t i = 0; i < n; ++i)
+    for (int half = 0; half < 2; ++half) {
+      float sum = 0.f, sum2 = 0.f;
+      const bool sparse = int(i % s.w) < 32;
+      for (int k = 0; k < 16; ++k) {
+        const float x =
+            sparse ? (u(rng) < 1.f / 32.f ? 6.4f : 0.f) : 2.f * (1.f + 4.f * gauss(rng));
+        sum += x, sum2 += x * x;
+      }
+      const float mean = sum / 16.f, var = std::max(0.f, sum2 - 16.f * mean * mean) / 15.f / 16.f;
+      for (int c = 0; c < 3; ++c) {
+        (half ? s.b : s.a)[3 * i + c] = mean;
+        (half ? vb : va)[3 * i + c] = var;
+        s.truth[3 * i + c] = sparse ? 0.2f : 2.f;
+      }
+    }
+  for (size_t k = 0; k < 3 * n; ++k) s.primal[k] = 0.5f * (s.a[k] + s.b[k]);
+  const detail::FeatureBuffers fb = detail::prepare_feature_buffers(
+      s.input(), s.a.data(), s.b.data(), s.primal.data(), va.data(), vb.data());
+  std::vector<float> noise(3 * n);  // per image: the variance summed over RGB
+  for (size_t i = 0; i < n; ++i) {
+    noise[i] = 3.f * va[3 * i], noise[n + i] = 3.f * vb[3 * i];
+    noise[2 * n + i] = 0.25f * (noise[i] + noise[n + i]);
+  }
+  const float* const planes[3] = {noise.data(), noise.data() + n, noise.data() + 2 * n};
+  const float* const images[3] = {fb.a.data(), fb.b.data(), fb.all.data()};
+  constexpr int kTol = detail::kColourToleranceCount, kWin = int(std::size(detail::kWindows));
+  // Per candidate: MSE over the sparse light (2 px off the edges), and the worst relative error
+  // of the lit floor's first column.
+  auto measure = [&](const float* const* noise_planes, int candidate) {
+    std::vector<float> all(kWin * kTol * 3 * n), error(kWin * kTol * n);
+    float* out[kWin * kTol];
+    detail::CandidateEstimates est[kWin * kTol];
+    for (int c = 0; c < kWin * kTol; ++c)
+      out[c] = all.data() + 3 * n * c, est[c] = {error.data() + n * c, nullptr};
+    detail::bilateral_candidates(fb, detail::kWindows, kWin, detail::kColourTolerances, kTol,
+                                 images, out, est, nullptr, nullptr, noise_planes);
+    const float* o = out[candidate];
+    double mse = 0.0, count = 0.0, edge = 0.0;
+    for (int y = 2; y < s.h - 2; ++y) {
+      for (int x = 2; x < 30; ++x, count += 1.0)
+        for (int c = 0; c < 3; ++c) mse += std::pow(o[3 * (size_t(y) * s.w + x) + c] - 0.2, 2);
+      edge = std::max(edge, std::fabs(o[3 * (size_t(y) * s.w + 32)] - 2.0) / 2.0);
+    }
+    return std::pair<double, double>(mse / (3.0 * count), edge);
+  };
+  for (int t = 0; t < 2; ++t) {  // the tolerances 0.05 and 0.2, 7 px window
+    const int candidate = 2 * kTol + t;
+    const auto [plain_mse, plain_edge] = measure(nullptr, candidate);
+    const auto [noisy_mse, noisy_edge] = measure(planes, candidate);
+    std::printf("tolerance %.2f: sparse light MSE %.4f -> %.4f, lit edge error %.4f -> %.4f\n",
+                detail::kColourTolerances[t], plain_mse, noisy_mse, plain_edge, noisy_edge);
+    EXPECT_LT(noisy_mse, plain_mse / 4.0);
+    EXPECT_LT(noisy_edge, 0.02);
   }
 }
 
