@@ -18,10 +18,10 @@
 //   - Feature (--norm feature): total time with the L1 guide (at its own reweightings and at the
 //     L1 norm's) and with the L2 guide, split into the
 //     guide solve, preparation, the cross-filtered candidates and the choice, on the synthetic
-//     room of testing/feature_scene.h (half noise 0.2, gradient noise 0.1), relMSE against L1,
-//     CPU time (the time on idle cores on a loaded machine) of the whole and of the filters and
-//     choice alone, and a digest of both outputs (to compare builds bit for bit); --feature-only
-//     runs just this case.
+//     room of testing/feature_scene.h (half noise 0.2 with its variances, gradient noise 0.1),
+//     relMSE against L1, CPU time (the time on idle cores on a loaded machine) of the whole and of
+//     the filters and choice alone, and a digest of both outputs (to compare builds bit for bit);
+//     --feature-only runs just this case.
 // --admm compares an ADMM L1 probe (l1_admm_probe.h) with the library's IRLS (see bench_admm).
 // --pcg counts PCG steps of the IRLS systems with DCT and multigrid preconditioners
 // (l1_pcg_probe.h); --pcg-mg only Jacobi and multigrid, at more reweightings.
@@ -308,8 +308,13 @@ Data make_outlier_data(int w, int h) {
 
 // The Feature reconstruction on the synthetic room: total time per guide and its split.
 void bench_feature(int width, int height, int threads) {
-  const gdpt::test::FeatureScene sc = gdpt::test::make_feature_scene(width, height, 0.2f, 0.1f, 7);
-  const gdpt::ReconstructionInput in = sc.input();
+  const float sigma_half = 0.2f;
+  const gdpt::test::FeatureScene sc =
+      gdpt::test::make_feature_scene(width, height, sigma_half, 0.1f, 7);
+  // The halves' variances, as a render writes them (they enter the colour distances).
+  const std::vector<float> half_variance(sc.a.size(), sigma_half * sigma_half);
+  gdpt::ReconstructionInput in = sc.input();
+  in.variance_a = in.variance_b = half_variance.data();
   gdpt::ReconstructionSettings s;
   s.threads = threads;
   s.norm = gdpt::ReconstructionNorm::L1;
@@ -337,8 +342,10 @@ void bench_feature(int width, int height, int threads) {
     const auto t2 = Clock::now();
     const double c2 = cpu_seconds();
     const long f2 = minor_faults();
-    arena.execute(
-        [&] { fr = gdpt::feature_filter(in, sc.a.data(), sc.b.data(), sc.primal.data()); });
+    arena.execute([&] {
+      fr = gdpt::feature_filter(in, sc.a.data(), sc.b.data(), sc.primal.data(), in.variance_a,
+                                in.variance_b);
+    });
     const double filter_wall = seconds_since(t2), filter_cpu = cpu_seconds() - c2;
     const long faults_filter = minor_faults() - f2;
     const double rel = gdpt::test::relative_mse(img, sc.truth);
