@@ -4,15 +4,13 @@
 #include <utility>
 
 #include "reconstruct/parallel.h"
+#include "reconstruct/stencil_lanes.h"
 
 namespace gdpt::detail {
 
 namespace {
 
 using Grid = MultigridGrid;
-
-// Pixels per vectorised group; lane k of a group is channel k % 3 of pixel k / 3.
-constexpr int kGroup = 4, kLanes = 3 * kGroup;
 
 // Per-thread rows of a stencil pass: u above, at and below the current row, and A u of it.
 struct Rows {
@@ -79,22 +77,11 @@ void apply_row(const Grid& g, int y, const float* uu, const float* uc, const flo
   int x = 1;
   // Interior in groups of kGroup pixels, lane k = channel k % 3 of pixel k / 3: vectorises.
   for (; x + kGroup <= W - 1; x += kGroup) {
-    float a0[kLanes], ax[kLanes], axl[kLanes], ay[kLanes], ayu[kLanes];
-    for (int k = 0; k < kLanes; ++k) {
-      const int xk = x + k / 3;
-      a0[k] = w0[xk];
-      ax[k] = wx[xk];
-      axl[k] = wx[xk - 1];
-      ay[k] = wy[xk];
-      ayu[k] = wyu[xk];
-    }
+    StencilLanes a;
+    a.gather(w0, wx, wy, wyu, x);
     const float *v = uc + 3 * x, *vd = ud + 3 * x, *vu = uu + 3 * x;
     float* out = au + 3 * x;
-    for (int k = 0; k < kLanes; ++k) {
-      const float vc = v[k];
-      out[k] = a0[k] * vc + ax[k] * (vc - v[k + 3]) + axl[k] * (vc - v[k - 3]) +
-               ay[k] * (vc - vd[k]) + ayu[k] * (vc - vu[k]);
-    }
+    for (int k = 0; k < kLanes; ++k) out[k] = a.apply(k, v, vd, vu);
   }
   for (; x < W - 1; ++x) {
     const float a0 = w0[x], ax = wx[x], axl = wx[x - 1], ay = wy[x], ayu = wyu[x];

@@ -7,6 +7,7 @@
 
 #include "core/huge_pages.h"
 #include "reconstruct/parallel.h"
+#include "reconstruct/stencil_lanes.h"
 
 namespace gdpt::detail {
 
@@ -67,10 +68,8 @@ std::array<double, 9> residual_pass(const WeightedProblem& pb, const float* x, f
   });
 }
 
-// Pixels are processed in groups of kGroup so that the compiler can vectorise the interleaved
-// RGB values: lane k of a group is channel k % 3 of pixel k / 3. Reductions keep one double
+// Pixels are processed in groups of kGroup (stencil_lanes.h). Reductions keep one double
 // accumulator per lane, folded into the channel sums in a fixed order (deterministic).
-constexpr int kGroup = 4, kLanes = 3 * kGroup;
 
 // Search direction v = z + beta p (z = D^-1 r) of the pixels [i0, i0 + W) of one row, into `v`.
 // p == nullptr on the first step (beta = 0): p is not read, so it needs no clearing.
@@ -167,23 +166,14 @@ std::array<double, 3> direction_pass(const WeightedProblem& pb, const float* r, 
       pixel(0, 0, std::min(1, W - 1), 0.f);
       int x = 1;
       for (; x + kGroup <= W - 1; x += kGroup) {  // interior pixels: both x-neighbours exist
-        float a0[kLanes], ax[kLanes], axl[kLanes], ay[kLanes], ayu[kLanes];
-        for (int k = 0; k < kLanes; ++k) {
-          const int xk = x + k / 3;
-          a0[k] = w0[xk];
-          ax[k] = wx[xk];
-          axl[k] = wx[xk - 1];
-          ay[k] = wy[xk];
-          ayu[k] = wyu[xk];
-        }
+        StencilLanes a;
+        a.gather(w0, wx, wy, wyu, x);
         const float *vg = vc + 3 * x, *vdg = vd + 3 * x, *vug = vu + 3 * x;
         float* qg = qr + 3 * x;
         for (int k = 0; k < kLanes; ++k) {
-          const float v = vg[k];
-          const float av = a0[k] * v + ax[k] * (v - vg[k + 3]) + axl[k] * (v - vg[k - 3]) +
-                           ay[k] * (v - vdg[k]) + ayu[k] * (v - vug[k]);
+          const float av = a.apply(k, vg, vdg, vug);
           qg[k] = av;
-          acc[k] += double(v) * av;
+          acc[k] += double(vg[k]) * av;
         }
       }
       for (; x < W - 1; ++x) pixel(x, x - 1, x + 1, wx[x - 1]);
