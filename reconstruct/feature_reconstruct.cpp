@@ -73,7 +73,7 @@ std::vector<float> solve(const ReconstructionInput& in, const ReconstructionSett
   gs.compute_objective = false;
   gs.progress = nullptr;
   // The L1 guide keeps the Jacobi schedule (12 -> 3 steps): the multigrid default's 3 -> 1 steps
-  // over its 12 reweightings made Feature worse (difficult_light 3-5x; /work/tools/evalvar.py).
+  // over its 12 reweightings made Feature worse (difficult_light 3-5x; docs/reconstruct.md).
   use_jacobi_l1_schedule(gs);
   gs.l1_reweightings = s.feature_guide_l1_reweightings;
   return reconstruct(gi, gs);
