@@ -11,7 +11,7 @@
 # --resolve: no rendering; the Feature renders already in --out are solved again by this build's
 # gdpt-reconstruct --norm feature (for a change to the reconstruction alone).
 # Prints one line per scene and seed, then per scene the mean relMSE of each and the ratio of the
-# means; writes bench/results/feature_low_samples.json.
+# means; writes bench/results/feature_low_samples.json (another budget: ..._<budget>s.json).
 import argparse
 import json
 import os
@@ -94,7 +94,8 @@ def main():
     finally:
         if blender:
             blender.close()
-    with open(os.path.join(ROOT, "bench", "results", "feature_low_samples.json"), "w") as f:
+    name = "feature_low_samples" + ("" if args.budget == 5 else f"_{args.budget}s") + ".json"
+    with open(os.path.join(ROOT, "bench", "results", name), "w") as f:
         json.dump(result, f, indent=1)
 
 
