@@ -4,6 +4,8 @@
 # A speckle is a pixel whose luminance is more than 4x the median of the reference's 5x5
 # neighbourhood (that median floored at 1e-3, so black regions count only real light). Also
 # relMSE (epsilon 0.01) against the reference, which decides which default the demo should use.
+# Also what a render with the reference's sample count scores (each reference half against the
+# other's medians) and, for each Feature speckle, its and the reference's ratio to the median.
 #   /usr/bin/python3 bench/demo/speckles.py [--build build] [--ref-samples 2048] [--seeds 4]
 # Writes bench/results/demo_speckles.json and prints one line per reconstruction.
 import argparse
@@ -23,13 +25,24 @@ import run as R  # noqa: E402
 SPECKLE_RATIO, MEDIAN_FLOOR = 4.0, 1e-3
 
 
+def floored_median(ref):
+    """The 5x5 median of `ref`'s luminance around each pixel, floored at MEDIAN_FLOOR."""
+    padded = np.pad(M.luminance(ref), 2, mode="edge")
+    return np.maximum(np.median(sliding_window_view(padded, (5, 5)), axis=(-2, -1)), MEDIAN_FLOOR)
+
+
 def speckles(img, ref):
     """Pixels of `img` brighter than SPECKLE_RATIO x the 5x5 median of `ref` around them."""
-    lum = M.luminance(ref)
-    padded = np.pad(lum, 2, mode="edge")
-    median = np.median(sliding_window_view(padded, (5, 5)), axis=(-2, -1))
-    return int(np.count_nonzero(M.luminance(img) > SPECKLE_RATIO * np.maximum(median,
-                                                                              MEDIAN_FLOOR)))
+    return int(np.count_nonzero(M.luminance(img) > SPECKLE_RATIO * floored_median(ref)))
+
+
+def speckle_details(img, ref):
+    """Each speckle of `img`: where, its and the reference's luminance over the median."""
+    median = floored_median(ref)
+    lum, lum_ref = M.luminance(img), M.luminance(ref)
+    return [{"x": int(x), "y": int(y), "over_median": float(lum[y, x] / median[y, x]),
+             "reference_over_median": float(lum_ref[y, x] / median[y, x])}
+            for y, x in zip(*np.nonzero(lum > SPECKLE_RATIO * median))]
 
 
 def main():
@@ -52,6 +65,10 @@ def main():
             R.render(blender, blend, "pt", path, samples=args.ref_samples, seed=1000 + seed)
             halves.append(R.rgb(path))
         ref = 0.5 * (halves[0] + halves[1])
+        # What a render of the reference's own sample count scores: each half against the other.
+        floor = 0.5 * (speckles(halves[0], halves[1]) + speckles(halves[1], halves[0]))
+        print(f"demo reference half ({args.ref_samples} spp) against the other half: speckles "
+              f"{floor:.1f}", flush=True)
         rows = {"primal": [], "l1": [], "feature": []}
         for seed in range(1, args.seeds + 1):
             raw = os.path.join(args.out, f"gpt_{seed}.exr")
@@ -63,12 +80,17 @@ def main():
             for name, img in (("primal", R.rgb(raw)), ("l1", l1), ("feature", R.rgb(feat))):
                 rows[name].append({"speckles": speckles(img, ref),
                                    "relmse": M.rel_mse_denoised(img, *halves)})
+            rows["feature"][-1]["speckle_pixels"] = speckle_details(R.rgb(feat), ref)
+            for d in rows["feature"][-1]["speckle_pixels"]:
+                print(f"  feature seed {seed} speckle ({d['x']}, {d['y']}): {d['over_median']:.2f}x "
+                      f"the median, reference {d['reference_over_median']:.2f}x", flush=True)
     finally:
         blender.close()
     result = {"samples": samples, "reference_samples_per_half": args.ref_samples,
               "seeds": args.seeds, "speckle_ratio": SPECKLE_RATIO, "commit": R.git(
                   "rev-parse", "--short", "HEAD"),
-              "pixels": int(ref.shape[0] * ref.shape[1]), "per_seed": rows}
+              "pixels": int(ref.shape[0] * ref.shape[1]), "reference_half_speckles": floor,
+              "per_seed": rows}
     for name, r in rows.items():
         s = [x["speckles"] for x in r]
         e = [x["relmse"] for x in r]
