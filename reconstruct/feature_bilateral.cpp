@@ -232,19 +232,34 @@ void tolerant_colour_weights(const FilterJob& job, int x0, int x1, int xb, const
 
 // Colour weights whose distance is the squared difference over the tolerance's share of the
 // centre's brightness plus both pixels' noise: a difference the noise explains is no edge.
+// dc = d2 s, s = 1 / (3 lum^2) (0: no colour test): d2 / (3 lum^2 tol^2 + w noise).
 void noisy_colour_weights(const FilterJob& job, const ChunkPlanes& p, int k, int y, int dy, int dx,
                           int x0, int x1, int xb, const float* scale, const float* dc,
                           float (*colour)[kBlock]) {
   const float *nc = p.noise_row(k, y), *nq = p.noise_row(k, y + dy);
-  for (int t = 0; t < job.ranges; ++t) {
-    const float inv = job.inv_range2[t];
-    if (!(inv > 0.f)) continue;
-    for (int x = x0; x < x1; ++x) {
-      // dc = d2 s, s = 1 / (3 lum^2) (0: no colour test): d2 / (3 lum^2 tol^2 + w noise).
-      const float s = scale[kBlock * k + x - xb];
-      const float noise = kNoiseWeight * (nc[x] + nq[x + dx]) * s * inv;
-      colour[t][x - xb] = exp_nonpositive(-0.5f * dc[x - xb] * inv / (1.f + noise));
+  // The factors every tolerance shares, once per tap (the same roundings as per tolerance).
+  float noise[kBlock], half[kBlock];
+  for (int x = x0; x < x1; ++x) {
+    noise[x - xb] = kNoiseWeight * (nc[x] + nq[x + dx]) * scale[kBlock * k + x - xb];
+    half[x - xb] = -0.5f * dc[x - xb];
+  }
+  int t[kMaxRanges], active = 0;
+  for (int u = 0; u < job.ranges; ++u)
+    if (job.inv_range2[u] > 0.f) t[active++] = u;
+  int a = 0;
+  for (; a + 1 < active; a += 2) {  // two tolerances per loop: two independent chains
+    const float i0 = job.inv_range2[t[a]], i1 = job.inv_range2[t[a + 1]];
+    float *c0 = colour[t[a]], *c1 = colour[t[a + 1]];
+    for (int x = x0 - xb; x < x1 - xb; ++x) {
+      c0[x] = exp_nonpositive(half[x] * i0 / (1.f + noise[x] * i0));
+      c1[x] = exp_nonpositive(half[x] * i1 / (1.f + noise[x] * i1));
     }
+  }
+  for (; a < active; ++a) {
+    const float inv = job.inv_range2[t[a]];
+    float* c = colour[t[a]];
+    for (int x = x0 - xb; x < x1 - xb; ++x)
+      c[x] = exp_nonpositive(half[x] * inv / (1.f + noise[x] * inv));
   }
 }
 
