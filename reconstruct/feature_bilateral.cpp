@@ -1,6 +1,7 @@
 #include "reconstruct/feature_bilateral.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -13,6 +14,14 @@
 
 #include "reconstruct/candidate_selection.h"
 #include "reconstruct/parallel.h"
+
+// A second build of the filters' pixel loops for AVX2 CPUs, where the tree is built for the
+// x86-64 baseline (GCC and Clang on x86-64; a GDPT_ARCH=x86-64-v3 tree has AVX2 everywhere).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX2__)
+#define GDPT_FILTER_AVX2 1
+#else
+#define GDPT_FILTER_AVX2 0
+#endif
 
 namespace gdpt::detail {
 
@@ -375,19 +384,61 @@ void range_setup(const float* ranges, int range_count, float* inv_range2, int* s
     if (squared_from[t] >= 0 && squared_from[squared_from[t]] >= 0) squared_from[t] = -1;
 }
 
+// The pixels of rows [y0, y1), inlined whole into each build of filter_rows below.
+inline void filter_rows_inline(const FilterJob& job, const ChunkPlanes& planes, int y0, int y1) {
+  BlockSums sums;
+  for (int y = y0; y < y1; ++y)
+    for (int xb = 0; xb < job.fb.width; xb += kBlock)
+      filter_block(job, planes, y, xb, std::min(job.fb.width, xb + kBlock), sums);
+}
+
+__attribute__((flatten)) void filter_rows_baseline(const FilterJob& job, const ChunkPlanes& planes,
+                                                   int y0, int y1) {
+  filter_rows_inline(job, planes, y0, y1);
+}
+
+#if GDPT_FILTER_AVX2
+// 8 floats per instruction instead of 4. AVX2 without FMA: the same roundings, bit for bit.
+__attribute__((target("avx2"), flatten)) void filter_rows_avx2(const FilterJob& job,
+                                                               const ChunkPlanes& planes, int y0,
+                                                               int y1) {
+  filter_rows_inline(job, planes, y0, y1);
+}
+#endif
+
+std::atomic<bool> avx2_allowed{true};
+
+void filter_rows(const FilterJob& job, const ChunkPlanes& planes, int y0, int y1) {
+#if GDPT_FILTER_AVX2
+  if (avx2_filters_available() && avx2_allowed.load(std::memory_order_relaxed))
+    return filter_rows_avx2(job, planes, y0, y1);
+#endif
+  filter_rows_baseline(job, planes, y0, y1);
+}
+
 void run(const FilterJob& job) {
   tbb::enumerable_thread_specific<ChunkPlanes> scratch;
   parallel_rows(job.fb.height, [&](int y0, int y1) {
     ChunkPlanes& planes = scratch.local();
     fill_chunk_planes(job, y0, y1, planes);
-    BlockSums sums;
-    for (int y = y0; y < y1; ++y)
-      for (int xb = 0; xb < job.fb.width; xb += kBlock)
-        filter_block(job, planes, y, xb, std::min(job.fb.width, xb + kBlock), sums);
+    filter_rows(job, planes, y0, y1);
   });
 }
 
 }  // namespace
+
+bool avx2_filters_available() {
+#if GDPT_FILTER_AVX2
+  static const bool available = __builtin_cpu_supports("avx2");
+  return available;
+#else
+  return false;
+#endif
+}
+
+void allow_avx2_filters(bool allow) {
+  avx2_allowed.store(allow, std::memory_order_relaxed);
+}
 
 std::vector<BilateralCandidate> default_bilateral_candidates() {
   std::vector<BilateralCandidate> c = {{{0, 1}, 0.f}};

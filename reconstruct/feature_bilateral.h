@@ -66,6 +66,12 @@ void bilateral_candidates(const FeatureBuffers& fb, const BilateralWindow* windo
                           const CandidateEstimates* estimates, const float* weight,
                           const float* multiply = nullptr, const float* const* noise = nullptr);
 
+// Whether the filters run their AVX2 build (x86-64 baseline trees, on CPUs with AVX2); its output
+// is bit for bit the baseline build's. allow_avx2_filters(false) makes them run the baseline
+// build (for the test that compares the two; not thread-safe against running filters).
+bool avx2_filters_available();
+void allow_avx2_filters(bool allow);
+
 inline void bilateral_filter(const FeatureBuffers& fb, const BilateralCandidate& candidate,
                              const float* const* images, float* const* out, int count) {
   bilateral_filter(fb, candidate.window, &candidate.range, 1, images, count, out);
