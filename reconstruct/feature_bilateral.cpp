@@ -15,12 +15,18 @@
 #include "reconstruct/candidate_selection.h"
 #include "reconstruct/parallel.h"
 
-// A second build of the filters' pixel loops for AVX2 CPUs, where the tree is built for the
-// x86-64 baseline (GCC and Clang on x86-64; a GDPT_ARCH=x86-64-v3 tree has AVX2 everywhere).
+// More builds of the filters' pixel loops, for CPUs with AVX2 or AVX-512, where the tree is built
+// without them (GCC and Clang on x86-64). This file is compiled with -ffp-contract=off: no build
+// fuses a multiply and an add, so all round alike.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX2__)
 #define GDPT_FILTER_AVX2 1
 #else
 #define GDPT_FILTER_AVX2 0
+#endif
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX512F__)
+#define GDPT_FILTER_AVX512 1
+#else
+#define GDPT_FILTER_AVX512 0
 #endif
 
 namespace gdpt::detail {
@@ -399,7 +405,7 @@ __attribute__((flatten)) void filter_rows_baseline(const FilterJob& job, const C
 }
 
 #if GDPT_FILTER_AVX2
-// 8 floats per instruction instead of 4. AVX2 without FMA: the same roundings, bit for bit.
+// 8 floats per instruction instead of 4.
 __attribute__((target("avx2"), flatten)) void filter_rows_avx2(const FilterJob& job,
                                                                const ChunkPlanes& planes, int y0,
                                                                int y1) {
@@ -407,11 +413,24 @@ __attribute__((target("avx2"), flatten)) void filter_rows_avx2(const FilterJob& 
 }
 #endif
 
-std::atomic<bool> avx2_allowed{true};
+#if GDPT_FILTER_AVX512
+// 16 floats per instruction (the 64-pixel blocks' loops, 12% faster than AVX2 on the Zen 5 here).
+__attribute__((target("avx512f,avx512vl,avx512bw,avx512dq"), flatten)) void filter_rows_avx512(
+    const FilterJob& job, const ChunkPlanes& planes, int y0, int y1) {
+  filter_rows_inline(job, planes, y0, y1);
+}
+#endif
+
+std::atomic<int> build_limit{int(FilterBuild::Avx512)};
 
 void filter_rows(const FilterJob& job, const ChunkPlanes& planes, int y0, int y1) {
+  [[maybe_unused]] const int limit = build_limit.load(std::memory_order_relaxed);
+#if GDPT_FILTER_AVX512
+  if (limit >= int(FilterBuild::Avx512) && filter_build_available(FilterBuild::Avx512))
+    return filter_rows_avx512(job, planes, y0, y1);
+#endif
 #if GDPT_FILTER_AVX2
-  if (avx2_filters_available() && avx2_allowed.load(std::memory_order_relaxed))
+  if (limit >= int(FilterBuild::Avx2) && filter_build_available(FilterBuild::Avx2))
     return filter_rows_avx2(job, planes, y0, y1);
 #endif
   filter_rows_baseline(job, planes, y0, y1);
@@ -428,17 +447,22 @@ void run(const FilterJob& job) {
 
 }  // namespace
 
-bool avx2_filters_available() {
+bool filter_build_available(FilterBuild build) {
 #if GDPT_FILTER_AVX2
-  static const bool available = __builtin_cpu_supports("avx2");
-  return available;
-#else
-  return false;
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (build == FilterBuild::Avx2) return avx2;
 #endif
+#if GDPT_FILTER_AVX512
+  static const bool avx512 =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+  if (build == FilterBuild::Avx512) return avx512;
+#endif
+  return build == FilterBuild::Baseline;
 }
 
-void allow_avx2_filters(bool allow) {
-  avx2_allowed.store(allow, std::memory_order_relaxed);
+void limit_filter_build(FilterBuild highest) {
+  build_limit.store(int(highest), std::memory_order_relaxed);
 }
 
 std::vector<BilateralCandidate> default_bilateral_candidates() {

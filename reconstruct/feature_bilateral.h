@@ -66,11 +66,13 @@ void bilateral_candidates(const FeatureBuffers& fb, const BilateralWindow* windo
                           const CandidateEstimates* estimates, const float* weight,
                           const float* multiply = nullptr, const float* const* noise = nullptr);
 
-// Whether the filters run their AVX2 build (x86-64 baseline trees, on CPUs with AVX2); its output
-// is bit for bit the baseline build's. allow_avx2_filters(false) makes them run the baseline
-// build (for the test that compares the two; not thread-safe against running filters).
-bool avx2_filters_available();
-void allow_avx2_filters(bool allow);
+// The builds of the filters' pixel loops: the tree's own and, on x86-64 CPUs that have them, AVX2
+// and AVX-512 ones (where the tree is built without); all give the same floats, bit for bit. The
+// filters run the widest available one up to limit_filter_build's (for the test that compares
+// them; not thread-safe against running filters).
+enum class FilterBuild { Baseline, Avx2, Avx512 };
+bool filter_build_available(FilterBuild build);
+void limit_filter_build(FilterBuild highest);
 
 inline void bilateral_filter(const FeatureBuffers& fb, const BilateralCandidate& candidate,
                              const float* const* images, float* const* out, int count) {

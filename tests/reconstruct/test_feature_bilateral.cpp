@@ -261,11 +261,14 @@ TEST(FeatureBilateral, DifferencesTheNoiseExplainsAreAveraged) {
   }
 }
 
-// The AVX2 build of the filters' loops against the baseline build, bit for bit: every candidate
-// and error estimate, with relative weights, output factor, per-pixel noise and the tolerant
-// (noise-free) colour weights of bilateral_filter.
-TEST(FeatureBilateral, Avx2BuildMatchesTheBaselineBitForBit) {
-  if (!detail::avx2_filters_available()) GTEST_SKIP() << "no AVX2 build on this CPU or tree";
+// The AVX2 and AVX-512 builds of the filters' loops against the baseline build, bit for bit: every
+// candidate and error estimate, with relative weights, output factor, per-pixel noise and the
+// tolerant (noise-free) colour weights of bilateral_filter.
+TEST(FeatureBilateral, WiderBuildsMatchTheBaselineBitForBit) {
+  using detail::FilterBuild;
+  if (!detail::filter_build_available(FilterBuild::Avx2) &&
+      !detail::filter_build_available(FilterBuild::Avx512))
+    GTEST_SKIP() << "no AVX2 or AVX-512 build on this CPU or tree";
   test::FeatureScene s;
   const detail::FeatureBuffers fb = noisy_buffers(s);
   const size_t n = size_t(s.w) * s.h, n3 = 3 * n;
@@ -278,8 +281,8 @@ TEST(FeatureBilateral, Avx2BuildMatchesTheBaselineBitForBit) {
   const float* const planes[3] = {noise.data(), noise.data() + n, noise.data() + 2 * n};
   const float* const images[3] = {fb.a.data(), fb.b.data(), fb.all.data()};
   constexpr int kTol = detail::kColourToleranceCount, kWin = int(std::size(detail::kWindows));
-  auto run = [&](bool avx2) {
-    detail::allow_avx2_filters(avx2);
+  auto run = [&](FilterBuild build) {
+    detail::limit_filter_build(build);
     std::vector<float> all((kWin * kTol + 3 * kTol) * n3 + 2 * kWin * kTol * n);
     float* out[kWin * kTol];
     detail::CandidateEstimates est[kWin * kTol];
@@ -292,16 +295,20 @@ TEST(FeatureBilateral, Avx2BuildMatchesTheBaselineBitForBit) {
     for (int k = 0; k < 3 * kTol; ++k, p += n3) tolerant[k] = p;
     detail::bilateral_filter(fb, detail::kWindows[3], detail::kColourTolerances, kTol, images, 3,
                              tolerant, multiply.data());
-    detail::allow_avx2_filters(true);
+    detail::limit_filter_build(FilterBuild::Avx512);
     return all;
   };
-  const std::vector<float> avx2 = run(true), baseline = run(false);
-  size_t differing = 0;
-  for (size_t i = 0; i < avx2.size(); ++i)
-    differing += std::memcmp(&avx2[i], &baseline[i], sizeof(float)) != 0;
-  EXPECT_EQ(differing, 0u) << "of " << avx2.size();
+  const std::vector<float> baseline = run(FilterBuild::Baseline);
+  for (const FilterBuild build : {FilterBuild::Avx2, FilterBuild::Avx512}) {
+    if (!detail::filter_build_available(build)) continue;
+    const std::vector<float> wide = run(build);
+    size_t differing = 0;
+    for (size_t i = 0; i < wide.size(); ++i)
+      differing += std::memcmp(&wide[i], &baseline[i], sizeof(float)) != 0;
+    EXPECT_EQ(differing, 0u) << "build " << int(build) << ", of " << wide.size();
+  }
   // The error estimates are written (not the zeros the buffer started with).
-  const float* first_error = avx2.data() + size_t(kWin * kTol) * n3;
+  const float* first_error = baseline.data() + size_t(kWin * kTol) * n3;
   EXPECT_GT(*std::max_element(first_error, first_error + n), 1e-4f);
 }
 
