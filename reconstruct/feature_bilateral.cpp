@@ -45,8 +45,8 @@ inline constexpr float kRangeFloor = 1e-3f;
 // 1 and 2 gave 2.763, 2.760, 2.743 and 2.719x L1; at 0.7 no cell is 2% worse than without noise).
 inline constexpr float kNoiseWeight = 0.7f;
 // Pixels of a row filtered together: their sums (every window, tolerance and image: 37 KB) stay
-// near while every tap adds to them; 64 rather than 32 halves the per-tap setup of the AVX2 loops
-// (4% less CPU here, 48 and 96 no better).
+// near while every tap adds to them; 64 rather than 32 halves the per-tap setup of the wide loops
+// (7% less CPU here; 96 and 128 no better).
 inline constexpr int kBlock = 64;
 
 // v where `keep`, else 0: a select by bit mask, so the loops over pixels stay branch-free.
