@@ -66,6 +66,14 @@ void bilateral_candidates(const FeatureBuffers& fb, const BilateralWindow* windo
                           const CandidateEstimates* estimates, const float* weight,
                           const float* multiply = nullptr, const float* const* noise = nullptr);
 
+// The builds of the filters' pixel loops: the tree's own and, on x86-64 CPUs that have them, AVX2
+// and AVX-512 ones (where the tree is built without); all give the same floats, bit for bit. The
+// filters run the widest available one up to limit_filter_build's (for the test that compares
+// them; not thread-safe against running filters).
+enum class FilterBuild { Baseline, Avx2, Avx512 };
+bool filter_build_available(FilterBuild build);
+void limit_filter_build(FilterBuild highest);
+
 inline void bilateral_filter(const FeatureBuffers& fb, const BilateralCandidate& candidate,
                              const float* const* images, float* const* out, int count) {
   bilateral_filter(fb, candidate.window, &candidate.range, 1, images, count, out);

@@ -261,5 +261,56 @@ TEST(FeatureBilateral, DifferencesTheNoiseExplainsAreAveraged) {
   }
 }
 
+// The AVX2 and AVX-512 builds of the filters' loops against the baseline build, bit for bit: every
+// candidate and error estimate, with relative weights, output factor, per-pixel noise and the
+// tolerant (noise-free) colour weights of bilateral_filter.
+TEST(FeatureBilateral, WiderBuildsMatchTheBaselineBitForBit) {
+  using detail::FilterBuild;
+  if (!detail::filter_build_available(FilterBuild::Avx2) &&
+      !detail::filter_build_available(FilterBuild::Avx512))
+    GTEST_SKIP() << "no AVX2 or AVX-512 build on this CPU or tree";
+  test::FeatureScene s;
+  const detail::FeatureBuffers fb = noisy_buffers(s);
+  const size_t n = size_t(s.w) * s.h, n3 = 3 * n;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.5f, 2.f), v(0.f, 0.05f);
+  std::vector<float> weight(n3), multiply(n3), noise(3 * n);
+  for (float& x : weight) x = u(rng);
+  for (float& x : multiply) x = u(rng);
+  for (float& x : noise) x = v(rng);
+  const float* const planes[3] = {noise.data(), noise.data() + n, noise.data() + 2 * n};
+  const float* const images[3] = {fb.a.data(), fb.b.data(), fb.all.data()};
+  constexpr int kTol = detail::kColourToleranceCount, kWin = int(std::size(detail::kWindows));
+  auto run = [&](FilterBuild build) {
+    detail::limit_filter_build(build);
+    std::vector<float> all((kWin * kTol + 3 * kTol) * n3 + 2 * kWin * kTol * n);
+    float* out[kWin * kTol];
+    detail::CandidateEstimates est[kWin * kTol];
+    float* p = all.data();
+    for (int c = 0; c < kWin * kTol; ++c, p += n3) out[c] = p;
+    for (int c = 0; c < kWin * kTol; ++c, p += 2 * n) est[c] = {p, p + n};
+    detail::bilateral_candidates(fb, detail::kWindows, kWin, detail::kColourTolerances, kTol,
+                                 images, out, est, weight.data(), multiply.data(), planes);
+    float* tolerant[3 * kTol];
+    for (int k = 0; k < 3 * kTol; ++k, p += n3) tolerant[k] = p;
+    detail::bilateral_filter(fb, detail::kWindows[3], detail::kColourTolerances, kTol, images, 3,
+                             tolerant, multiply.data());
+    detail::limit_filter_build(FilterBuild::Avx512);
+    return all;
+  };
+  const std::vector<float> baseline = run(FilterBuild::Baseline);
+  for (const FilterBuild build : {FilterBuild::Avx2, FilterBuild::Avx512}) {
+    if (!detail::filter_build_available(build)) continue;
+    const std::vector<float> wide = run(build);
+    size_t differing = 0;
+    for (size_t i = 0; i < wide.size(); ++i)
+      differing += std::memcmp(&wide[i], &baseline[i], sizeof(float)) != 0;
+    EXPECT_EQ(differing, 0u) << "build " << int(build) << ", of " << wide.size();
+  }
+  // The error estimates are written (not the zeros the buffer started with).
+  const float* first_error = baseline.data() + size_t(kWin * kTol) * n3;
+  EXPECT_GT(*std::max_element(first_error, first_error + n), 1e-4f);
+}
+
 }  // namespace
 }  // namespace gdpt
