@@ -12,7 +12,6 @@
 # gdpt-reconstruct --norm feature (for a change to the reconstruction alone).
 # Prints one line per scene and seed, then per scene the mean relMSE of each and the ratio of the
 # means; writes bench/results/feature_low_samples.json (another budget: ..._<budget>s.json).
-import argparse
 import json
 import os
 import sys
@@ -24,10 +23,6 @@ ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "bench", "report"))
 import metrics as M  # noqa: E402
 import run as R  # noqa: E402
-
-SCENES = ["cornell_panel", "interior", "glossy", "glass_caustics", "difficult_light", "outdoor",
-          "instances"]
-
 
 def samples_at(scene, curve, budget):
     with open(os.path.join(ROOT, "bench", "results", f"{scene}.json")) as f:
@@ -58,15 +53,9 @@ def measure(blender, args, scene, seed):
 
 
 def main():
-    p = argparse.ArgumentParser()
-    p.add_argument("--build", default="build")
+    p = R.rendered_scenes_parser("feature_low_samples")
     p.add_argument("--budget", type=int, default=5)
     p.add_argument("--seeds", default="7,1,2,3,4")
-    p.add_argument("--scenes", default=",".join(SCENES))
-    p.add_argument("--cache", default=os.path.join(ROOT, "bench", "results", "cache"))
-    p.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "feature_low_samples"))
-    p.add_argument("--resolve", action="store_true",
-                   help="solve the renders already in --out again instead of rendering")
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
     blender = None if args.resolve else R.Blender(args.build)

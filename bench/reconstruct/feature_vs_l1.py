@@ -8,7 +8,6 @@
 # --resolve: no rendering; the renders already in --out are solved again with both norms (for a
 # change to the reconstruction alone).
 # Prints one line per scene and writes bench/results/feature_vs_l1.json.
-import argparse
 import json
 import os
 import sys
@@ -20,10 +19,6 @@ sys.path.insert(0, os.path.join(ROOT, "bench", "report"))
 import metrics as M  # noqa: E402
 import run as R  # noqa: E402
 
-SCENES = ["cornell_panel", "interior", "glossy", "glass_caustics", "difficult_light", "outdoor",
-          "instances"]
-
-
 def samples_at_40s(scene):
     with open(os.path.join(ROOT, "bench", "results", f"{scene}.json")) as f:
         curve = json.load(f)["curves"]["gpt_l1"]
@@ -31,13 +26,7 @@ def samples_at_40s(scene):
 
 
 def main():
-    p = argparse.ArgumentParser()
-    p.add_argument("--build", default="build")
-    p.add_argument("--scenes", default=",".join(SCENES))
-    p.add_argument("--cache", default=os.path.join(ROOT, "bench", "results", "cache"))
-    p.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "feature_vs_l1"))
-    p.add_argument("--resolve", action="store_true",
-                   help="solve the renders already in --out again instead of rendering")
+    p = R.rendered_scenes_parser("feature_vs_l1")
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
     blender = None if args.resolve else R.Blender(args.build)

@@ -84,6 +84,19 @@ def samples_reached(log):
     return max(counts) if counts else 0
 
 
+def rendered_scenes_parser(out_name):
+    """The options the scripts that render the report's scenes again share (bench/reconstruct/):
+    --build, --scenes, --cache (the report's), --out (out/bench/<out_name>) and --resolve."""
+    p = argparse.ArgumentParser()
+    p.add_argument("--build", default="build")
+    p.add_argument("--scenes", default=",".join(SCENES))
+    p.add_argument("--cache", default=os.path.join(ROOT, "bench", "results", "cache"))
+    p.add_argument("--out", default=os.path.join(ROOT, "out", "bench", out_name))
+    p.add_argument("--resolve", action="store_true",
+                   help="solve the renders already in --out again instead of rendering")
+    return p
+
+
 def render(blender, blend, method, out, seconds=0.0, samples=0, seed=1):
     args = [blend, method, out] + (["--seconds", seconds] if seconds else ["--samples", samples])
     log = blender.run(os.path.join(HERE, "render_one.py"), *args, "--seed", seed)
