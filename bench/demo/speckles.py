@@ -31,14 +31,13 @@ def floored_median(ref):
     return np.maximum(np.median(sliding_window_view(padded, (5, 5)), axis=(-2, -1)), MEDIAN_FLOOR)
 
 
-def speckles(img, ref):
-    """Pixels of `img` brighter than SPECKLE_RATIO x the 5x5 median of `ref` around them."""
-    return int(np.count_nonzero(M.luminance(img) > SPECKLE_RATIO * floored_median(ref)))
+def speckles(img, median):
+    """Pixels of `img` brighter than SPECKLE_RATIO x `median` (a reference's floored_median)."""
+    return int(np.count_nonzero(M.luminance(img) > SPECKLE_RATIO * median))
 
 
-def speckle_details(img, ref):
+def speckle_details(img, ref, median):
     """Each speckle of `img`: where, its and the reference's luminance over the median."""
-    median = floored_median(ref)
     lum, lum_ref = M.luminance(img), M.luminance(ref)
     return [{"x": int(x), "y": int(y), "over_median": float(lum[y, x] / median[y, x]),
              "reference_over_median": float(lum_ref[y, x] / median[y, x])}
@@ -66,7 +65,9 @@ def main():
             halves.append(R.rgb(path))
         ref = 0.5 * (halves[0] + halves[1])
         # What a render of the reference's own sample count scores: each half against the other.
-        floor = 0.5 * (speckles(halves[0], halves[1]) + speckles(halves[1], halves[0]))
+        floor = 0.5 * (speckles(halves[0], floored_median(halves[1])) +
+                       speckles(halves[1], floored_median(halves[0])))
+        median = floored_median(ref)
         print(f"demo reference half ({args.ref_samples} spp) against the other half: speckles "
               f"{floor:.1f}", flush=True)
         rows = {"primal": [], "l1": [], "feature": []}
@@ -77,10 +78,11 @@ def main():
             feat = os.path.join(args.out, f"feature_{seed}.exr")
             R.render(blender, blend, "gpt_feature", feat, samples=samples, seed=seed)
             # Reconstruction None: Combined is the primal plus emission.
-            for name, img in (("primal", R.rgb(raw)), ("l1", l1), ("feature", R.rgb(feat))):
-                rows[name].append({"speckles": speckles(img, ref),
+            feature = R.rgb(feat)
+            for name, img in (("primal", R.rgb(raw)), ("l1", l1), ("feature", feature)):
+                rows[name].append({"speckles": speckles(img, median),
                                    "relmse": M.rel_mse_denoised(img, *halves)})
-            rows["feature"][-1]["speckle_pixels"] = speckle_details(R.rgb(feat), ref)
+            rows["feature"][-1]["speckle_pixels"] = speckle_details(feature, ref, median)
             for d in rows["feature"][-1]["speckle_pixels"]:
                 print(f"  feature seed {seed} speckle ({d['x']}, {d['y']}): {d['over_median']:.2f}x "
                       f"the median, reference {d['reference_over_median']:.2f}x", flush=True)
