@@ -411,6 +411,12 @@ def write_doc(results, meta, path, figures):
             lines += ["**The engines' references disagree on this scene (relMSE "
                       f"{r['cross_engine_relmse']['pt~cycles_unbiased']:.2e} on 4x4 blocks): the "
                       "comparison is void until the difference is explained.**", ""]
+        own = r.get("meta", meta)
+        if (own["commit"], own["date"]) != (meta["commit"], meta["date"]):
+            lines += [f"This scene's curves come from a later run, `{own['command']}` at commit "
+                      f"{own['commit']} on {own['date']} (every method rendered again, "
+                      "references included; ratios against the other scenes' columns may include "
+                      "the host's speed between the two runs).", ""]
         lines += [f"![relMSE against time]({figures[r['scene']][0]})", "",
                   f"![equal-time crops at {meta['crop_budget']} s]({figures[r['scene']][1]})", "",
                   "| method | " + " | ".join(f"{b} s" for b in r["budgets"]) + " |",
