@@ -11,7 +11,8 @@
 # --resolve: no rendering; the Feature renders already in --out are solved again by this build's
 # gdpt-reconstruct --norm feature (for a change to the reconstruction alone).
 # Prints one line per scene and seed, then per scene the mean relMSE of each and the ratio of the
-# means; writes bench/results/feature_low_samples.json (another budget: ..._<budget>s.json).
+# means; writes bench/results/feature_low_samples.json (another budget: ..._<budget>s.json), where
+# a run over --scenes replaces only those scenes.
 import json
 import os
 import sys
@@ -59,8 +60,7 @@ def main():
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
     blender = None if args.resolve else R.Blender(args.build)
-    result = {"budget": args.budget, "commit": R.git("rev-parse", "--short", "HEAD"),
-              "resolved": args.resolve, "scenes": {}}
+    commit, entries = R.git("rev-parse", "--short", "HEAD"), {}
     try:
         for scene in args.scenes.split(","):
             rows = []
@@ -74,8 +74,9 @@ def main():
             mean = {k: float(np.mean([r[k] for r in rows]))
                     for k in ("relmse_feature", "relmse_l1", "relmse_l1_on_feature_render")}
             wins = sum(r["relmse_feature"] < r["relmse_l1"] for r in rows)
-            result["scenes"][scene] = {"per_seed": rows, "mean": mean, "feature_lower": wins,
-                                       "l1_over_feature": mean["relmse_l1"] / mean["relmse_feature"]}
+            entries[scene] = {"per_seed": rows, "mean": mean, "feature_lower": wins,
+                              "l1_over_feature": mean["relmse_l1"] / mean["relmse_feature"],
+                              "commit": commit, "resolved": args.resolve}
             print(f"{scene:16s} mean  Feature {mean['relmse_feature']:.3e}  L1 {mean['relmse_l1']:.3e}"
                   f"  L1 / Feature {mean['relmse_l1'] / mean['relmse_feature']:.2f}x  Feature lower "
                   f"in {wins} of {len(rows)}  (L1 on the Feature render {mean['relmse_l1_on_feature_render']:.3e})",
@@ -84,8 +85,7 @@ def main():
         if blender:
             blender.close()
     name = "feature_low_samples" + ("" if args.budget == 5 else f"_{args.budget}s") + ".json"
-    with open(os.path.join(ROOT, "bench", "results", name), "w") as f:
-        json.dump(result, f, indent=1)
+    R.update_scene_results(name, entries, budget=args.budget)
 
 
 if __name__ == "__main__":

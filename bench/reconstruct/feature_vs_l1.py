@@ -7,7 +7,8 @@
 #                                                         [--resolve]
 # --resolve: no rendering; the renders already in --out are solved again with both norms (for a
 # change to the reconstruction alone).
-# Prints one line per scene and writes bench/results/feature_vs_l1.json.
+# Prints one line per scene and writes bench/results/feature_vs_l1.json (a run over --scenes
+# replaces only those scenes).
 import json
 import os
 import sys
@@ -30,7 +31,7 @@ def main():
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
     blender = None if args.resolve else R.Blender(args.build)
-    rows = []
+    commit, rows = R.git("rev-parse", "--short", "HEAD"), {}
     try:
         for scene in args.scenes.split(","):
             cache = os.path.join(args.cache, f"{scene}_320x240")
@@ -53,17 +54,17 @@ def main():
             row = {"scene": scene, "samples": info["samples"],
                    "relmse_l1": M.rel_mse_denoised(l1, *refs),
                    "relmse_feature": M.rel_mse_denoised(feature, *refs),
-                   "cli_seconds_l1": t_l1, "cli_seconds_feature": t_feature}
+                   "cli_seconds_l1": t_l1, "cli_seconds_feature": t_feature,
+                   "commit": commit, "resolved": args.resolve}
             row["l1_over_feature"] = row["relmse_l1"] / row["relmse_feature"]
-            rows.append(row)
+            rows[scene] = row
             print(f"{scene:16s} {row['samples']:5d} spp  relMSE L1 {row['relmse_l1']:.3e}  "
                   f"Feature {row['relmse_feature']:.3e}  L1 / Feature {row['l1_over_feature']:.2f}x"
                   f"  (gdpt-reconstruct {t_l1:.1f} s / {t_feature:.1f} s)", flush=True)
     finally:
         if blender:
             blender.close()
-    with open(os.path.join(ROOT, "bench", "results", "feature_vs_l1.json"), "w") as f:
-        json.dump(rows, f, indent=1)
+    R.update_scene_results("feature_vs_l1.json", rows)
 
 
 if __name__ == "__main__":

@@ -97,6 +97,21 @@ def rendered_scenes_parser(out_name):
     return p
 
 
+def update_scene_results(name, entries, **header):
+    """Writes bench/results/<name> as {**header, "scenes": {scene: entry}}, keeping the scenes of
+    the existing file that `entries` does not hold: a run over --scenes updates only those (each
+    entry should say the commit it was measured at)."""
+    path = os.path.join(ROOT, "bench", "results", name)
+    scenes = {}
+    if os.path.exists(path):
+        with open(path) as f:
+            old = json.load(f)
+        scenes = old["scenes"] if isinstance(old, dict) else {r["scene"]: r for r in old}
+    scenes.update(entries)
+    with open(path, "w") as f:
+        json.dump({**header, "scenes": {s: scenes[s] for s in SCENES if s in scenes}}, f, indent=1)
+
+
 def render(blender, blend, method, out, seconds=0.0, samples=0, seed=1):
     args = [blend, method, out] + (["--seconds", seconds] if seconds else ["--samples", samples])
     log = blender.run(os.path.join(HERE, "render_one.py"), *args, "--seed", seed)
