@@ -2,7 +2,8 @@
 #   blender -b --factory-startup --addons gdpt --python render_one.py -- \
 #       BLEND METHOD OUT.exr (--seconds T | --samples N) [--seed S]
 # METHOD: cycles_default (Cycles as a new scene has it, but denoising off: Debian's Blender has
-# no OpenImageDenoise), cycles_unbiased (the same with Filter Glossy 0 and no clamping), pt
+# no OpenImageDenoise), cycles_unbiased (the same with Filter Glossy 0 and no clamping),
+# cycles_bsdf (cycles_unbiased with emissive meshes lit by BSDF rays alone: no light sampling), pt
 # (Gradient PT's path tracer), gpt (Gradient PT's G-PT, no reconstruction: the report solves
 # its passes with gdpt-reconstruct), gpt_feature (G-PT with the Feature reconstruction in the
 # render, which computes the feature passes it needs). Prints one line `BENCH {json}` with the render call's wall
@@ -38,12 +39,15 @@ if method.startswith("cycles"):
     c.seed = seed
     c.samples = samples or many
     c.time_limit = seconds
-    if method == "cycles_unbiased":
+    if method in ("cycles_unbiased", "cycles_bsdf"):
         c.blur_glossy = 0.0
         c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
         # Adaptive sampling stops at its noise threshold, before small frames' budgets end: this
         # curve samples every pixel for the whole budget (the defaults' curve keeps it on).
         c.use_adaptive_sampling = False
+        if method == "cycles_bsdf":  # emissive meshes found by BSDF rays only (Multiple Importance off)
+            for m in bpy.data.materials:
+                m.cycles.sample_as_light = False
     elif method != "cycles_default":
         sys.exit(f"render_one.py: unknown method {method}")
 elif method in ("pt", "gpt", "gpt_feature"):
