@@ -419,7 +419,11 @@ def write_doc(results, meta, path, figures):
         lines.append(f"| {r['scene']} | " + " | ".join(cell(r) for _, cell in columns) + " |")
     lines += ["", "Ratios are Cycles' relMSE over GDPT's at the same time, against Cycles with its "
               "defaults unless the column names the unbiased setting; above 1x GDPT has the "
-              "lower error; \"-\" means the budget range did not reach that time.", ""]
+              "lower error; \"-\" means the budget range did not reach that time. \"refs agree\" is "
+              "the relMSE between GDPT PT's and Cycles unbiased's references on 4x4 blocks with both "
+              "references' noise subtracted: 0 up to that noise where the engines agree, and a scene "
+              "above 0.01 is marked void; the known causes of values above the noise are in "
+              "docs/lights.md (\"Where the references differ\").", ""]
     for r in results:
         lines += [f"## {r['scene']}", ""]
         if r["void"]:
