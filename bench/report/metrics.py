@@ -7,7 +7,7 @@ Images are float arrays (height, width, 3) in scene-linear RGB.
   made of two independent halves: E|x - r|^2 = E|x - t|^2 + E|r - t|^2 and
   E|r1 - r2|^2 = 4 E|r - t|^2, so the reference's own noise is subtracted.
 - rel_mse_between: the same correction for two noisy images (each from two halves), on block
-  means: how far apart two engines' converged images are.
+  means: how far apart two engines' converged images are; rel_mse_between_se its standard error.
 - ssim: structural similarity (Wang et al. 2004; 11-tap Gaussian window, sigma 1.5) of the
   luminance after a display transform (clip to [0, 1], gamma 1/2.2).
 - gradient_energy_ratio: the survey's predicted improvement of gradient sampling,
@@ -28,13 +28,25 @@ def rel_mse_denoised(x, ref_a, ref_b, eps=EPS):
     return float(np.mean((x - ref) ** 2 / (ref ** 2 + eps)) - noise)
 
 
-def rel_mse_between(a, b, block=1, eps=EPS):
-    """relMSE between two noisy images, each given as two independent halves, on block x block
-    means, with both images' noise subtracted: the squared bias between what they converge to."""
+def _between_terms(a, b, block, eps):
+    """rel_mse_between's term per block and channel."""
     a1, a2, b1, b2 = (block_mean(i, block) for i in (*a, *b))
     ma, mb = 0.5 * (a1 + a2), 0.5 * (b1 + b2)
     d = (ma - mb) ** 2 - 0.25 * (a1 - a2) ** 2 - 0.25 * (b1 - b2) ** 2
-    return float(np.mean(d / (mb ** 2 + eps)))
+    return d / (mb ** 2 + eps)
+
+
+def rel_mse_between(a, b, block=1, eps=EPS):
+    """relMSE between two noisy images, each given as two independent halves, on block x block
+    means, with both images' noise subtracted: the squared bias between what they converge to."""
+    return float(np.mean(_between_terms(a, b, block, eps)))
+
+
+def rel_mse_between_se(a, b, block=1, eps=EPS):
+    """The standard error of rel_mse_between from the spread of its per-block terms: a value
+    within a few of these of 0 is the references' noise, not a difference."""
+    t = _between_terms(a, b, block, eps).mean(axis=-1)  # a block's channels share their noise
+    return float(np.std(t) / np.sqrt(t.size))
 
 
 def block_mean(img, block):

@@ -160,6 +160,24 @@ def references(blender, build, blend, cache, seconds, log):
     return refs
 
 
+def cross_engine(result, refs):
+    """How far GDPT PT's converged image is from each Cycles reference, and that figure's
+    standard error (its noise), into `result`."""
+    for key, f in (("cross_engine_relmse", M.rel_mse_between),
+                   ("cross_engine_relmse_se", M.rel_mse_between_se)):
+        result[key] = {f"pt~{m}": f(refs["pt"], refs[m], CROSS_BLOCK)
+                       for m in ("cycles_unbiased", "cycles_default")}
+
+
+def cached_references(cache, seconds):
+    """The references of a finished run from its cache, or None when any is missing."""
+    paths = {m: [os.path.join(cache, f"ref_{m}_{seed}_{int(seconds)}s.exr") for seed in (1, 2)]
+             for m in ("cycles_default", "cycles_unbiased", "pt")}
+    if not all(os.path.exists(p) for ps in paths.values() for p in ps):
+        return None
+    return {m: tuple(rgb(p) for p in ps) for m, ps in paths.items()}
+
+
 def measure_scene(name, args, blender, log):
     cache = os.path.join(args.cache, f"{name}_{args.res}")
     os.makedirs(cache, exist_ok=True)
@@ -170,8 +188,7 @@ def measure_scene(name, args, blender, log):
     ref = {m: 0.5 * (a + b) for m, (a, b) in refs.items()}
     result = {"scene": name, "resolution": args.res, "budgets": args.budgets,
               "reference_seconds_per_half": args.ref_seconds, "curves": {c: [] for c in CURVES}}
-    result["cross_engine_relmse"] = {f"pt~{m}": M.rel_mse_between(refs["pt"], refs[m], CROSS_BLOCK)
-                                     for m in ("cycles_unbiased", "cycles_default")}
+    cross_engine(result, refs)
     result["void"] = result["cross_engine_relmse"]["pt~cycles_unbiased"] > CROSS_VOID
     result["predicted_improvement"] = M.gradient_energy_ratio(ref["pt"])
     crops = {}
@@ -391,8 +408,10 @@ def write_doc(results, meta, path, figures):
 
     # (header, cell of a result) per column; ratios over Cycles (defaults) unless named.
     columns = [
-        ("refs agree (relMSE PT~Cycles)", lambda r: (
-            f"{r['cross_engine_relmse']['pt~cycles_unbiased']:.1e}" + (" (void)" if r["void"] else ""))),
+        ("refs agree (relMSE PT~Cycles, ± its noise)", lambda r: (
+            f"{r['cross_engine_relmse']['pt~cycles_unbiased']:.1e}"
+            + (f" ± {r['cross_engine_relmse_se']['pt~cycles_unbiased']:.0e}"
+               if "cross_engine_relmse_se" in r else "") + (" (void)" if r["void"] else ""))),
         ("PT 10 s", lambda r: fmt(r["equal_time"]["10"]["improvement_over_cycles_default"]["pt"])),
         ("G-PT+L1 10 s", lambda r: fmt(
             r["equal_time"]["10"]["improvement_over_cycles_default"]["gpt_l1"])),
@@ -421,8 +440,9 @@ def write_doc(results, meta, path, figures):
               "defaults unless the column names the unbiased setting; above 1x GDPT has the "
               "lower error; \"-\" means the budget range did not reach that time. \"refs agree\" is "
               "the relMSE between GDPT PT's and Cycles unbiased's references on 4x4 blocks with both "
-              "references' noise subtracted: 0 up to that noise where the engines agree, and a scene "
-              "above 0.01 is marked void; the known causes of values above the noise are in "
+              "references' noise subtracted, ± its standard error: 0 within a few of those where the "
+              "engines agree, and a scene above 0.01 is marked void; the known causes of values "
+              "further from 0 are in "
               "docs/lights.md (\"Where the references differ\").", ""]
     for r in results:
         lines += [f"## {r['scene']}", ""]
@@ -486,6 +506,11 @@ def rewrite_doc(args, fig_dir, doc_dir):
             result = json.load(f)
         if args.resolve_feature:
             resolve_feature(name, args, result)
+        if "cross_engine_relmse_se" not in result:  # runs before it was recorded
+            refs = cached_references(os.path.join(args.cache, f"{name}_{result['resolution']}"),
+                                     result["reference_seconds_per_half"])
+            if refs:
+                cross_engine(result, refs)
         summarise(result)  # the derived ratios again; the measured points stay as they are
         result["meta"]["page_commit"] = git("rev-parse", "--short", "HEAD")
         with open(os.path.join(args.results, f"{name}.json"), "w") as f:

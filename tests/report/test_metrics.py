@@ -44,6 +44,20 @@ class Metrics(unittest.TestCase):
         # The noisy denominator leans the estimate up a little; the naive measure reads 4.1e-3.
         self.assertAlmostEqual(biased, 0.04 ** 2 / 0.65, delta=0.15 * 0.04 ** 2 / 0.65)
 
+    def test_rel_mse_between_se_is_the_spread_over_draws(self):
+        rng = np.random.default_rng(9)
+        t = np.full((256, 256, 3), 0.8)
+
+        def halves(s):
+            return t + rng.normal(0, s, t.shape), t + rng.normal(0, s, t.shape)
+
+        pairs = [(halves(0.1), halves(0.15)) for _ in range(12)]
+        values = [M.rel_mse_between(a, b, block=4) for a, b in pairs]
+        ses = [M.rel_mse_between_se(a, b, block=4) for a, b in pairs]
+        # Without a bias the values scatter about 0 by the standard error the function states.
+        self.assertAlmostEqual(np.std(values, ddof=1), np.mean(ses), delta=0.4 * np.mean(ses))
+        self.assertLess(abs(np.mean(values)), 3 * np.mean(ses) / np.sqrt(len(values)))
+
     def test_ssim(self):
         rng = np.random.default_rng(1)
         img = rng.uniform(0.0, 1.0, (64, 64, 3))
