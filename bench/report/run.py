@@ -143,13 +143,18 @@ def pass_mean(path, name):
     return float(np.mean(ch[key])) if key else None
 
 
+def reference_paths(cache, seconds):
+    """{method: (half 1's path, half 2's path)} of the references in a scene's cache."""
+    return {m: tuple(os.path.join(cache, f"ref_{m}_{seed}_{int(seconds)}s.exr") for seed in (1, 2))
+            for m in ("cycles_default", "cycles_unbiased", "pt")}
+
+
 def references(blender, build, blend, cache, seconds, log):
     """{method: (half a, half b)}, each half `seconds` long with its own seed, cached."""
     refs = {}
-    for method in ("cycles_default", "cycles_unbiased", "pt"):
+    for method, paths in reference_paths(cache, seconds).items():
         halves = []
-        for seed in (1, 2):
-            path = os.path.join(cache, f"ref_{method}_{seed}_{int(seconds)}s.exr")
+        for seed, path in zip((1, 2), paths):
             if not os.path.exists(path):
                 info = render(blender, blend, method, path + ".tmp.exr", seconds=seconds,
                               seed=1000 + seed)
@@ -171,8 +176,7 @@ def cross_engine(result, refs):
 
 def cached_references(cache, seconds):
     """The references of a finished run from its cache, or None when any is missing."""
-    paths = {m: [os.path.join(cache, f"ref_{m}_{seed}_{int(seconds)}s.exr") for seed in (1, 2)]
-             for m in ("cycles_default", "cycles_unbiased", "pt")}
+    paths = reference_paths(cache, seconds)
     if not all(os.path.exists(p) for ps in paths.values() for p in ps):
         return None
     return {m: tuple(rgb(p) for p in ps) for m, ps in paths.items()}
