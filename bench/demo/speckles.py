@@ -31,9 +31,13 @@ def floored_median(ref):
     return np.maximum(np.median(sliding_window_view(padded, (5, 5)), axis=(-2, -1)), MEDIAN_FLOOR)
 
 
-def speckles(img, median):
+def speckle_mask(img, median):
     """Pixels of `img` brighter than SPECKLE_RATIO x `median` (a reference's floored_median)."""
-    return int(np.count_nonzero(M.luminance(img) > SPECKLE_RATIO * median))
+    return M.luminance(img) > SPECKLE_RATIO * median
+
+
+def speckles(img, median):
+    return int(np.count_nonzero(speckle_mask(img, median)))
 
 
 def speckle_details(img, ref, median):
@@ -41,7 +45,7 @@ def speckle_details(img, ref, median):
     lum, lum_ref = M.luminance(img), M.luminance(ref)
     return [{"x": int(x), "y": int(y), "over_median": float(lum[y, x] / median[y, x]),
              "reference_over_median": float(lum_ref[y, x] / median[y, x])}
-            for y, x in zip(*np.nonzero(lum > SPECKLE_RATIO * median))]
+            for y, x in zip(*np.nonzero(speckle_mask(img, median)))]
 
 
 def main():
