@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -41,6 +42,12 @@ int tile_height(int w, int h, int workers) {
   return height;
 }
 
+// The samples of the whole frame (RenderSettings::frame_samples).
+uint64_t frame_total(const RenderSettings& settings) {
+  return settings.frame_samples ? uint64_t(settings.frame_samples)
+                                : uint64_t(settings.sample_offset) + uint64_t(settings.samples);
+}
+
 void check_settings(RenderSettings& settings) {
   if (settings.samples < 0) throw std::invalid_argument("render settings: samples must be >= 0");
   if (settings.max_bounces < 0 || settings.max_diffuse_bounces < 0 ||
@@ -51,6 +58,14 @@ void check_settings(RenderSettings& settings) {
   if (settings.threads < 0) throw std::invalid_argument("render settings: threads must be >= 0");
   if (uint64_t(settings.sample_offset) + uint64_t(settings.samples) > uint64_t(UINT32_MAX))
     throw std::invalid_argument("render settings: sample_offset + samples must be < 2^32");
+  if (settings.frame_samples != 0 &&
+      uint64_t(settings.frame_samples) < uint64_t(settings.sample_offset) + settings.samples)
+    throw std::invalid_argument(
+        "render settings: frame_samples (the frame's samples over all parts) must be at least "
+        "sample_offset + samples");
+  if (settings.feature_passes && frame_total(settings) >= (uint64_t(1) << 31))
+    throw std::invalid_argument("render settings: with the feature passes the frame's samples "
+                                "must be < 2^31");
   if (settings.samples_per_pass < 1) settings.samples_per_pass = 1;
 }
 }  // namespace
@@ -68,6 +83,10 @@ struct RenderSession::Impl {
   std::vector<std::string> warnings;
   // settings.threads worker slots (0 = all cores): used for the BVH build and every pass.
   std::unique_ptr<tbb::task_arena> arena;
+  // Whether the next render() sets the halves' split from its first sample's time.
+  bool estimate_split = false;
+  // Sets the halves' split from the first sample's time `seconds` (estimate_split).
+  void split_from_first_sample(double seconds);
   // The integrator, films and tiles for scene.camera (at construction and on set_camera).
   void setup_for_camera();
   // The arena, the context (BVH included), then setup_for_camera(), for scene and settings.
@@ -156,7 +175,16 @@ void RenderSession::Impl::setup_for_camera() {
       f->enable_feature_passes(settings.feature_passes);
     }
   }
-  for (Film* f : {&film, &pass_film}) f->set_sample_offset(settings.sample_offset);
+  // A time-limited render of a whole frame does not know the samples it will reach: its halves
+  // are split where the first sample's time predicts (render()); sample 0 is half A's first point
+  // at any split.
+  estimate_split = settings.feature_passes && settings.time_limit > 0.0 &&
+                   settings.frame_samples == 0 && settings.sample_offset == 0;
+  const uint32_t split = settings.feature_passes ? half_split(frame_total(settings)) : 0;
+  for (Film* f : {&film, &pass_film}) {
+    f->set_sample_offset(settings.sample_offset);
+    f->set_half_split(split);
+  }
   tiles.clear();
   const int th = tile_height(w, h, arena->max_concurrency());
   for (int y = 0; y < h; y += th)
@@ -169,6 +197,14 @@ void RenderSession::set_camera(const Camera& camera) {
   d.context->set_camera(camera);  // validates first: a bad camera leaves the session as it was
   d.scene.camera = camera;
   d.setup_for_camera();
+}
+
+void RenderSession::Impl::split_from_first_sample(double seconds) {
+  const double left = std::max(0.0, settings.time_limit - seconds);
+  const double predicted = 1.0 + std::floor(left / std::max(seconds, 1e-9));
+  const uint64_t total = uint64_t(std::min(double(settings.samples), predicted));
+  for (Film* f : {&film, &pass_film}) f->set_half_split(half_split(total));
+  estimate_split = false;
 }
 
 RenderSession::~RenderSession() = default;
@@ -188,7 +224,9 @@ void RenderSession::render(const std::function<void(const RenderProgress&)>& on_
     if (cancel.load(std::memory_order_relaxed)) break;
     if (d.settings.time_limit > 0.0 && elapsed() >= d.settings.time_limit) break;
     const uint32_t first = d.settings.sample_offset + uint32_t(done);
-    const uint32_t count = uint32_t(std::min(d.settings.samples_per_pass, total - done));
+    const bool probe = d.estimate_split && done == 0;
+    const uint32_t count =
+        probe ? 1u : uint32_t(std::min(d.settings.samples_per_pass, total - done));
 
     // --- One pass over every tile; a pass interrupted by cancel is discarded, so every pixel
     // always has the same sample count ---
@@ -228,6 +266,7 @@ void RenderSession::render(const std::function<void(const RenderProgress&)>& on_
                         });
     });
     done += int(count);
+    if (probe) d.split_from_first_sample(elapsed());
     if (on_pass) on_pass(RenderProgress{done, total, elapsed()});
   }
 }

@@ -112,6 +112,9 @@ void store_merged(ExrChannels& out, const std::vector<RenderPart>& merged_layers
     out.attributes[record_key(merged.name, "samples")] =
         std::to_string(uint32_t(*std::max_element(counts.begin(), counts.end())));
     out.attributes[record_key(merged.name, "merged_parts")] = std::to_string(files);
+    if (merged.record.half_split)
+      out.attributes[record_key(merged.name, "half_split")] =
+          std::to_string(merged.record.half_split);
   }
 }
 
@@ -149,6 +152,10 @@ std::map<std::string, RenderPart> parts_from_exr(const ExrChannels& image,
     r.reconstruction = attribute(image, name, record_key(layer, "reconstruction"));
     r.alpha = parse_number<float>(attribute(image, name, record_key(layer, "alpha")),
                                   "'" + name + "': alpha");
+    // Recorded since the halves share one sequence; older renders lack it (compared as 0).
+    const auto split = image.attributes.find(record_key(layer, "half_split"));
+    if (split != image.attributes.end())
+      r.half_split = parse_number<uint32_t>(split->second, "'" + name + "': the halves' split");
   }
   return parts;
 }

@@ -108,6 +108,12 @@ void Merger::check_compatible() {
       throw MergeError("'" + p.name + "' was rendered with seed " + std::to_string(p.record.seed) +
                        ", '" + first_.name + "' with seed " + std::to_string(first_.record.seed) +
                        ": only sample ranges of one seed merge into one render");
+    if (p.record.half_split != first_.record.half_split && first_.passes.count("Primal A"))
+      throw MergeError("'" + p.name + "' split its halves' samples at " +
+                       std::to_string(p.record.half_split) + " pairs, '" + first_.name + "' at " +
+                       std::to_string(first_.record.half_split) +
+                       ": the parts of one frame need the same Frame Samples "
+                       "(scene.gdpt.frame_samples, the frame's samples over all parts)");
     if (p.record.mode != first_.record.mode)
       throw MergeError("'" + p.name + "' was rendered in " + p.record.mode + " mode, '" +
                        first_.name + "' in " + first_.record.mode + " mode");

@@ -40,6 +40,9 @@ struct RenderRecord {
   uint32_t sample_offset = 0;  // the first global sample index
   std::string reconstruction;  // "L1", "L2", "WEIGHTED", "FEATURE" or "NONE"
   float alpha = 0.2f;          // the reconstruction's alpha
+  // Where the feature passes' halves split the frame's sample sequence (Film::half_split); 0:
+  // not recorded (renders without the feature passes, or older renders).
+  uint32_t half_split = 0;
 };
 
 // One pass: `channels` floats per pixel, interleaved, row 0 at the bottom.

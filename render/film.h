@@ -203,6 +203,14 @@ class Film {
   // halves are the even and odd global sample indices.
   void set_sample_offset(uint32_t offset) { sample_offset_ = offset; }
   uint32_t sample_offset() const { return sample_offset_; }
+  // The feature passes' halves split the sample sequence at `pairs` (core/sample_halves.h); 0
+  // without the feature passes, where sample s draws from sequence index s.
+  void set_half_split(uint32_t pairs) { half_split_ = pairs; }
+  uint32_t half_split() const { return half_split_; }
+  // The sequence index global sample `s` draws its numbers from.
+  uint32_t sequence_index(uint32_t s) const {
+    return half_split_ ? half_sequence_index(s, half_split_) : s;
+  }
   // Adds rows [y0, y1) of `pass` (same size) into this film and zeroes them in `pass`: how a
   // completed pass is committed.
   void take_rows(Film& pass, int y0, int y1);
@@ -242,6 +250,7 @@ class Film {
   HugePageVector<HalfAGradients> half_a_grad_;   // empty unless features_ and grad_ are not
   bool gradients_from_primal_ = false;
   uint32_t sample_offset_ = 0;
+  uint32_t half_split_ = 0;
 };
 
 }  // namespace gdpt

@@ -216,16 +216,6 @@ class Sampler {
     pixel_key_ = pixel_key(seed, x, y);
     set_index(index);
   }
-  // Starts sample `index` as one of two independent halves (even / odd indices, the feature
-  // passes' A and B): sample index / 2 of its half's own scrambled sequence. Halves split by
-  // parity from one sequence are anti-correlated (consecutive shuffled Sobol points fill
-  // complementary strata), which would bias the error estimate made from their difference.
-  void start_half(uint32_t seed, int x, int y, uint32_t index) {
-    start(half_seed(seed, index), x, y, index >> 1);
-  }
-  static uint32_t half_seed(uint32_t seed, uint32_t index) {
-    return (index & 1u) ? sampler_detail::hash_u32(seed ^ 0x68e31da4u) : seed;
-  }
   // Another sample index of the same pixel.
   void set_index(uint32_t index) { reversed_index_ = sampler_detail::reverse_bits(index); }
   // The hash of (seed, pixel) that every dimension's hash starts from.

@@ -22,6 +22,10 @@ struct RenderSettings {
   // sample_offset + samples - 1 of the seed's sequence, so renders of disjoint ranges are
   // independent parts of one render and merge exactly (reconstruct/pass_merge.h).
   uint32_t sample_offset = 0;
+  // The samples of the whole frame when renders of disjoint ranges make it up (a farm's total; 0:
+  // sample_offset + samples). The feature passes' halves split the frame's sample sequence at its
+  // middle (core/sample_halves.h), so every part of one frame must give the same total.
+  uint32_t frame_samples = 0;
   // Film > Pixel Filter, Cycles' meaning of the width (pixel_filter.h). The core's default is the
   // box over the pixel; the add-on passes scene.gdpt's (Cycles' default: Blackman-Harris 1.5).
   PixelFilterType pixel_filter = PixelFilterType::Box;

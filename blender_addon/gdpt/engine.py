@@ -126,11 +126,12 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         if show:
             self.update_result(result)
 
-    def _record(self, layer_name, settings, samples):
+    def _record(self, layer_name, settings, film):
         """Records in the render's metadata (multilayer EXR header `gdpt.<view layer>.<key>`)
         what gdpt-merge needs to merge renders of disjoint sample ranges and rebuild Combined."""
         record = {"mode": settings.mode, "seed": settings.seed,
-                  "sample_offset": settings.sample_offset, "samples": samples,
+                  "sample_offset": settings.sample_offset, "samples": film["samples"],
+                  "half_split": film["half_split"],
                   "reconstruction": settings.reconstruction, "alpha": repr(float(settings.alpha))}
         result = self.get_result()
         for key, value in record.items():
@@ -272,7 +273,7 @@ class GDPTRenderEngine(bpy.types.RenderEngine):
         t_reconstruct = time.perf_counter()
         self._write(result, layer, film, combined, buffers["layer"], show=False)
         self.end_result(result)
-        self._record(view_layer.name, settings, film["samples"])
+        self._record(view_layer.name, settings, film)
         # Gradient Reconstruct compositor nodes solve from this layer's passes now: Blender
         # composites after render() returns (compositor_node.py).
         try:

@@ -98,6 +98,11 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
         "takes samples Sample Offset .. Sample Offset + Samples - 1 of the seed's sequence, so "
         "renders of disjoint ranges merge exactly (gdpt-merge)", default=0, min=0,
         max=(1 << 31) - 1)
+    frame_samples: IntProperty(
+        name="Frame Samples", description="Samples of the whole frame when renders of disjoint "
+        "sample ranges make it up (0: Sample Offset + Samples). The Feature reconstruction's "
+        "halves split the frame's sample sequence at its middle, so every part of a frame must "
+        "give the same total (gdpt-farm sets it)", default=0, min=0, max=(1 << 31) - 1)
     threads: IntProperty(name="Threads", description="Render threads (0 = all cores)", default=0,
                          min=0, max=1024)
     clamp: FloatProperty(name="Clamp", description="Maximum sample value (0 = off)", default=0.0,
@@ -173,6 +178,7 @@ def settings_dict(scene):
         "rr_depth": int(s.min_light_bounces) + 1,
         "seed": int(s.seed),
         "sample_offset": int(s.sample_offset),
+        "frame_samples": int(s.frame_samples),
         "threads": int(s.threads),
         "clamp": float(s.clamp),
         "shift_threshold": float(s.shift_threshold),

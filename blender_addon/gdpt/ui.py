@@ -40,6 +40,7 @@ class GDPT_PT_sampling(_RenderPanel, Panel):
         col = layout.column()
         col.prop(s, "seed")
         col.prop(s, "sample_offset")
+        col.prop(s, "frame_samples")
         col.prop(s, "clamp")
         col.prop(s, "min_light_bounces")
 

@@ -49,7 +49,8 @@ def render_settings(scene):
     d["samples"] = int(s.preview_samples) or UNLIMITED_SAMPLES
     d["time_limit"] = 0.0
     d["samples_per_pass"] = 1
-    d["sample_offset"] = 0  # a farm setting: the viewport always starts at sample 0
+    d["sample_offset"] = 0  # farm settings: the viewport always renders a whole frame
+    d["frame_samples"] = 0
     return d
 
 

@@ -49,6 +49,7 @@ RenderSettings settings_from_dict(const py::dict& d) {
   get("max_transmission_bounces", s.max_transmission_bounces);
   get("seed", s.seed);
   get("sample_offset", s.sample_offset);
+  get("frame_samples", s.frame_samples);
   get("threads", s.threads);
   get("clamp", s.clamp);
   get("rr_depth", s.rr_depth);

@@ -89,6 +89,7 @@ py::dict film_dict(const FilmPasses& p) {
   d["width"] = p.width;
   d["height"] = p.height;
   d["samples"] = p.samples_done;
+  d["half_split"] = p.half_split;
   return d;
 }
 
@@ -98,6 +99,7 @@ void FilmPasses::read(const Film& film, int samples) {
   width = film.width();
   height = film.height();
   samples_done = samples;
+  half_split = film.half_split();
   const size_t n = film.pixel_count();
   primal.resize(n * 3);
   gradient_x.resize(n * 3);

@@ -29,6 +29,7 @@ namespace gdpt::python {
 // benchmark VM 0.4-0.7 s of page faults per read.
 struct FilmPasses {
   int width = 0, height = 0, samples_done = 0;
+  uint32_t half_split = 0;  // Film::half_split (0 without the feature passes)
   HugePageVector<float> primal, gradient_x, gradient_y, emission, variance, shift_failures, alpha,
       depth, object_index, material_index;
   // What merging renders of disjoint sample ranges needs (Film::sample_count, shift_attempts,

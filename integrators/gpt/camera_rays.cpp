@@ -11,12 +11,12 @@ static_assert(kRight == 0 && kUp == 1 && kLeft == 2 && kDown == 3);
 
 }  // namespace
 
-uint64_t trace_camera_grid(const GptContext& g, const Tile& tile, int W, int H, uint32_t s,
-                           CameraGrid& grid) {
+uint64_t trace_camera_grid(const GptContext& g, const Tile& tile, int W, int H,
+                           uint32_t index, CameraGrid& grid) {
   // The image-wide jitter: a sampler keyed to no pixel, (-1, -1). Every pixel takes the same
   // filter sample, so a neighbour's base ray is this pixel's offset ray.
   Sampler image_wide;
-  start_sample(g, image_wide, -1, -1, s);
+  start_sample(g, image_wide, -1, -1, index);
   const Vec2f jitter = image_wide.get2d(Sampler::kDimCamera);
   const PixelFilter& filter = g.ctx.pixel_filter();
   grid.x0 = std::max(tile.x0 - 1, 0);
@@ -61,15 +61,15 @@ CameraSample grid_sample(const CameraGrid& grid, int x, int y, const bool* mask)
   return cs;
 }
 
-uint64_t trace_camera_row(const GptContext& g, int W, int H, int x0, int y, int n, uint32_t s,
-                          CameraRow& row) {
+uint64_t trace_camera_row(const GptContext& g, int W, int H, int x0, int y, int n,
+                          uint32_t index, CameraRow& row) {
   const CameraModel& camera = g.ctx.camera();
   const int rx = camera.region_x(), ry = camera.region_y();  // frame raster
   for (int i = 0; i < kRow; ++i) {
     row.valid[i] = i < n;
     if (!row.valid[i]) continue;
     const int x = x0 + i;
-    start_sample(g, row.sampler[i], x + rx, y + ry, s);
+    start_sample(g, row.sampler[i], x + rx, y + ry, index);
     const Vec2f jitter = row.sampler[i].get2d(Sampler::kDimCamera);
     row.lens[i] = row.sampler[i].get2d(Sampler::kDimLens);
     row.raster[i] = g.ctx.pixel_filter().raster(x + rx, y + ry, jitter);

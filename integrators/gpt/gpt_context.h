@@ -58,13 +58,9 @@ struct GptContext {
   VertexRules rules(const PathState& state) const { return {filters, state}; }
 };
 
-// Starts sample `s` of pixel (x, y): with the feature passes, as one of two independent halves
-// (Sampler::start_half), whose difference the Feature reconstruction reads as noise.
-inline void start_sample(const GptContext& g, Sampler& sampler, int x, int y, uint32_t s) {
-  if (g.features.active())
-    sampler.start_half(g.settings.seed, x, y, s);
-  else
-    sampler.start(g.settings.seed, x, y, s);
+// Starts the sample of sequence index `index` (Film::sequence_index) of pixel (x, y).
+inline void start_sample(const GptContext& g, Sampler& sampler, int x, int y, uint32_t index) {
+  sampler.start(g.settings.seed, x, y, index);
 }
 
 }  // namespace gdpt

@@ -83,11 +83,12 @@ class GradientPathTracer final : public Integrator {
       CameraGrid& grid = scratch->grid;
       bool mask[kOffsets];
       for (uint32_t s = first_sample; s < end; ++s) {
-        rays += trace_camera_grid(g_, tile, W, H, s, grid);
+        const uint32_t index = film.sequence_index(s);
+        rays += trace_camera_grid(g_, tile, W, H, index, grid);
         for (int y = tile.y0; y < tile.y1; ++y)
           for (int x = tile.x0; x < tile.x1; ++x) {
             Sampler sampler;
-            start_sample(g_, sampler, x + rx, y + ry, s);
+            start_sample(g_, sampler, x + rx, y + ry, index);
             offset_mask(W, H, x, y, mask);
             const CameraSample cs = grid_sample(grid, x, y, mask);
             // Depth and index passes: the first sample's camera hit (sample 0, as Cycles).
@@ -102,7 +103,7 @@ class GradientPathTracer final : public Integrator {
         for (int y = tile.y0; y < tile.y1; ++y)
           for (int x0 = tile.x0; x0 < tile.x1; x0 += kRow) {
             const int n = std::min(kRow, tile.x1 - x0);
-            rays += trace_camera_row(g_, W, H, x0, y, n, s, row);
+            rays += trace_camera_row(g_, W, H, x0, y, n, film.sequence_index(s), row);
             for (int i = 0; i < n; ++i) {
               if (s == g_.settings.sample_offset && row.found[i])  // the first sample's hit
                 g_.ctx.record_first_hit(film, x0 + i, y, row.hit[i]);

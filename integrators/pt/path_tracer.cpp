@@ -63,9 +63,8 @@ class PathTracer final : public Integrator {
                    Film& film) const override {
     constexpr int kStream = 16;
     uint64_t rays = 0;
-    // The segment's Samplers, camera jitters and first vertices' numbers; with the feature passes
-    // one batch per half of the samples, each its own scrambled sequence (Sampler::start_half).
-    VertexNumberBatch batches[2];
+    // The segment's Samplers, camera jitters and first vertices' numbers, for one sample index.
+    VertexNumberBatch numbers;
     static_assert(VertexNumberBatch::kMaxPixels >= kStream);
     Ray camera_rays[kStream];
     bool valid[kStream], found[kStream];
@@ -79,14 +78,11 @@ class PathTracer final : public Integrator {
     for (int y = tile.y0; y < tile.y1; ++y) {
       for (int x0 = tile.x0; x0 < tile.x1; x0 += kStream) {
         const int n = std::min(kStream, tile.x1 - x0);
-        const bool halves = features_.active();
-        for (uint32_t h = 0; h < (halves ? 2u : 1u); ++h)
-          batches[h].prepare(halves ? Sampler::half_seed(settings_.seed, h) : settings_.seed,
-                             x0 + rx, y + ry, n, settings_.max_bounces + 1, !ctx_.lights().empty());
+        numbers.prepare(settings_.seed, x0 + rx, y + ry, n, settings_.max_bounces + 1,
+                        !ctx_.lights().empty());
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
           // --- Camera rays of the segment, traced together ---
-          VertexNumberBatch& numbers = halves ? batches[s & 1u] : batches[0];
-          numbers.fill(halves ? s >> 1 : s);
+          numbers.fill(film.sequence_index(s));
           for (int j = 0; j < n; ++j)
             camera_rays[j] = camera_ray(numbers.sampler(j), numbers.camera(j), x0 + j + rx, y + ry);
           ctx_.bvh().intersect_stream(camera_rays, valid, n, found, hits);

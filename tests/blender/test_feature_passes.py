@@ -53,7 +53,11 @@ def combined(ch):
 def main():
     os.makedirs(S.args()["out"], exist_ok=True)
     scene = build()
-    ch = exr.read_exr(S.render_engine(scene, "feature", 'GDPT', SPP, reconstruction='FEATURE'))
+    path = S.render_engine(scene, "feature", 'GDPT', SPP, reconstruction='FEATURE')
+    ch = exr.read_exr(path)
+    # The halves split the frame's SPP samples at its middle; gdpt-merge compares the record.
+    split = exr.read_string_attributes(path).get("gdpt.ViewLayer.half_split")
+    check(split == str(SPP // 2), f"the EXR records the halves' split at {SPP // 2} ({split})")
     for name in ("Denoising Albedo.R", "Denoising Albedo.G", "Denoising Albedo.B",
                  "Denoising Normal.X", "Denoising Normal.Y", "Denoising Normal.Z",
                  "Denoising Depth.Z"):

@@ -2,6 +2,8 @@
 // means with zero last column / row), shift-failure fractions and pass commits.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <set>
 #include <stdexcept>
 #include <vector>
 
@@ -19,6 +21,40 @@ void add(Film& f, int x, int y, Spectrum primal, Spectrum emission = Spectrum(0.
   const double l = luminance(primal);
   a.primal2 += l * l;
   f.add_sample_count(x, y);
+}
+
+// The feature passes' halves (core/sample_halves.h): A the first ceil(N / 2) points of the
+// sequence, B the next ones, so N samples take exactly the first N points; past the split (a
+// time-limited render that outran its estimate) further segments, the union a prefix whenever a
+// segment is full.
+TEST(Film, HalvesTakeConsecutiveSegmentsOfOneSequence) {
+  EXPECT_EQ(half_split(0), 1u);
+  EXPECT_EQ(half_split(1), 1u);
+  EXPECT_EQ(half_split(29), 15u);
+  EXPECT_EQ(half_split(30), 15u);
+  for (uint32_t n : {1u, 2u, 7u, 29u, 30u, 64u}) {
+    const uint32_t split = half_split(n);
+    std::set<uint32_t> a, b;
+    for (uint32_t s = 0; s < n; ++s) {
+      (in_half_a(s) ? a : b).insert(half_sequence_index(s, split));
+    }
+    std::set<uint32_t> all = a;
+    all.insert(b.begin(), b.end());
+    ASSERT_EQ(all.size(), size_t(n)) << n;
+    EXPECT_EQ(*all.rbegin(), n - 1) << n;  // distinct and below n: exactly 0 .. n - 1
+    EXPECT_EQ(*a.rbegin(), a.size() - 1) << n;  // A: 0 .. |A| - 1
+    if (!b.empty()) {
+      EXPECT_EQ(*b.begin(), split) << n;  // B from the split on
+    }
+  }
+  const uint32_t order[12] = {0, 3, 1, 4, 2, 5, 6, 9, 7, 10, 8, 11};
+  for (uint32_t s = 0; s < 12; ++s) EXPECT_EQ(half_sequence_index(s, 3), order[s]) << s;
+  Film film(4, 4, false);
+  EXPECT_EQ(film.sequence_index(5), 5u);  // no halves: the sample's own index
+  film.set_half_split(3);
+  EXPECT_EQ(film.sequence_index(5), 5u);
+  EXPECT_EQ(film.sequence_index(6), 6u);
+  EXPECT_EQ(film.sequence_index(3), 4u);
 }
 
 TEST(Film, MeansAndVarianceOfTheMean) {

@@ -32,7 +32,7 @@ RenderPart part_from_film(const Film& f, const RenderSettings& s, const std::str
   p.width = f.width();
   p.height = f.height();
   p.record = {s.mode == RenderSettings::Mode::PT ? "PT" : "GPT", s.seed, s.sample_offset, norm,
-              alpha};
+              alpha, f.half_split()};
   const size_t n = f.pixel_count();
   auto add = [&](const std::string& name, int channels, auto&& fill) {
     PassImage& image = p.passes[name];
@@ -86,10 +86,13 @@ RenderPart part_from_film(const Film& f, const RenderSettings& s, const std::str
   return p;
 }
 
+// Samples offset .. offset + samples - 1 of a frame of `frame` samples (frame_samples).
 RenderPart render_part(const Scene& scene, RenderSettings s, uint32_t offset, int samples,
-                       const std::string& norm = "L1", float alpha = 0.2f) {
+                       uint32_t frame = 0, const std::string& norm = "L1",
+                       float alpha = 0.2f) {
   s.sample_offset = offset;
   s.samples = samples;
+  s.frame_samples = frame;
   s.samples_per_pass = 3;  // pass boundaries that differ from the parts' ranges
   RenderSession session(scene, s);
   std::atomic<bool> cancel{false};
@@ -138,10 +141,10 @@ TEST(Merge, GptPartsEqualTheRenderOfAllSamples) {
   const Scene scene = gradient_test::make_scene(SceneKind::MixedLights, 20);
   const RenderSettings s = feature_settings(RenderSettings::Mode::GPT);
   // An odd first range: the halves' even / odd split follows the global sample index.
-  const RenderPart single = render_part(scene, s, 0, 16, "FEATURE");
-  const std::vector<RenderPart> parts = {render_part(scene, s, 5, 7, "FEATURE"),
-                                         render_part(scene, s, 0, 5, "FEATURE"),
-                                         render_part(scene, s, 12, 4, "FEATURE")};
+  const RenderPart single = render_part(scene, s, 0, 16, 0, "FEATURE");
+  const std::vector<RenderPart> parts = {render_part(scene, s, 5, 7, 16, "FEATURE"),
+                                         render_part(scene, s, 0, 5, 16, "FEATURE"),
+                                         render_part(scene, s, 12, 4, 16, "FEATURE")};
   const RenderPart merged = merge_render_parts(parts, {{}, {}, 2});
   EXPECT_EQ(merged.record.sample_offset, 0u);
   // G-PT's gradients over the halves too, merged by the parts' even / odd sample counts.
@@ -156,9 +159,9 @@ TEST(Merge, GptPartsEqualTheRenderOfAllSamples) {
 TEST(Merge, PtPartsEqualTheRenderOfAllSamplesWithEveryNorm) {
   const Scene scene = gradient_test::make_scene(SceneKind::CornellDiffuse, 16);
   const RenderSettings s = feature_settings(RenderSettings::Mode::PT);
-  const RenderPart single = render_part(scene, s, 0, 10, "WEIGHTED", 0.5f);
-  const RenderPart merged = merge_render_parts({render_part(scene, s, 0, 4, "WEIGHTED", 0.5f),
-                                                render_part(scene, s, 4, 6, "WEIGHTED", 0.5f)});
+  const RenderPart single = render_part(scene, s, 0, 10, 0, "WEIGHTED", 0.5f);
+  const RenderPart merged = merge_render_parts({render_part(scene, s, 0, 4, 10, "WEIGHTED", 0.5f),
+                                                render_part(scene, s, 4, 6, 10, "WEIGHTED", 0.5f)});
   expect_equal_passes(merged, single);
   for (const char* norm : {"L1", "L2", "NONE", "FEATURE"}) {
     const ReconstructionNorm n = *norm_from_name(norm);
@@ -178,9 +181,9 @@ TEST(Merge, GptWeightedVarianceMatters) {
   // adding the parts' gradient variances as if they were one half would not.
   const Scene scene = gradient_test::make_scene(SceneKind::CornellGlossy, 16);
   const RenderSettings s = gradient_test::settings(RenderSettings::Mode::GPT, 1, 3);
-  const RenderPart single = render_part(scene, s, 0, 12, "WEIGHTED");
+  const RenderPart single = render_part(scene, s, 0, 12, 0, "WEIGHTED");
   const RenderPart merged = merge_render_parts(
-      {render_part(scene, s, 0, 6, "WEIGHTED"), render_part(scene, s, 6, 6, "WEIGHTED")});
+      {render_part(scene, s, 0, 6, 12, "WEIGHTED"), render_part(scene, s, 6, 6, 12, "WEIGHTED")});
   expect_equal_passes(merged, single);
 }
 
@@ -218,6 +221,19 @@ TEST(Merge, RefusesPartsThatDoNotBelongTogether) {
   RenderPart unknown = b, a_unknown = a;
   unknown.passes["AO"] = a_unknown.passes["AO"] = {1, std::vector<float>(64, 0.0f)};
   EXPECT_NE(merge_error({a_unknown, unknown}).find("'AO'"), std::string::npos);
+}
+
+TEST(Merge, RefusesHalvesSplitForAnotherFrame) {
+  // Parts that took their ranges without the frame's total split their halves' sequence at
+  // different points: their halves are not halves of one render.
+  const Scene scene = gradient_test::make_scene(SceneKind::CornellDiffuse, 8);
+  const RenderSettings s = feature_settings(RenderSettings::Mode::GPT);
+  const RenderPart a = render_part(scene, s, 0, 4), b = render_part(scene, s, 4, 4);
+  EXPECT_EQ(a.record.half_split, 2u);
+  EXPECT_EQ(b.record.half_split, 4u);
+  EXPECT_NE(merge_error({a, b}).find("Frame Samples"), std::string::npos) << merge_error({a, b});
+  const RenderPart a8 = render_part(scene, s, 0, 4, 8), b8 = render_part(scene, s, 4, 4, 8);
+  EXPECT_EQ(merge_error({a8, b8}), "(no error)");
 }
 
 // --- gdpt-merge on files ---
