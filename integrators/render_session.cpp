@@ -64,8 +64,9 @@ void check_settings(RenderSettings& settings) {
         "render settings: frame_samples (the frame's samples over all parts) must be at least "
         "sample_offset + samples");
   if (settings.feature_passes && frame_total(settings) >= (uint64_t(1) << 31))
-    throw std::invalid_argument("render settings: with the feature passes the frame's samples "
-                                "must be < 2^31");
+    throw std::invalid_argument(
+        "render settings: with the feature passes the frame's samples "
+        "must be < 2^31");
   if (settings.samples_per_pass < 1) settings.samples_per_pass = 1;
 }
 }  // namespace

@@ -11,8 +11,8 @@ static_assert(kRight == 0 && kUp == 1 && kLeft == 2 && kDown == 3);
 
 }  // namespace
 
-uint64_t trace_camera_grid(const GptContext& g, const Tile& tile, int W, int H,
-                           uint32_t index, CameraGrid& grid) {
+uint64_t trace_camera_grid(const GptContext& g, const Tile& tile, int W, int H, uint32_t index,
+                           CameraGrid& grid) {
   // The image-wide jitter: a sampler keyed to no pixel, (-1, -1). Every pixel takes the same
   // filter sample, so a neighbour's base ray is this pixel's offset ray.
   Sampler image_wide;
@@ -61,8 +61,8 @@ CameraSample grid_sample(const CameraGrid& grid, int x, int y, const bool* mask)
   return cs;
 }
 
-uint64_t trace_camera_row(const GptContext& g, int W, int H, int x0, int y, int n,
-                          uint32_t index, CameraRow& row) {
+uint64_t trace_camera_row(const GptContext& g, int W, int H, int x0, int y, int n, uint32_t index,
+                          CameraRow& row) {
   const CameraModel& camera = g.ctx.camera();
   const int rx = camera.region_x(), ry = camera.region_y();  // frame raster
   for (int i = 0; i < kRow; ++i) {

@@ -53,9 +53,10 @@ struct CameraGrid {
 };
 
 // Traces the tile's camera rays and its halo for the sample of sequence index `index`
-// (Film::sequence_index) of a W x H image, with the image-wide jitter of that sample. Returns the number of rays.
-uint64_t trace_camera_grid(const GptContext& g, const Tile& tile, int W, int H,
-                           uint32_t index, CameraGrid& grid);
+// (Film::sequence_index) of a W x H image, with the image-wide jitter of that sample. Returns the
+// number of rays.
+uint64_t trace_camera_grid(const GptContext& g, const Tile& tile, int W, int H, uint32_t index,
+                           CameraGrid& grid);
 
 // Pixel (x, y)'s camera sample from a traced grid; `mask` from offset_mask().
 CameraSample grid_sample(const CameraGrid& grid, int x, int y, const bool* mask);
@@ -80,9 +81,10 @@ struct CameraRow {
   SurfaceHit cam_hit[kOffsets * kRow];
 };
 
-// Traces the n <= kRow pixels from (x0, y) on for the sample of sequence index `index`. Returns the number of rays.
-uint64_t trace_camera_row(const GptContext& g, int W, int H, int x0, int y, int n,
-                          uint32_t index, CameraRow& row);
+// Traces the n <= kRow pixels from (x0, y) on for the sample of sequence index `index`. Returns the
+// number of rays.
+uint64_t trace_camera_row(const GptContext& g, int W, int H, int x0, int y, int n, uint32_t index,
+                          CameraRow& row);
 
 // Pixel i's camera sample from a traced row.
 CameraSample row_sample(const CameraRow& row, int i);

@@ -41,7 +41,7 @@ TEST(Film, HalvesTakeConsecutiveSegmentsOfOneSequence) {
     std::set<uint32_t> all = a;
     all.insert(b.begin(), b.end());
     ASSERT_EQ(all.size(), size_t(n)) << n;
-    EXPECT_EQ(*all.rbegin(), n - 1) << n;  // distinct and below n: exactly 0 .. n - 1
+    EXPECT_EQ(*all.rbegin(), n - 1) << n;       // distinct and below n: exactly 0 .. n - 1
     EXPECT_EQ(*a.rbegin(), a.size() - 1) << n;  // A: 0 .. |A| - 1
     if (!b.empty()) {
       EXPECT_EQ(*b.begin(), split) << n;  // B from the split on

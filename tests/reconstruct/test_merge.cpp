@@ -31,8 +31,12 @@ RenderPart part_from_film(const Film& f, const RenderSettings& s, const std::str
   p.name = "offset " + std::to_string(s.sample_offset);
   p.width = f.width();
   p.height = f.height();
-  p.record = {s.mode == RenderSettings::Mode::PT ? "PT" : "GPT", s.seed, s.sample_offset, norm,
-              alpha, f.half_split()};
+  p.record = {s.mode == RenderSettings::Mode::PT ? "PT" : "GPT",
+              s.seed,
+              s.sample_offset,
+              norm,
+              alpha,
+              f.half_split()};
   const size_t n = f.pixel_count();
   auto add = [&](const std::string& name, int channels, auto&& fill) {
     PassImage& image = p.passes[name];
@@ -88,8 +92,7 @@ RenderPart part_from_film(const Film& f, const RenderSettings& s, const std::str
 
 // Samples offset .. offset + samples - 1 of a frame of `frame` samples (frame_samples).
 RenderPart render_part(const Scene& scene, RenderSettings s, uint32_t offset, int samples,
-                       uint32_t frame = 0, const std::string& norm = "L1",
-                       float alpha = 0.2f) {
+                       uint32_t frame = 0, const std::string& norm = "L1", float alpha = 0.2f) {
   s.sample_offset = offset;
   s.samples = samples;
   s.frame_samples = frame;
