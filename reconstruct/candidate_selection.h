@@ -5,6 +5,11 @@
 // the halved independent noise gives, for (FA + FB) / 2:
 //   e = ((FA - B)^2 + (FB - A)^2) / 2 - (VA + VB) / 2 - (FA - FB)^2 / 4.
 // e is unbiased but noisy per pixel; it is averaged over a window before candidates are compared.
+// The engine's halves are two segments of one stratified sequence (core/sample_halves.h), which
+// keeps the image of all samples as stratified as a render without halves; they are then
+// anti-correlated by what the whole stratifies better than its halves, and e overstates the
+// noise terms a little (the halves' (A - B)^2 / 4 read 1.04-1.26x the primal's true error on
+// the benchmark scenes at 5 s, docs/reconstruct.md).
 // The comparison weighs each channel's e by 1 / (g^2 + eps), g a candidate-independent guide of
 // the pixel's colour: the error compared is relative, so a few bright pixels (a light seen in a
 // mirror, a noisy highlight edge) cannot choose, for a whole window, a filter that spreads them

@@ -1,6 +1,6 @@
 // The inputs of the Feature reconstruction, made ready for the per-pixel filters: the base image
-// (the gradient-domain solution of all samples, or the primal) and its two independent halves
-// with non-finite values masked, and the guide features (albedo, normal, depth) with their
+// (the gradient-domain solution of all samples, or the primal) and its two halves with
+// non-finite values masked, and the guide features (albedo, normal, depth) with their
 // variances.
 #pragma once
 
@@ -33,7 +33,7 @@ inline constexpr int kFeatureChannels = 7;
 
 // `a`, `b`: the halves' images (RGB); `all`: the image the chosen filter is applied to;
 // `variance_a` / `variance_b`: the halves' variances (RGB), both or neither: without them
-// (A - B)^2 / 2 stands in, unbiased for independent halves.
+// (A - B)^2 / 2 stands in, unbiased for independent halves (candidate_selection.h).
 FeatureBuffers prepare_feature_buffers(const ReconstructionInput& in, const float* a,
                                        const float* b, const float* all, const float* variance_a,
                                        const float* variance_b);

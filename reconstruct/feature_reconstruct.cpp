@@ -55,7 +55,7 @@ void validate_feature(const ReconstructionInput& in, const ReconstructionSetting
         "reconstruct: give all four gradient halves (x and y of A and B) or none");
 }
 
-// The images the filters run on: two independent halves and the image of all samples.
+// The images the filters run on: the two halves and the image of all samples.
 struct FeatureBase {
   std::vector<float> a, b, all;
   const float *pa = nullptr, *pb = nullptr, *pall = nullptr;

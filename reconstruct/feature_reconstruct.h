@@ -1,5 +1,5 @@
 // The Feature reconstruction (ReconstructionNorm::Feature): feature-guided filters of the
-// gradient-domain solution, chosen per pixel by an error estimate from independent halves.
+// gradient-domain solution, chosen per pixel by an error estimate from two halves of the samples.
 //
 //   1. base images: the solution of all samples with settings.feature_guide at settings.alpha,
 //      and, from the gradient halves, each half's own L2 solution (fast and exact; only used to

@@ -16,7 +16,7 @@
 //             `weighted_tolerance`.
 //   None      primal (+ emission).
 //   Feature   feature-guided edge-aware filters of the gradient-domain solution (feature_guide),
-//             chosen per pixel by an error estimate from two independent halves of the samples,
+//             chosen per pixel by an error estimate from two halves of the samples,
 //             each with its own gradient-domain solve (feature_reconstruct.h).
 // Non-finite inputs are missing data: a term (primal, dx or dy of a pixel) with any non-finite
 // channel gets zero weight. The output is always finite.
@@ -102,7 +102,7 @@ struct ReconstructionInput {
   const float* variance = nullptr;    // 3 per pixel (primal, dx, dy luminance); Weighted only
   const float* emission = nullptr;    // RGB, optional: added to the solution
 
-  // Feature norm. The primal as two independent halves (e.g. even / odd samples), each the mean
+  // Feature norm. The primal as two halves (the engine's even / odd samples), each the mean
   // of its half's samples, both required; `primal` may then be null (the halves' mean is used).
   const float* primal_a = nullptr;    // RGB
   const float* primal_b = nullptr;    // RGB

@@ -8,6 +8,10 @@ Images are float arrays (height, width, 3) in scene-linear RGB.
   E|r1 - r2|^2 = 4 E|r - t|^2, so the reference's own noise is subtracted.
 - rel_mse_between: the same correction for two noisy images (each from two halves), on block
   means: how far apart two engines' converged images are; rel_mse_between_se its standard error.
+- half_noise_ratio: what two halves of a render say its noise is, (A - B)^2 / 4 relative, over
+  the render's true relMSE (rel_mse_denoised): 1 for independent halves of an unbiased render,
+  above 1 when the halves are anti-correlated (the Feature reconstruction's error estimate reads
+  its noise terms that much too high).
 - ssim: structural similarity (Wang et al. 2004; 11-tap Gaussian window, sigma 1.5) of the
   luminance after a display transform (clip to [0, 1], gamma 1/2.2).
 - gradient_energy_ratio: the survey's predicted improvement of gradient sampling,
@@ -26,6 +30,14 @@ def rel_mse_denoised(x, ref_a, ref_b, eps=EPS):
     ref = 0.5 * (ref_a + ref_b)
     noise = 0.25 * np.mean((ref_a - ref_b) ** 2 / (ref ** 2 + eps))
     return float(np.mean((x - ref) ** 2 / (ref ** 2 + eps)) - noise)
+
+
+def half_noise_ratio(a, b, x, ref_a, ref_b, eps=EPS):
+    """The halves' estimate of x's noise, mean (a - b)^2 / 4 / (r^2 + eps), over x's relMSE
+    against the noisy reference (its noise subtracted); x = (a + b) / 2 up to the halves' counts."""
+    ref = 0.5 * (ref_a + ref_b)
+    estimate = 0.25 * np.mean((a - b) ** 2 / (ref ** 2 + eps))
+    return float(estimate / rel_mse_denoised(x, ref_a, ref_b, eps))
 
 
 def _between_terms(a, b, block, eps):

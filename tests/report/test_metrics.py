@@ -31,6 +31,19 @@ class Metrics(unittest.TestCase):
         self.assertGreater(M.rel_mse(x, 0.5 * (a + b)), 1.5 * truth)  # naive: off by s^2 / 2
         self.assertAlmostEqual(M.rel_mse_denoised(x, a, b), truth, delta=0.05 * truth)
 
+    def test_half_noise_ratio(self):
+        rng = np.random.default_rng(3)
+        t = rng.uniform(0.2, 1.0, (256, 256, 3))
+        ra, rb = (t + rng.normal(0, 0.02, t.shape) for _ in range(2))
+        a, b = t + rng.normal(0, 0.1, t.shape), t + rng.normal(0, 0.1, t.shape)
+        self.assertAlmostEqual(M.half_noise_ratio(a, b, 0.5 * (a + b), ra, rb), 1.0, delta=0.03)
+        # Anti-correlated halves (a shared error e of opposite signs, sd 0.1) read the noise of
+        # their mean high: Var (A - B) / 4 = (0.1^2 + 0.1^2 + 4 0.1^2) / 4 against
+        # (0.1^2 + 0.1^2) / 4 for the mean, which e leaves out.
+        e = rng.normal(0, 0.1, t.shape)
+        a, b = a + e, b - e
+        self.assertAlmostEqual(M.half_noise_ratio(a, b, 0.5 * (a + b), ra, rb), 3.0, delta=0.1)
+
     def test_rel_mse_between_sees_bias_not_noise(self):
         rng = np.random.default_rng(5)
         t = np.full((512, 512, 3), 0.8)
