@@ -1301,7 +1301,8 @@ TEST(Render, FeatureAlbedoOfPrincipledCountsTheSpecularFresnel) {
 // anti-correlated only by what the whole sequence stratifies better than its halves:
 // E[(A - B)^2] over Var A + Var B (measured across seeds) is 1.09 (PT) and 0.97 (G-PT) here;
 // halves split by the parity of one sequence gave about 1.5.
-TEST(Render, FeaturePassesPrimalHalves) {
+// A diffuse ball on a diffuse plane under a white sky, seen from above (32 x 32).
+Scene ball_under_sky() {
   Scene scene;
   scene.meshes.push_back(quad(10.0f));
   scene.meshes.push_back(sphere(0.5f, 12, 8, {0, 0, 0.5f}));
@@ -1310,6 +1311,11 @@ TEST(Render, FeaturePassesPrimalHalves) {
   scene.instances.push_back(place(1, 0));
   scene.world.color = Spectrum(1.0f);
   scene.camera = top_camera(32, 2.5f, 7.0f);
+  return scene;
+}
+
+TEST(Render, FeaturePassesPrimalHalves) {
+  const Scene scene = ball_under_sky();
   for (const auto mode : {RenderSettings::Mode::PT, RenderSettings::Mode::GPT}) {
     RenderSettings s = pt(64);
     s.mode = mode;
@@ -1354,12 +1360,7 @@ TEST(Render, FeaturePassesPrimalHalves) {
 // A time-limited render cannot split its halves at a frame total it does not know: it splits them
 // where its first sample's time predicts, far below a sample count it cannot reach.
 TEST(Render, TimeLimitedHalvesSplitAtThePredictedCount) {
-  Scene scene;
-  scene.meshes.push_back(quad(10.0f));
-  scene.materials.push_back(diffuse(Spectrum(0.6f)));
-  scene.instances.push_back(place(0, 0));
-  scene.world.color = Spectrum(1.0f);
-  scene.camera = top_camera(32, 2.5f, 7.0f);
+  const Scene scene = ball_under_sky();
   RenderSettings s = pt(1 << 20);
   s.mode = RenderSettings::Mode::GPT;
   s.feature_passes = true;
