@@ -8,7 +8,7 @@
 // The engine's halves are two segments of one stratified sequence (core/sample_halves.h), which
 // keeps the image of all samples as stratified as a render without halves; they are then
 // anti-correlated by what the whole stratifies better than its halves, and e overstates the
-// noise terms a little (the halves' (A - B)^2 / 4 read 1.04-1.26x the primal's true error on
+// noise terms a little (the halves' (A - B)^2 / 4 read 1.00-1.44x the primal's true error on
 // the benchmark scenes at 5 s, docs/reconstruct.md).
 // The comparison weighs each channel's e by 1 / (g^2 + eps), g a candidate-independent guide of
 // the pixel's colour: the error compared is relative, so a few bright pixels (a light seen in a

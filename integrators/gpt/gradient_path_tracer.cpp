@@ -99,17 +99,19 @@ class GradientPathTracer final : public Integrator {
       }
     } else {
       CameraRow& row = scratch->row;
-      for (uint32_t s = first_sample; s < end; ++s)
+      for (uint32_t s = first_sample; s < end; ++s) {
+        const uint32_t index = film.sequence_index(s);
         for (int y = tile.y0; y < tile.y1; ++y)
           for (int x0 = tile.x0; x0 < tile.x1; x0 += kRow) {
             const int n = std::min(kRow, tile.x1 - x0);
-            rays += trace_camera_row(g_, W, H, x0, y, n, film.sequence_index(s), row);
+            rays += trace_camera_row(g_, W, H, x0, y, n, index, row);
             for (int i = 0; i < n; ++i) {
               if (s == g_.settings.sample_offset && row.found[i])  // the first sample's hit
                 g_.ctx.record_first_hit(film, x0 + i, y, row.hit[i]);
               rays += run_path(row.sampler[i], row_sample(row, i), x0 + i, y, s, *scratch, r, film);
             }
           }
+      }
     }
     for (int y = tile.y0; y < tile.y1; ++y)
       for (int x = tile.x0; x < tile.x1; ++x) film.add_sample_count(x, y, sample_count);
