@@ -2,9 +2,10 @@
 // gradient-domain solution, chosen per pixel by an error estimate from two halves of the samples.
 //
 //   1. base images: the solution of all samples with settings.feature_guide at settings.alpha,
-//      and, from the gradient halves, each half's own L2 solution (fast and exact; only used to
-//      estimate errors). Without gradient halves, or with the guide None, the base is the primal:
-//      its halves and their mean;
+//      and, from the gradient halves, each half's own solution by the same norm (a shorter L1
+//      schedule; only used to estimate errors). Without gradient halves, or with the guide None,
+//      the base is the primal: its halves and their mean. With the variance buffer, also the
+//      Weighted solutions of the halves and their mean: one more candidate, taken as it is;
 //   2. per candidate filter (feature_bilateral.h): each half filtered alone and the solution of
 //      all samples filtered alike, all three divided by the albedo before and multiplied by it
 //      after (the filters smooth the illumination; textures stay sharp); with the primal halves'
@@ -14,14 +15,14 @@
 //      then the choices blended over the estimate's window (blend_choices); output = the blend
 //      of the candidates applied to all samples (+ emission).
 //
-// Memory beyond the inputs: at most about 492 bytes per pixel, 492 MB per megapixel, while the
-// windows are filtered (feature buffers 105, the solved halves and image 36, their albedo-divided
-// copies and the albedo 48, the choice and its weights 33, every candidate's image and key for
-// the blend 208, the windows' raw error estimates 48, the pixels' noise for the colour distances
-// 12, with the halves' variances; the guide's two filtered copies, 24, and the
-// identity's filtered halves and estimates, 32, before; the blend's scratch, 24, after the
-// estimates and the divided copies are released), plus the gradient-domain solves' own buffers
-// while they run.
+// Memory beyond the inputs: at most about 528 bytes per pixel, 528 MB per megapixel, while the
+// windows are filtered (feature buffers 105, the solved halves and image 36, the Weighted
+// candidate's three images 36, their albedo-divided copies and the albedo 48, the choice and its
+// weights 33, every candidate's image and key for the blend 208, the windows' raw error estimates
+// 48, the pixels' noise for the colour distances 12, with the halves' variances; the guide's two
+// filtered copies, 24, and the identity's filtered halves and estimates, 32, before; the Weighted
+// candidate's estimate and key, 8, and the blend's scratch, 24, after the estimates and the
+// divided copies are released), plus the gradient-domain solves' own buffers while they run.
 #pragma once
 
 #include <vector>
@@ -45,13 +46,20 @@ struct FeatureReconstruction {
   double prepare_seconds = 0.0, filter_seconds = 0.0, select_seconds = 0.0, blend_seconds = 0.0;
 };
 
+// One more candidate taken as it is: its image of each half and of all samples (RGB).
+struct IdentityCandidate {
+  const float *a = nullptr, *b = nullptr, *all = nullptr;
+};
+
 // Steps 2 and 3 on given base images (RGB): halves `a`, `b` (variances optional, both or
 // neither) and `all`, with the features of `input`, in the caller's TBB arena. chosen[i] indexes
-// detail::default_bilateral_candidates().
+// detail::default_bilateral_candidates(), then `extra` (optional; its images must stay alive
+// during the call).
 FeatureReconstruction feature_filter(const ReconstructionInput& input, const float* a,
                                      const float* b, const float* all,
                                      const float* variance_a = nullptr,
-                                     const float* variance_b = nullptr);
+                                     const float* variance_b = nullptr,
+                                     const IdentityCandidate* extra = nullptr);
 
 // reconstruct() for ReconstructionNorm::Feature: the base images, then feature_filter, then the
 // output rule (+ emission, non-finite -> 0).

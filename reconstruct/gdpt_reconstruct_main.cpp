@@ -39,8 +39,9 @@ constexpr const char* kUsage =
     "                        feature: the L1 solution filtered by feature-guided filters,\n"
     "                        chosen per pixel by an error estimate from the samples' two\n"
     "                        halves; needs Primal A / Primal B, Gradient X / Y, Denoising\n"
-    "                        Albedo, Normal and Depth (1 channel); Primal A / B Variance and\n"
-    "                        Denoising Albedo / Normal / Depth Variance used when present;\n"
+    "                        Albedo, Normal and Depth (1 channel); Variance, Primal A / B\n"
+    "                        Variance and Denoising Albedo / Normal / Depth Variance used\n"
+    "                        when present;\n"
     "                        G-PT's gradients over the halves, Gradient X A / X B / Y A / Y B,\n"
     "                        used when present (all four or none)\n"
     "  --layer NAME          view layer (default: the first layer with a Primal pass)\n"
@@ -57,6 +58,7 @@ const std::vector<std::string> kFeaturePasses = {
     "Primal A",         "Primal B",         "Gradient X",     "Gradient Y",
     "Denoising Albedo", "Denoising Normal", "Denoising Depth"};
 const std::vector<std::string> kFeatureOptional = {"Primal",
+                                                   "Variance",
                                                    "Emission",
                                                    "Primal A Variance",
                                                    "Primal B Variance",
@@ -204,6 +206,7 @@ void set_feature_input(const gdpt::ExrPasses& in, gdpt::ReconstructionInput& inp
   input.gradient_y = pass("Gradient Y");
   input.primal_a = pass("Primal A");
   input.primal_b = pass("Primal B");
+  input.variance = pass("Variance");  // the Weighted candidate's, when present
   input.variance_a = pass("Primal A Variance");
   input.variance_b = pass("Primal B Variance");
   input.albedo = pass("Denoising Albedo");

@@ -291,8 +291,8 @@ std::vector<float> l2_solution(const Prepared& pr, double alpha, bool measure,
   return x;
 }
 
-// The start of a warm L1 solve: input.initial minus the emission, the primal where that is not
-// finite.
+// The start of a warm L1 or Weighted solve: input.initial minus the emission, the primal where
+// that is not finite.
 std::vector<float> warm_start(const Prepared& pr, const ReconstructionInput& in) {
   const int W = pr.width;
   auto x = huge_vector<float>(3 * size_t(W) * pr.height);
@@ -426,7 +426,9 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
     const bool finish_in_l2 =
         settings.norm == ReconstructionNorm::L2 && !(settings.compute_objective && input.emission);
     bool finished = false;
-    const bool warm = settings.norm == ReconstructionNorm::L1 && input.initial;
+    const bool warm = (settings.norm == ReconstructionNorm::L1 ||
+                       settings.norm == ReconstructionNorm::Weighted) &&
+                      input.initial;
     Prepared pr;
     if (!gradients) {
       pr = prepare(input, false);

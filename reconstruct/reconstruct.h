@@ -77,10 +77,24 @@ struct ReconstructionSettings {
   // Feature: the gradient-domain solution that is filtered (L1, L2, Weighted at `alpha`, or None:
   // the primal is filtered).
   ReconstructionNorm feature_guide = ReconstructionNorm::L1;
-  // Feature with the L1 guide: its reweightings (inner steps and preconditioner as L1's). The
-  // filters need no fully converged L1: 12 instead of 36 gave a lower relMSE on six of the seven
-  // benchmark scenes for a third of the solve (bench/reconstruct/feature_vs_l1.py --resolve).
-  int feature_guide_l1_reweightings = 12;
+  // Feature with the L1 guide: its reweightings (the Jacobi schedule's steps, 12 falling to 3).
+  // The filters need no fully converged L1. Geometric mean L1 / Feature over the report's 28
+  // renders (bench/reconstruct/feature_resolve.py): 3.51 at 6, 3.45 at 8, 3.30 at 12; below 8
+  // glass_caustics at 40 s loses (6.18x at 6, 6.67x at 8, 7.32x at 12).
+  int feature_guide_l1_reweightings = 8;
+  // Feature: each half (for the error estimates) is solved by the guide's norm, with the L1 guide
+  // at this many reweightings (2: 12 + 3 Jacobi-PCG steps): the filters are judged on images like
+  // the one they are applied to. Geometric mean as above, with the guide at 12: 3.30 at 2, 3.24
+  // at 1, 3.31 at 4, 3.28 at 8; 3.08 with fewer steps (1 reweighting of 4, 2 of 3).
+  int feature_halves_l1_reweightings = 2;
+  // Feature, given the variance buffer and gradient halves, with a guide other than Weighted: one
+  // more candidate, the Weighted solution itself: each half's, with the variances of all samples,
+  // feature_weighted_cg_steps Jacobi-PCG steps from the half's guide-norm solution, and their mean
+  // for all samples. Per-pixel variances weigh primal and gradients where one alpha cannot
+  // (bump-mapped textures, sky); docs/reconstruct.md. Steps 8 / 15 / 30: geometric mean 3.28 /
+  // 3.30 / 3.30 (guide at 12).
+  bool feature_weighted_candidate = true;
+  int feature_weighted_cg_steps = 15;
   // Called with the completed fraction in [0, 1] (from the calling thread).
   std::function<void(float)> progress;
 };
@@ -123,12 +137,12 @@ struct ReconstructionInput {
   const float* depth = nullptr;            // 1 per pixel
   const float* depth_variance = nullptr;   // 1 per pixel
 
-  // L1 only, optional: a previous output of reconstruct() for the same passes (emission included:
-  // it is subtracted), e.g. at a nearby alpha. IRLS then starts from it with the shorter warm
-  // schedule (ReconstructionSettings::l1_warm_*) instead of from the L2 solution. Non-finite
-  // values fall back to the primal's. The short schedule assumes the start is near the minimum:
-  // alpha x1.25 or x0.75 stays within 0.1% of a tight solve's objective, x4 does not
-  // (docs/reconstruct.md).
+  // L1 and Weighted, optional: a previous output of reconstruct() for the same passes (emission
+  // included: it is subtracted), e.g. at a nearby alpha. IRLS then starts from it with the shorter
+  // warm schedule (ReconstructionSettings::l1_warm_*) instead of from the L2 solution; Weighted's
+  // CG starts from it instead of from the L2 solution. Non-finite values fall back to the
+  // primal's. The short schedule assumes the start is near the minimum: alpha x1.25 or x0.75
+  // stays within 0.1% of a tight solve's objective, x4 does not (docs/reconstruct.md).
   const float* initial = nullptr;  // RGB
 };
 

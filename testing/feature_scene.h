@@ -45,6 +45,8 @@ struct FeatureScene {
   }
 };
 
+inline void add_noise(FeatureScene& s, float sigma_half, float sigma_gradient, unsigned seed);
+
 inline FeatureScene make_feature_scene(int w, int h, float sigma_half, float sigma_gradient,
                                        unsigned seed, bool shadow = true) {
   FeatureScene s;
@@ -96,6 +98,14 @@ inline FeatureScene make_feature_scene(int w, int h, float sigma_half, float sig
       }
       s.depth[i] = dep;
     }
+  add_noise(s, sigma_half, sigma_gradient, seed);
+  return s;
+}
+
+// Draws the noisy halves, their mean and the noisy gradients (and their halves) of s.truth.
+inline void add_noise(FeatureScene& s, float sigma_half, float sigma_gradient, unsigned seed) {
+  const int w = s.w, h = s.h;
+  const size_t n = size_t(w) * h;
   std::mt19937 rng(seed);
   std::normal_distribution<float> half(0.f, sigma_half);
   s.a.resize(3 * n);
@@ -124,7 +134,6 @@ inline FeatureScene make_feature_scene(int w, int h, float sigma_half, float sig
           s.gy[i] = 0.5f * (s.gya[i] + s.gyb[i]);
         }
       }
-  return s;
 }
 
 // Mean over pixels and channels of (x - truth)^2 / (truth^2 + 0.01).

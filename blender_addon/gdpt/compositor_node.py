@@ -52,10 +52,11 @@ REQUIRED = INPUTS[:3]
 FILM_KEYS = {"Primal": "primal", "Gradient X": "gradient_x", "Gradient Y": "gradient_y",
              "Emission": "emission", **HALF_GRADIENT_KEYS}
 # The Feature norm's inputs besides (engine film keys): a render with the Feature reconstruction
-# caches them; they are not Blender passes, so the node reads them only from Render Layers.
+# caches them; they are not Blender passes, so the node reads them only from Render Layers. The
+# variances of the pixel means (the Variance pass) give the Weighted candidate, as in the render.
 FEATURE_KEYS = tuple(f"{k}{v}" for k in ("primal_a", "primal_b", "denoising_albedo",
                                          "denoising_normal", "denoising_depth")
-                     for v in ("", "_variance"))
+                     for v in ("", "_variance")) + ("variance",)
 
 # (scene name, view layer name) -> {film key: (height, width, 3) float32} of the last render, and
 # under "placement" (frame width, frame height, x, y) when it rendered an uncropped Render Region:
@@ -312,7 +313,8 @@ def _warm_start(node, request):
 def _solve(request, progress=None):
     """The C++ solve of a request: safe off the main thread (the call releases the GIL)."""
     r = request
-    return _module().reconstruct(*r["passes"], None, r["emission"], r["norm"], r["alpha"],
+    variance = r["features"]["variance"] if r["features"] else None
+    return _module().reconstruct(*r["passes"], variance, r["emission"], r["norm"], r["alpha"],
                                  r["threads"], features=r["features"], progress=progress,
                                  initial=r["initial"])
 

@@ -160,8 +160,8 @@ def test_module_half_gradient_keys(ch, feature):
 
     def solve(f):
         return _gdpt.reconstruct(get("Primal", "RGB"), get("Gradient X", "RGB"),
-                                 get("Gradient Y", "RGB"), None, get("Emission", "RGB"),
-                                 'FEATURE', 0.2, 0, features=f)
+                                 get("Gradient Y", "RGB"), get("Variance", "XYZ"),
+                                 get("Emission", "RGB"), 'FEATURE', 0.2, 0, features=f)
     err = float(np.abs(solve(features) - feature).max() / max(float(np.abs(feature).max()), 1e-6))
     check(err < 1e-5, f"_gdpt.reconstruct with the half gradients = the engine's Combined "
                       f"(max diff / max {err:.2e})")
