@@ -91,7 +91,7 @@ struct ReconstructionSettings {
   // more candidate, the Weighted solution itself: each half's, with the variances of all samples,
   // feature_weighted_cg_steps Jacobi-PCG steps from the half's guide-norm solution, and their mean
   // for all samples. Per-pixel variances weigh primal and gradients where one alpha cannot
-  // (bump-mapped textures, sky); docs/reconstruct.md. Steps 8 / 15 / 30: geometric mean 3.28 /
+  // (bump-mapped textures); docs/reconstruct.md. Steps 8 / 15 / 30: geometric mean 3.28 /
   // 3.30 / 3.30 (guide at 12).
   bool feature_weighted_candidate = true;
   int feature_weighted_cg_steps = 15;

@@ -192,7 +192,8 @@ PYBIND11_MODULE(_gdpt, m) {
         "progress: optional float32 array; its first value is set to the solved fraction "
         "(0 to 1) while the solve runs without the GIL, for a caller polling from Python. "
         "initial: optional float32 array, a previous L1 result for the same passes (e.g. at "
-        "another alpha): L1 starts from it with a much shorter schedule");
+        "another alpha): L1 starts from it with a much shorter schedule, WEIGHTED's solve "
+        "starts from it");
   m.def("read_exr_passes", &read_exr_passes_dict, py::arg("path"), py::arg("layer"),
         py::arg("required"), py::arg("optional") = std::vector<std::string>{});
 }

@@ -309,6 +309,17 @@ TEST(Weighted, BeatsUniformL2WithNonUniformGradientVariance) {
     best_l2 = std::min(best_l2, rms_error(reconstruct(in, s2), truth));
   }
   EXPECT_LT(ew, 0.8 * best_l2) << "weighted rms " << ew << ", best uniform L2 rms " << best_l2;
+
+  // From `initial` (the Feature norm starts its Weighted halves there): no step returns the start
+  // itself, and the solve to the tolerance reaches the same minimum as from L2.
+  const auto start = add(truth, zero_mean_noise(px, 0.05f, 24));
+  ReconstructionInput warm = in;
+  warm.initial = start.data();
+  ReconstructionSettings none = sw;
+  none.max_cg_iterations = 0;
+  EXPECT_EQ(reconstruct(warm, none), start);
+  const auto from_start = reconstruct(warm, sw);
+  EXPECT_LT(rms_error(from_start, weighted), 1e-3 * rms_error(start, weighted));
 }
 
 }  // namespace
