@@ -79,8 +79,8 @@ struct ReconstructionSettings {
   ReconstructionNorm feature_guide = ReconstructionNorm::L1;
   // Feature with the L1 guide: its reweightings (the Jacobi schedule's steps, 12 falling to 3).
   // The filters need no fully converged L1. Geometric mean L1 / Feature over the report's 28
-  // renders (bench/reconstruct/feature_resolve.py): 3.51 at 6, 3.45 at 8, 3.30 at 12; below 8
-  // glass_caustics at 40 s loses (6.18x at 6, 6.67x at 8, 7.32x at 12).
+  // renders (bench/reconstruct/feature_resolve.py): 3.51 at 6, 3.45 at 8, 3.30 at 12; fewer
+  // cost glass_caustics at 40 s (7.32x at 12, 6.67x at 8, 6.18x at 6).
   int feature_guide_l1_reweightings = 8;
   // Feature: each half (for the error estimates) is solved by the guide's norm, with the L1 guide
   // at this many reweightings (2: 12 + 3 Jacobi-PCG steps): the filters are judged on images like
