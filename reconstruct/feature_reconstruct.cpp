@@ -228,9 +228,11 @@ FeatureReconstruction feature_filter(const ReconstructionInput& input, const flo
     std::copy(b + k0, b + k1, lb.begin() + k0);
     std::copy(all + k0, all + k1, lall.begin() + k0);
   });
-  r.limited = detail::limit_half_outliers(
-      input.width, input.height, input.primal_a ? input.primal_a : a,
-      input.primal_b ? input.primal_b : b, la.data(), lb.data(), lall.data());
+  r.limited =
+      detail::limit_half_outliers(input.width, input.height, input.primal_a ? input.primal_a : a,
+                                  input.primal_b ? input.primal_b : b, la.data(), lb.data(),
+                                  lall.data(), input.primal_a ? input.variance_a : variance_a,
+                                  input.primal_b ? input.variance_b : variance_b);
   const detail::FeatureBuffers fb = detail::prepare_feature_buffers(
       input, la.data(), lb.data(), lall.data(), variance_a, variance_b);
   FreshHugeVector<float>().swap(la), FreshHugeVector<float>().swap(lb);

@@ -40,7 +40,7 @@ struct FeatureReconstruction {
   std::vector<uint8_t> chosen;
   int features = 0;  // feature channels used
   int missing = 0;   // pixels with some non-finite input
-  int limited = 0;   // pixels where one half was limited as an outlier (half_outliers.h)
+  int limited = 0;   // pixels where one half or both were limited as outliers (half_outliers.h)
   // Wall time of the steps: the outlier limit and feature buffers; the filters (with the
   // relative-error guide and the albedo division); the error estimates and choice; the blend.
   double prepare_seconds = 0.0, filter_seconds = 0.0, select_seconds = 0.0, blend_seconds = 0.0;

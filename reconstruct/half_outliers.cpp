@@ -60,12 +60,29 @@ Luminances luminances(int width, int height, const float* primal_a, const float*
   return l;
 }
 
+// Luminance of an RGB variance whose channels move together, as where one sample carries the
+// pixel: the square of the luminance of the standard deviations.
+float luminance_variance(const float* v) {
+  const float sd[3] = {std::sqrt(std::max(v[0], 0.f)), std::sqrt(std::max(v[1], 0.f)),
+                       std::sqrt(std::max(v[2], 0.f))};
+  const float l = luminance(sd);
+  return l * l;
+}
+
+// Whether one sample carries a half's pixel: the variance of its mean at least
+// kHalfDominance times its mean squared.
+bool one_sample_carries(const float* variance, size_t i, float mean) {
+  return luminance_variance(variance + 3 * i) >= kHalfDominance * mean * mean;
+}
+
 }  // namespace
 
 int limit_half_outliers(int width, int height, const float* primal_a, const float* primal_b,
-                        float* a, float* b, float* all) {
+                        float* a, float* b, float* all, const float* variance_a,
+                        const float* variance_b) {
   const size_t n = size_t(width) * height;
   const Luminances l = luminances(width, height, primal_a, primal_b, a, b, all);
+  const bool dominance = variance_a && variance_b;
   FreshHugeVector<float> scale_a(n), scale_b(n), scale_all(n);  // set per pixel below
   std::vector<int> fired(height, 0);
   parallel_rows(height, [&](int y0, int y1) {
@@ -80,8 +97,12 @@ int limit_half_outliers(int width, int height, const float* primal_a, const floa
         const float high = a_high ? l.pa[i] : l.pb[i], low = a_high ? l.pb[i] : l.pa[i];
         const float around = neighbour_median(l.primal_mean.data(), width, height, x, y);
         const float bound = kHalfOutlierRatio * std::max({low, around, kHalfOutlierFloor});
-        if (!(high > bound)) continue;
-        const float rest = std::max(low, 0.f);  // high > bound > 0: the ratios are finite
+        const float both_bound = kHalfOutlierRatio * std::max(around, kHalfOutlierFloor);
+        const bool one_half = high > bound;
+        const bool both_halves = !one_half && dominance && low > both_bound &&
+                                 one_sample_carries(variance_a, i, l.pa[i]) &&
+                                 one_sample_carries(variance_b, i, l.pb[i]);
+        if (!one_half && !both_halves) continue;
         const float half_floor =
             kHalfOutlierRatio *
             std::max(neighbour_median(l.half_mean.data(), width, height, x, y), kHalfOutlierFloor);
@@ -91,9 +112,16 @@ int limit_half_outliers(int width, int height, const float* primal_a, const floa
             kHalfOutlierRatio *
             std::max(std::min(neighbour_median(l.all.data(), width, height, x, y), around),
                      kHalfOutlierFloor);
-        (a_high ? scale_a : scale_b)[i] =
-            limited_scale(bound / high, a_high ? l.a[i] : l.b[i], half_floor);
-        scale_all[i] = limited_scale((bound + rest) / (high + rest), l.all[i], all_floor);
+        if (one_half) {
+          const float rest = std::max(low, 0.f);  // high > bound > 0: the ratios are finite
+          (a_high ? scale_a : scale_b)[i] =
+              limited_scale(bound / high, a_high ? l.a[i] : l.b[i], half_floor);
+          scale_all[i] = limited_scale((bound + rest) / (high + rest), l.all[i], all_floor);
+        } else {  // both halves to the neighbourhood's bound (low > both_bound > 0)
+          scale_a[i] = limited_scale(both_bound / l.pa[i], l.a[i], half_floor);
+          scale_b[i] = limited_scale(both_bound / l.pb[i], l.b[i], half_floor);
+          scale_all[i] = limited_scale(both_bound / l.primal_mean[i], l.all[i], all_floor);
+        }
         ++fired[y];
       }
   });

@@ -364,6 +364,74 @@ TEST(Feature, FireflySpreadByTheSolveIsLimited) {
     }
 }
 
+// Both halves bright at one pixel, each carried by one sample (variance of the mean near its mean
+// squared): two rare paths, limited to the neighbourhood's bound. The same brightness seen by many
+// samples (a small variance), inside a bright region, or without the variances is kept.
+TEST(Feature, BothHalfFirefliesCarriedByOneSampleAreLimited) {
+  const int w = 16, h = 16;
+  const size_t n = size_t(w) * h, p = size_t(5) * w + 5, q = size_t(10) * w + 10;
+  std::vector<float> pa(3 * n, 0.2f), pb = pa, va(3 * n, 0.01f), vb = va;
+  auto set = [&](size_t i, float value, float variance) {
+    for (int c = 0; c < 3; ++c) {
+      pa[3 * i + c] = pb[3 * i + c] = value;
+      va[3 * i + c] = vb[3 * i + c] = variance;
+    }
+  };
+  set(p, 3.f, 0.9f * 9.f);  // one sample of 48 among 15 dark ones in each half of 16
+  set(q, 3.f, 0.9f * 9.f);  // the same at q, but inside a 3x3 bright square
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = 0; dx <= 1; ++dx) set(q + dy * w + dx, 3.f, 0.01f);
+  auto limit = [&](const float* variance_a, const float* variance_b, std::vector<float>& out) {
+    std::vector<float> a = pa, b = pb;
+    out = pa;
+    return detail::limit_half_outliers(w, h, pa.data(), pb.data(), a.data(), b.data(), out.data(),
+                                       variance_a, variance_b);
+  };
+  std::vector<float> all;
+  EXPECT_EQ(limit(va.data(), vb.data(), all), 1);
+  EXPECT_NEAR(luminance(all, p), 3.f * 0.2f, 1e-5f);
+  EXPECT_EQ(luminance(all, q), 3.f);
+  EXPECT_EQ(limit(nullptr, nullptr, all), 0);
+  // Converging: eight samples of each half see it (variance of the mean 7/8 x 9 / 8 of 16).
+  set(p, 3.f, 9.f * 7.f / 64.f);
+  EXPECT_EQ(limit(va.data(), vb.data(), all), 0);
+  EXPECT_EQ(luminance(all, p), 3.f);
+}
+
+// Through the whole Feature filter with the halves' variances: a firefly in both halves on the
+// flat plane ends below 4x the truth; the real highlights (variances of many samples) keep their
+// light.
+TEST(Feature, NoSpecklesFromBothHalfFireflies) {
+  FireflyScene f = make_firefly_scene(0.1f);
+  FeatureScene& s = f.s;
+  const size_t n = size_t(s.w) * s.h;
+  std::vector<float> va(3 * n), vb(3 * n);
+  for (size_t i = 0; i < 3 * n; ++i) {
+    va[i] = vb[i] = 0.01f * s.truth[i] * s.truth[i];
+    s.a[i] = s.b[i] = s.primal[i] = 0.5f * (s.a[i] + s.b[i]);  // both halves have each firefly
+  }
+  for (size_t i : f.fireflies)
+    for (int c = 0; c < 3; ++c) va[3 * i + c] = vb[3 * i + c] = 0.9f * 100.f * 100.f;
+  ReconstructionInput in = s.input();
+  in.variance_a = va.data(), in.variance_b = vb.data();
+  const FeatureReconstruction r = feature_filter(in, s.a.data(), s.b.data(), s.primal.data());
+  float worst = 0.f, kept = 1.f;
+  for (size_t i : f.fireflies) worst = std::max(worst, luminance(r.image, i) / 0.2f);
+  for (size_t i : f.highlights) kept = std::min(kept, luminance(r.image, i) / 5.f);
+  std::printf(
+      "both-half fireflies: worst %.2fx the truth (limited %d pixels), highlights kept "
+      ">= %.2f\n",
+      worst, r.limited, kept);
+  EXPECT_EQ(r.limited, int(f.fireflies.size()));
+  EXPECT_LT(worst, 4.f);
+  EXPECT_GT(kept, 0.5f);
+  const FeatureReconstruction plain = filter_primal(s);  // no variances: the fireflies stay
+  float plain_worst = 0.f;
+  for (size_t i : f.fireflies)
+    plain_worst = std::max(plain_worst, luminance(plain.image, i) / 0.2f);
+  EXPECT_GT(plain_worst, 4.f);
+}
+
 TEST(Feature, SameResultOnOneAndTwoThreads) {
   const FeatureScene s = make_feature_scene(150, 70, 0.15f, 0.02f, 51);
   ReconstructionSettings settings;
