@@ -6,8 +6,17 @@
 # relMSE (epsilon 0.01) against the reference, which decides which default the demo should use.
 # Also what a render with the reference's sample count scores (each reference half against the
 # other's medians) and, for each Feature speckle, its and the reference's ratio to the median.
+# Also, over the seeds, how the Feature render's halves see their own error where the reference
+# is a bright feature (over 1.7x its median): their (A - B)^2 / 4 over the true squared error of
+# (A + B) / 2, and the correlation of the halves' errors (an estimate the halves understate there
+# would let both halves' rare bright paths through as light), and how often both halves of one
+# render have a firefly (over 4x the median) at the same pixel of a flat region (the reference
+# within 0.7-1.3x its median) against halves of different seeds: more in one render would mean
+# the halves, two segments of one sequence, draw rare paths together.
 #   /usr/bin/python3 bench/demo/speckles.py [--build build] [--ref-samples 2048] [--seeds 4]
-# Writes bench/results/demo_speckles.json and prints one line per reconstruction.
+#       [--samples N]
+# Writes bench/results/demo_speckles.json (demo_speckles_<N>spp.json with --samples; its renders
+# in out/bench/demo_<N>spp) and prints one line per reconstruction.
 import argparse
 import json
 import os
@@ -23,6 +32,7 @@ import metrics as M  # noqa: E402
 import run as R  # noqa: E402
 
 SPECKLE_RATIO, MEDIAN_FLOOR = 4.0, 1e-3
+BRIGHT_FEATURE_RATIO = 1.7
 
 
 def floored_median(ref):
@@ -48,20 +58,51 @@ def speckle_details(img, ref, median):
             for y, x in zip(*np.nonzero(speckle_mask(img, median)))]
 
 
+def halves_estimate(halves_a, halves_b, ref, median):
+    """Over the seeds, at the reference's bright features: the halves' (A - B)^2 / 4 over the
+    true squared error of their mean, and the correlation of their errors (luminance)."""
+    truth = M.luminance(ref)
+    mask = truth > BRIGHT_FEATURE_RATIO * median
+    a = np.array([M.luminance(x)[mask] for x in halves_a]) - truth[mask]
+    b = np.array([M.luminance(x)[mask] for x in halves_b]) - truth[mask]
+    return {"pixels": int(np.count_nonzero(mask)),
+            "estimate_over_true": float(np.sum((a - b) ** 2 / 4) / np.sum(((a + b) / 2) ** 2)),
+            "error_correlation": float(np.sum(a * b) / np.sqrt(np.sum(a * a) * np.sum(b * b)))}
+
+
+def halves_fireflies(halves_a, halves_b, ref, median):
+    """Pixels of flat regions where both halves are over SPECKLE_RATIO x the median: summed over
+    the renders, and for halves of different seeds (mean over the seed pairings)."""
+    lum = M.luminance(ref)
+    flat = (lum > 0.7 * median) & (lum < 1.3 * median)
+    fa = [speckle_mask(x, median) & flat for x in halves_a]
+    fb = [speckle_mask(x, median) & flat for x in halves_b]
+    n = len(fa)
+    both = [sum(int(np.count_nonzero(fa[i] & fb[(i + k) % n])) for i in range(n))
+            for k in range(n)]
+    return {"flat_pixels": int(np.count_nonzero(flat)) * n,
+            "one_half": sum(int(np.count_nonzero(x)) for x in fa + fb) / 2,
+            "both_halves_same_render": both[0],
+            "both_halves_different_seeds": float(np.mean(both[1:])) if n > 1 else None}
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--build", default="build")
     p.add_argument("--ref-samples", type=int, default=2048, help="per reference half")
     p.add_argument("--seeds", type=int, default=4, help="G-PT renders (seeds) to average over")
-    p.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "demo"))
+    p.add_argument("--samples", type=int, help="G-PT samples instead of the demo's own")
+    p.add_argument("--out", help="renders' folder (default out/bench/demo[_<N>spp])")
     args = p.parse_args()
+    suffix = f"_{args.samples}spp" if args.samples else ""
+    args.out = args.out or os.path.join(ROOT, "out", "bench", "demo" + suffix)
     os.makedirs(args.out, exist_ok=True)
     blender = R.Blender(args.build)
     try:
         blend = os.path.join(args.out, "demo.blend")
         blender.run(os.path.join(ROOT, "blender_addon", "demo", "make_demo_scene.py"), blend)
-        samples = int(blender.run(os.path.join(HERE, "demo_samples.py"), blend).split(
-            "DEMO_SAMPLES ")[1].split()[0])
+        samples = args.samples or int(blender.run(os.path.join(HERE, "demo_samples.py"),
+                                                  blend).split("DEMO_SAMPLES ")[1].split()[0])
         halves = []
         for seed in (1, 2):
             path = os.path.join(args.out, f"ref_{seed}.exr")
@@ -75,6 +116,7 @@ def main():
         print(f"demo reference half ({args.ref_samples} spp) against the other half: speckles "
               f"{floor:.1f}", flush=True)
         rows = {"primal": [], "l1": [], "feature": []}
+        feature_halves = ([], [])
         for seed in range(1, args.seeds + 1):
             raw = os.path.join(args.out, f"gpt_{seed}.exr")
             R.render(blender, blend, "gpt", raw, samples=samples, seed=seed)
@@ -83,6 +125,8 @@ def main():
             R.render(blender, blend, "gpt_feature", feat, samples=samples, seed=seed)
             # Reconstruction None: Combined is the primal plus emission.
             feature = R.rgb(feat)
+            for half, name in zip(feature_halves, ("Primal A", "Primal B")):
+                half.append(R.rgb(feat, f"ViewLayer.{name}."))
             for name, img in (("primal", R.rgb(raw)), ("l1", l1), ("feature", feature)):
                 rows[name].append({"speckles": speckles(img, median),
                                    "relmse": M.rel_mse_denoised(img, *halves)})
@@ -96,14 +140,24 @@ def main():
               "seeds": args.seeds, "speckle_ratio": SPECKLE_RATIO, "commit": R.git(
                   "rev-parse", "--short", "HEAD"),
               "pixels": int(ref.shape[0] * ref.shape[1]), "reference_half_speckles": floor,
-              "per_seed": rows}
+              "per_seed": rows,
+              "bright_features_halves": halves_estimate(*feature_halves, ref, median),
+              "flat_region_fireflies": halves_fireflies(*feature_halves, ref, median)}
     for name, r in rows.items():
         s = [x["speckles"] for x in r]
         e = [x["relmse"] for x in r]
         result[name] = {"speckles_mean": float(np.mean(s)), "relmse_mean": float(np.mean(e))}
         print(f"demo {samples} spp {name:8s} speckles {np.mean(s):7.1f} (per seed {s}) "
               f"relMSE {np.mean(e):.3e}", flush=True)
-    with open(os.path.join(ROOT, "bench", "results", "demo_speckles.json"), "w") as f:
+    h = result["bright_features_halves"]
+    print(f"Feature halves at the reference's {h['pixels']} bright-feature pixels: (A - B)^2 / 4 "
+          f"over the true error {h['estimate_over_true']:.2f}, error correlation "
+          f"{h['error_correlation']:.2f}", flush=True)
+    f = result["flat_region_fireflies"]
+    print(f"Feature halves' fireflies in flat regions ({f['flat_pixels']} pixels over the renders): "
+          f"{f['one_half']:.1f} per half, in both halves {f['both_halves_same_render']} (one render) "
+          f"against {f['both_halves_different_seeds']} (different seeds)", flush=True)
+    with open(os.path.join(ROOT, "bench", "results", f"demo_speckles{suffix}.json"), "w") as f:
         json.dump(result, f, indent=1)
 
 
