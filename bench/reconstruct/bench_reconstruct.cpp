@@ -20,7 +20,8 @@
 //     guide solve, preparation, the cross-filtered candidates and the choice, on the synthetic
 //     room of testing/feature_scene.h (half noise 0.2 with its variances, gradient noise 0.1),
 //     relMSE against L1, CPU time (the time on idle cores on a loaded machine) of the whole and of
-//     the filters and choice alone, and a digest of both outputs (to compare builds bit for bit);
+//     the filters and choice alone and its system part (first touches of fresh memory), a digest
+//     of both outputs (to compare builds bit for bit), and what 1 GiB of fresh memory costs here;
 //     --feature-only runs just this case.
 // --admm compares an ADMM L1 probe (l1_admm_probe.h) with the library's IRLS (see bench_admm).
 // --pcg counts PCG steps of the IRLS systems with DCT and multigrid preconditioners
@@ -47,6 +48,7 @@
 #include <ctime>
 #include <random>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -55,6 +57,7 @@
 
 #include "bench/reconstruct/l1_admm_probe.h"
 #include "bench/reconstruct/l1_pcg_probe.h"
+#include "core/huge_pages.h"
 #include "reconstruct/dct_solver.h"
 #include "reconstruct/feature_reconstruct.h"
 #include "reconstruct/parallel.h"
@@ -77,6 +80,36 @@ double cpu_seconds() {
   timespec ts{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// System CPU time of the process so far (all threads): on Linux mostly the kernel backing first
+// touches of fresh pages.
+double system_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_stime.tv_usec);
+}
+
+// Seconds to first-touch `bytes` of fresh huge-page memory (one write per 4 KB page).
+double touch_fresh(size_t bytes) {
+  char* p = static_cast<char*>(gdpt::allocate_huge(bytes));
+  const auto t = Clock::now();
+  for (size_t i = 0; i < bytes; i += 4096) p[i] = 1;
+  const double seconds = seconds_since(t);
+  gdpt::free_huge(p);
+  return seconds;
+}
+
+// What fresh memory costs on this machine, which the Feature timings include: 1 GiB touched
+// after 5 s in which the system had it free, then again right after it was freed. (On a virtual
+// machine whose host reclaims the guest's free memory the first is several times the second.)
+void print_fresh_memory_cost() {
+  constexpr size_t kGiB = size_t(1) << 30;
+  std::this_thread::sleep_for(std::chrono::seconds(5));
+  const double first = touch_fresh(kGiB);
+  const double again = touch_fresh(kGiB);
+  std::printf("fresh memory: 1 GiB first touched in %.3f s, again right after freeing %.3f s\n",
+              first, again);
 }
 
 // Minor page faults of the process so far (first touches of fresh memory).
@@ -336,22 +369,24 @@ void bench_feature(int width, int height, int threads) {
     s.feature_guide_l1_reweightings = k;
     gdpt::ReconstructionReport r;
     const auto t1 = Clock::now();
-    const double c1 = cpu_seconds();
+    const double c1 = cpu_seconds(), sys1 = system_seconds();
     const long f1 = minor_faults();
     const auto img = gdpt::reconstruct(in, s, &r);
     const double total = seconds_since(t1), cpu_total = cpu_seconds() - c1;
+    const double sys_total = system_seconds() - sys1;
     const long faults_total = minor_faults() - f1;
     // The filters and the choice alone, on the primal halves (the same work per candidate).
     gdpt::FeatureReconstruction fr;
     tbb::task_arena arena(threads);
     const auto t2 = Clock::now();
-    const double c2 = cpu_seconds();
+    const double c2 = cpu_seconds(), sys2 = system_seconds();
     const long f2 = minor_faults();
     arena.execute([&] {
       fr = gdpt::feature_filter(in, sc.a.data(), sc.b.data(), sc.primal.data(), in.variance_a,
                                 in.variance_b);
     });
     const double filter_wall = seconds_since(t2), filter_cpu = cpu_seconds() - c2;
+    const double filter_sys = system_seconds() - sys2;
     const long faults_filter = minor_faults() - f2;
     const double rel = gdpt::test::relative_mse(img, sc.truth);
     const double split =
@@ -370,12 +405,15 @@ void bench_feature(int width, int height, int threads) {
         filter_cpu / threads);
     // Wall time depends on what else runs; CPU time (all threads) / threads is the time on
     // otherwise idle cores.
-    std::printf("  CPU time: total %.2f s (%.2f s per thread)\n", cpu_total, cpu_total / threads);
+    std::printf(
+        "  CPU time: total %.2f s (%.2f s per thread); system %.2f s, filters alone %.2f s\n",
+        cpu_total, cpu_total / threads, sys_total, filter_sys);
     std::printf("  minor page faults: total %ld, filters alone %ld\n", faults_total, faults_filter);
     std::printf("  digest: whole %016llx, filters alone %016llx\n",
                 static_cast<unsigned long long>(digest(img)),
                 static_cast<unsigned long long>(digest(fr.image)));
   }
+  print_fresh_memory_cost();
 }
 
 // --admm: the ADMM probe (l1_admm_probe.h) against the library's IRLS L1, in one run: a tight
