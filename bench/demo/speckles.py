@@ -13,14 +13,22 @@
 # render have a firefly (over 4x the median) at the same pixel of a flat region (the reference
 # within 0.7-1.3x its median) against halves of different seeds: more in one render would mean
 # the halves, two segments of one sequence, draw rare paths together.
+# Which speckles are isolated (the reference there under 1.7x its median: light the scene does
+# not have there) and which sit on a bright feature of the reference; and, in the demo's view
+# (Filmic, through OpenColorIO by oiiotool), how far each Feature speckle is from the reference in
+# 8-bit display levels and how many pixels of the same render are farther.
 #   /usr/bin/python3 bench/demo/speckles.py [--build build] [--ref-samples 2048] [--seeds 4]
-#       [--samples N]
+#       [--samples N] [--reuse]
+# --reuse takes the renders already in the folder (after a change that leaves the renders and the
+# in-render reconstruction alone).
 # Writes bench/results/demo_speckles.json (demo_speckles_<N>spp.json with --samples; its renders
 # in out/bench/demo_<N>spp) and prints one line per reconstruction.
 import argparse
 import json
 import os
+import subprocess
 import sys
+import tempfile
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -30,9 +38,12 @@ ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "bench", "report"))
 import metrics as M  # noqa: E402
 import run as R  # noqa: E402
+import exr  # noqa: E402  (tests/blender, on the path run.py sets)
 
 SPECKLE_RATIO, MEDIAN_FLOOR = 4.0, 1e-3
 BRIGHT_FEATURE_RATIO = 1.7
+DEMO_VIEW = ("sRGB", "Filmic")  # make_demo_scene.py's display and view transform
+OCIO_CONFIG = os.environ.get("OCIO", "/usr/share/blender/datafiles/colormanagement/config.ocio")
 
 
 def floored_median(ref):
@@ -48,6 +59,30 @@ def speckle_mask(img, median):
 
 def speckles(img, median):
     return int(np.count_nonzero(speckle_mask(img, median)))
+
+
+def display_levels(paths, prefix="ViewLayer.Combined."):
+    """The mean of the EXRs' RGB (scene linear) in the demo's view, in 8-bit levels (0-255)."""
+    cmd = ["oiiotool"]
+    for k, path in enumerate(paths):
+        cmd += [path, "--ch", ",".join(f"{c}={prefix}{c}" for c in "RGB")]
+        if k:
+            cmd += ["--add"]
+    if len(paths) > 1:
+        cmd += ["--mulc", str(1.0 / len(paths))]
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "display.exr")
+        cmd += ["--colorconfig", OCIO_CONFIG, "--ociodisplay:from=Linear", *DEMO_VIEW, "-d",
+                "float", "-o", out]
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        ch = exr.read_exr(out)
+        return 255.0 * np.stack([ch[c] for c in "RGB"], axis=-1).astype(np.float64)
+
+
+def isolated(img, ref, median):
+    """Speckles of `img` where the reference is under BRIGHT_FEATURE_RATIO x its median."""
+    flat = M.luminance(ref) < BRIGHT_FEATURE_RATIO * median
+    return int(np.count_nonzero(speckle_mask(img, median) & flat))
 
 
 def speckle_details(img, ref, median):
@@ -93,22 +128,30 @@ def main():
     p.add_argument("--seeds", type=int, default=4, help="G-PT renders (seeds) to average over")
     p.add_argument("--samples", type=int, help="G-PT samples instead of the demo's own")
     p.add_argument("--out", help="renders' folder (default out/bench/demo[_<N>spp])")
+    p.add_argument("--reuse", action="store_true", help="take the renders already in --out")
     args = p.parse_args()
     suffix = f"_{args.samples}spp" if args.samples else ""
     args.out = args.out or os.path.join(ROOT, "out", "bench", "demo" + suffix)
     os.makedirs(args.out, exist_ok=True)
     blender = R.Blender(args.build)
+
+    def render(blend, method, path, **kw):
+        if not (args.reuse and os.path.exists(path)):
+            R.render(blender, blend, method, path, **kw)
+
     try:
         blend = os.path.join(args.out, "demo.blend")
-        blender.run(os.path.join(ROOT, "blender_addon", "demo", "make_demo_scene.py"), blend)
+        if not (args.reuse and os.path.exists(blend)):
+            blender.run(os.path.join(ROOT, "blender_addon", "demo", "make_demo_scene.py"), blend)
         samples = args.samples or int(blender.run(os.path.join(HERE, "demo_samples.py"),
                                                   blend).split("DEMO_SAMPLES ")[1].split()[0])
         halves = []
         for seed in (1, 2):
             path = os.path.join(args.out, f"ref_{seed}.exr")
-            R.render(blender, blend, "pt", path, samples=args.ref_samples, seed=1000 + seed)
+            render(blend, "pt", path, samples=args.ref_samples, seed=1000 + seed)
             halves.append(R.rgb(path))
         ref = 0.5 * (halves[0] + halves[1])
+        ref_display = display_levels([os.path.join(args.out, f"ref_{k}.exr") for k in (1, 2)])
         # What a render of the reference's own sample count scores: each half against the other.
         floor = 0.5 * (speckles(halves[0], floored_median(halves[1])) +
                        speckles(halves[1], floored_median(halves[0])))
@@ -119,21 +162,29 @@ def main():
         feature_halves = ([], [])
         for seed in range(1, args.seeds + 1):
             raw = os.path.join(args.out, f"gpt_{seed}.exr")
-            R.render(blender, blend, "gpt", raw, samples=samples, seed=seed)
+            render(blend, "gpt", raw, samples=samples, seed=seed)
             l1, _ = R.solve(args.build, raw, "l1", raw[:-4] + "_l1.exr")
             feat = os.path.join(args.out, f"feature_{seed}.exr")
-            R.render(blender, blend, "gpt_feature", feat, samples=samples, seed=seed)
+            render(blend, "gpt_feature", feat, samples=samples, seed=seed)
             # Reconstruction None: Combined is the primal plus emission.
             feature = R.rgb(feat)
             for half, name in zip(feature_halves, ("Primal A", "Primal B")):
                 half.append(R.rgb(feat, f"ViewLayer.{name}."))
             for name, img in (("primal", R.rgb(raw)), ("l1", l1), ("feature", feature)):
                 rows[name].append({"speckles": speckles(img, median),
+                                   "isolated": isolated(img, ref, median),
                                    "relmse": M.rel_mse_denoised(img, *halves)})
-            rows["feature"][-1]["speckle_pixels"] = speckle_details(feature, ref, median)
-            for d in rows["feature"][-1]["speckle_pixels"]:
+            details = speckle_details(feature, ref, median)
+            display_error = np.abs(display_levels([feat]) - ref_display).max(axis=-1)
+            for d in details:
+                e = display_error[d["y"], d["x"]]
+                d["display_error_levels"] = float(e)
+                d["pixels_farther_in_display"] = int(np.count_nonzero(display_error > e))
                 print(f"  feature seed {seed} speckle ({d['x']}, {d['y']}): {d['over_median']:.2f}x "
-                      f"the median, reference {d['reference_over_median']:.2f}x", flush=True)
+                      f"the median, reference {d['reference_over_median']:.2f}x; in the demo's "
+                      f"view {e:.1f} levels from the reference, "
+                      f"{d['pixels_farther_in_display']} pixels farther", flush=True)
+            rows["feature"][-1]["speckle_pixels"] = details
     finally:
         blender.close()
     result = {"samples": samples, "reference_samples_per_half": args.ref_samples,
@@ -145,10 +196,12 @@ def main():
               "flat_region_fireflies": halves_fireflies(*feature_halves, ref, median)}
     for name, r in rows.items():
         s = [x["speckles"] for x in r]
+        iso = [x["isolated"] for x in r]
         e = [x["relmse"] for x in r]
-        result[name] = {"speckles_mean": float(np.mean(s)), "relmse_mean": float(np.mean(e))}
-        print(f"demo {samples} spp {name:8s} speckles {np.mean(s):7.1f} (per seed {s}) "
-              f"relMSE {np.mean(e):.3e}", flush=True)
+        result[name] = {"speckles_mean": float(np.mean(s)), "isolated_mean": float(np.mean(iso)),
+                        "relmse_mean": float(np.mean(e))}
+        print(f"demo {samples} spp {name:8s} speckles {np.mean(s):7.1f} (per seed {s}), isolated "
+              f"{np.mean(iso):.1f}, relMSE {np.mean(e):.3e}", flush=True)
     h = result["bright_features_halves"]
     print(f"Feature halves at the reference's {h['pixels']} bright-feature pixels: (A - B)^2 / 4 "
           f"over the true error {h['estimate_over_true']:.2f}, error correlation "
