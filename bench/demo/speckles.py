@@ -16,7 +16,8 @@
 # Which speckles are isolated (the reference there under 1.7x its median: light the scene does
 # not have there) and which sit on a bright feature of the reference; and, in the demo's view
 # (Filmic, through OpenColorIO by oiiotool), how far each Feature speckle is from the reference in
-# 8-bit display levels and how many pixels of the same render are farther.
+# 8-bit display levels and how many pixels of the same render are farther; and per render the
+# 99.9th percentile of every pixel's display distance.
 #   /usr/bin/python3 bench/demo/speckles.py [--build build] [--ref-samples 2048] [--seeds 4]
 #       [--samples N] [--reuse]
 # --reuse takes the renders already in the folder (after a change that leaves the renders and the
@@ -170,12 +171,18 @@ def main():
             feature = R.rgb(feat)
             for half, name in zip(feature_halves, ("Primal A", "Primal B")):
                 half.append(R.rgb(feat, f"ViewLayer.{name}."))
-            for name, img in (("primal", R.rgb(raw)), ("l1", l1), ("feature", feature)):
+            display_errors = {}
+            for name, img, path, prefix in (("primal", R.rgb(raw), raw, "ViewLayer.Combined."),
+                                            ("l1", l1, raw[:-4] + "_l1.exr", ""),
+                                            ("feature", feature, feat, "ViewLayer.Combined.")):
+                err = np.abs(display_levels([path], prefix) - ref_display).max(axis=-1)
+                display_errors[name] = err
                 rows[name].append({"speckles": speckles(img, median),
                                    "isolated": isolated(img, ref, median),
-                                   "relmse": M.rel_mse_denoised(img, *halves)})
+                                   "relmse": M.rel_mse_denoised(img, *halves),
+                                   "display_error_p999": float(np.percentile(err, 99.9))})
             details = speckle_details(feature, ref, median)
-            display_error = np.abs(display_levels([feat]) - ref_display).max(axis=-1)
+            display_error = display_errors["feature"]
             for d in details:
                 e = display_error[d["y"], d["x"]]
                 d["display_error_levels"] = float(e)
@@ -198,10 +205,13 @@ def main():
         s = [x["speckles"] for x in r]
         iso = [x["isolated"] for x in r]
         e = [x["relmse"] for x in r]
+        p999 = [x["display_error_p999"] for x in r]
         result[name] = {"speckles_mean": float(np.mean(s)), "isolated_mean": float(np.mean(iso)),
-                        "relmse_mean": float(np.mean(e))}
+                        "relmse_mean": float(np.mean(e)),
+                        "display_error_p999_mean": float(np.mean(p999))}
         print(f"demo {samples} spp {name:8s} speckles {np.mean(s):7.1f} (per seed {s}), isolated "
-              f"{np.mean(iso):.1f}, relMSE {np.mean(e):.3e}", flush=True)
+              f"{np.mean(iso):.1f}, relMSE {np.mean(e):.3e}, display error's 99.9th percentile "
+              f"{np.mean(p999):.1f} levels", flush=True)
     h = result["bright_features_halves"]
     print(f"Feature halves at the reference's {h['pixels']} bright-feature pixels: (A - B)^2 / 4 "
           f"over the true error {h['estimate_over_true']:.2f}, error correlation "
