@@ -101,7 +101,11 @@ void weighted_images(const ReconstructionInput& all, const ReconstructionSetting
     base.weighted_all[i] = 0.5f * (base.weighted_a[i] + base.weighted_b[i]);
 }
 
-FeatureBase base_images(const ReconstructionInput& in, const ReconstructionSettings& s) {
+FeatureBase base_images(const ReconstructionInput& in, const ReconstructionSettings& settings) {
+  // The guide's, the halves' and the Weighted candidate's solves share their CG and weight
+  // buffers, released before the filters allocate theirs.
+  ReconstructionSettings s = settings;
+  if (!s.scratch) s.scratch = make_reconstruction_scratch();
   FeatureBase base;
   const size_t n3 = 3 * size_t(in.width) * in.height;
   std::vector<float> mean;

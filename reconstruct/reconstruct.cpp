@@ -7,6 +7,8 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
@@ -20,6 +22,15 @@
 #include "reconstruct/weighted_cg.h"
 
 namespace gdpt {
+
+struct ReconstructionScratch {
+  detail::CgWorkspace cg;
+  std::vector<std::vector<float>> spare_planes;  // per-pixel planes no solve holds now
+};
+
+std::shared_ptr<ReconstructionScratch> make_reconstruction_scratch() {
+  return std::make_shared<ReconstructionScratch>();
+}
 
 namespace {
 
@@ -131,16 +142,43 @@ double squared3(const float* e) {
   return double(e[0]) * e[0] + double(e[1]) * e[1] + double(e[2]) * e[2];
 }
 
-// Per-pixel weights of a quadratic problem (alpha^2 folded into w0).
-struct Weights {
-  std::vector<float> w0, wx, wy;
-  explicit Weights(size_t n)
-      : w0(huge_vector<float>(n)), wx(huge_vector<float>(n)), wy(huge_vector<float>(n)) {}
+// A per-pixel float plane (contents unspecified until written), taken from the scratch's spares
+// when it has one and given back there when done; without a scratch, a fresh buffer.
+class Plane {
+ public:
+  Plane(size_t n, ReconstructionScratch* scratch) : scratch_(scratch) {
+    if (scratch_ && !scratch_->spare_planes.empty()) {
+      v_ = std::move(scratch_->spare_planes.back());
+      scratch_->spare_planes.pop_back();
+      resize_huge(v_, n);
+    } else {
+      v_ = huge_vector<float>(n);
+    }
+  }
+  Plane(Plane&& o) noexcept : v_(std::move(o.v_)), scratch_(std::exchange(o.scratch_, nullptr)) {}
+  Plane& operator=(Plane&&) = delete;
+  ~Plane() {
+    if (scratch_) scratch_->spare_planes.push_back(std::move(v_));
+  }
+  float* data() { return v_.data(); }
+  const float* data() const { return v_.data(); }
+  float& operator[](size_t i) { return v_[i]; }
+
+ private:
+  std::vector<float> v_;
+  ReconstructionScratch* scratch_;
 };
 
-Weights uniform_weights(const Prepared& pr, double alpha) {
+// Per-pixel weights of a quadratic problem (alpha^2 folded into w0).
+struct Weights {
+  Plane w0, wx, wy;
+  Weights(size_t n, ReconstructionScratch* scratch)
+      : w0(n, scratch), wx(n, scratch), wy(n, scratch) {}
+};
+
+Weights uniform_weights(const Prepared& pr, double alpha, ReconstructionScratch* scratch) {
   const int W = pr.width, H = pr.height;
-  Weights w(size_t(W) * H);
+  Weights w(size_t(W) * H, scratch);
   const float a2 = float(alpha * alpha);
   parallel_rows(H, [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y)
@@ -178,9 +216,9 @@ VarianceScale variance_scale(const Prepared& pr, const float* variance) {
 }
 
 Weights variance_weights(const Prepared& pr, const float* variance, double alpha,
-                         const VarianceScale& vs) {
+                         const VarianceScale& vs, ReconstructionScratch* scratch) {
   const int W = pr.width, H = pr.height;
-  Weights w(size_t(W) * H);
+  Weights w(size_t(W) * H, scratch);
   auto inverse = [&](float v) {
     return std::isfinite(v) ? float(vs.mean / std::max(double(v), vs.floor)) : 0.f;
   };
@@ -348,8 +386,8 @@ void solve_l1(const Prepared& pr, const ReconstructionSettings& settings, bool w
               std::vector<float>& x, detail::CgWorkspace& ws, ReconstructionReport& rep,
               const Progress& progress) {
   const size_t n = size_t(pr.width) * pr.height;
-  Weights w(n);
-  auto inv_diag = huge_vector<float>(n);
+  Weights w(n, settings.scratch.get());
+  Plane inv_diag(n, settings.scratch.get());
   ws.resize(3 * n);
   const detail::IrlsData data{pr.width,      pr.height,
                               pr.primal,     pr.gradient_x,
@@ -448,11 +486,13 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
         pr = prepare(input, true);
         x = l2_solution(pr, alpha, settings.fft_measure, nullptr, false);
       }
-      detail::CgWorkspace ws;
+      ReconstructionScratch* const scratch = settings.scratch.get();
+      detail::CgWorkspace own_ws;
+      detail::CgWorkspace& ws = scratch ? scratch->cg : own_ws;
       if (settings.norm == ReconstructionNorm::L2 && pr.missing > 0) {
         // Missing terms break the DCT's constant coefficients: finish with CG on the masked
         // system from the DCT solution of the zero-filled data.
-        const Weights w = uniform_weights(pr, alpha);
+        const Weights w = uniform_weights(pr, alpha, scratch);
         auto pb = make_problem(pr, w);
         const auto inv_diag = detail::jacobi_inverse_diagonal(pb);
         pb.inv_diagonal = inv_diag.data();
@@ -464,7 +504,7 @@ std::vector<float> reconstruct(const ReconstructionInput& input,
         solve_l1(pr, settings, warm, x, ws, rep, progress);
       } else if (settings.norm == ReconstructionNorm::Weighted) {
         const VarianceScale vs = variance_scale(pr, input.variance);
-        const Weights w = variance_weights(pr, input.variance, alpha, vs);
+        const Weights w = variance_weights(pr, input.variance, alpha, vs, scratch);
         auto pb = make_problem(pr, w);
         const auto inv_diag = detail::jacobi_inverse_diagonal(pb);
         pb.inv_diagonal = inv_diag.data();

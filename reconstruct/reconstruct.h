@@ -24,6 +24,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 namespace gdpt {
@@ -34,6 +35,9 @@ enum class ReconstructionNorm : uint8_t { L2, L1, Weighted, None, Feature };
 // follow the IRLS weights (reconstruct/multigrid.h), at the finest level additive (D^-1 plus the
 // coarse correction) or a full V(1,1).
 enum class L1Preconditioner : uint8_t { Jacobi, MultigridAdditive, MultigridVCycle };
+
+// Buffers that consecutive solves can share (ReconstructionSettings::scratch).
+struct ReconstructionScratch;
 
 struct ReconstructionSettings {
   ReconstructionNorm norm = ReconstructionNorm::L1;
@@ -97,7 +101,13 @@ struct ReconstructionSettings {
   int feature_weighted_cg_steps = 15;
   // Called with the completed fraction in [0, 1] (from the calling thread).
   std::function<void(float)> progress;
+  // Optional buffers shared by a sequence of solves of one image size, one at a time (the
+  // Feature norm's guide, halves and Weighted solves): CG vectors and per-pixel weights stay
+  // allocated between them instead of being freed and first-touched again. Same results.
+  std::shared_ptr<ReconstructionScratch> scratch;
 };
+
+std::shared_ptr<ReconstructionScratch> make_reconstruction_scratch();
 
 // The cold L1 schedule that was the default before the multigrid one: 36 reweightings of 12 -> 3
 // Jacobi-PCG steps (270 inner steps; 1.6-1.8x the CPU time of the multigrid default at 1080p).
