@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "integrators/adaptive_sampling.h"
 #include "integrators/gpt/gradient_path_tracer.h"
 #include "integrators/integrator.h"
 #include "integrators/pt/path_tracer.h"
@@ -31,6 +32,9 @@ constexpr int kTileSize = 16;
 constexpr int kTilesPerWorker = 32;
 // Pixel-samples per render_tile call (16 spp of a full tile): a few milliseconds of PT or G-PT.
 constexpr uint32_t kChunkSamples = 16 * kTileSize * kTileSize;
+// Adaptive sampling judges the pixels at least every this many samples (even: the feature
+// passes' halves stay equal).
+constexpr int kAdaptiveStep = 4;
 // Film pairs of other sizes a session keeps: the viewport's start resolutions (divider 16 to 2).
 constexpr size_t kMaxSpareFilms = 4;
 
@@ -67,6 +71,16 @@ void check_settings(RenderSettings& settings) {
     throw std::invalid_argument(
         "render settings: with the feature passes the frame's samples "
         "must be < 2^31");
+  if (!(settings.adaptive_threshold >= 0.0f) || !std::isfinite(settings.adaptive_threshold))
+    throw std::invalid_argument("render settings: the noise threshold must be >= 0");
+  if (settings.adaptive_min_samples < 0)
+    throw std::invalid_argument("render settings: adaptive min samples must be >= 0");
+  // Parts of a split frame stop their pixels apart: merged, they would be no render's samples.
+  if (settings.adaptive_threshold > 0.0f &&
+      (settings.sample_offset != 0 || settings.frame_samples != 0))
+    throw std::invalid_argument(
+        "render settings: adaptive sampling (noise threshold) renders a whole frame; turn it off "
+        "for a render that is one part of a split frame (sample offset / frame samples)");
   if (settings.samples_per_pass < 1) settings.samples_per_pass = 1;
 }
 }  // namespace
@@ -81,6 +95,8 @@ struct RenderSession::Impl {
   // go through a few start resolutions to the full view, each size's films are kept.
   std::vector<std::pair<Film, Film>> spare_films;
   std::vector<Tile> tiles;
+  // Adaptive sampling: the pixels that keep sampling (adaptive_sampling.h), the pass film's mask.
+  std::vector<uint8_t> sampling_mask;
   std::vector<std::string> warnings;
   // settings.threads worker slots (0 = all cores): used for the BVH build and every pass.
   std::unique_ptr<tbb::task_arena> arena;
@@ -219,18 +235,37 @@ void RenderSession::render(const std::function<void(const RenderProgress&)>& on_
   };
   tbb::task_arena& arena = *d.arena;
   const int total = d.settings.samples;
-  int done = int(d.film.min_samples());
+  // Adaptive sampling: from adaptive_from samples on, only the pixels of the mask sample.
+  const bool adaptive = d.settings.adaptive_threshold > 0.0f;
+  const int adaptive_from = adaptive ? adaptive_min_samples(d.settings) : total;
+  d.pass_film.set_sampling_mask(nullptr);
+  d.sampling_mask.clear();
+  int done = int(adaptive ? d.film.max_samples() : d.film.min_samples());
   const int height = d.film.height();
   while (done < total) {
     if (cancel.load(std::memory_order_relaxed)) break;
     if (d.settings.time_limit > 0.0 && elapsed() >= d.settings.time_limit) break;
+    // With the feature passes a pixel stops only after an even count: its halves stay equal.
+    if (done >= adaptive_from && (done % 2 == 0 || !d.settings.feature_passes)) {
+      size_t sampling = 0;
+      arena.execute([&] {
+        sampling = update_sampling_mask(d.film, d.settings.adaptive_threshold, d.sampling_mask);
+      });
+      if (sampling == 0) break;  // every pixel is below the noise threshold
+      d.pass_film.set_sampling_mask(d.sampling_mask.data());
+    }
     const uint32_t first = d.settings.sample_offset + uint32_t(done);
     const bool probe = d.estimate_split && done == 0;
-    const uint32_t count =
-        probe ? 1u : uint32_t(std::min(d.settings.samples_per_pass, total - done));
+    int per_pass = std::min(d.settings.samples_per_pass, total - done);
+    // Adaptive sampling: a pass ends at the minimum samples, and after it every kAdaptiveStep
+    // samples at most, where the pixels are judged again.
+    if (adaptive)
+      per_pass = done < adaptive_from ? std::min(per_pass, adaptive_from - done)
+                                      : std::min(per_pass, kAdaptiveStep);
+    const uint32_t count = probe ? 1u : uint32_t(per_pass);
 
     // --- One pass over every tile; a pass interrupted by cancel is discarded, so every pixel
-    // always has the same sample count ---
+    // always has the same sample count (adaptive sampling: every pixel that still samples) ---
     std::atomic<bool> aborted{false};
     arena.execute([&] {
       tbb::parallel_for(
@@ -270,6 +305,7 @@ void RenderSession::render(const std::function<void(const RenderProgress&)>& on_
     if (probe) d.split_from_first_sample(elapsed());
     if (on_pass) on_pass(RenderProgress{done, total, elapsed()});
   }
+  d.pass_film.set_sampling_mask(nullptr);
 }
 
 const Film& RenderSession::film() const {

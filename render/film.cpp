@@ -159,6 +159,27 @@ uint32_t Film::min_samples() const {
   return *std::min_element(samples_.begin(), samples_.end());
 }
 
+uint32_t Film::max_samples() const {
+  if (samples_.empty()) return 0;
+  return *std::max_element(samples_.begin(), samples_.end());
+}
+
+double Film::pixel_luminance(size_t i) const {
+  return samples_[i] ? lum(acc_[i].primal) / samples_[i] : 0.0;
+}
+
+double Film::pixel_variance(size_t i) const {
+  const uint32_t n = samples_[i];
+  double v = variance_of_mean(lum(acc_[i].primal), acc_[i].primal2, n);
+  if (!gradients_from_primal_) {
+    const GradientAccumulator& g = grad_[i];
+    v += variance_of_mean(lum(g.dx), g.dx2, n) + variance_of_mean(lum(g.dy), g.dy2, n) +
+         variance_of_mean(lum(g.dx_left), g.dx_left2, n) +
+         variance_of_mean(lum(g.dy_down), g.dy_down2, n);
+  }
+  return v;
+}
+
 void Film::primal_rgb(float* out) const {
   for (size_t i = 0; i < acc_.size(); ++i) {
     const double inv = samples_[i] ? 1.0 / samples_[i] : 0.0;

@@ -88,6 +88,20 @@ class Film {
   bool has_mist() const { return !mist_.empty(); }
   uint32_t samples(int x, int y) const { return samples_[size_t(y) * width_ + x]; }
   uint32_t min_samples() const;
+  uint32_t max_samples() const;
+  // What adaptive sampling weighs (integrators/adaptive_sampling.h), for pixel i: the luminance
+  // of its primal mean, and the variance of that mean plus, with G-PT's gradients, the variances
+  // of its own four gradient halves' means (the base paths it traced), all in luminance.
+  double pixel_luminance(size_t i) const;
+  double pixel_variance(size_t i) const;
+
+  // Adaptive sampling: the integrators add samples only to pixels whose `mask` entry is non-zero
+  // (width x height, row 0 at the bottom; not owned, kept alive by the caller); null, the
+  // default: every pixel.
+  void set_sampling_mask(const uint8_t* mask) { sampling_mask_ = mask; }
+  bool sampling(int x, int y) const {
+    return !sampling_mask_ || sampling_mask_[size_t(y) * width_ + x];
+  }
 
   // --- Accumulation (called by the integrators; each pixel is written by one thread at a time) ---
   // What every sample adds: one cache line per pixel (alignas), the whole film in PT mode.
@@ -249,6 +263,7 @@ class Film {
   HugePageVector<FeatureAccumulator> features_;  // empty when the feature passes are off
   HugePageVector<HalfAGradients> half_a_grad_;   // empty unless features_ and grad_ are not
   bool gradients_from_primal_ = false;
+  const uint8_t* sampling_mask_ = nullptr;
   uint32_t sample_offset_ = 0;
   uint32_t half_split_ = 0;
 };

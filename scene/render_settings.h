@@ -54,6 +54,12 @@ struct RenderSettings {
   // off: no cost.
   bool feature_passes = false;
   int samples_per_pass = 1;  // progressive granularity (a pass = this many spp over the image)
+  // Adaptive sampling (Cycles' Noise Threshold; integrators/adaptive_sampling.h): after each pass
+  // from adaptive_min_samples on, a pixel whose relative noise is below the threshold and whose
+  // neighbours' is too stops taking samples. 0 = off (every pixel takes `samples`).
+  // adaptive_min_samples 0 = automatic (a quarter of `samples`, at least 4).
+  float adaptive_threshold = 0.0f;
+  int adaptive_min_samples = 0;
   // Debug / benchmark: run the kernel with every feature path on (same image, slower), to measure
   // what the per-scene specialisation buys.
   bool force_all_features = false;

@@ -1,12 +1,13 @@
 # One timed render of the benchmark report (runs inside Blender, the add-on staged):
 #   blender -b --factory-startup --addons gdpt --python render_one.py -- \
-#       BLEND METHOD OUT.exr (--seconds T | --samples N) [--seed S]
+#       BLEND METHOD OUT.exr (--seconds T | --samples N) [--seed S] [--adaptive THRESHOLD [--adaptive-min N]]
 # METHOD: cycles_default (Cycles as a new scene has it, but denoising off: Debian's Blender has
 # no OpenImageDenoise), cycles_unbiased (the same with Filter Glossy 0 and no clamping),
 # cycles_bsdf (cycles_unbiased with emissive meshes lit by BSDF rays alone: no light sampling), pt
 # (Gradient PT's path tracer), gpt (Gradient PT's G-PT, no reconstruction: the report solves
 # its passes with gdpt-reconstruct), gpt_feature (G-PT with the Feature reconstruction in the
-# render, which computes the feature passes it needs). Prints one line `BENCH {json}` with the render call's wall
+# render, which computes the feature passes it needs). --adaptive: Gradient PT's adaptive sampling
+# at that noise threshold (off by default, as the add-on's), --adaptive-min its Min Samples. Prints one line `BENCH {json}` with the render call's wall
 # time; the samples reached are parsed by the caller from the engines' console lines.
 import json
 import os
@@ -25,6 +26,7 @@ opts = dict(zip(argv[3::2], argv[4::2]))
 seconds = float(opts.get("--seconds", 0))
 samples = int(opts.get("--samples", 0))
 seed = int(opts.get("--seed", 1))
+adaptive = float(opts.get("--adaptive", 0))
 if (seconds > 0) == (samples > 0):
     sys.exit("render_one.py: give exactly one of --seconds and --samples")
 
@@ -59,6 +61,10 @@ elif method in ("pt", "gpt", "gpt_feature"):
     g.samples = samples or many
     g.time_limit = seconds
     g.blur_glossy = 0.0  # unbiased, as the cycles_unbiased reference
+    g.use_adaptive_sampling = adaptive > 0
+    if adaptive > 0:
+        g.adaptive_threshold = adaptive
+        g.adaptive_min_samples = int(opts.get("--adaptive-min", 0))
 else:
     sys.exit(f"render_one.py: unknown method {method}")
 scene.render.use_persistent_data = False

@@ -112,8 +112,11 @@ def update_scene_results(name, entries, **header):
         json.dump({**header, "scenes": {s: scenes[s] for s in SCENES if s in scenes}}, f, indent=1)
 
 
-def render(blender, blend, method, out, seconds=0.0, samples=0, seed=1):
+def render(blender, blend, method, out, seconds=0.0, samples=0, seed=1, adaptive=0.0,
+           adaptive_min=0):
     args = [blend, method, out] + (["--seconds", seconds] if seconds else ["--samples", samples])
+    if adaptive:
+        args += ["--adaptive", adaptive, "--adaptive-min", adaptive_min]
     log = blender.run(os.path.join(HERE, "render_one.py"), *args, "--seed", seed)
     line = next(ln for ln in log.splitlines() if ln.startswith("BENCH "))
     info = json.loads(line[6:])

@@ -32,6 +32,19 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
     transmission_bounces: IntProperty(
         name="Transmission", description="Maximum number of transmission bounces, bounded by the "
         "total maximum", default=12, min=0, max=1024)
+    # Sampling > Noise Threshold, Cycles' names and ranges (integrators/adaptive_sampling.h).
+    # Off by default here: GDPT's benchmarks and tests render fixed sample counts.
+    use_adaptive_sampling: BoolProperty(
+        name="Noise Threshold", description="Adaptively stop sampling pixels once their noise "
+        "is below the threshold (and their neighbours' too)", default=False)
+    adaptive_threshold: FloatProperty(
+        name="Noise Threshold", description="Noise level at which a pixel stops taking samples: "
+        "the standard deviation of its estimate over the square root of its brightness, as "
+        "Cycles' (lower is less noisy and slower)", default=0.01, min=0.0001, max=1.0,
+        soft_min=0.001, precision=4)
+    adaptive_min_samples: IntProperty(
+        name="Min Samples", description="Samples every pixel takes before it may stop (0: a "
+        "quarter of the samples, at least 4)", default=0, min=0, max=4096)
     # Light Paths > Caustics, Cycles' names, ranges and defaults.
     blur_glossy: FloatProperty(
         name="Filter Glossy", description="Adaptively blur glossy shaders after blurry bounces, "
@@ -181,6 +194,8 @@ def settings_dict(scene):
         "frame_samples": int(s.frame_samples),
         "threads": int(s.threads),
         "clamp": float(s.clamp),
+        "adaptive_threshold": float(s.adaptive_threshold) if s.use_adaptive_sampling else 0.0,
+        "adaptive_min_samples": int(s.adaptive_min_samples),
         "shift_threshold": float(s.shift_threshold),
         "pixel_filter": s.pixel_filter_type,
         "filter_width": float(s.filter_width),

@@ -37,6 +37,15 @@ class GDPT_PT_sampling(_RenderPanel, Panel):
         col = layout.column(align=True)
         col.prop(s, "samples")
         col.prop(s, "time_limit")
+        # Cycles' layout: the toggle as a heading checkbox, its threshold beside it.
+        row = layout.row(heading="Noise Threshold", align=True)
+        row.prop(s, "use_adaptive_sampling", text="")
+        sub = row.row()
+        sub.active = s.use_adaptive_sampling
+        sub.prop(s, "adaptive_threshold", text="")
+        sub = layout.column()
+        sub.active = s.use_adaptive_sampling
+        sub.prop(s, "adaptive_min_samples", text="Min Samples")
         col = layout.column()
         col.prop(s, "seed")
         col.prop(s, "sample_offset")

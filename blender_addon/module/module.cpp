@@ -52,6 +52,8 @@ RenderSettings settings_from_dict(const py::dict& d) {
   get("frame_samples", s.frame_samples);
   get("threads", s.threads);
   get("clamp", s.clamp);
+  get("adaptive_threshold", s.adaptive_threshold);
+  get("adaptive_min_samples", s.adaptive_min_samples);
   get("rr_depth", s.rr_depth);
   get("shift_threshold", s.shift_roughness_threshold);
   get("filter_width", s.filter_width);

@@ -271,7 +271,9 @@ py::dict RenderJob::passes() {
   FilmPasses p;
   {
     py::gil_scoped_release no_gil;
-    p.read(session_->film(), int(session_->film().min_samples()));
+    // The samples the render reached: every pixel's, or with adaptive sampling the most any
+    // pixel took (its Sample Count pass has each pixel's).
+    p.read(session_->film(), int(session_->film().max_samples()));
   }
   return p.to_python_owning();
 }

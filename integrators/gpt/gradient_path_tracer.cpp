@@ -87,6 +87,8 @@ class GradientPathTracer final : public Integrator {
         rays += trace_camera_grid(g_, tile, W, H, index, grid);
         for (int y = tile.y0; y < tile.y1; ++y)
           for (int x = tile.x0; x < tile.x1; ++x) {
+            // Adaptive sampling: a stopped pixel's camera ray is still its neighbours' offset.
+            if (!film.sampling(x, y)) continue;
             Sampler sampler;
             start_sample(g_, sampler, x + rx, y + ry, index);
             offset_mask(W, H, x, y, mask);
@@ -106,6 +108,7 @@ class GradientPathTracer final : public Integrator {
             const int n = std::min(kRow, tile.x1 - x0);
             rays += trace_camera_row(g_, W, H, x0, y, n, index, row);
             for (int i = 0; i < n; ++i) {
+              if (!film.sampling(x0 + i, y)) continue;
               if (s == g_.settings.sample_offset && row.found[i])  // the first sample's hit
                 g_.ctx.record_first_hit(film, x0 + i, y, row.hit[i]);
               rays += run_path(row.sampler[i], row_sample(row, i), x0 + i, y, s, *scratch, r, film);
@@ -114,7 +117,8 @@ class GradientPathTracer final : public Integrator {
       }
     }
     for (int y = tile.y0; y < tile.y1; ++y)
-      for (int x = tile.x0; x < tile.x1; ++x) film.add_sample_count(x, y, sample_count);
+      for (int x = tile.x0; x < tile.x1; ++x)
+        if (film.sampling(x, y)) film.add_sample_count(x, y, sample_count);
     count_rays(rays);
   }
 

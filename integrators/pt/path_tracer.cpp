@@ -74,12 +74,14 @@ class PathTracer final : public Integrator {
     const float clamp = settings_.clamp;
     // Raster positions and sampler keys are the frame's (a render region samples as the frame).
     const int rx = ctx_.camera().region_x(), ry = ctx_.camera().region_y();
-    std::fill(valid, valid + kStream, true);
     for (int y = tile.y0; y < tile.y1; ++y) {
       for (int x0 = tile.x0; x0 < tile.x1; x0 += kStream) {
         const int n = std::min(kStream, tile.x1 - x0);
         numbers.prepare(settings_.seed, x0 + rx, y + ry, n, settings_.max_bounces + 1,
                         !ctx_.lights().empty());
+        int sampling = 0;  // adaptive sampling: the segment's pixels that take samples
+        for (int j = 0; j < n; ++j) sampling += valid[j] = film.sampling(x0 + j, y);
+        if (sampling == 0) continue;
         for (uint32_t s = first_sample; s < first_sample + sample_count; ++s) {
           // --- Camera rays of the segment, traced together ---
           numbers.fill(film.sequence_index(s));
@@ -91,6 +93,7 @@ class PathTracer final : public Integrator {
               if (found[j]) ctx_.record_first_hit(film, x0 + j, y, hits[j]);
           // --- The paths ---
           for (int j = 0; j < n; ++j) {
+            if (!valid[j]) continue;
             const PathResult r =
                 trace(numbers, j, camera_rays[j], found[j], closures, scratch, filtered, hits[j]);
             rays += r.rays;
@@ -103,7 +106,8 @@ class PathTracer final : public Integrator {
           }
         }
       }
-      for (int x = tile.x0; x < tile.x1; ++x) film.add_sample_count(x, y, sample_count);
+      for (int x = tile.x0; x < tile.x1; ++x)
+        if (film.sampling(x, y)) film.add_sample_count(x, y, sample_count);
     }
     count_rays(rays);
   }

@@ -1,0 +1,86 @@
+# Adaptive sampling on the demo (integrators/adaptive_sampling.h): per seed, the demo's Feature
+# render at its own samples against one with adaptive sampling (up to --max-samples, at noise
+# threshold --threshold, from --min-samples), both rendered and timed in this run: speckles and isolated speckles
+# (speckles.py's definitions, against its converged reference), relMSE, the 99.9th percentile of
+# the display error, the render call's seconds and the mean samples per pixel.
+#   /usr/bin/python3 bench/demo/adaptive.py [--build build] [--seeds 4] --threshold T
+#       --max-samples M [--min-samples N]
+# Needs speckles.py's scene and reference (out/bench/demo: run speckles.py first). Writes
+# bench/results/demo_adaptive.json.
+import argparse
+import json
+import os
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import speckles as SP  # noqa: E402
+
+R, M, exr = SP.R, SP.M, SP.exr
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--build", default="build")
+    p.add_argument("--seeds", type=int, default=4)
+    p.add_argument("--threshold", type=float, required=True)
+    p.add_argument("--max-samples", type=int, required=True)
+    p.add_argument("--min-samples", type=int, default=0, help="0: a quarter of the maximum")
+    args = p.parse_args()
+    demo = os.path.join(SP.ROOT, "out", "bench", "demo")
+    refs = [os.path.join(demo, f"ref_{k}.exr") for k in (1, 2)]
+    blend = os.path.join(demo, "demo.blend")
+    if not all(os.path.exists(f) for f in refs + [blend]):
+        sys.exit(f"adaptive.py: run speckles.py first (needs {blend} and its references)")
+    out = os.path.join(SP.ROOT, "out", "bench", "demo_adaptive")
+    os.makedirs(out, exist_ok=True)
+    halves = [R.rgb(f) for f in refs]
+    ref = 0.5 * (halves[0] + halves[1])
+    ref_display = SP.display_levels(refs)
+    median = SP.floored_median(ref)
+    blender = R.Blender(args.build)
+    rows = {"uniform": [], "adaptive": []}
+    try:
+        samples = int(blender.run(os.path.join(HERE, "demo_samples.py"),
+                                  blend).split("DEMO_SAMPLES ")[1].split()[0])
+        for seed in range(1, args.seeds + 1):
+            for name, n, threshold in (("uniform", samples, 0.0),
+                                       ("adaptive", args.max_samples, args.threshold)):
+                path = os.path.join(out, f"{name}_{seed}.exr")
+                info = R.render(blender, blend, "gpt_feature", path, samples=n, seed=seed,
+                                adaptive=threshold, adaptive_min=args.min_samples)
+                img = R.rgb(path)
+                counts = exr.read_exr(path)["ViewLayer.Sample Count.X"]
+                err = np.abs(SP.display_levels([path]) - ref_display).max(axis=-1)
+                rows[name].append({"seconds": info["seconds"],
+                                   "mean_samples": float(counts.mean()),
+                                   "max_samples": int(counts.max()),
+                                   "speckles": SP.speckles(img, median),
+                                   "isolated": SP.isolated(img, ref, median),
+                                   "relmse": M.rel_mse_denoised(img, *halves),
+                                   "display_error_p999": float(np.percentile(err, 99.9))})
+                r = rows[name][-1]
+                print(f"seed {seed} {name:8s} {r['seconds']:.2f} s, {r['mean_samples']:.1f} "
+                      f"samples per pixel (max {r['max_samples']}), speckles {r['speckles']}, "
+                      f"relMSE {r['relmse']:.3e}", flush=True)
+    finally:
+        blender.close()
+    result = {"demo_samples": samples, "threshold": args.threshold,
+              "max_samples": args.max_samples, "min_samples": args.min_samples, "seeds": args.seeds,
+              "commit": R.git("rev-parse", "--short", "HEAD"), "per_seed": rows}
+    for name, r in rows.items():
+        mean = {k: float(np.mean([x[k] for x in r]))
+                for k in ("seconds", "mean_samples", "speckles", "isolated", "relmse",
+                          "display_error_p999")}
+        result[name] = mean
+        print(f"{name:8s} {mean['seconds']:.2f} s, {mean['mean_samples']:.1f} spp, speckles "
+              f"{mean['speckles']:.2f}, isolated {mean['isolated']:.2f}, relMSE "
+              f"{mean['relmse']:.3e}, display p99.9 {mean['display_error_p999']:.1f}", flush=True)
+    with open(os.path.join(SP.ROOT, "bench", "results", "demo_adaptive.json"), "w") as f:
+        json.dump(result, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
