@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <stdexcept>
@@ -180,6 +182,43 @@ TEST(AdaptiveSampling, LowerErrorAtEqualPixelSamples) {
               uniform_l2 / seeds);
   EXPECT_LT(adaptive_primal, uniform_primal);
   EXPECT_LT(adaptive_l2, uniform_l2);
+}
+
+// A cancel keeps the finished passes, pixels stopped or not; a time limit ends the render with
+// each pixel's count between the minimum and the samples.
+TEST(AdaptiveSampling, CancelAndTimeLimitKeepTheSamplesDone) {
+  const Scene scene = glass_box(24);
+  RenderSettings s = adaptive(RenderSettings::Mode::GPT, 1 << 20, 0.05f);
+  s.adaptive_min_samples = 8;
+  s.samples_per_pass = 64;  // passes end at the minimum, then every 4 samples
+  RenderSession session(scene, s);
+  std::atomic<bool> cancel{false};
+  int passes = 0;
+  session.render(
+      [&](const RenderProgress& p) {
+        if (++passes == 6) cancel.store(true);
+        EXPECT_EQ(uint32_t(p.samples_done), session.film().max_samples());
+      },
+      cancel);
+  const Film& f = session.film();
+  EXPECT_EQ(f.min_samples(), 8u);
+  EXPECT_EQ(f.max_samples(), 8u + 5u * 4u);  // the minimum's pass, then five passes of 4
+  std::vector<float> primal(3 * f.pixel_count());
+  f.primal_rgb(primal.data());
+  double sum = 0.0;
+  for (float v : primal) sum += v;
+  EXPECT_GT(sum, 0.0);
+
+  s.time_limit = 0.3;
+  const auto start = std::chrono::steady_clock::now();
+  RenderSession timed(scene, s);
+  std::atomic<bool> never{false};
+  timed.render(nullptr, never);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 5.0);
+  EXPECT_GE(timed.film().min_samples(), 1u);
+  EXPECT_LT(timed.film().max_samples(), uint32_t(s.samples));
 }
 
 TEST(AdaptiveSampling, RefusesSplitFramesAndBadThresholds) {
