@@ -75,6 +75,47 @@ TEST(AdaptiveSampling, MinSamples) {
   EXPECT_EQ(adaptive_min_samples(s), 10);
 }
 
+// The mask on a film of known sums: one noisy pixel keeps its 3x3 neighbourhood sampling (clipped
+// at the border), a pixel that stopped stays stopped, black noiseless pixels stop.
+TEST(AdaptiveSampling, MaskKeepsTheNoisyPixelsNeighbourhood) {
+  Film film(6, 5, true);                              // PT layout: the primal alone
+  auto set = [&](int x, int y, double a, double b) {  // two samples of luminance-neutral grey
+    Film::Accumulator& p = film.pixel(x, y);
+    for (int c = 0; c < 3; ++c) p.primal[c] = a + b;
+    p.primal2 = a * a + b * b;
+    film.add_sample_count(x, y, 2);
+  };
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 6; ++x) {
+      if (x == 0 && y == 0)
+        set(x, y, 0.0, 0.0);  // black: converged, not 0 / 0
+      else if (x == 4 && y == 2)
+        set(x, y, 0.0, 2.0);  // the mean's standard deviation 1, luminance 1: noise ~1
+      else
+        set(x, y, 0.5, 0.5);  // no noise
+    }
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 6; ++x) {
+      if (!(x == 4 && y == 2)) {
+        EXPECT_EQ(adaptive_noise(film, size_t(y) * 6 + x), 0.0);
+      }
+    }
+  EXPECT_NEAR(adaptive_noise(film, 2 * 6 + 4), 1.0, 1e-3);
+  std::vector<uint8_t> mask;
+  EXPECT_EQ(update_sampling_mask(film, 0.5f, mask), 9u);
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 6; ++x)
+      EXPECT_EQ(mask[size_t(y) * 6 + x], x >= 3 && x <= 5 && y >= 1 && y <= 3) << x << "," << y;
+  // A threshold above every pixel's noise stops them all, and they stay stopped.
+  EXPECT_EQ(update_sampling_mask(film, 2.0f, mask), 0u);
+  EXPECT_EQ(update_sampling_mask(film, 0.5f, mask), 0u);  // the noisy pixel stopped at 2.0
+  mask.clear();                                           // a new render: every pixel samples again
+  EXPECT_EQ(update_sampling_mask(film, 0.5f, mask), 9u);
+  for (int c = 0; c < 3; ++c) film.pixel(4, 2).primal[c] = 2.0;  // now two samples of 1
+  film.pixel(4, 2).primal2 = 2.0;
+  EXPECT_EQ(update_sampling_mask(film, 0.5f, mask), 0u);
+}
+
 // Each pixel's sums are those of a uniform render of its own sample count, bit for bit (its
 // samples are the prefix of its sample indices); the counts span min .. samples; every pixel
 // that stopped early is below the threshold.
