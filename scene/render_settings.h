@@ -57,7 +57,7 @@ struct RenderSettings {
   // Adaptive sampling (Cycles' Noise Threshold; integrators/adaptive_sampling.h): after each pass
   // from adaptive_min_samples on, a pixel whose relative noise is below the threshold and whose
   // neighbours' is too stops taking samples. 0 = off (every pixel takes `samples`).
-  // adaptive_min_samples 0 = automatic (a quarter of `samples`, at least 4).
+  // adaptive_min_samples 0 = automatic (a quarter of `samples`, 4 to 64).
   float adaptive_threshold = 0.0f;
   int adaptive_min_samples = 0;
   // Debug / benchmark: run the kernel with every feature path on (same image, slower), to measure

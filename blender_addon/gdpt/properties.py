@@ -44,7 +44,7 @@ class GDPTRenderSettings(bpy.types.PropertyGroup):
         soft_min=0.001, precision=4)
     adaptive_min_samples: IntProperty(
         name="Min Samples", description="Samples every pixel takes before it may stop (0: a "
-        "quarter of the samples, at least 4)", default=0, min=0, max=4096)
+        "quarter of the samples, from 4 to 64)", default=0, min=0, max=4096)
     # Light Paths > Caustics, Cycles' names, ranges and defaults.
     blur_glossy: FloatProperty(
         name="Filter Glossy", description="Adaptively blur glossy shaders after blurry bounces, "

@@ -70,6 +70,8 @@ TEST(AdaptiveSampling, MinSamples) {
   EXPECT_EQ(adaptive_min_samples(s), 4);
   s.samples = 3;
   EXPECT_EQ(adaptive_min_samples(s), 3);
+  s.samples = 1 << 24;  // a time-limited render's count
+  EXPECT_EQ(adaptive_min_samples(s), 64);
   s.samples = 64;
   s.adaptive_min_samples = 10;
   EXPECT_EQ(adaptive_min_samples(s), 10);
