@@ -19,7 +19,8 @@ constexpr int kMaxAutomaticMinSamples = 64;
 int adaptive_min_samples(const RenderSettings& settings) {
   // At most kMaxAutomaticMinSamples: a time-limited render asks for an unbounded count.
   const int automatic = std::clamp((settings.samples / 4 + 1) / 2 * 2, 4, kMaxAutomaticMinSamples);
-  const int m = settings.adaptive_min_samples > 0 ? settings.adaptive_min_samples : automatic;
+  int m = settings.adaptive_min_samples > 0 ? settings.adaptive_min_samples : automatic;
+  if (settings.feature_passes) m += m % 2;  // pixels stop at even counts only: start at one
   return std::min(m, settings.samples);
 }
 

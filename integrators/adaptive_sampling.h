@@ -25,7 +25,7 @@ namespace gdpt {
 
 // The samples every pixel takes before any may stop: settings.adaptive_min_samples, or (0) a
 // quarter of settings.samples rounded up to even, 4 to 64 (a time-limited render's sample count
-// is unbounded); never more than settings.samples.
+// is unbounded); with the feature passes rounded up to even; never more than settings.samples.
 int adaptive_min_samples(const RenderSettings& settings);
 
 // A pixel's relative noise as compared with the threshold (Film::pixel_variance, ..._luminance).

@@ -75,6 +75,10 @@ TEST(AdaptiveSampling, MinSamples) {
   s.samples = 64;
   s.adaptive_min_samples = 10;
   EXPECT_EQ(adaptive_min_samples(s), 10);
+  s.adaptive_min_samples = 5;
+  EXPECT_EQ(adaptive_min_samples(s), 5);
+  s.feature_passes = true;  // pixels stop at even counts only
+  EXPECT_EQ(adaptive_min_samples(s), 6);
 }
 
 // The mask on a film of known sums: one noisy pixel keeps its 3x3 neighbourhood sampling (clipped
@@ -154,15 +158,19 @@ TEST(AdaptiveSampling, StoppedPixelsHoldARenderOfTheirCount) {
 // With the feature passes a pixel stops only after an even number of samples: its halves (even
 // and odd sample indices) stay equal.
 TEST(AdaptiveSampling, FeaturePassesStopAtEvenCounts) {
-  RenderSettings s = adaptive(RenderSettings::Mode::GPT, 21, 0.05f);
-  s.feature_passes = true;
-  const Rendered a = render(glass_box(16), s);
-  int below = 0;
-  for (uint32_t c : a.counts) {
-    EXPECT_TRUE(c % 2 == 0 || c == 21u) << c;
-    below += c < 21u;
+  for (int min_samples : {0, 5}) {  // 5: the first judgement at 6
+    RenderSettings s = adaptive(RenderSettings::Mode::GPT, 21, 0.05f);
+    s.feature_passes = true;
+    s.adaptive_min_samples = min_samples;
+    s.samples_per_pass = 8;
+    const Rendered a = render(glass_box(16), s);
+    int below = 0;
+    for (uint32_t c : a.counts) {
+      EXPECT_TRUE(c % 2 == 0 || c == 21u) << c;
+      below += c < 21u;
+    }
+    EXPECT_GT(below, 0) << min_samples;
   }
-  EXPECT_GT(below, 0);
 }
 
 // The rare bright paths through the glass keep their pixels sampling; the smooth walls stop
