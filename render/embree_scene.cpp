@@ -456,9 +456,7 @@ Vec3f world_direction(const float (*cols)[4], Vec3f v) {
 
 }  // namespace
 
-bool EmbreeScene::world_smooth_triangle(const InstanceData& d, uint32_t prim, SmoothTriangle& t) {
-  const bool corner = prim < d.corner_normal_tris;
-  if (!corner && !d.vertex_normals) return false;
+void EmbreeScene::world_corners(const InstanceData& d, uint32_t prim, SmoothTriangle& t) {
   const uint32_t* idx = d.indices + size_t(prim) * 3;
   for (int i = 0; i < 3; ++i) {
     const Vec3f p = d.positions[idx[i]];
@@ -466,10 +464,26 @@ bool EmbreeScene::world_smooth_triangle(const InstanceData& d, uint32_t prim, Sm
                  ? p
                  : world_direction(d.to_world_cols, p) +
                        Vec3f(d.to_world_cols[3][0], d.to_world_cols[3][1], d.to_world_cols[3][2]);
+  }
+}
+
+bool EmbreeScene::world_smooth_triangle(const InstanceData& d, uint32_t prim, SmoothTriangle& t) {
+  const bool corner = prim < d.corner_normal_tris;
+  if (!corner && !d.vertex_normals) return false;
+  const uint32_t* idx = d.indices + size_t(prim) * 3;
+  world_corners(d, prim, t);
+  for (int i = 0; i < 3; ++i) {
     const Vec3f n = corner ? d.corner_normals[size_t(prim) * 3 + i] : d.vertex_normals[idx[i]];
     t.n[i] = normalize(world_direction(d.normal_cols, n));
   }
   return true;
+}
+
+void EmbreeScene::world_triangle(const SurfaceHit& hit, SmoothTriangle& t) const {
+  const InstanceData& d = instances_[top_ids_[hit.instance]];
+  if (world_smooth_triangle(d, hit.primitive, t)) return;
+  world_corners(d, hit.primitive, t);
+  for (int i = 0; i < 3; ++i) t.n[i] = hit.geometric_normal;
 }
 
 bool EmbreeScene::lifts_shadow_rays(const SurfaceHit& hit) const {

@@ -183,6 +183,9 @@ class EmbreeScene {
   // Whether shadow rays from `hit` may start lifted: a smooth-shaded triangle of an instance
   // with a Geometry Offset.
   bool lifts_shadow_rays(const SurfaceHit& hit) const;
+  // The hit triangle's corners and unit shading normals in world space (a flat triangle: its
+  // geometric normal at every corner), for the manifold walk (integrators/common/manifold_nee.h).
+  void world_triangle(const SurfaceHit& hit, SmoothTriangle& t) const;
 
   size_t triangle_count() const { return triangles_; }  // unique (per mesh)
   size_t instanced_triangle_count() const { return instanced_triangles_; }
@@ -299,6 +302,7 @@ class EmbreeScene {
   // A smooth triangle's corners and unit shading normals in world space (Cycles lifts objects
   // with their transform applied); false for a flat triangle.
   static bool world_smooth_triangle(const InstanceData& d, uint32_t prim, SmoothTriangle& t);
+  static void world_corners(const InstanceData& d, uint32_t prim, SmoothTriangle& t);  // t.p only
   // The mesh attributes (SurfaceAttributes) at barycentrics (u, v) of triangle `primitive`.
   static SurfaceAttributes attributes_at(const InstanceData& d, uint32_t primitive,
                                          const uint32_t* idx, float u, float v);

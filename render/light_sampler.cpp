@@ -139,6 +139,7 @@ LightSampler::LightSampler(const Scene& scene, std::span<const Material> materia
         lights::AreaLight a = lights::AreaLight::from_light(l);
         a.camera_visible = l.camera_visible;
         a.cast_shadow = l.cast_shadow;
+        a.caustics = l.caustics_light;
         const float p = a.power();
         if (!(p > 0.0f) || !std::isfinite(p)) break;
         I.entries.push_back({Kind::Area, uint32_t(areas_.size())});
@@ -308,6 +309,7 @@ LightSample LightSampler::sample_any(Vec3f ref, float u_select, Vec2f u) const {
     case Kind::Area:
       ok = areas_[e.index].sample(ref, u, s);
       s.cast_shadow = areas_[e.index].cast_shadow;
+      s.caustics = areas_[e.index].caustics;
       break;
     case Kind::Sun:
       ok = I.suns[e.index].sample(ref, u, s);
@@ -368,6 +370,7 @@ void LightSampler::fill_hit(const lights::AreaLight& l, Vec3f origin, Vec3f dire
   hit.pdf *= l.select_pmf;
   hit.area_pdf = l.area_pdf;
   hit.camera_visible = l.camera_visible;
+  hit.caustics = l.caustics;
 }
 
 bool LightSampler::intersect_any(Vec3f origin, Vec3f direction, float t_max, LightHit& hit) const {

@@ -77,10 +77,12 @@ class LightSampler {
   // store-forwarding stall on every light sample.
   [[gnu::always_inline]] LightSample sample_only_area(Vec3f ref, Vec2f u) const {
     LightSample s;
-    if (areas_[0].sample(ref, u, s))
+    if (areas_[0].sample(ref, u, s)) {
       s.cast_shadow = areas_[0].cast_shadow;
-    else
+      s.caustics = areas_[0].caustics;
+    } else {
       s = LightSample{};
+    }
     return s;
   }
   LightSample sample_any(Vec3f ref_position, float u_select, Vec2f u) const;

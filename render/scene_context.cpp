@@ -98,7 +98,10 @@ bool same_placement(const Instance& a, const Instance& b) {
   return a.mesh == b.mesh &&
          std::memcmp(&a.object_to_world, &b.object_to_world, sizeof(Transform)) == 0 &&
          a.slot_material == b.slot_material && a.visibility == b.visibility &&
-         a.holdout == b.holdout;
+         a.holdout == b.holdout &&
+         // The BVH's instance data holds the shadow terminator offsets.
+         a.terminator_geometry_offset == b.terminator_geometry_offset &&
+         a.terminator_shading_offset == b.terminator_shading_offset;
 }
 
 }  // namespace
@@ -145,6 +148,15 @@ void SceneContext::finish_shading(const RenderSettings& settings) {
   bvh_->set_materials(materials_);
   has_holdout_ = false;
   for (const Instance& inst : scene.instances) has_holdout_ = has_holdout_ || inst.holdout;
+  // Shadow caustics need a caster, a receiver and an area lamp that lights them.
+  bool caster = false, receiver = false, lamp = false;
+  for (const Instance& inst : scene.instances) {
+    caster = caster || inst.caustics_caster;
+    receiver = receiver || inst.caustics_receiver;
+  }
+  for (const Light& l : scene.lights)
+    lamp = lamp || (l.caustics_light && l.type == Light::Type::Area);
+  shadow_caustics_ = caster && receiver && lamp;
   lights_ = std::make_unique<LightSampler>(scene, materials_, textures_);
   camera_ = CameraModel(scene.camera);
   for (Material& m : materials_) m.set_camera(camera_.shading_camera());

@@ -69,6 +69,14 @@ class SceneContext {
   Spectrum transmittance(Ray ray, ClosureSet& scratch, uint32_t& rays) const;
   // Holdout (Instance::holdout): whether the scene has any, and whether `hit` is on one.
   bool has_holdout() const { return has_holdout_; }
+  // Cycles' Shadow Caustics (integrators/common/manifold_nee.h): some caster, receiver and lamp.
+  bool shadow_caustics() const { return shadow_caustics_; }
+  bool is_caustics_receiver(const SurfaceHit& hit) const {
+    return scene_.instances[hit.instance].caustics_receiver;
+  }
+  bool is_caustics_caster(const SurfaceHit& hit) const {
+    return scene_.instances[hit.instance].caustics_caster;
+  }
   bool is_holdout(const SurfaceHit& hit) const {
     return hit.instance < scene_.instances.size() && scene_.instances[hit.instance].holdout;
   }
@@ -95,6 +103,7 @@ class SceneContext {
   std::unique_ptr<EmbreeScene> bvh_;
   std::unique_ptr<LightSampler> lights_;
   bool has_holdout_ = false;
+  bool shadow_caustics_ = false;
   CameraModel camera_;
   PixelFilter pixel_filter_;
   uint32_t features_ = 0, scene_features_ = 0;

@@ -76,6 +76,10 @@ struct Instance {
   // Object > Shading > Shadow Terminator > Shading Offset (Cycles' object setting, in [0, 1],
   // default 0): the BSDFs' values darken towards the terminator (core/shadow_terminator.h).
   float terminator_shading_offset = 0.0f;
+  // obj.cycles.is_caustics_caster (Shadow Caustics): a refractive object whose caustics MNEE finds
+  bool caustics_caster = false;
+  // obj.cycles.is_caustics_receiver (Shadow Caustics): a surface that receives those caustics
+  bool caustics_receiver = false;
 };
 
 // Blender camera. Looks down its local -Z with +Y up, like Blender.
@@ -124,6 +128,8 @@ struct Light {
   // Cycles' Light > Cast Shadow (light.cycles.cast_shadow): off, light samples of this lamp skip
   // the shadow ray (nothing occludes it); rays that hit it by BSDF sampling are still blocked.
   bool cast_shadow = true;
+  // light.cycles.is_caustics_light (Cycles' Shadow Caustics): the lamp lights shadow caustics
+  bool caustics_light = false;
 };
 
 // A world background: a constant colour, or an equirectangular image, times strength.

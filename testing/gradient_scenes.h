@@ -221,6 +221,37 @@ inline Scene make_panel_scene(int res, Vec3f at = {0, 0, 0}, float gap = 1e-3f,
   return s;
 }
 
+// A smooth glass ball (radius 0.45, IOR `ior`, at height 1) above a diffuse floor z = 0 under a
+// 0.3 m square lamp at height 3 facing down; the camera looks down at the floor at 45 degrees,
+// at the ball's caustic (at IOR 1.5 the lamp's image lies on the floor). `shadow_caustics`: the
+// floor receives, the ball casts and the lamp lights Shadow Caustics (manifold NEE).
+inline Scene make_caustic_scene(int res, bool shadow_caustics, float ior = 1.5f,
+                                float height = 1.0f, float lamp = 0.3f) {
+  Scene s;
+  s.world.color = Spectrum(0.0f);
+  s.meshes.push_back(quad(1.5f));
+  s.meshes.push_back(sphere(0.45f, 48, 24));
+  s.materials.push_back(diffuse({0.8f, 0.8f, 0.8f}));
+  s.materials.push_back(glass(0.0f, ior));
+  s.instances.push_back(place(0, 0, transform(0, 0, {0, 0, 0})));
+  s.instances.push_back(place(1, 1, transform(0, 0, {0, 0, height})));
+  s.instances[0].caustics_receiver = shadow_caustics;
+  s.instances[1].caustics_caster = shadow_caustics;
+  Light l;
+  l.type = Light::Type::Area;
+  l.power = 20.0f;
+  l.size_x = l.size_y = lamp;
+  l.light_to_world = transform(0, 0, {0, 0, 3.0f});  // emits towards -z
+  l.caustics_light = shadow_caustics;
+  s.lights.push_back(l);
+  Camera& c = s.camera;
+  c.width = c.height = res;
+  c.focal_length_mm = 200.0f;  // the floor around the caustic, the ball out of view
+  c.sensor_width_mm = 36.0f;
+  c.camera_to_world = transform(kPi / 4, 0, {0, -2.5f, 2.5f});
+  return s;
+}
+
 struct Passes {
   int w = 0, h = 0;
   std::vector<float> primal, dx, dy, emission, variance, failures;

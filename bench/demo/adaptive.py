@@ -18,7 +18,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import speckles as SP  # noqa: E402
 
-R, M, exr = SP.R, SP.M, SP.exr
+R, exr = SP.R, SP.exr
 
 
 def main():
@@ -29,17 +29,10 @@ def main():
     p.add_argument("--max-samples", type=int, required=True)
     p.add_argument("--min-samples", type=int, default=0, help="0: a quarter of the maximum")
     args = p.parse_args()
-    demo = os.path.join(SP.ROOT, "out", "bench", "demo")
-    refs = [os.path.join(demo, f"ref_{k}.exr") for k in (1, 2)]
-    blend = os.path.join(demo, "demo.blend")
-    if not all(os.path.exists(f) for f in refs + [blend]):
-        sys.exit(f"adaptive.py: run speckles.py first (needs {blend} and its references)")
+    ref = SP.Reference()
+    blend = ref.blend
     out = os.path.join(SP.ROOT, "out", "bench", "demo_adaptive")
     os.makedirs(out, exist_ok=True)
-    halves = [R.rgb(f) for f in refs]
-    ref = 0.5 * (halves[0] + halves[1])
-    ref_display = SP.display_levels(refs)
-    median = SP.floored_median(ref)
     blender = R.Blender(args.build)
     rows = {"uniform": [], "adaptive": []}
     try:
@@ -51,16 +44,10 @@ def main():
                 path = os.path.join(out, f"{name}_{seed}.exr")
                 info = R.render(blender, blend, "gpt_feature", path, samples=n, seed=seed,
                                 adaptive=threshold, adaptive_min=args.min_samples)
-                img = R.rgb(path)
                 counts = exr.read_exr(path)["ViewLayer.Sample Count.X"]
-                err = np.abs(SP.display_levels([path]) - ref_display).max(axis=-1)
                 rows[name].append({"seconds": info["seconds"],
                                    "mean_samples": float(counts.mean()),
-                                   "max_samples": int(counts.max()),
-                                   "speckles": SP.speckles(img, median),
-                                   "isolated": SP.isolated(img, ref, median),
-                                   "relmse": M.rel_mse_denoised(img, *halves),
-                                   "display_error_p999": float(np.percentile(err, 99.9))})
+                                   "max_samples": int(counts.max()), **ref.score(path)})
                 r = rows[name][-1]
                 print(f"seed {seed} {name:8s} {r['seconds']:.2f} s, {r['mean_samples']:.1f} "
                       f"samples per pixel (max {r['max_samples']}), speckles {r['speckles']}, "

@@ -86,6 +86,31 @@ def isolated(img, ref, median):
     return int(np.count_nonzero(speckle_mask(img, median) & flat))
 
 
+class Reference:
+    """The demo's converged reference (speckles.py's two halves in out/bench/demo) and what the
+    other demo scripts score renders against."""
+
+    def __init__(self):
+        demo = os.path.join(ROOT, "out", "bench", "demo")
+        self.paths = [os.path.join(demo, f"ref_{k}.exr") for k in (1, 2)]
+        self.blend = os.path.join(demo, "demo.blend")
+        if not all(os.path.exists(f) for f in self.paths + [self.blend]):
+            sys.exit(f"run bench/demo/speckles.py first (needs {self.blend} and its references)")
+        self.halves = [R.rgb(f) for f in self.paths]
+        self.image = 0.5 * (self.halves[0] + self.halves[1])
+        self.display = display_levels(self.paths)
+        self.median = floored_median(self.image)
+
+    def score(self, path):
+        """Speckles, isolated speckles, relMSE and the display error's 99.9th percentile."""
+        img = R.rgb(path)
+        err = np.abs(display_levels([path]) - self.display).max(axis=-1)
+        return {"speckles": speckles(img, self.median),
+                "isolated": isolated(img, self.image, self.median),
+                "relmse": M.rel_mse_denoised(img, *self.halves),
+                "display_error_p999": float(np.percentile(err, 99.9))}
+
+
 def speckle_details(img, ref, median):
     """Each speckle of `img`: where, its and the reference's luminance over the median."""
     lum, lum_ref = M.luminance(img), M.luminance(ref)

@@ -1,13 +1,16 @@
 # One timed render of the benchmark report (runs inside Blender, the add-on staged):
 #   blender -b --factory-startup --addons gdpt --python render_one.py -- \
 #       BLEND METHOD OUT.exr (--seconds T | --samples N) [--seed S] [--adaptive THRESHOLD [--adaptive-min N]]
+#       [--shadow-caustics OBJECT]
 # METHOD: cycles_default (Cycles as a new scene has it, but denoising off: Debian's Blender has
 # no OpenImageDenoise), cycles_unbiased (the same with Filter Glossy 0 and no clamping),
 # cycles_bsdf (cycles_unbiased with emissive meshes lit by BSDF rays alone: no light sampling), pt
 # (Gradient PT's path tracer), gpt (Gradient PT's G-PT, no reconstruction: the report solves
 # its passes with gdpt-reconstruct), gpt_feature (G-PT with the Feature reconstruction in the
 # render, which computes the feature passes it needs). --adaptive: Gradient PT's adaptive sampling
-# at that noise threshold (off by default, as the add-on's), --adaptive-min its Min Samples. Prints one line `BENCH {json}` with the render call's wall
+# at that noise threshold (off by default, as the add-on's), --adaptive-min its Min Samples.
+# --shadow-caustics: Cycles' Shadow Caustics with OBJECT the caster, every other mesh a receiver
+# and every lamp a caustics light (both engines). Prints one line `BENCH {json}` with the render call's wall
 # time; the samples reached are parsed by the caller from the engines' console lines.
 import json
 import os
@@ -32,6 +35,14 @@ if (seconds > 0) == (samples > 0):
 
 bpy.ops.wm.open_mainfile(filepath=blend)
 scene = bpy.context.scene
+caster = opts.get("--shadow-caustics")
+if caster:
+    for ob in scene.objects:
+        if ob.type == 'MESH':
+            ob.cycles.is_caustics_caster = ob.name == caster
+            ob.cycles.is_caustics_receiver = ob.name != caster
+        elif ob.type == 'LIGHT':
+            ob.data.cycles.is_caustics_light = True
 many = 1 << 24  # a sample count the time limit ends first
 if method.startswith("cycles"):
     scene.render.engine = 'CYCLES'

@@ -24,6 +24,9 @@ def light_dict(obj, matrix, warn):
         "camera_visible": bool(obj.visible_camera),
         # Cycles' Light > Cast Shadow (its add-on's property group; absent without Cycles).
         "cast_shadow": bool(getattr(getattr(light, "cycles", None), "cast_shadow", True)),
+        # Cycles' Light > Shadow Caustics (read for shadow caustics; off without Cycles).
+        "caustics_light": bool(getattr(getattr(light, "cycles", None), "is_caustics_light",
+                                       False)),
     }
     if light.type in {'POINT', 'SPOT'}:
         d["radius"] = float(light.shadow_soft_size)

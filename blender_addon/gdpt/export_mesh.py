@@ -233,8 +233,8 @@ def ray_visibility(obj):
 
 def _cycles_object_setting(obj, name, default):
     # Cycles' object settings live in the Cycles add-on's properties (obj.cycles); without that
-    # add-on they take Cycles' defaults.
-    return float(getattr(getattr(obj, "cycles", None), name, default))
+    # add-on they take Cycles' defaults. The value has the default's type (float or bool).
+    return type(default)(getattr(getattr(obj, "cycles", None), name, default))
 
 
 def terminator_geometry_offset(obj):
@@ -245,6 +245,16 @@ def terminator_geometry_offset(obj):
 def terminator_shading_offset(obj):
     """Object > Shading > Shadow Terminator > Shading Offset (Cycles' default 0)."""
     return _cycles_object_setting(obj, "shadow_terminator_offset", 0.0)
+
+
+def caustics_caster(obj):
+    """Object > Shading > Caustics > Cast Shadow Caustics (Cycles' default off)."""
+    return _cycles_object_setting(obj, "is_caustics_caster", False)
+
+
+def caustics_receiver(obj):
+    """Object > Shading > Caustics > Receive Shadow Caustics (Cycles' default off)."""
+    return _cycles_object_setting(obj, "is_caustics_receiver", False)
 
 
 def _matrix12(m):
@@ -349,4 +359,6 @@ class GeometryExporter:
         self.builder.add_instance(mesh, _matrix12(matrix), slots, obj.pass_index,
                                   ray_visibility(obj), bool(obj.is_holdout),
                                   terminator_geometry_offset(obj),
-                                  terminator_shading_offset(obj))
+                                  terminator_shading_offset(obj),
+                                  caustics_caster=caustics_caster(obj),
+                                  caustics_receiver=caustics_receiver(obj))

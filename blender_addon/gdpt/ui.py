@@ -196,8 +196,30 @@ class GDPT_PT_ray_visibility(_Panel, Panel):
         col.prop(ob, "visible_shadow", text="Shadow", toggle=False)
 
 
+class GDPT_PT_object_caustics(_Panel, Panel):
+    """Object Properties: Cycles' Shadow Caustics flags (Cycles' Object > Shading > Caustics; its
+    properties, shown when Cycles is loaded)."""
+    bl_label = "Caustics"
+    bl_context = "object"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    @classmethod
+    def poll(cls, context):
+        ob = context.object
+        return super().poll(context) and ob is not None and hasattr(ob, "cycles") and \
+            ob.type in {'MESH', 'CURVE', 'SURFACE', 'FONT', 'META'}
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        cob = context.object.cycles
+        col = layout.column()
+        col.prop(cob, "is_caustics_caster", text="Cast Shadow Caustics")
+        col.prop(cob, "is_caustics_receiver", text="Receive Shadow Caustics")
+
+
 class GDPT_PT_light_shadow(_Panel, Panel):
-    """Light Properties: Cycles' Cast Shadow (its property; shown when Cycles is loaded)."""
+    """Light Properties: Cycles' Cast Shadow and Shadow Caustics (its properties; shown when
+    Cycles is loaded)."""
     bl_label = "Shadow"
     bl_context = "data"
 
@@ -209,12 +231,13 @@ class GDPT_PT_light_shadow(_Panel, Panel):
     def draw(self, context):
         layout = _split(self.layout)
         layout.prop(context.light.cycles, "cast_shadow")
+        layout.prop(context.light.cycles, "is_caustics_light", text="Shadow Caustics")
 
 
 _classes = (GDPT_PT_sampling, GDPT_PT_sampling_viewport, GDPT_PT_light_paths,
             GDPT_PT_light_paths_caustics, GDPT_PT_film, GDPT_PT_gradient_domain,
             GDPT_PT_reconstruction, GDPT_PT_performance, GDPT_PT_passes, GDPT_PT_ray_visibility,
-            GDPT_PT_light_shadow)
+            GDPT_PT_object_caustics, GDPT_PT_light_shadow)
 
 # Blender's engine-agnostic panels carry 'BLENDER_RENDER' in COMPAT_ENGINES (the convention of
 # Blender's own "Custom Render Engine" template); EEVEE's light / material / world panels draw the

@@ -133,7 +133,8 @@ PYBIND11_MODULE(_gdpt, m) {
            py::arg("slot_material"), py::arg("pass_index") = 0,
            py::arg("visibility") = uint32_t(kRayAll), py::arg("holdout") = false,
            py::arg("terminator_geometry_offset") = 0.1f,
-           py::arg("terminator_shading_offset") = 0.0f)
+           py::arg("terminator_shading_offset") = 0.0f, py::arg("caustics_caster") = false,
+           py::arg("caustics_receiver") = false)
       .def("add_material", &SceneBuilder::add_material)
       .def("add_image", &SceneBuilder::add_image, py::arg("name"), py::arg("width"),
            py::arg("height"), py::arg("rgba").noconvert(), py::arg("colorspace"))
@@ -141,6 +142,8 @@ PYBIND11_MODULE(_gdpt, m) {
       .def("set_camera", &SceneBuilder::set_camera)
       .def("set_world", &SceneBuilder::set_world)
       .def("mesh_arrays", &SceneBuilder::mesh_arrays, py::arg("index"))
+      .def("instance_settings", &SceneBuilder::instance_settings, py::arg("index"))
+      .def("light_settings", &SceneBuilder::light_settings, py::arg("index"))
       .def("stored_mesh", &SceneBuilder::stored_mesh, py::arg("index"))
       .def("add_stored_mesh", &SceneBuilder::add_stored_mesh, py::arg("stored"))
       .def("set_mesh_texspace", &SceneBuilder::set_mesh_texspace, py::arg("index"),

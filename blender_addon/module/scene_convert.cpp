@@ -557,7 +557,8 @@ py::dict SceneBuilder::mesh_arrays(int index) const {
 
 void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
                                 int pass_index, uint32_t visibility, bool holdout,
-                                float terminator_geometry_offset, float terminator_shading_offset) {
+                                float terminator_geometry_offset, float terminator_shading_offset,
+                                bool caustics_caster, bool caustics_receiver) {
   if (mesh < 0 || size_t(mesh) >= scene_.meshes.size())
     throw std::invalid_argument("add_instance: mesh index out of range");
   if (!(terminator_geometry_offset >= 0.0f && terminator_geometry_offset <= 1.0f))
@@ -576,6 +577,8 @@ void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::li
   inst.holdout = holdout;
   inst.terminator_geometry_offset = terminator_geometry_offset;
   inst.terminator_shading_offset = terminator_shading_offset;
+  inst.caustics_caster = caustics_caster;
+  inst.caustics_receiver = caustics_receiver;
   inst.slot_material.reserve(py::len(slot_material));
   for (const auto& m : slot_material) {
     const int32_t index = m.cast<int32_t>();
@@ -587,6 +590,32 @@ void SceneBuilder::add_instance(int mesh, const FloatArray& matrix, const py::li
     inst.slot_material.push_back(index);
   }
   scene_.instances.push_back(std::move(inst));
+}
+
+py::dict SceneBuilder::instance_settings(int index) const {
+  if (index < 0 || size_t(index) >= scene_.instances.size())
+    throw std::invalid_argument("instance_settings: instance index out of range");
+  const Instance& inst = scene_.instances[size_t(index)];
+  py::dict d;
+  d["pass_index"] = inst.pass_index;
+  d["visibility"] = inst.visibility;
+  d["holdout"] = inst.holdout;
+  d["terminator_geometry_offset"] = inst.terminator_geometry_offset;
+  d["terminator_shading_offset"] = inst.terminator_shading_offset;
+  d["caustics_caster"] = inst.caustics_caster;
+  d["caustics_receiver"] = inst.caustics_receiver;
+  return d;
+}
+
+py::dict SceneBuilder::light_settings(int index) const {
+  if (index < 0 || size_t(index) >= scene_.lights.size())
+    throw std::invalid_argument("light_settings: light index out of range");
+  const Light& light = scene_.lights[size_t(index)];
+  py::dict d;
+  d["camera_visible"] = light.camera_visible;
+  d["cast_shadow"] = light.cast_shadow;
+  d["caustics_light"] = light.caustics_light;
+  return d;
 }
 
 size_t SceneBuilder::triangle_count() const {
@@ -806,6 +835,7 @@ void SceneBuilder::add_light(const py::dict& d) {
   get(d, "size_y", light.size_y);
   get(d, "camera_visible", light.camera_visible);
   get(d, "cast_shadow", light.cast_shadow);
+  get(d, "caustics_light", light.caustics_light);
   scene_.lights.push_back(light);
 }
 

@@ -10,7 +10,8 @@
 //             shift_y, ortho_scale, clip_start, clip_end, aperture_radius, focus_distance, width,
 //             height, pixel_aspect
 //   light:    type 'POINT'|'SPOT'|'SUN'|'AREA', shape 'SQUARE'|'RECTANGLE'|'DISK'|'ELLIPSE',
-//             matrix, color (3), power, radius, spot_size, spot_blend, sun_angle, size_x, size_y
+//             matrix, color (3), power, radius, spot_size, spot_blend, sun_angle, size_x, size_y,
+//             camera_visible, cast_shadow, caustics_light
 //   world:    color (3), strength, image (int), rotation (12 floats)
 //   material: name, root, nodes: list of dicts {kind: 'DIFFUSE'|'GLOSSY'|'GLASS'|'PRINCIPLED'|
 //             'EMISSION'|'TRANSPARENT'|'MIX'|'ADD', a, b, distribution 'GGX'|'BECKMANN' (Glossy,
@@ -87,10 +88,12 @@ class SceneBuilder {
   // terminator_geometry_offset: Object > Shading > Shadow Terminator > Geometry Offset, in
   // [0, 1] (Instance::terminator_geometry_offset); terminator_shading_offset: its Shading
   // Offset, in [0, 1] (Instance::terminator_shading_offset).
+  // caustics_caster / caustics_receiver: Cycles' Cast / Receive Shadow Caustics
+  // (Instance::caustics_caster / caustics_receiver).
   void add_instance(int mesh, const FloatArray& matrix, const py::list& slot_material,
                     int pass_index = 0, uint32_t visibility = kRayAll, bool holdout = false,
-                    float terminator_geometry_offset = 0.1f,
-                    float terminator_shading_offset = 0.0f);
+                    float terminator_geometry_offset = 0.1f, float terminator_shading_offset = 0.0f,
+                    bool caustics_caster = false, bool caustics_receiver = false);
   int add_material(const py::dict& material);
   // rgba: (h, w, 4) or flat, row 0 at the bottom; converted to scene linear from `colorspace`
   // unless it is empty (already scene linear).
@@ -113,6 +116,12 @@ class SceneBuilder {
   void set_mesh_geometry_attributes(int index, const IntArray& edges,
                                     const FloatArray& vertex_normals, bool pointiness,
                                     bool random_per_island);
+  // The per-object settings of instance `index` / the flags of light `index` as the core holds
+  // them, for the export tests: {pass_index, visibility, holdout, terminator_geometry_offset,
+  // terminator_shading_offset, caustics_caster, caustics_receiver} / {camera_visible,
+  // cast_shadow, caustics_light}.
+  py::dict instance_settings(int index) const;
+  py::dict light_settings(int index) const;
   size_t mesh_count() const { return scene_.meshes.size(); }
   size_t instance_count() const { return scene_.instances.size(); }
   size_t triangle_count() const;

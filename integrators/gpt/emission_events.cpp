@@ -136,7 +136,9 @@ Vec3d lamp_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, 
   const Vec3d fb = bp.fb;
   const double pb = bp.pb;
   Vec3d emit_merged;
-  const bool base_lit = light_hit && !is_black(lh.radiance);
+  // A caustics lamp behind caster refractions from a receiver is manifold NEE's light; the
+  // offsets, which copy the base's events, drop it with it.
+  const bool base_lit = light_hit && !is_black(lh.radiance) && !bp.caustic.drops(lh.caustics);
   const float pl = (base_lit && !delta) ? lh.pdf : 0.0f;
   if (base_lit) out.primal += beta * lh.radiance * (delta ? 1.0f : power_heuristic(pdf_b, pl));
   // The pair weights' light density (mis_light_pdf); the primal keeps PT's.
@@ -171,7 +173,8 @@ Vec3d lamp_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, 
         // The offset's own direction: does its ray cross a light before its surface?
         LightHit lo;
         const float t_o = o.next_found || o.holdout_end ? o.next_hit.t : kInf;
-        if (lights.intersect(o.ray.origin, o.ray.direction, t_o, lo))
+        if (lights.intersect(o.ray.origin, o.ray.direction, t_o, lo) &&
+            !bp.caustic.drops(lo.caustics))
           co = mul(mul(o.f, o.seg_value), lo.radiance) * o.seg_jacobian;
         d_off = shift::offset_densities(o.p, o.seg_jacobian, 0.0, o.seg_pdf);
       }

@@ -19,8 +19,10 @@
 #include <limits>
 #include <memory>
 
+#include "integrators/common/manifold_nee.h"
 #include "integrators/common/path_state.h"
 #include "integrators/gpt/camera_rays.h"
+#include "integrators/gpt/caustic_pairs.h"
 #include "integrators/gpt/emission_events.h"
 #include "integrators/gpt/gpt_context.h"
 #include "integrators/gpt/nee_pairs.h"
@@ -194,7 +196,10 @@ class GradientPathTracer final : public Integrator {
                 ? sampler.get1d(Sampler::bounce_dim(bounce, Sampler::kLightSelect))
                 : 0.0f;
         const LightSample ls = lights.sample(base.hit.position, u_select, u.light);
-        if (ls.valid && ls.pdf > 0.0f)
+        // Shadow caustics take the samples whose segment crosses casters (caustic_pairs.h).
+        if (ls.valid && ls.pdf > 0.0f &&
+            !(runs_shadow_caustics(g_.ctx, base.hit, ls) &&
+              caustic_pairs(g_, base, bp, ls, u_select, u.light, open_mask, scratch, out)))
           nee_pairs(g_, base, bp, ls, u_select, u.light, open_mask, scratch, out);
       }
 
@@ -214,6 +219,7 @@ class GradientPathTracer final : public Integrator {
       ray.kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
       bp.state.count_event(crossing, ray.kind, bs.lobe);
       if (!crossing) bp.state.scattered(bs);
+      bp.caustic.scattered(g_.ctx, base.hit, bs);
 
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
       if (!crossing) {

@@ -4,7 +4,9 @@
 #include <bit>
 #include <cmath>
 
+#include "integrators/common/manifold_nee.h"
 #include "integrators/common/mis.h"
+#include "integrators/gpt/caustic_pairs.h"
 #include "integrators/gpt/mis_weights.h"
 #include "integrators/gpt/shadow_rays.h"
 
@@ -111,7 +113,7 @@ void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, cons
   // First pass: the offsets' light samples and the shadow rays of the not-connected
   // ones. Each is its own occlusion query: Embree's 4-ray packets (rtcOccluded4) of these
   // rays from neighbouring points towards the same light point cost more time.
-  enum class NeeCase : uint8_t { Skip, Shared, NoLight, Shifted };
+  enum class NeeCase : uint8_t { Skip, Shared, NoLight, Shifted, Caustic };
   NeeCase nc[kOffsets];
   LightSample* lo = scratch.lo;
   double J[kOffsets];
@@ -156,6 +158,17 @@ void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, cons
             !lamp_visible(g, o.v, ls, lo[k], scratch.shadow_closures, lo[k].radiance, out.rays);
       }
     }
+    // Casters on the offset's own segment (caustic_pairs.h): its refracted path, in the base's
+    // solid-angle measure (d A(y) = d omega d^2 / cos_l at the base).
+    if ((!test[k] || blocked[k]) && runs_shadow_caustics(g.ctx, o.v.hit, ls)) {
+      const CausticEvent e = caustic_event(g, o.v, ls, scratch, out.rays);
+      if (e.casters > 0) {
+        nc[k] = NeeCase::Caustic;
+        fo[k] = e.valid ? o.v.closures->eval(o.v.wi, e.wo) * e.transport *
+                              (ls.distance * ls.distance / std::fabs(dot(ls.direction, ls.normal)))
+                        : Spectrum(0.0f);
+      }
+    }
   }
   // Second pass: contributions and weights.
   for (unsigned m = open_mask; m != 0; m &= m - 1) {
@@ -185,6 +198,10 @@ void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, cons
         d_off = shift::offset_densities(o.p, 1.0, pl_mis, pdf_o);
         break;
       }
+      case NeeCase::Caustic:
+        co = mul(o.f, Vec3d(fo[k]));
+        d_off = shift::offset_densities(o.p, 1.0, pl_mis, 0.0);
+        break;
       case NeeCase::Shifted: {
         const bool vis_o = test[k] && !blocked[k];
         const float pdf_o = (!ls.is_delta && vis_o) ? pdf_fo[k] : 0.0f;

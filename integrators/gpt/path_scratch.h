@@ -5,6 +5,7 @@
 
 #include "integrators/common/data_passes.h"
 #include "integrators/common/feature_passes.h"
+#include "integrators/common/manifold_nee.h"
 #include "integrators/common/path_state.h"
 #include "integrators/gpt/camera_rays.h"
 #include "integrators/gpt/offset_path.h"
@@ -30,6 +31,7 @@ struct SampleResult {
 // solid-angle densities).
 struct BasePath {
   PathState state;
+  CausticChain caustic;  // whether a caustics lamp met now is manifold NEE's (manifold_nee.h)
   Spectrum beta{1.0f};
   shift::Vec3d fb{1.0, 1.0, 1.0};
   double pb = 1.0;

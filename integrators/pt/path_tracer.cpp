@@ -11,6 +11,7 @@
 #include "integrators/common/data_passes.h"
 #include "integrators/common/feature_passes.h"
 #include "integrators/common/light_path_filters.h"
+#include "integrators/common/manifold_nee.h"
 #include "integrators/common/mis.h"
 #include "integrators/common/path_state.h"
 #include "integrators/common/shadow_ray.h"
@@ -137,6 +138,7 @@ class PathTracer final : public Integrator {
     bool prev_delta = true;             // no MIS for camera rays and delta lobes
     Vec3f prev_position;                // the last scattering vertex (NEE ran from there)
     bool crossed_since_vertex = false;  // transparent crossings since prev_position
+    CausticChain caustic;               // lamps whose light manifold NEE counted
   };
 
   // A light sample whose shadow ray is traced after the BSDF sample, which does not depend on
@@ -224,7 +226,7 @@ class PathTracer final : public Integrator {
                                                     sf.ng, wi_world, sf.rotated);
 
       const PendingShadow nee =
-          sample_light(path, hit, frame, sf.ng, wi, closures, sampler, u, vertex);
+          sample_light(path, hit, frame, sf.ng, wi, closures, sampler, u, vertex, scratch, out);
       const bool continues = extend(path, hit, frame, sf.ng, wi, closures, sampler, u, vertex, ray);
       if (nee.pending) {
         const Spectrum tr = nee.cast ? transmittance(nee.ray, scratch, out.rays) : Spectrum(1.0f);
@@ -245,6 +247,7 @@ class PathTracer final : public Integrator {
       if (lh.camera_visible) out.emission += path.beta * lh.radiance;
       return;
     }
+    if (path.caustic.drops(lh.caustics)) return;
     float light_pdf = lh.pdf;
     if (!path.prev_delta && path.crossed_since_vertex) {
       // NEE ran from prev_position, behind the transparent surfaces just crossed: its density
@@ -292,9 +295,11 @@ class PathTracer final : public Integrator {
   }
 
   // Next-event estimation: the light sample and its BSDF value; the shadow ray is the caller's.
+  // A sample whose segment crosses caustics casters is manifold NEE's, added here to `out`.
   PendingShadow sample_light(const Path& path, const SurfaceHit& hit, const Frame& frame, Vec3f ng,
                              Vec3f wi, const ClosureSet& closures, const Sampler& sampler,
-                             const Sampler::VertexNumbers& u, int vertex) const {
+                             const Sampler::VertexNumbers& u, int vertex, ClosureSet& scratch,
+                             PathResult& out) const {
     PendingShadow nee;
     const LightSampler& lights = ctx_.lights();
     if (lights.empty()) return nee;
@@ -304,6 +309,8 @@ class PathTracer final : public Integrator {
                                : 0.0f;
     const LightSample ls = lights.sample(hit.position, u_select, u.light);
     if (!ls.valid || !(ls.pdf > 0.0f) || is_black(ls.radiance)) return nee;
+    if (runs_shadow_caustics(ctx_, hit, ls)) [[unlikely]]
+      if (caustic_nee(path, hit, frame, ng, wi, closures, ls, scratch, out)) return nee;
     const Vec3f wo = frame.to_local(ls.direction);
     const float cos_ng = dot(ls.direction, ng);
     // The geometric and shading hemispheres must agree, or light leaks through the surface.
@@ -325,6 +332,23 @@ class PathTracer final : public Integrator {
     return nee;
   }
 
+  // Manifold NEE of the light sample `ls` (manifold_nee.h); false when no caster stands on its
+  // segment (the plain light sample then stands), true when casters do: they would block the
+  // plain shadow ray, and the refracted path through them, if found, is added to `out`.
+  bool caustic_nee(const Path& path, const SurfaceHit& hit, const Frame& frame, Vec3f ng, Vec3f wi,
+                   const ClosureSet& closures, const LightSample& ls, ClosureSet& scratch,
+                   PathResult& out) const {
+    const Vec3f ng_light = dot(ls.direction, ng) > 0.0f ? ng : -ng;
+    const CausticConnection cc =
+        caustic_connection(ctx_, hit.position, ng_light, ls, scratch, out.rays);
+    if (cc.casters == 0) return false;
+    if (!cc.valid) return true;
+    const Vec3f wo = frame.to_local(cc.direction);
+    if (light_side_ok(ctx_.bvh(), hit, closures, wo, dot(cc.direction, ng)))
+      out.primal += path.beta * closures.eval(wi, wo) * cc.transport / light_area_density(ls);
+    return true;
+  }
+
   // BSDF sampling, the roulette and the next ray. False when the path ends here.
   bool extend(Path& path, const SurfaceHit& hit, const Frame& frame, Vec3f ng, Vec3f wi,
               const ClosureSet& closures, const Sampler& sampler, const Sampler::VertexNumbers& u,
@@ -344,6 +368,7 @@ class PathTracer final : public Integrator {
     const bool crossing = bs.is_straight_crossing();
     const uint32_t kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
     path.state.count_event(crossing, kind, bs.lobe);
+    path.caustic.scattered(ctx_, hit, bs);
     if (!crossing) path.state.scattered(bs);
     path.crossed_since_vertex = crossing;
     bool continues = true;

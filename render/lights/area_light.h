@@ -36,6 +36,7 @@ struct AreaLight {
   float select_pmf = 0.0f;      // filled by LightSampler
   bool camera_visible = false;  // filled by LightSampler
   bool cast_shadow = true;      // filled by LightSampler
+  bool caustics = false;        // Light::caustics_light, filled by LightSampler
   // Dual basis of (axis_u, axis_v): local coordinates of a point in the plane are dot products.
   Vec3f dual_u, dual_v;
   bool orthogonal = false;  // rectangle with orthogonal axes: spherical sampling possible

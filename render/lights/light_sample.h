@@ -18,6 +18,7 @@ struct LightSample {
   bool is_infinite = false;  // sun or world
   bool valid = false;
   bool cast_shadow = true;  // false: unoccluded, no shadow ray (Light::cast_shadow)
+  bool caustics = false;    // an area lamp with Shadow Caustics (Light::caustics_light)
   // Area lights only (0 for the others): selection pmf / area, the density per unit area of
   // uniform area sampling. G-PT weighs its techniques with the area-sampling density
   // area_pdf d^2 / cos of a light point, the same function from every reference point.
@@ -30,6 +31,7 @@ struct LightHit {
   float pdf = 0;  // density sample() would have produced this direction from the ray origin
   Vec3f position, normal;
   bool camera_visible = false;  // the lamp shows to camera rays (Light::camera_visible)
+  bool caustics = false;        // LightSample::caustics
   float area_pdf = 0;           // area lights: selection pmf / area (LightSample::area_pdf)
 };
 

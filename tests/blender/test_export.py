@@ -11,11 +11,15 @@
 #  - custom split normals;
 #  - an evaluated mesh (Subdivision Surface modifier) from the depsgraph;
 #  - the object's ray visibility flags as the core's bits, and their panel;
+#  - Cycles' Shadow Caustics flags (object Cast / Receive, light Shadow Caustics) through a whole
+#    export into the core's Instance / Light fields, an instanced object with its own object's
+#    flags, and their panels;
 #  - subsurface materials: Principled's subsurface and the Subsurface Scattering node become the
 #    diffuse Cycles falls back to, reported once per material by node name when the radius is
 #    not 0 (Cycles would carry light under the surface).
 import os
 import sys
+from types import SimpleNamespace
 
 import bpy
 import numpy as np
@@ -262,6 +266,81 @@ def main():
     check(not light_dict(bpy.data.objects.new("lamp2", lamp), obj.matrix_world, print)[
         "cast_shadow"], "Cycles' Cast Shadow off is exported")
     check("GDPT" in bpy.types.GDPT_PT_light_shadow.COMPAT_ENGINES, "the Shadow light panel")
+    shadow_caustics_flags()
+
+
+def shadow_caustics_flags():
+    """Cycles' Shadow Caustics flags, set in Blender, arrive in the core's Instance / Light fields
+    through a whole export (export_scene, the depsgraph's object instances)."""
+    from gdpt import _gdpt, export_scene
+    scene = S.clear()
+    S.camera((0, -6, 2), (0, 0, 0.5))
+    glass = S.uv_sphere("glass", 0.5, (0, 0, 0.5), segments=8, rings=4)
+    glass.cycles.is_caustics_caster = True
+    floor = S.plane("floor", 4, (0, 0, 0))
+    floor.cycles.is_caustics_receiver = True
+    wall = S.plane("wall", 4, (0, 2, 2), (1.5708, 0, 0))
+    # A collection instance: the instanced object's own flags (caster, not receiver), not its
+    # instancer's (receiver only).
+    source = bpy.data.objects.new("source", glass.data)
+    source.cycles.is_caustics_caster = True
+    coll = bpy.data.collections.new("casters")
+    coll.objects.link(source)
+    instancer = S.link(bpy.data.objects.new("instancer", None))
+    instancer.instance_type = 'COLLECTION'
+    instancer.instance_collection = coll
+    instancer.location = (1.5, 0, 0.5)
+    instancer.cycles.is_caustics_receiver = True
+    for index, obj in enumerate((glass, floor, wall, source), start=1):
+        obj.pass_index = index  # tells the instances apart in the export
+    lamp = S.light('POINT', (0, 0, 3), 100.0)
+    lamp.data.cycles.is_caustics_light = True
+    sun = S.light('SUN', (0, 0, 5), 3.0)
+    sun.data.cycles.cast_shadow = False  # tells the lights apart
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    warnings = []
+    builder, _ = export_scene.export_scene(_gdpt, depsgraph, scene.camera.evaluated_get(depsgraph),
+                                           warnings.append)
+    flags = {}
+    for i in range(builder.instance_count):
+        d = builder.instance_settings(i)
+        flags[round(d["pass_index"])] = (d["caustics_caster"], d["caustics_receiver"])
+    check(flags == {1: (True, False), 2: (False, True), 3: (False, False), 4: (True, False)},
+          f"Cast / Receive Shadow Caustics arrive in the core's instances, the collection "
+          f"instance with its object's own flags ({flags})")
+    lights = sorted((builder.light_settings(i)["cast_shadow"],
+                     builder.light_settings(i)["caustics_light"]) for i in range(2))
+    check(lights == [(False, False), (True, True)],
+          f"Cycles' light Shadow Caustics arrives in the core's lights ({lights})")
+
+    # The panels, drawn into a recording layout (a background Blender draws no panels): they
+    # show these properties with Cycles' labels (the properties' own names).
+    class Layout:
+        def __init__(self):
+            self.props = []
+
+        def column(self, **_):
+            return self
+
+        def prop(self, data, name, text=None, **_):
+            self.props.append((data, name, text))
+
+    shown = {}
+    context = SimpleNamespace(object=glass, light=lamp.data)
+    for panel in (bpy.types.GDPT_PT_object_caustics, bpy.types.GDPT_PT_light_shadow):
+        layout = Layout()
+        panel.draw(SimpleNamespace(layout=layout), context)
+        shown.update({name: (text, data.bl_rna.properties[name].name)
+                      for data, name, text in layout.props if name.startswith("is_caustics")})
+    check(shown == {"is_caustics_caster": ("Cast Shadow Caustics",) * 2,
+                    "is_caustics_receiver": ("Receive Shadow Caustics",) * 2,
+                    "is_caustics_light": ("Shadow Caustics",) * 2},
+          f"the Caustics object panel and the Shadow light panel show the three flags with "
+          f"Cycles' labels ({shown})")
+    panel = bpy.types.GDPT_PT_object_caustics
+    check(panel.bl_context == "object" and "GDPT" in panel.COMPAT_ENGINES,
+          "the object Caustics panel is in Object Properties for Gradient PT")
 
 
 main()

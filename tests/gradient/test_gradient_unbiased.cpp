@@ -335,6 +335,16 @@ TEST(GradientUnbiased, SmoothGlass) {
 // path's value at a vertex is the compensated lobe evaluated for its own incoming direction. A
 // Glass BSDF at roughness 1 and a Principled with transmission 1 at roughness 0.8 (rough, so that
 // the compensation is large: up to 2.4x from inside).
+// Shadow caustics (manifold NEE, caustic_pairs.h): the offsets' own refracted paths to the
+// base's light point, plain light samples where an offset's segment misses the ball, the
+// BSDF-sampled caustic dropped on both sides; against PT with the same flags (the same estimator
+// of the same light). The lamp focused on the floor (IOR 1.5) and short of it (1.3, ball at 0.6).
+TEST(GradientUnbiased, ShadowCaustics) {
+  expect_unbiased("shadow-caustics-focus", make_caustic_scene(16, true), 4096, 1024, 0.04f);
+  expect_unbiased("shadow-caustics-near", make_caustic_scene(16, true, 1.3f, 0.6f), 4096, 1024,
+                  0.14f);
+}
+
 TEST(GradientUnbiased, MultiscatterGlass) {
   Scene glass_ball = make_scene(SceneKind::CornellGlass, 16, 1.0f);
   glass_ball.materials[3].nodes[0].distribution = MicrofacetDistribution::MultiscatterGGX;

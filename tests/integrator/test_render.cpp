@@ -2101,6 +2101,13 @@ TEST(Render, UpdateRendersAsANewSession) {
     moved.instances[1].object_to_world.m[2][3] += 0.2f;
     EXPECT_FALSE(session.update(moved, s2));
     expect_as_new(session, moved, s2, "a moved instance");
+
+    // The shadow terminator offsets live in the BVH's instance data: a new BVH.
+    Scene offset = moved;
+    offset.instances[1].terminator_shading_offset = 0.8f;
+    offset.instances[1].terminator_geometry_offset = 0.5f;
+    EXPECT_FALSE(session.update(offset, s2));
+    expect_as_new(session, offset, s2, "shadow terminator offsets");
   }
 }
 

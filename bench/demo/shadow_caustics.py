@@ -1,0 +1,63 @@
+# Shadow caustics (manifold next-event estimation, integrators/common/manifold_nee.h) on the
+# demo: per seed, the demo's Feature render at its own samples without and with Cycles' Shadow
+# Caustics (the glass sphere casting, every other mesh receiving, the lamp lighting them), both
+# rendered and timed in this run, scored as speckles.py scores (against its converged reference,
+# rendered without them): speckles, isolated speckles, relMSE, the display error's 99.9th
+# percentile, the render call's seconds.
+#   /usr/bin/python3 bench/demo/shadow_caustics.py [--build build] [--seeds 4]
+# Needs speckles.py's scene and reference (out/bench/demo: run speckles.py first). Writes
+# bench/results/demo_shadow_caustics.json.
+import argparse
+import json
+import os
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import speckles as SP  # noqa: E402
+
+R = SP.R
+CASTER = "Glass Ball"  # make_demo_scene.py's glass sphere
+KEYS = ("seconds", "speckles", "isolated", "relmse", "display_error_p999")
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--build", default="build")
+    p.add_argument("--seeds", type=int, default=4)
+    args = p.parse_args()
+    ref = SP.Reference()
+    out = os.path.join(SP.ROOT, "out", "bench", "demo_shadow_caustics")
+    os.makedirs(out, exist_ok=True)
+    blender = R.Blender(args.build)
+    rows = {"plain": [], "shadow_caustics": []}
+    try:
+        samples = int(blender.run(os.path.join(HERE, "demo_samples.py"),
+                                  ref.blend).split("DEMO_SAMPLES ")[1].split()[0])
+        for seed in range(1, args.seeds + 1):
+            for name, caster in (("plain", None), ("shadow_caustics", CASTER)):
+                path = os.path.join(out, f"{name}_{seed}.exr")
+                info = R.render(blender, ref.blend, "gpt_feature", path, samples=samples,
+                                seed=seed, shadow_caustics=caster)
+                rows[name].append({"seconds": info["seconds"], **ref.score(path)})
+                r = rows[name][-1]
+                print(f"seed {seed} {name:15s} {r['seconds']:.2f} s, speckles {r['speckles']}, "
+                      f"relMSE {r['relmse']:.3e}", flush=True)
+    finally:
+        blender.close()
+    result = {"demo_samples": samples, "seeds": args.seeds,
+              "commit": R.git("rev-parse", "--short", "HEAD"), "per_seed": rows}
+    for name, r in rows.items():
+        result[name] = {k: float(np.mean([x[k] for x in r])) for k in KEYS}
+        m = result[name]
+        print(f"{name:15s} {m['seconds']:.2f} s, speckles {m['speckles']:.2f}, isolated "
+              f"{m['isolated']:.2f}, relMSE {m['relmse']:.3e}, display p99.9 "
+              f"{m['display_error_p999']:.1f}", flush=True)
+    with open(os.path.join(SP.ROOT, "bench", "results", "demo_shadow_caustics.json"), "w") as f:
+        json.dump(result, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,87 @@
+// Manifold next-event estimation (Hanika, Droske and Fascione 2015): Cycles' Shadow Caustics.
+//
+// Light that reaches a diffuse surface through smooth glass (a lamp focused by a glass ball onto
+// the floor) is found by path tracing only when a BSDF sample happens to leave through the glass
+// towards the lamp: rare, bright paths, the speckles of a caustic. Here a light sample of a lamp
+// with Shadow Caustics, taken at a surface of a caustics receiver, whose straight segment crosses
+// caustics casters, seeds a Newton walk on the specular manifold: the caster vertices move
+// until every one refracts by Snell's law between its neighbours, and the path so found carries
+// the lamp's light with its generalized geometry term (the density of the light point mapped
+// through the refractions).
+//
+// Settings, as in Cycles (Blender 3.4):
+//  - Object > Shading > Caustics > Cast Shadow Caustics (Instance::caustics_caster): a
+//    refractive object: its material a single smooth Glass or Refraction BSDF (else no
+//    connection), its normals those the walk follows (interpolated corner normals).
+//  - ... > Receive Shadow Caustics (Instance::caustics_receiver): where the light samples run it.
+//  - Light > Shadow Caustics (Light::caustics_light): area lamps only here (Cycles also takes
+//    point, spot and sun lamps and the world).
+// The light such a connection stands for is estimated by it alone: a path that left a receiver
+// by a non-delta BSDF sample and then only refracted through casters adds nothing when it meets
+// a caustics lamp (CausticChain), as Cycles culls it. Where the walk fails (no solution reached
+// from the straight seed, or a chain of another number of interfaces) that light is missing:
+// the technique's bias, which the tests measure against path tracing.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "core/vec.h"
+#include "render/embree_scene.h"
+#include "render/lights/light_sample.h"
+#include "render/scene_context.h"
+#include "shaders/bsdf.h"
+
+namespace gdpt {
+
+inline constexpr int kMaxCausticCasters = 4;
+
+// A caustic path from a receiver point to a light point through caster refractions.
+struct CausticConnection {
+  Vec3f direction;  // unit, world: from the receiver towards the first caster vertex
+  // Caster transmittances x lamp radiance x the generalized geometry term d omega / d A(y): the
+  // path's contribution per unit area of the light point, the receiver's BSDF aside.
+  Spectrum transport{0.0f};
+  int casters = 0;  // casters on the straight segment (the seed), found or not
+  bool valid = false;
+};
+
+// Whether the light sample `ls` taken at `hit` runs manifold NEE.
+inline bool runs_shadow_caustics(const SceneContext& ctx, const SurfaceHit& hit,
+                                 const LightSample& ls) {
+  return ctx.shadow_caustics() && ls.caustics && ls.area_pdf > 0.0f &&
+         ctx.is_caustics_receiver(hit);
+}
+
+// The density per unit area of the light point of `ls`, sampled from the receiver along the
+// straight segment (solid-angle density times cos_l / d^2).
+inline float light_area_density(const LightSample& ls) {
+  return ls.pdf * std::fabs(dot(ls.direction, ls.normal)) / (ls.distance * ls.distance);
+}
+
+// The caustic path from the receiver point `x` (geometric normal `ng_x`, on the side the light
+// is sampled from) to the light point of `ls` (an area lamp sampled from x): found when the
+// straight segment crosses casters and the walk converges to a valid, unoccluded chain.
+// `scratch` holds the casters' closures; `rays` counts the rays traced.
+CausticConnection caustic_connection(const SceneContext& ctx, Vec3f x, Vec3f ng_x,
+                                     const LightSample& ls, ClosureSet& scratch, uint32_t& rays);
+
+// The path rule that keeps the estimates apart: whether the path is inside a chain of caster
+// refractions that left a receiver by a non-delta BSDF sample, so that a caustics lamp it meets
+// is manifold NEE's light (dropped). One per path, updated at every scattering vertex.
+struct CausticChain {
+  uint8_t state = 0;  // 0: none; 1: just left a receiver; 2: refracted through casters since
+
+  void scattered(const SceneContext& ctx, const SurfaceHit& hit, const BsdfSample& bs) {
+    if (!ctx.shadow_caustics()) return;
+    const bool refraction = bs.is_delta() && (bs.lobe & kLobeTransmission) != 0 && bs.eta != 1.0f;
+    if (refraction && ctx.is_caustics_caster(hit))
+      state = state != 0 ? 2 : 0;
+    else
+      state = (!bs.is_delta() && ctx.is_caustics_receiver(hit)) ? 1 : 0;
+  }
+  // A lamp with Shadow Caustics met now carries light manifold NEE already counted.
+  bool drops(bool lamp_caustics) const { return state == 2 && lamp_caustics; }
+};
+
+}  // namespace gdpt
