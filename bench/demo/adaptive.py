@@ -12,8 +12,6 @@ import json
 import os
 import sys
 
-import numpy as np
-
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import speckles as SP  # noqa: E402
@@ -57,14 +55,7 @@ def main():
     result = {"demo_samples": samples, "threshold": args.threshold,
               "max_samples": args.max_samples, "min_samples": args.min_samples, "seeds": args.seeds,
               "commit": R.git("rev-parse", "--short", "HEAD"), "per_seed": rows}
-    for name, r in rows.items():
-        mean = {k: float(np.mean([x[k] for x in r]))
-                for k in ("seconds", "mean_samples", "speckles", "isolated", "relmse",
-                          "display_error_p999")}
-        result[name] = mean
-        print(f"{name:8s} {mean['seconds']:.2f} s, {mean['mean_samples']:.1f} spp, speckles "
-              f"{mean['speckles']:.2f}, isolated {mean['isolated']:.2f}, relMSE "
-              f"{mean['relmse']:.3e}, display p99.9 {mean['display_error_p999']:.1f}", flush=True)
+    SP.summarise(result, rows, 8, extra=("mean_samples",))
     with open(os.path.join(SP.ROOT, "bench", "results", "demo_adaptive.json"), "w") as f:
         json.dump(result, f, indent=1)
 

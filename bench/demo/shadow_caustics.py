@@ -12,15 +12,12 @@ import json
 import os
 import sys
 
-import numpy as np
-
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import speckles as SP  # noqa: E402
 
 R = SP.R
 CASTER = "Glass Ball"  # make_demo_scene.py's glass sphere
-KEYS = ("seconds", "speckles", "isolated", "relmse", "display_error_p999")
 
 
 def main():
@@ -49,12 +46,7 @@ def main():
         blender.close()
     result = {"demo_samples": samples, "seeds": args.seeds,
               "commit": R.git("rev-parse", "--short", "HEAD"), "per_seed": rows}
-    for name, r in rows.items():
-        result[name] = {k: float(np.mean([x[k] for x in r])) for k in KEYS}
-        m = result[name]
-        print(f"{name:15s} {m['seconds']:.2f} s, speckles {m['speckles']:.2f}, isolated "
-              f"{m['isolated']:.2f}, relMSE {m['relmse']:.3e}, display p99.9 "
-              f"{m['display_error_p999']:.1f}", flush=True)
+    SP.summarise(result, rows, 15)
     with open(os.path.join(SP.ROOT, "bench", "results", "demo_shadow_caustics.json"), "w") as f:
         json.dump(result, f, indent=1)
 

@@ -111,6 +111,21 @@ class Reference:
                 "display_error_p999": float(np.percentile(err, 99.9))}
 
 
+SCORE_KEYS = ("seconds", "speckles", "isolated", "relmse", "display_error_p999")
+
+
+def summarise(result, rows, name_width, extra=()):
+    """Per method in `rows` (lists of per-seed scores with "seconds"), the means of SCORE_KEYS
+    and `extra` into `result`, one printed line each; writes nothing."""
+    for name, r in rows.items():
+        m = {k: float(np.mean([x[k] for x in r])) for k in SCORE_KEYS + tuple(extra)}
+        result[name] = m
+        more = "".join(f", {k} {m[k]:.1f}" for k in extra)
+        print(f"{name:{name_width}s} {m['seconds']:.2f} s{more}, speckles {m['speckles']:.2f}, "
+              f"isolated {m['isolated']:.2f}, relMSE {m['relmse']:.3e}, display p99.9 "
+              f"{m['display_error_p999']:.1f}", flush=True)
+
+
 def speckle_details(img, ref, median):
     """Each speckle of `img`: where, its and the reference's luminance over the median."""
     lum, lum_ref = M.luminance(img), M.luminance(ref)
