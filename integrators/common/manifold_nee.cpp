@@ -377,4 +377,15 @@ CausticConnection caustic_connection(const SceneContext& ctx, Vec3f x, Vec3f ng_
   return out;
 }
 
+bool CausticChain::drops(const SceneContext& ctx, const LightHit& lh, ClosureSet& scratch,
+                         uint32_t& rays) const {
+  if (state != 2 || !lh.caustics || !(lh.area_pdf > 0.0f)) return false;
+  LightSample ls;
+  ls.position = lh.position;
+  ls.normal = lh.normal;
+  const CausticConnection c = caustic_connection(ctx, receiver, receiver_ng, ls, scratch, rays);
+  // The walk converges to within 1e-4 of Snell's law: the same path agrees far closer than this.
+  return c.valid && dot(c.direction, direction) > 1.0f - 5e-5f;
+}
+
 }  // namespace gdpt

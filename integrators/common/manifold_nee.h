@@ -66,22 +66,36 @@ inline float light_area_density(const LightSample& ls) {
 CausticConnection caustic_connection(const SceneContext& ctx, Vec3f x, Vec3f ng_x,
                                      const LightSample& ls, ClosureSet& scratch, uint32_t& rays);
 
-// The path rule that keeps the estimates apart: whether the path is inside a chain of caster
-// refractions that left a receiver by a non-delta BSDF sample, so that a caustics lamp it meets
-// is manifold NEE's light (dropped). One per path, updated at every scattering vertex.
+// The path rule that keeps the estimates apart. A path that left a receiver by a non-delta BSDF
+// sample, refracted through casters only and met a caustics lamp is manifold NEE's light when
+// the walk from that receiver to the point it met finds this very path (the same first
+// direction): then it is dropped here. Where the walk finds another path or none (several
+// refracted paths join the two points), BSDF sampling keeps it: every path is counted once.
+// One per path, updated at every scattering vertex.
 struct CausticChain {
   uint8_t state = 0;  // 0: none; 1: just left a receiver; 2: refracted through casters since
+  Vec3f receiver, receiver_ng, direction;  // the receiver point, its side, the direction left
 
-  void scattered(const SceneContext& ctx, const SurfaceHit& hit, const BsdfSample& bs) {
+  // The event `bs` at `hit`, leaving in the world direction `wo`.
+  void scattered(const SceneContext& ctx, const SurfaceHit& hit, const BsdfSample& bs, Vec3f wo) {
     if (!ctx.shadow_caustics()) return;
     const bool refraction = bs.is_delta() && (bs.lobe & kLobeTransmission) != 0 && bs.eta != 1.0f;
-    if (refraction && ctx.is_caustics_caster(hit))
+    if (refraction && ctx.is_caustics_caster(hit)) {
       state = state != 0 ? 2 : 0;
-    else
-      state = (!bs.is_delta() && ctx.is_caustics_receiver(hit)) ? 1 : 0;
+    } else if (!bs.is_delta() && ctx.is_caustics_receiver(hit)) {
+      state = 1;
+      receiver = hit.position;
+      receiver_ng =
+          dot(wo, hit.geometric_normal) > 0.0f ? hit.geometric_normal : -hit.geometric_normal;
+      direction = wo;
+    } else {
+      state = 0;
+    }
   }
-  // A lamp with Shadow Caustics met now carries light manifold NEE already counted.
-  bool drops(bool lamp_caustics) const { return state == 2 && lamp_caustics; }
+  // Whether the lamp point `lh` met now carries light manifold NEE counted (`scratch` holds the
+  // casters' closures of the walk, `rays` counts its rays).
+  bool drops(const SceneContext& ctx, const LightHit& lh, ClosureSet& scratch,
+             uint32_t& rays) const;
 };
 
 }  // namespace gdpt

@@ -136,9 +136,10 @@ Vec3d lamp_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, 
   const Vec3d fb = bp.fb;
   const double pb = bp.pb;
   Vec3d emit_merged;
-  // A caustics lamp behind caster refractions from a receiver is manifold NEE's light; the
-  // offsets, which copy the base's events, drop it with it.
-  const bool base_lit = light_hit && !is_black(lh.radiance) && !bp.caustic.drops(lh.caustics);
+  // A caustics lamp behind caster refractions from a receiver may be manifold NEE's light:
+  // then dropped (CausticChain), for the base and each offset by its own path.
+  const bool base_hit = light_hit && !is_black(lh.radiance);
+  const bool base_lit = base_hit && !bp.caustic.drops(g.ctx, lh, *e.scratch, out.rays);
   const float pl = (base_lit && !delta) ? lh.pdf : 0.0f;
   if (base_lit) out.primal += beta * lh.radiance * (delta ? 1.0f : power_heuristic(pdf_b, pl));
   // The pair weights' light density (mis_light_pdf); the primal keeps PT's.
@@ -150,8 +151,8 @@ Vec3d lamp_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, 
   if (base_lit) emit_merged = connected_event(mul(seg_b, lh.radiance), pdf_b, pl_mis, pdf_b);
   for (unsigned m = open_mask; m != 0; m &= m - 1) {
     Offset& o = off[std::countr_zero(m)];
-    // Without a lit base only a half-vector offset's own ray can find a light.
-    if (!base_lit && o.shift != Shift::HalfVector) continue;
+    // Without a lamp at the base's end only a half-vector offset's own ray can find a light.
+    if (!base_hit && o.shift != Shift::HalfVector) continue;
     Vec3d co;
     PathDensities d_off{0.0, 0.0, 0.0};
     const float pl_pair = o.nee_on ? pl_mis : 0.0f;
@@ -160,8 +161,9 @@ Vec3d lamp_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, 
                                g.classify(o.v.roughness) == VertexType::Diffuse;
     if (o.alive) {
       if (o.shift == Shift::Follow || o.shift == Shift::RecentEval) {
-        if (base_lit) {
-          co = mul(mul(o.f, o.seg_value), lh.radiance);
+        if (base_hit) {
+          if (!o.caustic.drops(g.ctx, lh, *e.scratch, out.rays))
+            co = mul(mul(o.f, o.seg_value), lh.radiance);
           d_off = shift::offset_densities(o.p, 1.0, pl_pair, o.seg_pdf);
         }
       } else if (reconnectable) {
@@ -174,7 +176,7 @@ Vec3d lamp_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, 
         LightHit lo;
         const float t_o = o.next_found || o.holdout_end ? o.next_hit.t : kInf;
         if (lights.intersect(o.ray.origin, o.ray.direction, t_o, lo) &&
-            !bp.caustic.drops(lo.caustics))
+            !o.caustic.drops(g.ctx, lo, *e.scratch, out.rays))
           co = mul(mul(o.f, o.seg_value), lo.radiance) * o.seg_jacobian;
         d_off = shift::offset_densities(o.p, o.seg_jacobian, 0.0, o.seg_pdf);
       }

@@ -219,7 +219,7 @@ class GradientPathTracer final : public Integrator {
       ray.kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
       bp.state.count_event(crossing, ray.kind, bs.lobe);
       if (!crossing) bp.state.scattered(bs);
-      bp.caustic.scattered(g_.ctx, base.hit, bs);
+      bp.caustic.scattered(g_.ctx, base.hit, bs, normalize(wo_world));
 
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
       if (!crossing) {
@@ -270,6 +270,16 @@ class GradientPathTracer final : public Integrator {
           shift_segment(g_, off[std::countr_zero(m)], st, out.rays);
       }
 
+      // Shadow caustics' rule follows each offset's own path: a connected offset's is the base's.
+      if (g_.ctx.shadow_caustics())
+        for (Offset& o : scratch.off) {
+          if (!o.active || !o.alive) continue;
+          if (o.link == Link::NotConnected)
+            o.caustic.scattered(g_.ctx, o.v.hit, bs, o.seg_dir);
+          else
+            o.caustic = bp.caustic;
+        }
+
       // --- Emission events at the end of the segment (emission_events.h) ---
       const Vec3d seg_b = Vec3d(bs.value);
       const SegmentEnd e{
@@ -285,7 +295,8 @@ class GradientPathTracer final : public Integrator {
           camera_path,
           camera_path ? g_.has_camera_world && !settings.transparent_background : g_.has_world,
           light_hit,
-          &lh};
+          &lh,
+          &scratch.shadow_closures};
       Vec3d emit_merged = lamp_events(g_, e, bp, open_mask, off, out);
       end_events(g_, e, bp, open_mask, off, emit_merged, out);
       if (!is_zero(emit_merged)) add_merged(off, bp.fb, bp.pb, emit_merged);

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "integrators/common/manifold_nee.h"
 #include "integrators/gpt/gpt_context.h"
 #include "integrators/gpt/path_vertex.h"
 #include "integrators/gpt/shift_mapping.h"
@@ -45,7 +46,8 @@ struct Offset {
   bool next_found = false;
   bool holdout_end = false;  // next_found is false because the segment met a holdout
   SurfaceHit next_hit;
-  bool killed = false;  // the continuing path is not invertible / mismatched
+  bool killed = false;   // the continuing path is not invertible / mismatched
+  CausticChain caustic;  // shadow caustics' rule on the offset's own path (manifold_nee.h)
 };
 
 // The base's segment x_d -> x_{d+1} as the offsets' shift_segment() calls see it.

@@ -175,7 +175,7 @@ class PathTracer final : public Integrator {
                          : distance_only(last, kEmissive) ? bvh.intersect_distance(ray, hit.t)
                                                           : bvh.intersect(ray, hit);
       ++out.rays;
-      if constexpr (kAnalytic) lamps_before(path, ray, found ? hit.t : ray.t_max, out);
+      if constexpr (kAnalytic) lamps_before(path, ray, found ? hit.t : ray.t_max, scratch, out);
       if (!found) {
         escape(path, ray, out);
         break;
@@ -239,7 +239,9 @@ class PathTracer final : public Integrator {
 
   // Analytic lights the ray crosses before `t_hit`. Camera rays see a lamp only when its object
   // is visible to the camera (Blender's Object.visible_camera, off by default as in Cycles).
-  void lamps_before(const Path& path, const Ray& ray, float t_hit, PathResult& out) const {
+  // `scratch`: closures for the walk of shadow caustics' rule (CausticChain::drops).
+  void lamps_before(const Path& path, const Ray& ray, float t_hit, ClosureSet& scratch,
+                    PathResult& out) const {
     const LightSampler& lights = ctx_.lights();
     LightHit lh;
     if (!lights.intersect(ray.origin, ray.direction, t_hit, lh)) return;
@@ -247,7 +249,7 @@ class PathTracer final : public Integrator {
       if (lh.camera_visible) out.emission += path.beta * lh.radiance;
       return;
     }
-    if (path.caustic.drops(lh.caustics)) return;
+    if (path.caustic.drops(ctx_, lh, scratch, out.rays)) return;
     float light_pdf = lh.pdf;
     if (!path.prev_delta && path.crossed_since_vertex) {
       // NEE ran from prev_position, behind the transparent surfaces just crossed: its density
@@ -368,7 +370,7 @@ class PathTracer final : public Integrator {
     const bool crossing = bs.is_straight_crossing();
     const uint32_t kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
     path.state.count_event(crossing, kind, bs.lobe);
-    path.caustic.scattered(ctx_, hit, bs);
+    path.caustic.scattered(ctx_, hit, bs, normalize(wo_world));
     if (!crossing) path.state.scattered(bs);
     path.crossed_since_vertex = crossing;
     bool continues = true;

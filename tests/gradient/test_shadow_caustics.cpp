@@ -36,11 +36,11 @@ Sums compare(const Passes& img, const Passes& ref) {
 }
 
 // A small lamp (0.1 m), whose image through the ball BSDF sampling rarely finds: at 64 samples
-// the caustic with a small fraction of path tracing's squared error, its light within a few
-// percent of the reference (plain PT at 65536 samples). A larger lamp (0.3 m), whose image BSDF
-// sampling finds often, loses: where the refracted light folds (the caustic's bright curves)
-// the generalized geometry term is very large and the rare samples landing there outweigh the
-// noise saved (1.6x plain PT's squared error when written).
+// the caustic with a small fraction of path tracing's squared error (0.15x when written), its
+// light within a few percent of the reference (plain PT at 65536 samples). A larger lamp
+// (0.3 m), whose image BSDF sampling finds often, loses: where the refracted light folds (the
+// caustic's bright curves) the generalized geometry term is very large and the rare samples
+// landing there outweigh the noise saved (1.9x plain PT's squared error when written).
 TEST(ShadowCaustics, PaysForSmallLamps) {
   for (float lamp : {0.1f, 0.3f}) {
     const Passes ref = render(make_caustic_scene(24, false, 1.5f, 1.0f, lamp),
@@ -50,25 +50,26 @@ TEST(ShadowCaustics, PaysForSmallLamps) {
     const Passes mnee = render(make_caustic_scene(24, true, 1.5f, 1.0f, lamp),
                                settings(RenderSettings::Mode::PT, 64, 1));
     const Sums r = compare(ref, ref), p = compare(plain, ref), m = compare(mnee, ref);
-    std::printf("lamp %.1f m: light %.4f of the reference (plain PT %.4f); squared error %.4g "
-                "(plain PT %.4g)\n",
-                lamp, m.total / r.total, p.total / r.total, m.squared_error, p.squared_error);
+    std::printf(
+        "lamp %.1f m: light %.4f of the reference (plain PT %.4f); squared error %.4g "
+        "(plain PT %.4g)\n",
+        lamp, m.total / r.total, p.total / r.total, m.squared_error, p.squared_error);
     if (lamp < 0.2f) {
-      EXPECT_GT(m.total / r.total, 0.90);  // 0.939 when written
-      EXPECT_LT(m.total / r.total, 1.02);
-      EXPECT_LT(m.squared_error, 0.2 * p.squared_error);  // 0.068 when written
+      EXPECT_NEAR(m.total / r.total, 1.0, 0.06);  // 1.02 when written
+      EXPECT_LT(m.squared_error, 0.25 * p.squared_error);
     } else {
       EXPECT_GT(m.squared_error, p.squared_error);
     }
   }
 }
 
-// The technique's limit, measured: where several refracted paths join a lamp point to a floor
-// point (IOR 1.3, the ball's aberration caustic on the floor), the walk from the straight seed
-// finds one, and the light of the others is missing (the BSDF-sampled paths that would carry it
-// are dropped, as in Cycles). At 1024 samples the image holds 0.48 of the reference's light
-// (the caustic's core 0.4) when written; at IOR 1.5 (the lamp focused on the floor) 0.95.
-TEST(ShadowCaustics, SeveralPathsToOnePointAreMissed) {
+// Every path counted once: where several refracted paths join a lamp point to a floor point
+// (IOR 1.3, the ball's aberration caustic on the floor) the walk from the straight seed finds one
+// of them, and BSDF sampling keeps the others (CausticChain): at 1024 samples the light is
+// 1.032 of the reference's (0.48 when every such BSDF-sampled path was dropped, as Cycles does);
+// with the lamp focused on the floor (IOR 1.5) 0.986. Both estimates are heavy-tailed (the
+// geometry term at the caustic's folds): over seeds 1-5, 0.99-1.08 and 0.99-1.03.
+TEST(ShadowCaustics, EveryPathCountedOnce) {
   for (float ior : {1.5f, 1.3f}) {
     const Passes ref =
         render(make_caustic_scene(24, false, ior), settings(RenderSettings::Mode::PT, 16384, 7));
@@ -76,7 +77,7 @@ TEST(ShadowCaustics, SeveralPathsToOnePointAreMissed) {
         render(make_caustic_scene(24, true, ior), settings(RenderSettings::Mode::PT, 1024, 1));
     const double ratio = compare(mnee, ref).total / compare(ref, ref).total;
     std::printf("IOR %.1f: light %.4f of the reference\n", ior, ratio);
-    EXPECT_NEAR(ratio, ior == 1.5f ? 0.955 : 0.48, 0.03) << ior;
+    EXPECT_NEAR(ratio, 1.0, 0.06) << ior;
   }
 }
 
