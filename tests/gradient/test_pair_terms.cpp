@@ -210,8 +210,20 @@ void run_segment(Pair& p, Segment& s, bool events = true) {
   }
   shift_segment(g, p.offset(), st, s.out.rays);
   if (!events) return;
-  const SegmentEnd e{&base, base_type, &s.ray, false,       Vec3d(s.bs.value), s.bs.pdf, s.found,
-                     false, &s.next,   false,  g.has_world, s.light_hit,       &s.lh};
+  const SegmentEnd e{&base,
+                     base_type,
+                     &s.ray,
+                     false,
+                     Vec3d(s.bs.value),
+                     s.bs.pdf,
+                     s.found,
+                     false,
+                     &s.next,
+                     false,
+                     g.has_world,
+                     s.light_hit,
+                     &s.lh,
+                     &p.scratch->shadow_closures};
   BasePath bp;
   Vec3d merged = lamp_events(g, e, bp, 1u, p.scratch->off, s.out);
   end_events(g, e, bp, 1u, p.scratch->off, merged, s.out);
