@@ -384,7 +384,9 @@ bool CausticChain::drops(const SceneContext& ctx, const LightHit& lh, ClosureSet
   ls.position = lh.position;
   ls.normal = lh.normal;
   const CausticConnection c = caustic_connection(ctx, receiver, receiver_ng, ls, scratch, rays);
-  // The walk converges to within 1e-4 of Snell's law: the same path agrees far closer than this.
+  // The walk stops within 1e-4 of Snell's law; near the caustic's folds the same path's first
+  // direction still differs by up to half a degree (measured: at 1 - 1e-6 too few paths were
+  // dropped, 1.047 of the light at IOR 1.3 against 1.032 here), distinct paths by more.
   return c.valid && dot(c.direction, direction) > 1.0f - 5e-5f;
 }
 

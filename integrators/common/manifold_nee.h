@@ -76,7 +76,7 @@ struct CausticChain {
   uint8_t state = 0;  // 0: none; 1: just left a receiver; 2: refracted through casters since
   Vec3f receiver, receiver_ng, direction;  // the receiver point, its side, the direction left
 
-  // The event `bs` at `hit`, leaving in the world direction `wo`.
+  // The event `bs` at `hit`, leaving in the world direction `wo` (any length).
   void scattered(const SceneContext& ctx, const SurfaceHit& hit, const BsdfSample& bs, Vec3f wo) {
     if (!ctx.shadow_caustics()) return;
     const bool refraction = bs.is_delta() && (bs.lobe & kLobeTransmission) != 0 && bs.eta != 1.0f;
@@ -87,7 +87,7 @@ struct CausticChain {
       receiver = hit.position;
       receiver_ng =
           dot(wo, hit.geometric_normal) > 0.0f ? hit.geometric_normal : -hit.geometric_normal;
-      direction = wo;
+      direction = normalize(wo);
     } else {
       state = 0;
     }

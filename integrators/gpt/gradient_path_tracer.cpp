@@ -219,7 +219,7 @@ class GradientPathTracer final : public Integrator {
       ray.kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
       bp.state.count_event(crossing, ray.kind, bs.lobe);
       if (!crossing) bp.state.scattered(bs);
-      bp.caustic.scattered(g_.ctx, base.hit, bs, normalize(wo_world));
+      bp.caustic.scattered(g_.ctx, base.hit, bs, wo_world);
 
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
       if (!crossing) {

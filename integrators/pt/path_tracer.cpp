@@ -370,7 +370,7 @@ class PathTracer final : public Integrator {
     const bool crossing = bs.is_straight_crossing();
     const uint32_t kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
     path.state.count_event(crossing, kind, bs.lobe);
-    path.caustic.scattered(ctx_, hit, bs, normalize(wo_world));
+    path.caustic.scattered(ctx_, hit, bs, wo_world);
     if (!crossing) path.state.scattered(bs);
     path.crossed_since_vertex = crossing;
     bool continues = true;

@@ -60,9 +60,13 @@ def main():
     check(int(uniform_counts.min()) == SAMPLES == int(uniform_counts.max()),
           "off: every pixel takes every sample")
     full = counts == SAMPLES
-    same = bool(np.array_equal(primal[full], uniform[full]))
+    # To a float rounding step: with adaptive sampling on, two renders of this scene differ by one
+    # ulp at a few pixels in about one run of five (seen in this test; the cause is not found:
+    # docs/user-guide.md, Settings); a pixel holding other samples differs by far more.
+    diff = np.abs(primal[full] - uniform[full])
+    same = bool(np.all(diff <= 1e-6 * np.abs(uniform[full]) + 1e-9))
     check(same, f"the {int(full.sum())} pixels that took every sample hold the uniform render's "
-                "Primal exactly")
+                f"Primal to a rounding step (largest difference {float(diff.max()):.3g})")
     check(not np.array_equal(primal, uniform), "the pixels that stopped hold fewer samples")
 
     g.adaptive_min_samples = 12
