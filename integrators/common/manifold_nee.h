@@ -18,9 +18,9 @@
 //    point, spot and sun lamps and the world).
 // The light such a connection stands for is estimated by it alone: a path that left a receiver
 // by a non-delta BSDF sample and then only refracted through casters adds nothing when it meets
-// a caustics lamp (CausticChain), as Cycles culls it. Where the walk fails (no solution reached
-// from the straight seed, or a chain of another number of interfaces) that light is missing:
-// the technique's bias, which the tests measure against path tracing.
+// a caustics lamp and the walk from its receiver finds that very path (CausticChain). Paths the
+// walk does not find (several refracted paths join the two points, or a chain of another number
+// of interfaces) stay with BSDF sampling, so every path counts once; Cycles drops them all.
 #pragma once
 
 #include <cmath>

@@ -78,8 +78,8 @@ bool caustic_pairs(const GptContext& g, const Vertex& base, const BasePath& bp,
       if (eb.valid) co = mul(o.f, Vec3d(o.shared->eval(o.wi_shared, eb.wo) * eb.transport));
       d_off = shift::offset_densities(o.p, 1.0, p_mis, 0.0);
     } else {
-      // A pair that cannot shift light samples (a vertex not diffuse) leaves the base alone:
-      // the BSDF-sampled hits that stand for light samples in such pairs are dropped here.
+      // A pair that cannot shift light samples (a vertex not diffuse) leaves the base alone (its
+      // BSDF-sampled copies of the path, which carry such pairs' light elsewhere, are dropped).
       if (!o.nee_on) {
         if (!is_zero(cb)) o.grad = o.grad - cb * shift::mis_weight_over_pdf(db, d_off, tech);
         continue;

@@ -2,7 +2,7 @@
 // shift to the offsets: each offset reuses the base's light point (Jacobian 1 in the light
 // point's area measure). What a light sample estimates at a receiver depends on its segment: one
 // that crosses casters is the refracted path through them (no BSDF technique competes: the
-// BSDF-sampled paths it stands for add nothing, CausticChain), a clear one the plain light
+// BSDF-sampled copies of that path add nothing, CausticChain), a clear one the plain light
 // sample. An offset evaluates its own segment so: at the caster's silhouette a pair mixes the two
 // (here and in nee_pairs()).
 #pragma once
