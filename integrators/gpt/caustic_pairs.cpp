@@ -7,7 +7,6 @@
 #include "integrators/gpt/mis_weights.h"
 #include "integrators/gpt/nee_pairs.h"
 #include "integrators/gpt/offset_path.h"
-#include "integrators/gpt/shadow_rays.h"
 
 namespace gdpt {
 
@@ -25,16 +24,11 @@ void plain_offset(const GptContext& g, const Offset& o, const LightSample& ls, f
   if (!offset_light(g.ctx.lights(), o.v.hit.position, u_select, u_light, ls, lo)) return;
   Vec3f wo;
   float pdf_fo = 0.0f;
-  Spectrum le = lo.radiance;
-  bool visible = false;
-  Spectrum fo(0.0f);
-  if (light_dir(g.ctx.bvh(), o.v, lo.direction, wo)) {
-    fo = o.v.closures->eval_pdf(o.v.wi, wo, pdf_fo);
-    if (!is_black(fo) && !is_black(le))
-      visible = lamp_visible(g, o.v, ls, lo, scratch.shadow_closures, le, rays);
-  }
+  Spectrum fo;
+  const bool visible = offset_arrival(g, o.v, ls, lo, wo, fo, pdf_fo, scratch.shadow_closures,
+                                      rays) == Arrival::Visible;
   const float to_area = std::fabs(dot(lo.direction, lo.normal)) / (lo.distance * lo.distance);
-  if (visible) co = mul(o.f, Vec3d(fo * le * to_area));
+  if (visible) co = mul(o.f, Vec3d(fo * lo.radiance * to_area));
   d_off = shift::offset_densities(o.p, 1.0, p_mis, visible ? pdf_fo * to_area : 0.0f);
 }
 

@@ -76,6 +76,17 @@ bool offset_light(const LightSampler& lights, Vec3f y, float u_select, Vec2f u_l
   return out.valid && length_squared(out.position - ls.position) < 1e-8f * scale * scale;
 }
 
+Arrival offset_arrival(const GptContext& g, const Vertex& v, const LightSample& ls, LightSample& lo,
+                       Vec3f& wo, Spectrum& f, float& pdf, ClosureSet& scratch, uint32_t& rays) {
+  f = Spectrum(0.0f);
+  if (!light_dir(g.ctx.bvh(), v, lo.direction, wo)) return Arrival::None;
+  f = v.closures->eval_pdf(v.wi, wo, pdf);
+  if (is_black(f) || is_black(lo.radiance)) return Arrival::None;
+  // The same lamp as the base's sample (its cast_shadow and is_delta).
+  return lamp_visible(g, v, ls, lo, scratch, lo.radiance, rays) ? Arrival::Visible
+                                                                : Arrival::Blocked;
+}
+
 void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, const LightSample& ls,
                float u_select, Vec2f u_light, unsigned open_mask, PathScratch& scratch,
                SampleResult& out) {
@@ -148,16 +159,10 @@ void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, cons
     J[k] = ls.is_delta || ls.is_infinite
                ? 1.0
                : shift::light_reconnection_jacobian(light_base, o.v.hit.position);
-    fo[k] = Spectrum(0.0f);
-    if (light_dir(g.ctx.bvh(), o.v, lo[k].direction, wo_o[k])) {
-      fo[k] = o.v.closures->eval_pdf(o.v.wi, wo_o[k], pdf_fo[k]);
-      if (!is_black(fo[k]) && !is_black(lo[k].radiance)) {
-        test[k] = true;
-        // The same lamp as the base's sample (its cast_shadow and is_delta).
-        blocked[k] =
-            !lamp_visible(g, o.v, ls, lo[k], scratch.shadow_closures, lo[k].radiance, out.rays);
-      }
-    }
+    const Arrival a = offset_arrival(g, o.v, ls, lo[k], wo_o[k], fo[k], pdf_fo[k],
+                                     scratch.shadow_closures, out.rays);
+    test[k] = a != Arrival::None;
+    blocked[k] = a == Arrival::Blocked;
     // Casters on the offset's own segment (caustic_pairs.h): its refracted path, in the base's
     // solid-angle measure (d A(y) = d omega d^2 / cos_l at the base).
     if ((!test[k] || blocked[k]) && runs_shadow_caustics(g.ctx, o.v.hit, ls)) {

@@ -17,6 +17,13 @@ namespace gdpt {
 bool offset_light(const LightSampler& lights, Vec3f y, float u_select, Vec2f u_light,
                   const LightSample& ls, LightSample& out);
 
+// How an offset vertex `v` sees its light sample `lo` (offset_light() of the base's `ls`): its
+// local direction `wo`, the BSDF value `f` and density `pdf` towards it, and the lamp's light
+// arriving (`lo.radiance` times the transmittance of delta lamps' rays).
+enum class Arrival : uint8_t { None, Blocked, Visible };  // None: no BSDF value or no radiance
+Arrival offset_arrival(const GptContext& g, const Vertex& v, const LightSample& ls, LightSample& lo,
+                       Vec3f& wo, Spectrum& f, float& pdf, ClosureSet& scratch, uint32_t& rays);
+
 // Squared distance of two unit normals of the same surface point evaluated from two reference
 // points (rounding only); receiver-facing discs differ by the angle between the two receivers
 // seen from the light, far above this.
