@@ -77,6 +77,10 @@ class SceneContext {
   bool is_caustics_caster(const SurfaceHit& hit) const {
     return scene_.instances[hit.instance].caustics_caster;
   }
+  // A caster while shadow caustics run: Filter Glossy leaves its smooth glass sharp.
+  bool is_sharp_caster(const SurfaceHit& hit) const {
+    return shadow_caustics_ && is_caustics_caster(hit);
+  }
   bool is_holdout(const SurfaceHit& hit) const {
     return hit.instance < scene_.instances.size() && scene_.instances[hit.instance].holdout;
   }

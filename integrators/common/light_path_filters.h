@@ -12,6 +12,9 @@
 //    and refraction by 1 - F, in one lobe) loses its reflected or refracted part, or all of it
 //    when both are off; a Multiscatter GGX glass lobe (Closure::multiscatter: Cycles' single
 //    random-walk closure) is kept whole unless both are off.
+// Smooth glass of a shadow caustics caster is never blurred (`sharp_caster`): manifold NEE
+// connects through it smooth, and BSDF sampling must take the same chain (Cycles leaves Sharp
+// closures unblurred everywhere).
 #pragma once
 
 #include <cmath>
@@ -20,6 +23,7 @@
 #include "integrators/common/path_state.h"
 #include "scene/render_settings.h"
 #include "shaders/bsdf.h"
+#include "shaders/microfacet.h"
 
 namespace gdpt {
 
@@ -48,8 +52,9 @@ class LightPathFilters {
     return blur_alpha(state) > 0.0f || drops_reflection(state) || drops_refraction(state);
   }
 
-  // Rewrites `set` (a copy the caller owns) for a vertex reached with `state`.
-  void apply(const PathState& state, ClosureSet& set) const {
+  // Rewrites `set` (a copy the caller owns) for a vertex reached with `state`; `sharp_caster`:
+  // the vertex is on a shadow caustics caster (SceneContext::is_sharp_caster).
+  void apply(const PathState& state, ClosureSet& set, bool sharp_caster) const {
     const float blur = blur_alpha(state);
     const bool no_reflection = drops_reflection(state), no_refraction = drops_refraction(state);
     for (int i = set.count() - 1; i >= 0; --i) {
@@ -65,7 +70,9 @@ class LightPathFilters {
         c.drop_reflection = no_reflection;
         c.drop_refraction = no_refraction;
       }
-      if (kind == Kind::Other) continue;
+      if (kind == Kind::Other ||
+          (sharp_caster && kind != Kind::Reflection && is_delta_alpha(c.alpha)))
+        continue;
       if (c.alpha < blur) c.alpha = blur;
       if (is_anisotropic(c) && c.alpha_y < blur) c.alpha_y = blur;  // Cycles raises both widths
     }

@@ -5,7 +5,9 @@
 
 #include "core/frame.h"
 #include "core/shadow_terminator.h"
+#include "integrators/common/mis.h"
 #include "integrators/common/shadow_ray.h"
+#include "shaders/bsdf_ggx_dielectric.h"
 #include "shaders/fresnel.h"
 #include "shaders/microfacet.h"
 #include "shaders/shading_context.h"
@@ -348,10 +350,13 @@ CausticConnection caustic_connection(const SceneContext& ctx, Vec3f x, Vec3f ng_
     Closure lobe;
     if (!smooth_refraction(ctx, hit, scratch, lobe)) return out;
     const Vec3f wi = normalize(from - v[i].p);
-    const float cos_i = std::fabs(dot(wi, hit.shading_normal));
+    const float cos_n = dot(wi, hit.shading_normal), cos_i = std::fabs(cos_n);
     const float fresnel =
         lobe.fresnel == FresnelMode::RefractionOnly ? 0.0f : fresnel_dielectric(cos_i, lobe.ior);
     throughput = throughput * lobe.weight * lobe.transmission_tint * (1.0f - fresnel);
+    // The glass lobe's own choice between reflection and refraction (ggx_dielectric::sample).
+    const float eta = cos_n > 0.0f ? lobe.ior : 1.0f / lobe.ior;
+    out.refraction_pdf *= 1.0f - ggx_dielectric::split(lobe, eta, cos_i).p_reflect;
     from = v[i].p;
     from_ng = v[i].ng;
   }
@@ -372,14 +377,36 @@ CausticConnection caustic_connection(const SceneContext& ctx, Vec3f x, Vec3f ng_
   const float g = std::fabs(dot(wo_x / d0, v[0].ng)) / (d0 * d0) * transfer;
   if (!(g > 0.0f) || !std::isfinite(g)) return out;
   out.transport = throughput * lh.radiance * g;
+  out.solid_angle_per_area = g;
   out.direction = wo_x / d0;
   out.valid = !is_black(out.transport);
   return out;
 }
 
-bool CausticChain::drops(const SceneContext& ctx, const LightHit& lh, ClosureSet& scratch,
-                         uint32_t& rays) const {
-  if (state != 2 || !lh.caustics || !(lh.area_pdf > 0.0f)) return false;
+CausticShare caustic_share(const PathState& before, const RenderSettings& s) {
+  CausticShare share;
+  share.mis = s.caustics_refractive;
+  const BounceCounts& n = before.kinds;
+  if (n.diffuse + 1 > s.max_diffuse_bounces || n.glossy + 1 > s.max_glossy_bounces) return share;
+  // The lamp counts when the last caster still scatters: its bounce and transmission counts
+  // within the limits (the receiver's bounce counted as a transmission too).
+  share.reach = std::max(
+      0, std::min(s.max_bounces - before.bounce, s.max_transmission_bounces - n.transmission));
+  return share;
+}
+
+float manifold_nee_weight(const CausticConnection& c, const CausticShare& share, float area_pdf,
+                          Vec3f ng_x) {
+  if (!share.mis || c.casters > share.reach) return 1.0f;
+  const float bsdf_pdf =
+      std::fabs(dot(c.direction, ng_x)) * kInvPi * c.refraction_pdf * c.solid_angle_per_area;
+  return power_heuristic(area_pdf, bsdf_pdf);
+}
+
+float CausticChain::weight(const SceneContext& ctx, const LightHit& lh, ClosureSet& scratch,
+                           uint32_t& rays) const {
+  if (state != 2 || !lh.caustics || !(lh.area_pdf > 0.0f)) return 1.0f;
+  if (!share.mis) return 0.0f;  // Cycles' rule: manifold NEE alone
   LightSample ls;
   ls.position = lh.position;
   ls.normal = lh.normal;
@@ -387,7 +414,8 @@ bool CausticChain::drops(const SceneContext& ctx, const LightHit& lh, ClosureSet
   // The walk stops within 1e-4 of Snell's law; near the caustic's folds the same path's first
   // direction still differs by up to half a degree (measured: at 1 - 1e-6 too few paths were
   // dropped, 1.047 of the light at IOR 1.3 against 1.032 here), distinct paths by more.
-  return c.valid && dot(c.direction, direction) > 1.0f - 5e-5f;
+  if (!(c.valid && dot(c.direction, direction) > 1.0f - 5e-5f)) return 1.0f;
+  return 1.0f - manifold_nee_weight(c, share, lh.area_pdf, receiver_ng);
 }
 
 }  // namespace gdpt

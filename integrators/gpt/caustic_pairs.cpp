@@ -35,13 +35,13 @@ void plain_offset(const GptContext& g, const Offset& o, const LightSample& ls, f
 }  // namespace
 
 CausticEvent caustic_event(const GptContext& g, const Vertex& v, const LightSample& ls,
-                           PathScratch& scratch, uint32_t& rays) {
+                           const CausticShare& share, PathScratch& scratch, uint32_t& rays) {
   const Vec3f ng = dot(ls.position - v.hit.position, v.ng) > 0.0f ? v.ng : -v.ng;
   const CausticConnection c =
       caustic_connection(g.ctx, v.hit.position, ng, ls, scratch.shadow_closures, rays);
   CausticEvent e;
   e.casters = c.casters;
-  e.transport = c.transport;
+  e.transport = c.transport * manifold_nee_weight(c, share, ls.area_pdf, ng);
   e.valid = c.valid && light_dir(g.ctx.bvh(), v, c.direction, e.wo);
   return e;
 }
@@ -49,7 +49,9 @@ CausticEvent caustic_event(const GptContext& g, const Vertex& v, const LightSamp
 bool caustic_pairs(const GptContext& g, const Vertex& base, const BasePath& bp,
                    const LightSample& ls, float u_select, Vec2f u_light, unsigned open_mask,
                    PathScratch& scratch, SampleResult& out) {
-  const CausticEvent eb = caustic_event(g, base, ls, scratch, out.rays);
+  // Offsets shade with the base's path state: one share for the pair.
+  const CausticShare share = caustic_share(bp.state, g.settings);
+  const CausticEvent eb = caustic_event(g, base, ls, share, scratch, out.rays);
   if (eb.casters == 0) return false;
   const Spectrum yb =
       eb.valid ? base.closures->eval(base.wi, eb.wo) * eb.transport : Spectrum(0.0f);
@@ -73,13 +75,13 @@ bool caustic_pairs(const GptContext& g, const Vertex& base, const BasePath& bp,
       d_off = shift::offset_densities(o.p, 1.0, p_mis, 0.0);
     } else {
       // A pair that cannot shift light samples (a vertex not diffuse) leaves the base alone (its
-      // BSDF-sampled copies of the path, which carry such pairs' light elsewhere, are dropped).
+      // BSDF-sampled copies of the path carry the rest of such pairs' light elsewhere).
       if (!o.nee_on) {
         if (!is_zero(cb)) o.grad = o.grad - cb * shift::mis_weight_over_pdf(db, d_off, tech);
         continue;
       }
       const CausticEvent eo = runs_shadow_caustics(g.ctx, o.v.hit, ls)
-                                  ? caustic_event(g, o.v, ls, scratch, out.rays)
+                                  ? caustic_event(g, o.v, ls, share, scratch, out.rays)
                                   : CausticEvent{};
       if (eo.casters > 0) {
         if (eo.valid) co = mul(o.f, Vec3d(o.v.closures->eval(o.v.wi, eo.wo) * eo.transport));

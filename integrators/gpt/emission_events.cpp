@@ -136,19 +136,21 @@ Vec3d lamp_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, 
   const Vec3d fb = bp.fb;
   const double pb = bp.pb;
   Vec3d emit_merged;
-  // A caustics lamp behind caster refractions from a receiver may be manifold NEE's light:
-  // then dropped (CausticChain), for the base and each offset by its own path.
+  // A caustics lamp behind caster refractions from a receiver may be shared with manifold NEE
+  // (CausticChain): weighed for the base and each offset by its own path.
   const bool base_hit = light_hit && !is_black(lh.radiance);
-  const bool base_lit = base_hit && !bp.caustic.drops(g.ctx, lh, *e.scratch, out.rays);
+  const float caustic_w = base_hit ? bp.caustic.weight(g.ctx, lh, *e.scratch, out.rays) : 0.0f;
+  const bool base_lit = caustic_w > 0.0f;
+  const Spectrum le = lh.radiance * caustic_w;
   const float pl = (base_lit && !delta) ? lh.pdf : 0.0f;
-  if (base_lit) out.primal += beta * lh.radiance * (delta ? 1.0f : power_heuristic(pdf_b, pl));
+  if (base_lit) out.primal += beta * le * (delta ? 1.0f : power_heuristic(pdf_b, pl));
   // The pair weights' light density (mis_light_pdf); the primal keeps PT's.
   const float pl_mis =
       pl > 0.0f && std::isfinite(lh.distance)
           ? mis_light_pdf(lh.area_pdf, pl, lh.distance, -dot(ray.direction, lh.normal))
           : pl;
-  const Vec3d cb = base_lit ? mul(mul(fb, seg_b), lh.radiance) : Vec3d();
-  if (base_lit) emit_merged = connected_event(mul(seg_b, lh.radiance), pdf_b, pl_mis, pdf_b);
+  const Vec3d cb = base_lit ? mul(mul(fb, seg_b), le) : Vec3d();
+  if (base_lit) emit_merged = connected_event(mul(seg_b, le), pdf_b, pl_mis, pdf_b);
   for (unsigned m = open_mask; m != 0; m &= m - 1) {
     Offset& o = off[std::countr_zero(m)];
     // Without a lamp at the base's end only a half-vector offset's own ray can find a light.
@@ -162,8 +164,8 @@ Vec3d lamp_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, 
     if (o.alive) {
       if (o.shift == Shift::Follow || o.shift == Shift::RecentEval) {
         if (base_hit) {
-          if (!o.caustic.drops(g.ctx, lh, *e.scratch, out.rays))
-            co = mul(mul(o.f, o.seg_value), lh.radiance);
+          co = mul(mul(o.f, o.seg_value), lh.radiance) *
+               double(o.caustic.weight(g.ctx, lh, *e.scratch, out.rays));
           d_off = shift::offset_densities(o.p, 1.0, pl_pair, o.seg_pdf);
         }
       } else if (reconnectable) {
@@ -175,9 +177,9 @@ Vec3d lamp_events(const GptContext& g, const SegmentEnd& e, const BasePath& bp, 
         // The offset's own direction: does its ray cross a light before its surface?
         LightHit lo;
         const float t_o = o.next_found || o.holdout_end ? o.next_hit.t : kInf;
-        if (lights.intersect(o.ray.origin, o.ray.direction, t_o, lo) &&
-            !o.caustic.drops(g.ctx, lo, *e.scratch, out.rays))
-          co = mul(mul(o.f, o.seg_value), lo.radiance) * o.seg_jacobian;
+        if (lights.intersect(o.ray.origin, o.ray.direction, t_o, lo))
+          co = mul(mul(o.f, o.seg_value), lo.radiance) *
+               (o.seg_jacobian * o.caustic.weight(g.ctx, lo, *e.scratch, out.rays));
         d_off = shift::offset_densities(o.p, o.seg_jacobian, 0.0, o.seg_pdf);
       }
     }

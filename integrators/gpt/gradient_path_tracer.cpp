@@ -217,9 +217,12 @@ class GradientPathTracer final : public Integrator {
       bp.beta *= bs.value / bs.pdf;
       const bool crossing = bs.is_straight_crossing();
       ray.kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
+      // Shadow caustics' rule from the path state before this bounce (offsets below share it).
+      const CausticShare caustic_share_here =
+          g_.ctx.shadow_caustics() ? caustic_share(bp.state, settings) : CausticShare{};
+      bp.caustic.scattered(g_.ctx, base.hit, bs, wo_world, caustic_share_here);
       bp.state.count_event(crossing, ray.kind, bs.lobe);
       if (!crossing) bp.state.scattered(bs);
-      bp.caustic.scattered(g_.ctx, base.hit, bs, wo_world);
 
       // --- Russian roulette, decided by the base; q enters every density of the pair ---
       if (!crossing) {
@@ -275,7 +278,7 @@ class GradientPathTracer final : public Integrator {
         for (Offset& o : scratch.off) {
           if (!o.active || !o.alive) continue;
           if (o.link == Link::NotConnected)
-            o.caustic.scattered(g_.ctx, o.v.hit, bs, o.seg_dir);
+            o.caustic.scattered(g_.ctx, o.v.hit, bs, o.seg_dir, caustic_share_here);
           else
             o.caustic = bp.caustic;
         }

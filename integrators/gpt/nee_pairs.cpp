@@ -166,7 +166,8 @@ void nee_pairs(const GptContext& g, const Vertex& base, const BasePath& bp, cons
     // Casters on the offset's own segment (caustic_pairs.h): its refracted path, in the base's
     // solid-angle measure (d A(y) = d omega d^2 / cos_l at the base).
     if ((!test[k] || blocked[k]) && runs_shadow_caustics(g.ctx, o.v.hit, ls)) {
-      const CausticEvent e = caustic_event(g, o.v, ls, scratch, out.rays);
+      const CausticEvent e =
+          caustic_event(g, o.v, ls, caustic_share(bp.state, g.settings), scratch, out.rays);
       if (e.casters > 0) {
         nc[k] = NeeCase::Caustic;
         fo[k] = e.valid ? o.v.closures->eval(o.v.wi, e.wo) * e.transport *

@@ -40,7 +40,7 @@ float hit_roughness(const SceneContext& ctx, std::span<const MaterialSide> sides
     cs.assign(*side.set);
   else
     ctx.materials()[size_t(h.material)].evaluate(shading_context_of(h), cs);
-  if (filtered) rules.filters.apply(rules.state, cs);
+  if (filtered) rules.filters.apply(rules.state, cs, ctx.is_sharp_caster(h));
   return vertex_roughness(cs);
 }
 
@@ -71,7 +71,7 @@ void finish_vertex(const SceneContext& ctx, std::span<const MaterialSide> sides,
       if (m.reads_path()) sc.path = &path;
       m.evaluate(sc, v.own);
     }
-    if (filtered) rules.filters.apply(rules.state, v.own);
+    if (filtered) rules.filters.apply(rules.state, v.own, ctx.is_sharp_caster(hit));
     v.closures = &v.own;
     if (!per_path) v.roughness = vertex_roughness(v.own);
     // Such a set is another set from another path (no same_side() sharing).
@@ -103,7 +103,7 @@ const ClosureSet& shared_closures(const SceneContext& ctx, const VertexRules& ru
   m.evaluate(sc, scratch);
   // The light-path rules as at the base, which shares its path state with the offset.
   if (rules.filters.enabled() && rules.filters.active(rules.state))
-    rules.filters.apply(rules.state, scratch);
+    rules.filters.apply(rules.state, scratch, ctx.is_sharp_caster(base.hit));
   // Bump shadowing as at the base (`rotated`: let shading_closures compare the normals).
   return shading_closures(scratch, scratch, base.hit, base.frame, base.ng, wi_world, true);
 }

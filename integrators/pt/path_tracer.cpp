@@ -207,7 +207,7 @@ class PathTracer final : public Integrator {
       const ClosureSet* evaluated = &material.closures(sc, closure_scratch);
       if (filters_.enabled() && filters_.active(path.state)) {
         filtered.assign(*evaluated);
-        filters_.apply(path.state, filtered);
+        filters_.apply(path.state, filtered, ctx_.is_sharp_caster(hit));
         evaluated = &filtered;
       }
       const ClosureSet& material_closures = *evaluated;
@@ -239,7 +239,7 @@ class PathTracer final : public Integrator {
 
   // Analytic lights the ray crosses before `t_hit`. Camera rays see a lamp only when its object
   // is visible to the camera (Blender's Object.visible_camera, off by default as in Cycles).
-  // `scratch`: closures for the walk of shadow caustics' rule (CausticChain::drops).
+  // `scratch`: closures for the walk of shadow caustics' rule (CausticChain::weight).
   void lamps_before(const Path& path, const Ray& ray, float t_hit, ClosureSet& scratch,
                     PathResult& out) const {
     const LightSampler& lights = ctx_.lights();
@@ -249,7 +249,8 @@ class PathTracer final : public Integrator {
       if (lh.camera_visible) out.emission += path.beta * lh.radiance;
       return;
     }
-    if (path.caustic.drops(ctx_, lh, scratch, out.rays)) return;
+    const float caustic_w = path.caustic.weight(ctx_, lh, scratch, out.rays);
+    if (caustic_w == 0.0f) return;
     float light_pdf = lh.pdf;
     if (!path.prev_delta && path.crossed_since_vertex) {
       // NEE ran from prev_position, behind the transparent surfaces just crossed: its density
@@ -261,7 +262,7 @@ class PathTracer final : public Integrator {
         light_pdf = from_vertex.pdf;
     }
     const float w = path.prev_delta ? 1.0f : power_heuristic(path.prev_pdf, light_pdf);
-    out.primal += path.beta * lh.radiance * w;
+    out.primal += path.beta * lh.radiance * (w * caustic_w);
   }
 
   // The ray left the scene: the world (with a transparent background a camera path leaves it
@@ -346,8 +347,11 @@ class PathTracer final : public Integrator {
     if (cc.casters == 0) return false;
     if (!cc.valid) return true;
     const Vec3f wo = frame.to_local(cc.direction);
-    if (light_side_ok(ctx_.bvh(), hit, closures, wo, dot(cc.direction, ng)))
-      out.primal += path.beta * closures.eval(wi, wo) * cc.transport / light_area_density(ls);
+    if (light_side_ok(ctx_.bvh(), hit, closures, wo, dot(cc.direction, ng))) {
+      const float w =
+          manifold_nee_weight(cc, caustic_share(path.state, settings_), ls.area_pdf, ng_light);
+      out.primal += path.beta * closures.eval(wi, wo) * cc.transport * (w / light_area_density(ls));
+    }
     return true;
   }
 
@@ -369,8 +373,9 @@ class PathTracer final : public Integrator {
     // vertex is still the competing technique.
     const bool crossing = bs.is_straight_crossing();
     const uint32_t kind = crossing ? ray.kind : ray_kind_of_lobe(bs.lobe);
+    if (ctx_.shadow_caustics())
+      path.caustic.scattered(ctx_, hit, bs, wo_world, caustic_share(path.state, settings_));
     path.state.count_event(crossing, kind, bs.lobe);
-    path.caustic.scattered(ctx_, hit, bs, wo_world);
     if (!crossing) path.state.scattered(bs);
     path.crossed_since_vertex = crossing;
     bool continues = true;

@@ -62,7 +62,7 @@ TEST(LightPathFilters, FilterGlossyRaisesGlossyAlphaAsCycles) {
   const float want = 0.5f * std::sqrt(1.0f - 0.5f / 2.0f);
   EXPECT_FLOAT_EQ(f.blur_alpha(st), want);
   ClosureSet set = mixed_set();
-  f.apply(st, set);
+  f.apply(st, set, false);
   ASSERT_EQ(set.count(), 6);
   EXPECT_EQ(set[0].alpha, 0.0f);  // Lambert
   EXPECT_FLOAT_EQ(set[1].alpha, want);
@@ -82,8 +82,29 @@ TEST(LightPathFilters, FilterGlossyRaisesGlossyAlphaAsCycles) {
   // A rougher lobe keeps its roughness.
   ClosureSet rough;
   rough.add(lobe(ClosureType::GGXReflection, 0.8f));
-  f.apply(st, rough);
+  f.apply(st, rough, false);
   EXPECT_EQ(rough[0].alpha, 0.8f);
+}
+
+// On a shadow caustics caster the smooth glass and refraction lobes stay sharp (manifold NEE
+// connects through them smooth); glossy reflections and rough lobes blur as anywhere.
+TEST(LightPathFilters, ShadowCausticsCastersKeepSmoothGlassSharp) {
+  RenderSettings s;
+  s.blur_glossy = 2.0f;
+  const LightPathFilters f(s);
+  PathState st;
+  st.count_event(false, kRayDiffuse, kLobeReflection | kLobeDiffuse);
+  st.scattered(sample(kLobeDiffuse | kLobeReflection, 0.5f));
+  const float want = f.blur_alpha(st);
+  ASSERT_GT(want, 0.0f);
+  ClosureSet set = mixed_set();
+  set.add(lobe(ClosureType::GGXDielectric, 0.0f, FresnelMode::RefractionOnly));
+  f.apply(st, set, true);
+  EXPECT_FLOAT_EQ(set[1].alpha, want);  // glossy reflection
+  EXPECT_FLOAT_EQ(set[2].alpha, want);  // clearcoat
+  EXPECT_EQ(set[3].alpha, 0.0f);        // smooth glass
+  EXPECT_FLOAT_EQ(set[4].alpha, want);  // rough refraction
+  EXPECT_EQ(set[6].alpha, 0.0f);        // smooth refraction
 }
 
 int count_type(const ClosureSet& s, ClosureType t, FresnelMode fresnel) {
@@ -118,7 +139,7 @@ TEST(LightPathFilters, CausticsTogglesDropLobesAfterADiffuseBounce) {
     s.caustics_refractive = k.refractive;
     const LightPathFilters f(s);
     ClosureSet set = mixed_set();
-    f.apply(after_diffuse, set);
+    f.apply(after_diffuse, set, false);
     EXPECT_EQ(set.count(), k.left) << k.reflective << k.refractive;
     EXPECT_EQ(count_type(set, ClosureType::GGXReflection, FresnelMode::None), int(k.glossy));
     EXPECT_EQ(count_type(set, ClosureType::Clearcoat, FresnelMode::None), int(k.clearcoat));
@@ -137,14 +158,14 @@ TEST(LightPathFilters, CausticsTogglesDropLobesAfterADiffuseBounce) {
     Closure g = lobe(ClosureType::GGXDielectric, 0.3f, FresnelMode::Dielectric);
     g.multiscatter = true;
     multiscatter.add(g);
-    f.apply(after_diffuse, multiscatter);
+    f.apply(after_diffuse, multiscatter, false);
     ASSERT_EQ(multiscatter.count(), int(k.reflective || k.refractive));
     if (multiscatter.count() == 1) {
       EXPECT_FALSE(multiscatter[0].drop_reflection);
       EXPECT_FALSE(multiscatter[0].drop_refraction);
     }
     ClosureSet untouched = mixed_set();
-    f.apply(after_glossy, untouched);
+    f.apply(after_glossy, untouched, false);
     EXPECT_EQ(untouched.count(), 6);
   }
 }
