@@ -27,7 +27,7 @@ struct SegmentEnd {
   bool world_seen;              // the world emits into this segment
   bool light_hit;               // the segment crosses an analytic light before x_{d+1}: `lh`
   const LightHit* lh;
-  ClosureSet* scratch;  // closures for the walk of shadow caustics' rule (CausticChain::drops)
+  ClosureSet* scratch;  // closures for the walk of shadow caustics' rule (CausticChain::weight)
 };
 
 // (a) Analytic lights the segment crosses before its end. Returns the merged offsets' event
