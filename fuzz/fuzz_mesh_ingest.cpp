@@ -35,6 +35,8 @@ void check_mesh(const Mesh& m) {
                    m.corner_tangent_signs.size(), m.corner_colors.size()})
     require(n == 0 || n == 3 * triangles);
   require(m.vertex_normals.empty() || m.vertex_normals.size() == m.positions.size());
+  for (const auto& n : m.vertex_normals)
+    require(std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z));
   require(m.material_slot.empty() || m.material_slot.size() == triangles);
   for (int32_t s : m.material_slot) require(s >= 0 && s < gdpt::ingest::kMaxMaterialSlots);
 }
@@ -55,7 +57,9 @@ Mesh ingest(const gdpt::fuzz::MeshInput& in) {
   loops.loop_colors = floats(a[5]);
   if (in.mode == MeshMode::Loops)
     return gdpt::ingest::mesh_from_loops(loops, ints(a[6]), ints(a[7]));
-  return gdpt::ingest::mesh_from_polys(loops, ints(a[6]), ints(a[7]), ints(a[8]));
+  // The flag also asks for the add-on's smooth vertex normals (refused with normals given).
+  return gdpt::ingest::mesh_from_polys(loops, ints(a[6]), ints(a[7]), ints(a[8]),
+                                       in.normals_per_loop);
 }
 
 }  // namespace

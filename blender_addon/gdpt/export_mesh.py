@@ -71,20 +71,24 @@ def _corner_loops_slow(mesh):
     return corners, tri_poly
 
 
-def _normals_and_uvs(mesh):
-    """(normals, per_loop, loop_uvs) in Blender's domains. All smooth without custom normals:
-    vertex normals. Custom / auto-smooth normals or a smooth/flat mix: Blender's split (per-loop)
-    normals, which hold face normals for flat faces. All flat: none (the core then uses the
-    geometric normals). UVs: the active render UV map, per loop, or none."""
+def _normals_and_uvs(mesh, own_vertex_normals=False):
+    """(normals, per_loop, smooth_vertex_normals, loop_uvs) in Blender's domains. All smooth
+    without custom normals: vertex normals, or with `own_vertex_normals` none and
+    smooth_vertex_normals True (the module computes them, the same from one export to the next,
+    which Blender's are not). Custom / auto-smooth normals or a smooth/flat mix: Blender's split
+    (per-loop) normals, which hold face normals for flat faces. All flat: none (the core then
+    uses the geometric normals). UVs: the active render UV map, per loop, or none."""
     smooth = np.empty(len(mesh.polygons), dtype=bool)
     mesh.polygons.foreach_get("use_smooth", smooth)
     normals = np.empty(0, dtype=np.float32)
-    per_loop = False
+    per_loop = own = False
     if mesh.has_custom_normals or (smooth.any() and (mesh.use_auto_smooth or not smooth.all())):
         mesh.calc_normals_split()
         normals = _empty(len(mesh.loops) * 3, np.float32)
         mesh.loops.foreach_get("normal", normals)
         per_loop = True
+    elif smooth.any() and own_vertex_normals:
+        own = True
     elif smooth.any():
         normals = _empty(len(mesh.vertices) * 3, np.float32)
         mesh.vertex_normals.foreach_get("vector", normals)  # raw array, unlike vertices.normal
@@ -98,7 +102,7 @@ def _normals_and_uvs(mesh):
     if uv_layer is not None:
         loop_uvs = _empty(len(mesh.loops) * 2, np.float32)
         uv_layer.data.foreach_get("uv", loop_uvs)
-    return normals, per_loop, loop_uvs
+    return normals, per_loop, own, loop_uvs
 
 
 def _poly_material(mesh):
@@ -195,14 +199,15 @@ def add_mesh(builder, mesh, tangents=False, warn=print, color_attribute=None,
     mesh.vertices.foreach_get("co", positions)
     loop_total = _int_field(mesh.polygons, 1, "loop_total")  # MPoly.totloop
     loop_vertex = _int_field(mesh.loops, 0, "vertex_index")  # MLoop.v
-    normals, per_loop, loop_uvs = _normals_and_uvs(mesh)
     poly_material = _poly_material(mesh)
     if loop_total.min() >= 3 and loop_total.max() <= 4:
         loop_start = _int_field(mesh.polygons, 0, "loop_start")  # MPoly.loopstart
+        normals, per_loop, own, loop_uvs = _normals_and_uvs(mesh, own_vertex_normals=True)
         index = builder.add_mesh_polys(positions, loop_vertex, loop_start, loop_total, normals,
                                        per_loop, loop_uvs, poly_material, loop_tangents,
-                                       loop_colors)
+                                       loop_colors, smooth_vertex_normals=own)
     else:
+        normals, per_loop, _, loop_uvs = _normals_and_uvs(mesh)
         # N-gons: Blender's ear clipping, through its loop triangles (slower reads).
         corner_loops, tri_poly = _corner_loops_slow(mesh)
         if len(corner_loops) == 0:

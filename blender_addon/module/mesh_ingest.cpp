@@ -2,6 +2,7 @@
 // inner loops index without checks.
 #include "blender_addon/module/mesh_ingest.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -238,8 +239,72 @@ Mesh mesh_from_loops(const LoopArrays& loops, std::span<const int32_t> corner_lo
                      });
 }
 
+namespace {
+
+// Double precision: differences of finite float coordinates near FLT_MAX overflow in float.
+struct D3 {
+  double x = 0.0, y = 0.0, z = 0.0;
+};
+D3 operator-(const D3& a, const D3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+D3 scaled(const D3& a, double k) {
+  return {a.x * k, a.y * k, a.z * k};
+}
+double dot3(const D3& a, const D3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+D3 cross3(const D3& a, const D3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+// `a` made unit; zero when it has no length (Blender's normalize_v3 of a zero vector).
+D3 unit3(const D3& a) {
+  const double len = std::sqrt(dot3(a, a));
+  return len > 0.0 ? scaled(a, 1.0 / len) : D3{};
+}
+
+}  // namespace
+
+std::vector<Vec3f> smooth_vertex_normals(std::span<const float> positions,
+                                         std::span<const int32_t> loop_vertex,
+                                         std::span<const int32_t> loop_start,
+                                         std::span<const int32_t> loop_total) {
+  const size_t vertex_count = positions.size() / 3;
+  auto at = [&](int32_t loop) {
+    const size_t v = 3 * size_t(loop_vertex[size_t(loop)]);
+    return D3{positions[v], positions[v + 1], positions[v + 2]};
+  };
+  std::vector<D3> sums(vertex_count);
+  for (size_t p = 0; p < loop_start.size(); ++p) {
+    const int32_t s = loop_start[p], n = loop_total[p];
+    // Blender's normal_tri_v3 / normal_quad_v3 (the quad's diagonals).
+    const D3 face = unit3(n == 3 ? cross3(at(s + 1) - at(s), at(s + 2) - at(s))
+                                 : cross3(at(s) - at(s + 2), at(s + 1) - at(s + 3)));
+    for (int32_t i = 0; i < n; ++i) {
+      const D3 here = at(s + i);
+      // A zero-length edge's direction is zero: a right angle, as in Blender.
+      const D3 to_prev = unit3(at(s + (i + n - 1) % n) - here);
+      const D3 to_next = unit3(at(s + (i + 1) % n) - here);
+      const double angle = std::acos(std::clamp(dot3(to_prev, to_next), -1.0, 1.0));
+      D3& sum = sums[size_t(loop_vertex[size_t(s + i)])];
+      sum = {sum.x + face.x * angle, sum.y + face.y * angle, sum.z + face.z * angle};
+    }
+  }
+  std::vector<Vec3f> normals(vertex_count);
+  for (size_t v = 0; v < vertex_count; ++v) {
+    D3 u = unit3(sums[v]);
+    // A vertex of no area: its position's direction (Blender's fallback), else +z.
+    if (dot3(u, u) == 0.0)
+      u = unit3(D3{positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]});
+    if (dot3(u, u) == 0.0) u = D3{0.0, 0.0, 1.0};
+    normals[v] = Vec3f(float(u.x), float(u.y), float(u.z));
+  }
+  return normals;
+}
+
 Mesh mesh_from_polys(const LoopArrays& loops, std::span<const int32_t> loop_start,
-                     std::span<const int32_t> loop_total, std::span<const int32_t> poly_material) {
+                     std::span<const int32_t> loop_total, std::span<const int32_t> poly_material,
+                     bool smooth_vertex_normals_wanted) {
   const CornerSource src = corner_source(loops);
   const size_t poly_count = loop_start.size();
   require_nonempty(poly_count, "loop_start", "polygon");
@@ -263,26 +328,32 @@ Mesh mesh_from_polys(const LoopArrays& loops, std::span<const int32_t> loop_star
                                ") out of range [0, " + std::to_string(src.loop_count) + ")");
     triangles += size_t(total[p] - 2);
   }
+  if (smooth_vertex_normals_wanted && src.normals)
+    reject("normals", "given with smooth_vertex_normals (the vertex normals are computed here)");
   // The split is chosen once per quad, not once per output array.
   std::vector<uint8_t> flip(poly_count, 0);
   for (size_t p = 0; p < poly_count; ++p)
     if (total[p] == 4) flip[p] = quad_splits_1_3(src, start[p]);
-  return gather_mesh(src, triangles, material && any_nonzero(poly_material),
-                     [&](const auto& emit, const auto& emit_material) {
-                       for (size_t p = 0; p < poly_count; ++p) {
-                         const int32_t s = start[p];
-                         const int32_t m = material ? material[p] : 0;
-                         if (total[p] == 3) {
-                           emit(s), emit(s + 1), emit(s + 2), emit_material(m);
-                         } else if (!flip[p]) {
-                           emit(s), emit(s + 1), emit(s + 2), emit_material(m);
-                           emit(s), emit(s + 2), emit(s + 3), emit_material(m);
-                         } else {
-                           emit(s), emit(s + 1), emit(s + 3), emit_material(m);
-                           emit(s + 1), emit(s + 2), emit(s + 3), emit_material(m);
-                         }
-                       }
-                     });
+  Mesh mesh = gather_mesh(src, triangles, material && any_nonzero(poly_material),
+                          [&](const auto& emit, const auto& emit_material) {
+                            for (size_t p = 0; p < poly_count; ++p) {
+                              const int32_t s = start[p];
+                              const int32_t m = material ? material[p] : 0;
+                              if (total[p] == 3) {
+                                emit(s), emit(s + 1), emit(s + 2), emit_material(m);
+                              } else if (!flip[p]) {
+                                emit(s), emit(s + 1), emit(s + 2), emit_material(m);
+                                emit(s), emit(s + 2), emit(s + 3), emit_material(m);
+                              } else {
+                                emit(s), emit(s + 1), emit(s + 3), emit_material(m);
+                                emit(s + 1), emit(s + 2), emit(s + 3), emit_material(m);
+                              }
+                            }
+                          });
+  if (smooth_vertex_normals_wanted)
+    mesh.vertex_normals =
+        smooth_vertex_normals(loops.positions, loops.loop_vertex, loop_start, loop_total);
+  return mesh;
 }
 
 }  // namespace gdpt::ingest

@@ -42,7 +42,21 @@ Mesh mesh_from_loops(const LoopArrays& loops, std::span<const int32_t> corner_lo
 
 // Triangles and quads from Blender's polygon arrays (loop_start, loop_total: one per polygon),
 // triangulated with Blender's loop-triangle rule; poly_material 1 per polygon or empty.
+// `smooth_vertex_normals` (loops.normals empty): the vertex normals of a smooth-shaded mesh
+// computed here as Blender defines them (smooth_vertex_normals()).
 Mesh mesh_from_polys(const LoopArrays& loops, std::span<const int32_t> loop_start,
-                     std::span<const int32_t> loop_total, std::span<const int32_t> poly_material);
+                     std::span<const int32_t> loop_total, std::span<const int32_t> poly_material,
+                     bool smooth_vertex_normals = false);
+
+// Blender's vertex normals of a polygon mesh (3 floats per vertex in `positions`; polygons of
+// 3 or 4 corners, already validated): each polygon's normal weighted by its corner angle at the
+// vertex, summed in polygon order and normalised (a vertex of no area: its position's
+// direction). Blender sums the same terms over threads in the order they finish, so its own
+// normals of one mesh differ by a float rounding step from one evaluation to the next, and so
+// would renders that read them (docs/conventions.md, Determinism).
+std::vector<Vec3f> smooth_vertex_normals(std::span<const float> positions,
+                                         std::span<const int32_t> loop_vertex,
+                                         std::span<const int32_t> loop_start,
+                                         std::span<const int32_t> loop_total);
 
 }  // namespace gdpt::ingest

@@ -128,7 +128,8 @@ PYBIND11_MODULE(_gdpt, m) {
            py::arg("loop_total").noconvert(), py::arg("normals").noconvert(),
            py::arg("normals_per_loop"), py::arg("loop_uvs").noconvert(),
            py::arg("poly_material").noconvert(), py::arg("loop_tangents").noconvert() = py::none(),
-           py::arg("loop_colors").noconvert() = py::none())
+           py::arg("loop_colors").noconvert() = py::none(),
+           py::arg("smooth_vertex_normals") = false)
       .def("add_instance", &SceneBuilder::add_instance, py::arg("mesh"), py::arg("matrix"),
            py::arg("slot_material"), py::arg("pass_index") = 0,
            py::arg("visibility") = uint32_t(kRayAll), py::arg("holdout") = false,

@@ -493,13 +493,15 @@ int SceneBuilder::add_mesh_polys(const FloatArray& positions, const IntArray& lo
                                  const FloatArray& normals, bool normals_per_loop,
                                  const FloatArray& loop_uvs, const IntArray& poly_material,
                                  const std::optional<FloatArray>& loop_tangents,
-                                 const std::optional<FloatArray>& loop_colors) {
+                                 const std::optional<FloatArray>& loop_colors,
+                                 bool smooth_vertex_normals) {
   Mesh mesh;
   {
     py::gil_scoped_release no_gil;
     mesh = ingest::mesh_from_polys(loop_arrays(positions, loop_vertex, normals, normals_per_loop,
                                                loop_uvs, loop_tangents, loop_colors),
-                                   view(loop_start), view(loop_total), view(poly_material));
+                                   view(loop_start), view(loop_total), view(poly_material),
+                                   smooth_vertex_normals);
   }
   scene_.meshes.push_back(std::move(mesh));
   return int(scene_.meshes.size()) - 1;

@@ -81,7 +81,7 @@ class SceneBuilder {
                      const IntArray& loop_start, const IntArray& loop_total,
                      const FloatArray& normals, bool normals_per_loop, const FloatArray& loop_uvs,
                      const IntArray& poly_material, const std::optional<FloatArray>& loop_tangents,
-                     const std::optional<FloatArray>& loop_colors);
+                     const std::optional<FloatArray>& loop_colors, bool smooth_vertex_normals);
   // pass_index: the object's Pass Index (IndexOB pass).
   // visibility: RayKind bits of the rays that see the instance (Object > Visibility > Ray
   // Visibility).

@@ -283,11 +283,8 @@ def main():
         check(not flat_warnings and not warnings,
               f"{case}: no warnings ({flat_warnings + warnings})")
         check(flat.mean() > 0.01, f"{case}: the image is lit (mean {flat.mean():.4f})")
-        # Identical up to the one-ulp moves seen between any two renders inside Blender
-        # (docs/conventions.md, "Determinism"); a group default lost differs by ~1.
         diff = float(np.abs(grouped - flat).max())
-        tol = 1e-6 * max(1.0, float(np.abs(flat).max()))
-        check(diff <= tol, f"{case}: grouped and flat images identical (max difference {diff:g})")
+        check(diff == 0.0, f"{case}: grouped and flat images identical (max difference {diff:g})")
     print("ALL NODE GROUP CASES PASSED", flush=True)
 
 

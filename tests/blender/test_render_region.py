@@ -8,11 +8,8 @@
 #    reconstruction of the region is close to the frame's there;
 #  - not cropped: a frame-sized image with the region in place (alpha 1 inside, 0 outside);
 #
-# "Equal" here allows last-bit differences in a few values: inside Blender, renders of the same
-# scene are not bit-for-bit repeatable (1-3 values of ~3800 off by one ulp, 6e-8, in about a third
-# of the renders; cause not isolated, docs/conventions.md "Determinism"), while outside
-# Blender they are (the C++ region tests compare exactly). A wrong region offset changes nearly
-# every value.
+# "Equal" is bit for bit (docs/conventions.md, "Determinism"). A wrong region offset changes
+# nearly every value.
 #  - the Gradient Reconstruct compositor node: its image is the cropped region, or the frame with
 #    the region in place, equal to the engine's Combined;
 #  - a resolution percentage whose float product would round differently (29% of 100 px) still
@@ -55,9 +52,11 @@ def render(scene, path, border, crop, multilayer=True):
 
 
 def same_pixels(a, b):
-    """Equal up to last-bit noise in at most 0.5% of the values (see the header)."""
-    off = np.abs(a - b) > 1e-5 * np.maximum(np.abs(b), 1.0)
-    return a.shape == b.shape and off.mean() <= 0.005, off.mean()
+    """Equal bit for bit; also the fraction of the values that differ."""
+    if a.shape != b.shape:
+        return False, 1.0
+    off = a != b
+    return not off.any(), off.mean()
 
 
 def blender_region(width, height):

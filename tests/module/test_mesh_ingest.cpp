@@ -77,6 +77,63 @@ TEST(MeshIngest, ValidQuadPolygonIsSplitAlong02) {
   EXPECT_EQ(m.material_slot, Ints({2, 2}));
 }
 
+// Blender's vertex normals: each polygon's normal weighted by its angle at the vertex. Two
+// triangles meet at O = (0, 0, 0) and Y = (0, 1, 0): one in z = 0 (normal +z, 90 degrees at O,
+// 45 at Y), one in x = 0 (normal +x, 45 degrees at O, 90 at Y): O's normal (1, 0, 2) / sqrt 5, Y's
+// (2, 0, 1) / sqrt 5. A cube's corners (three quads at 90 degrees): (+-1, +-1, +-1) / sqrt 3.
+TEST(MeshIngest, SmoothVertexNormalsWeighPolygonsByCornerAngle) {
+  LoopArrays a;
+  const Floats positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1, 1};
+  const Ints loops = {0, 1, 2, 0, 2, 3};
+  a.positions = positions;
+  a.loop_vertex = loops;
+  const Ints start = {0, 3}, total = {3, 3};
+  const Mesh m = mesh_from_polys(a, start, total, {}, true);
+  ASSERT_EQ(m.vertex_normals.size(), 4u);
+  const float r5 = 1.0f / std::sqrt(5.0f);
+  EXPECT_NEAR(m.vertex_normals[0].x, r5, 1e-6f);
+  EXPECT_NEAR(m.vertex_normals[0].y, 0.0f, 1e-6f);
+  EXPECT_NEAR(m.vertex_normals[0].z, 2.0f * r5, 1e-6f);
+  EXPECT_NEAR(m.vertex_normals[2].x, 2.0f * r5, 1e-6f);
+  EXPECT_NEAR(m.vertex_normals[2].z, r5, 1e-6f);
+  EXPECT_NEAR(m.vertex_normals[1].z, 1.0f, 1e-6f);  // only in the first triangle
+  EXPECT_NEAR(m.vertex_normals[3].x, 1.0f, 1e-6f);  // only in the second
+
+  // A unit cube of six outward quads.
+  const Floats cube = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+  const Ints faces = {0, 3, 2, 1, 4, 5, 6, 7, 0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 3, 0, 4, 7};
+  LoopArrays c;
+  c.positions = cube;
+  c.loop_vertex = faces;
+  const Ints cube_start = {0, 4, 8, 12, 16, 20}, fours = {4, 4, 4, 4, 4, 4};
+  const Mesh box = mesh_from_polys(c, cube_start, fours, {}, true);
+  ASSERT_EQ(box.vertex_normals.size(), 8u);
+  const float r3 = 1.0f / std::sqrt(3.0f);
+  for (size_t v = 0; v < 8; ++v) {
+    const Vec3f want((cube[3 * v] - 0.5f) * 2.0f * r3, (cube[3 * v + 1] - 0.5f) * 2.0f * r3,
+                     (cube[3 * v + 2] - 0.5f) * 2.0f * r3);
+    EXPECT_NEAR(box.vertex_normals[v].x, want.x, 1e-6f) << v;
+    EXPECT_NEAR(box.vertex_normals[v].y, want.y, 1e-6f) << v;
+    EXPECT_NEAR(box.vertex_normals[v].z, want.z, 1e-6f) << v;
+  }
+  // Finite coordinates near FLT_MAX: their differences overflow a float, the normals do not.
+  const float big = 3e38f;
+  const Floats huge = {-big, -big, 0, big, -big, 0, 0, big, 0};
+  const Ints tri = {0, 1, 2}, zero = {0}, three = {3};
+  LoopArrays h;
+  h.positions = huge;
+  h.loop_vertex = tri;
+  const Mesh far = mesh_from_polys(h, zero, three, {}, true);
+  ASSERT_EQ(far.vertex_normals.size(), 3u);
+  for (const Vec3f& n : far.vertex_normals) EXPECT_NEAR(n.z, 1.0f, 1e-6f);
+  // Blender's own normals given too: refused, not silently replaced.
+  LoopArrays given = c;
+  const Floats normals(24, 0.0f);
+  given.normals = normals;
+  expect_names(rejection([&] { mesh_from_polys(given, cube_start, fours, {}, true); }), "normals",
+               {"smooth_vertex_normals"});
+}
+
 TEST(MeshIngest, ValidLoopTrianglesGatherCorners) {
   LoopArrays a = quad_loops();
   const Floats normals = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
