@@ -39,6 +39,14 @@ BsdfSample sample(uint8_t lobe_flags, float pdf) {
   return bs;
 }
 
+// The path state after one diffuse bounce sampled with density `pdf`.
+PathState after_diffuse_bounce(float pdf) {
+  PathState st;
+  st.count_event(false, kRayDiffuse, kLobeReflection | kLobeDiffuse);
+  st.scattered(sample(kLobeDiffuse | kLobeReflection, pdf));
+  return st;
+}
+
 TEST(LightPathFilters, OffByDefaultAndOnTheCameraPath) {
   RenderSettings s;
   EXPECT_FALSE(LightPathFilters(s).enabled());
@@ -53,9 +61,7 @@ TEST(LightPathFilters, FilterGlossyRaisesGlossyAlphaAsCycles) {
   RenderSettings s;
   s.blur_glossy = 2.0f;
   const LightPathFilters f(s);
-  PathState st;
-  st.count_event(false, kRayDiffuse, kLobeReflection | kLobeDiffuse);
-  st.scattered(sample(kLobeDiffuse | kLobeReflection, 0.5f));
+  PathState st = after_diffuse_bounce(0.5f);
   st.count_event(false, kRayGlossy, kLobeReflection | kLobeGlossy);
   st.scattered(sample(kLobeGlossy | kLobeReflection, 30.0f));  // a higher density: min stays
   EXPECT_FLOAT_EQ(st.min_ray_pdf, 0.5f);
@@ -92,9 +98,7 @@ TEST(LightPathFilters, ShadowCausticsCastersKeepSmoothGlassSharp) {
   RenderSettings s;
   s.blur_glossy = 2.0f;
   const LightPathFilters f(s);
-  PathState st;
-  st.count_event(false, kRayDiffuse, kLobeReflection | kLobeDiffuse);
-  st.scattered(sample(kLobeDiffuse | kLobeReflection, 0.5f));
+  const PathState st = after_diffuse_bounce(0.5f);
   const float want = f.blur_alpha(st);
   ASSERT_GT(want, 0.0f);
   ClosureSet set = mixed_set();
@@ -114,9 +118,7 @@ int count_type(const ClosureSet& s, ClosureType t, FresnelMode fresnel) {
 }
 
 TEST(LightPathFilters, CausticsTogglesDropLobesAfterADiffuseBounce) {
-  PathState after_diffuse, after_glossy;
-  after_diffuse.count_event(false, kRayDiffuse, kLobeReflection | kLobeDiffuse);
-  after_diffuse.scattered(sample(kLobeDiffuse | kLobeReflection, 0.3f));
+  PathState after_diffuse = after_diffuse_bounce(0.3f), after_glossy;
   after_glossy.count_event(false, kRayGlossy, kLobeReflection | kLobeGlossy);
   after_glossy.scattered(sample(kLobeGlossy | kLobeReflection, 0.3f));
   // A transparent crossing keeps the flag (no scattered() call).
