@@ -29,13 +29,11 @@ def main():
     args = p.parse_args()
     ref = SP.Reference()
     blend = ref.blend
-    out = os.path.join(SP.ROOT, "out", "bench", "demo_adaptive")
-    os.makedirs(out, exist_ok=True)
+    out = SP.out_dir("demo_adaptive")
     blender = R.Blender(args.build)
     rows = {"uniform": [], "adaptive": []}
     try:
-        samples = int(blender.run(os.path.join(HERE, "demo_samples.py"),
-                                  blend).split("DEMO_SAMPLES ")[1].split()[0])
+        samples = SP.demo_samples(blender, blend)
         for seed in range(1, args.seeds + 1):
             for name, n, threshold in (("uniform", samples, 0.0),
                                        ("adaptive", args.max_samples, args.threshold)):

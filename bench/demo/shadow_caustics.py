@@ -26,13 +26,11 @@ def main():
     p.add_argument("--seeds", type=int, default=4)
     args = p.parse_args()
     ref = SP.Reference()
-    out = os.path.join(SP.ROOT, "out", "bench", "demo_shadow_caustics")
-    os.makedirs(out, exist_ok=True)
+    out = SP.out_dir("demo_shadow_caustics")
     blender = R.Blender(args.build)
     rows = {"plain": [], "shadow_caustics": []}
     try:
-        samples = int(blender.run(os.path.join(HERE, "demo_samples.py"),
-                                  ref.blend).split("DEMO_SAMPLES ")[1].split()[0])
+        samples = SP.demo_samples(blender, ref.blend)
         for seed in range(1, args.seeds + 1):
             for name, caster in (("plain", None), ("shadow_caustics", CASTER)):
                 path = os.path.join(out, f"{name}_{seed}.exr")

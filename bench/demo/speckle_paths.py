@@ -45,13 +45,11 @@ def main():
     p.add_argument("--seeds", type=int, default=4)
     args = p.parse_args()
     ref = SP.Reference()
-    out = os.path.join(SP.ROOT, "out", "bench", "demo_speckle_paths")
-    os.makedirs(out, exist_ok=True)
+    out = SP.out_dir("demo_speckle_paths")
     blender = R.Blender(args.build)
     paths = {"glass": [], "no_floor_reflection": []}
     try:
-        samples = int(blender.run(os.path.join(HERE, "demo_samples.py"),
-                                  ref.blend).split("DEMO_SAMPLES ")[1].split()[0])
+        samples = SP.demo_samples(blender, ref.blend)
         script = os.path.join(out, "no_floor_reflection.py")
         with open(script, "w") as f:
             f.write(NO_FLOOR_REFLECTION)

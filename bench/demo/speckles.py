@@ -47,6 +47,19 @@ DEMO_VIEW = ("sRGB", "Filmic")  # make_demo_scene.py's display and view transfor
 OCIO_CONFIG = os.environ.get("OCIO", "/usr/share/blender/datafiles/colormanagement/config.ocio")
 
 
+def demo_samples(blender, blend):
+    """The demo scene's own sample count (demo_samples.py inside Blender on `blend`)."""
+    return int(blender.run(os.path.join(HERE, "demo_samples.py"),
+                           blend).split("DEMO_SAMPLES ")[1].split()[0])
+
+
+def out_dir(name):
+    """out/bench/<name>, created."""
+    path = os.path.join(ROOT, "out", "bench", name)
+    os.makedirs(path, exist_ok=True)
+    return path
+
+
 def floored_median(ref):
     """The 5x5 median of `ref`'s luminance around each pixel, floored at MEDIAN_FLOOR."""
     padded = np.pad(M.luminance(ref), 2, mode="edge")
@@ -184,8 +197,7 @@ def main():
         blend = os.path.join(args.out, "demo.blend")
         if not (args.reuse and os.path.exists(blend)):
             blender.run(os.path.join(ROOT, "blender_addon", "demo", "make_demo_scene.py"), blend)
-        samples = args.samples or int(blender.run(os.path.join(HERE, "demo_samples.py"),
-                                                  blend).split("DEMO_SAMPLES ")[1].split()[0])
+        samples = args.samples or demo_samples(blender, blend)
         halves = []
         for seed in (1, 2):
             path = os.path.join(args.out, f"ref_{seed}.exr")
