@@ -191,6 +191,28 @@ bool quad_splits_1_3(const CornerSource& src, int32_t s) {
   return dot(v3, tangent) >= d || dot(v1, tangent) <= d;
 }
 
+// Double precision: differences of finite float coordinates near FLT_MAX overflow in float.
+struct D3 {
+  double x = 0.0, y = 0.0, z = 0.0;
+};
+D3 operator-(const D3& a, const D3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+D3 scaled(const D3& a, double k) {
+  return {a.x * k, a.y * k, a.z * k};
+}
+double dot3(const D3& a, const D3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+D3 cross3(const D3& a, const D3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+// `a` made unit; zero when it has no length (Blender's normalize_v3 of a zero vector).
+D3 unit3(const D3& a) {
+  const double len = std::sqrt(dot3(a, a));
+  return len > 0.0 ? scaled(a, 1.0 / len) : D3{};
+}
+
 }  // namespace
 
 Mesh mesh_from_triangles(std::span<const float> positions, std::span<const int32_t> indices,
@@ -238,32 +260,6 @@ Mesh mesh_from_loops(const LoopArrays& loops, std::span<const int32_t> corner_lo
                        }
                      });
 }
-
-namespace {
-
-// Double precision: differences of finite float coordinates near FLT_MAX overflow in float.
-struct D3 {
-  double x = 0.0, y = 0.0, z = 0.0;
-};
-D3 operator-(const D3& a, const D3& b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-D3 scaled(const D3& a, double k) {
-  return {a.x * k, a.y * k, a.z * k};
-}
-double dot3(const D3& a, const D3& b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-D3 cross3(const D3& a, const D3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-// `a` made unit; zero when it has no length (Blender's normalize_v3 of a zero vector).
-D3 unit3(const D3& a) {
-  const double len = std::sqrt(dot3(a, a));
-  return len > 0.0 ? scaled(a, 1.0 / len) : D3{};
-}
-
-}  // namespace
 
 std::vector<Vec3f> smooth_vertex_normals(std::span<const float> positions,
                                          std::span<const int32_t> loop_vertex,
