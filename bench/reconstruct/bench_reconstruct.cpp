@@ -3,6 +3,7 @@
 //   bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] [--l2-only] [--feature-only]
 //                     [--memory] [--admm] [--pcg] [--pcg-mg] [--warm]
 //                     [--schedules K,F,L[,P[,S]] ... [--rounds N] [--l1d] [--outlier-data]]
+//                     [--json PATH [--commit HASH]]
 //
 // Reports, per thread count:
 //   - one bare FFTW forward + inverse 2-D DCT of the 3 planes (double, the same cached plans the
@@ -34,6 +35,9 @@
 // using it (none: all; the default is 30,3,1,v,1,1,16); --rounds N repeats each pair, --l1d adds
 // the objective against the L1D scheme,
 // --outlier-data uses test L1.BeatsL2OnSparseOutlierGradients' data (e.g. --width 96 --height 64).
+// --json PATH also writes, per thread count run, L1's time and objective against L1D and the
+// Feature reconstruction's time and split with the default guide (the benchmark report's table of
+// the reconstruction's targets reads it), with --commit HASH's label as the commit measured.
 // --memory only measures the peak resident memory (getrusage) after one solve of each norm, in the
 // order L2, Weighted, L1: each figure is the process's peak so far, inputs included.
 // Synthetic data: a smooth image with edges; primal noise sigma 0.2 (0.05 in the right half),
@@ -339,8 +343,38 @@ Data make_outlier_data(int w, int h) {
   return d;
 }
 
-// The Feature reconstruction on the synthetic room: total time per guide and its split.
-void bench_feature(int width, int height, int threads) {
+// What --json writes for one thread count (-1: not run).
+struct Figures {
+  int threads = 0;
+  double l1_seconds = -1.0, l1_objective_vs_l1d = 0.0;  // objective / L1D's - 1
+  // The Feature reconstruction with the default guide: wall time, its split, relMSE over L1's.
+  double feature_seconds = -1.0, feature_solves = 0.0, feature_filters = 0.0;
+  double feature_relmse_l1_over_feature = 0.0;
+};
+
+// --json PATH: the figures of every thread count run, for the benchmark report.
+bool write_json(const char* path, const std::string& commit, int width, int height,
+                const std::vector<Figures>& all) {
+  FILE* f = std::fopen(path, "w");
+  if (!f) return false;
+  std::fprintf(f, "{\n \"commit\": \"%s\",\n \"width\": %d,\n \"height\": %d,\n \"runs\": [",
+               commit.c_str(), width, height);
+  for (size_t i = 0; i < all.size(); ++i) {
+    const Figures& r = all[i];
+    std::fprintf(f,
+                 "%s\n  {\"threads\": %d, \"l1_seconds\": %.4f, \"l1_objective_vs_l1d\": %.3e, "
+                 "\"feature_seconds\": %.4f, \"feature_solves_seconds\": %.4f, "
+                 "\"feature_filters_seconds\": %.4f, \"feature_relmse_l1_over_feature\": %.4f}",
+                 i ? "," : "", r.threads, r.l1_seconds, r.l1_objective_vs_l1d, r.feature_seconds,
+                 r.feature_solves, r.feature_filters, r.feature_relmse_l1_over_feature);
+  }
+  std::fprintf(f, "\n ]\n}\n");
+  return std::fclose(f) == 0;
+}
+
+// The Feature reconstruction on the synthetic room: total time per guide and its split; the
+// default guide's figures go into `out`.
+void bench_feature(int width, int height, int threads, Figures& out) {
   const float sigma_half = 0.2f;
   const gdpt::test::FeatureScene sc =
       gdpt::test::make_feature_scene(width, height, sigma_half, 0.1f, 7);
@@ -391,6 +425,12 @@ void bench_feature(int width, int height, int threads) {
     const double rel = gdpt::test::relative_mse(img, sc.truth);
     const double split =
         fr.prepare_seconds + fr.filter_seconds + fr.select_seconds + fr.blend_seconds;
+    if (guide == gdpt::ReconstructionNorm::L1 && k == guide_k && out.feature_seconds < 0.0) {
+      out.feature_seconds = total;
+      out.feature_solves = r.guide_seconds;
+      out.feature_filters = total - r.guide_seconds;
+      out.feature_relmse_l1_over_feature = rel_l1 / rel;
+    }
     std::printf(
         "Feature (guide %s, %d reweightings): %8.1f ms = solves %.1f ms + filters %.1f ms; "
         "relMSE %.5f vs L1 %.5f (%.1f ms): %.2fx lower\n",
@@ -611,6 +651,8 @@ int main(int argc, char** argv) {
   bool outlier_data = false, l1d = false;
   int rounds = 1;
   std::vector<std::string> schedules;
+  const char* json = nullptr;
+  std::string commit = "unknown";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--width" && i + 1 < argc)
@@ -641,13 +683,18 @@ int main(int argc, char** argv) {
       l1d = true;
     else if (a == "--rounds" && i + 1 < argc)
       rounds = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--json" && i + 1 < argc)
+      json = argv[++i];
+    else if (a == "--commit" && i + 1 < argc)
+      commit = argv[++i];
     else if (a == "--schedules")
       while (i + 1 < argc && argv[i + 1][0] != '-') schedules.push_back(argv[++i]);
     else {
       std::fprintf(stderr,
                    "usage: bench_reconstruct [--width W] [--height H] [--threads N] [--sweep] "
                    "[--l2-only] [--feature-only] [--memory] [--admm] [--pcg] [--pcg-mg] [--warm] "
-                   "[--schedules K,F,L[,P[,S]] ... [--rounds N] [--l1d] [--outlier-data]]\n");
+                   "[--schedules K,F,L[,P[,S]] ... [--rounds N] [--l1d] [--outlier-data]] "
+                   "[--json PATH [--commit HASH]]\n");
       return 2;
     }
   }
@@ -668,11 +715,15 @@ int main(int argc, char** argv) {
 
   std::vector<int> thread_counts = {1, 2};
   if (only_threads > 0) thread_counts = {only_threads};
+  std::vector<Figures> figures;
   for (int threads : thread_counts) {
     tbb::task_arena arena(threads);
     std::printf("\n== %d thread%s\n", threads, threads > 1 ? "s" : "");
+    figures.push_back(Figures{});
+    Figures& fig = figures.back();
+    fig.threads = threads;
     if (feature_only) {
-      bench_feature(width, height, threads);
+      bench_feature(width, height, threads, fig);
       continue;
     }
 
@@ -781,7 +832,9 @@ int main(int argc, char** argv) {
         gdpt::reconstruction_objective(input, gdpt::ReconstructionNorm::Weighted, alpha, wt.data()),
         gdpt::test::rms_error(wt, d.truth));
 
-    bench_feature(width, height, threads);
+    fig.l1_seconds = t_l1;
+    fig.l1_objective_vs_l1d = obj_l1 / obj_l1d - 1.0;
+    bench_feature(width, height, threads, fig);
 
     if (sweep) {
       std::printf(
@@ -804,6 +857,10 @@ int main(int argc, char** argv) {
                       rr.iterations, 100.0 * (obj / obj_l1d - 1.0));
         }
     }
+  }
+  if (json && !write_json(json, commit, width, height, figures)) {
+    std::fprintf(stderr, "bench_reconstruct: cannot write %s\n", json);
+    return 1;
   }
   return 0;
 }

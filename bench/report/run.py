@@ -376,7 +376,7 @@ def verdict(r):
     return out
 
 
-def write_doc(results, meta, path, figures):
+def write_doc(results, meta, path, figures, results_dir):
     lines = [
         "# Benchmarks: GDPT against Cycles at equal time",
         "",
@@ -453,6 +453,7 @@ def write_doc(results, meta, path, figures):
               "engines agree, and a scene above 0.01 is marked void; the known causes of values "
               "further from 0 are in "
               "docs/lights.md (\"Where the references differ\").", ""]
+    lines += targets_section(results, results_dir)
     for r in results:
         lines += [f"## {r['scene']}", ""]
         if r["void"]:
@@ -485,6 +486,113 @@ def write_doc(results, meta, path, figures):
         lines += [" ".join(verdict(r)), ""] if verdict(r) else []
     with open(path, "w") as f:
         f.write("\n".join(lines))
+
+
+# The Feature reconstruction's targets: its gains on these scenes, and what other benchmarks
+# measure (their results files, when present): the demo's speckles (bench/demo/speckles.py) and
+# the reconstruction's time at 1920x1080 (bench_reconstruct --json).
+FEATURE_OVER_L1, OVER_CYCLES, INTERIORS = 2.0, 10.0, ("cornell_panel", "interior")
+FEATURE_SECONDS_1080P, L1_SECONDS_1080P, L1_OBJECTIVE_TOLERANCE = 5.0, 2.0, 1e-3
+
+
+def read_result(results_dir, name):
+    path = os.path.join(results_dir, name)
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        return json.load(f)
+
+
+def met(ok):
+    return "met" if ok else "**not met**"
+
+
+def scene_targets(results):
+    """Rows of the targets table measured on this page's scenes."""
+    rows = []
+    ratios = {r["scene"]: {t: r["equal_time"][t].get("feature_over_l1") for t in ("10", "40")}
+              for r in results}
+    at40 = {s: v["40"] for s, v in ratios.items() if v["40"]}
+    if at40:
+        every = [(v, s, t) for s, row in ratios.items() for t, v in row.items() if v]
+        low = min(every)
+        wins = [s for s, v in at40.items() if v >= FEATURE_OVER_L1]
+        rows.append((f"Feature at least {FEATURE_OVER_L1:g}x lower relMSE than G-PT + L1 at equal "
+                     "time on most scenes, never higher",
+                     f"at 40 s {FEATURE_OVER_L1:g}x or more on {len(wins)} of {len(at40)} "
+                     f"scenes ({', '.join(f'{s} {v:.2f}x' for s, v in at40.items())}); the "
+                     f"lowest at 10 and 40 s {low[0]:.2f}x ({low[1]}, {low[2]} s)",
+                     met(2 * len(wins) > len(at40) and low[0] >= 1.0), "the scenes below"))
+    inside = [r for r in results if r["scene"] in INTERIORS]
+    if inside:
+        cells = [(r["scene"], r["equal_time"]["40"]["improvement_over_cycles_default"].get(
+            "gpt_feature"), r["equal_time"]["40"]) for r in inside]
+        unbiased = [e["cycles_unbiased"] / e["gpt_feature"] for _, _, e in cells
+                    if e.get("cycles_unbiased") and e.get("gpt_feature")]
+        rows.append((f"Feature at least {OVER_CYCLES:g}x lower relMSE than Cycles without "
+                     "denoising on the diffuse interiors",
+                     "at 40 s " + ", ".join(f"{s} {fmt(v)}" for s, v, _ in cells)
+                     + " against Cycles' defaults ("
+                     + ", ".join(f"{v:.2f}x" for v in unbiased) + " against its unbiased setting)",
+                     met(all(v and v >= OVER_CYCLES for _, v, _ in cells)), "the scenes below"))
+    return rows
+
+
+def speckle_target(d):
+    """The demo's speckles (bench/results/demo_speckles.json) as a targets row."""
+    flagged = [p for row in d["per_seed"]["feature"] for p in row.get("speckle_pixels", [])]
+    where = ""
+    if flagged:
+        truth = [p["reference_over_median"] for p in flagged]
+        over = [p["over_median"] / p["reference_over_median"] for p in flagged]
+        where = (f"; every Feature one on a bright feature of the reference ({min(truth):.2f}-"
+                 f"{max(truth):.2f}x its median there), at {min(over):.2f}-{max(over):.2f}x the "
+                 "reference")
+    per = {m: d[m] for m in ("primal", "l1", "feature")}
+    return ("No isolated bright speckles on the demo at its default samples (pixels over "
+            f"{d['speckle_ratio']:g}x the reference's 5x5 median)",
+            f"per render at {d['samples']} samples: primal {per['primal']['speckles_mean']:.1f}, "
+            f"L1 {per['l1']['speckles_mean']:.1f}, Feature {per['feature']['speckles_mean']:.2f}; "
+            "isolated (the reference under 1.7x its median there) "
+            f"{per['primal']['isolated_mean']:.1f}, {per['l1']['isolated_mean']:.1f}, "
+            f"{per['feature']['isolated_mean']:.2f}" + where,
+            met(per["feature"]["isolated_mean"] == 0),
+            f"`bench/demo/speckles.py`, {d['seeds']} seeds, commit {d['commit']}")
+
+
+def time_targets(d):
+    """The 1920x1080 times (bench/results/reconstruct.json) as targets rows."""
+    run = next((r for r in d["runs"] if r["threads"] == 2), None)
+    if run is None or (d["width"], d["height"]) != (1920, 1080):
+        return []
+    source = f"`bench_reconstruct --json`, commit {d.get('commit', '?')}"
+    rows = [(f"Feature at 1920x1080 under {FEATURE_SECONDS_1080P:g} s on 2 cores",
+             f"{run['feature_seconds']:.2f} s = solves {run['feature_solves_seconds']:.2f} s "
+             f"+ filters {run['feature_filters_seconds']:.2f} s",
+             met(run["feature_seconds"] < FEATURE_SECONDS_1080P), source)]
+    if run["l1_seconds"] >= 0:
+        rows.append((f"L1 at 1920x1080 under {L1_SECONDS_1080P:g} s on 2 cores, objective within "
+                     f"{L1_OBJECTIVE_TOLERANCE:.1%} of the reference scheme's",
+                     f"{run['l1_seconds']:.2f} s, objective {run['l1_objective_vs_l1d']:+.4%} "
+                     "against L1D's",
+                     met(run["l1_seconds"] < L1_SECONDS_1080P
+                         and run["l1_objective_vs_l1d"] <= L1_OBJECTIVE_TOLERANCE), source))
+    return rows
+
+
+def targets_section(results, results_dir):
+    rows = scene_targets(results)
+    speckles = read_result(results_dir, "demo_speckles.json")
+    rows += [speckle_target(speckles)] if speckles else []
+    timing = read_result(results_dir, "reconstruct.json")
+    rows += time_targets(timing) if timing else []
+    if not rows:
+        return []
+    return (["## The Feature reconstruction's targets", "",
+             "From this page's scenes and the results of the other benchmarks `make bench` runs "
+             "(docs/reconstruct.md explains each measurement).", "",
+             "| target | measured | status | source |", "| --- | --- | --- | --- |"]
+            + [f"| {t} | {m} | {ok} | {src} |" for t, m, ok, src in rows] + [""])
 
 
 def git(*args):
@@ -528,7 +636,7 @@ def rewrite_doc(args, fig_dir, doc_dir):
         rel = os.path.relpath(fig_dir, doc_dir)
         figures[name] = (f"{rel}/{name}_relmse.png", f"{rel}/{name}_crops.png")
         results.append(result)
-    write_doc(results, results[0]["meta"], args.out_doc, figures)
+    write_doc(results, results[0]["meta"], args.out_doc, figures, args.results)
     print(f"rewrote {args.out_doc} from {len(results)} result files in {args.results}")
 
 
@@ -610,7 +718,7 @@ def main():
             results.append(result)
     finally:
         blender.close()
-    write_doc(results, meta, args.out_doc, figures)
+    write_doc(results, meta, args.out_doc, figures, args.results)
     print(f"wrote {args.out_doc} and {len(results)} result files in {args.results}")
 
 
