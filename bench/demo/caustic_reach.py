@@ -1,15 +1,16 @@
 # Why the demo's last bright pixels stay at 32 samples: at each Feature speckle pixel that
-# speckles.py lists (bench/results/demo_speckles.json), the floor points the pixel sees (its
+# speckles.py lists (bench/results/demo_speckles.json), the surfaces the pixel sees (its
 # camera ray's centre and the branches it takes through the glass sphere, reflection weighted by
-# Fresnel, refraction by the rest), and at each such point how the lamp's light through the sphere
+# Fresnel, refraction by the rest), and at each such surface point how the lamp's light through the sphere
 # can be found: the chance that a cosine-weighted BSDF sample refracts into and out of the sphere
 # and meets the lamp (and, apart, that it reflects off the sphere onto it), the share of the lamp's
 # area such refracted paths reach (where a manifold walk from a light sample can succeed: Shadow
 # Caustics), the share whose straight segment crosses the sphere (the walk's seeds) and the share
 # the point sees directly. A few percent for each technique means a caustic of rare, bright
-# paths: 0-3 per half of 16 samples. The scene is traced analytically (a true sphere for the
-# 64 x 32 UV sphere, the floor at z = 0 inside the 4 m room) from the geometry demo_geometry.py
-# reads from the demo's .blend.
+# paths: 0-3 per half of 16 samples. The scene is traced analytically from the geometry
+# demo_geometry.py reads from the demo's .blend: a true sphere for the glass ball's 64 x 32 UV
+# sphere, the lamp and the room's five sides (the metal sphere, which none of these pixels sees,
+# is left out).
 #   /usr/bin/python3 bench/demo/caustic_reach.py [--build build] [--directions 2000000]
 # Needs speckles.py's scene (out/bench/demo/demo.blend) and its results. Writes
 # bench/results/demo_caustic_reach.json.
@@ -115,7 +116,8 @@ def branch_ends(ball, g, o, d, weight=1.0, path="", depth=0):
     return out
 
 
-def lamp_corners(g):
+def lamp_square(g):
+    """The lamp's centre and half size (a level square facing down, as the demo's)."""
     half = g["lamp_size"] / 2
     assert g["lamp_shape"] == "SQUARE" and not any(g["lamp_rotation"]), "a level square lamp"
     return np.array(g["lamp_center"]), half
@@ -123,7 +125,7 @@ def lamp_corners(g):
 
 def on_lamp(g, o, d):
     """Where rays o + t d (going up) meet the lamp's plane, and whether inside the lamp."""
-    c, half = lamp_corners(g)
+    c, half = lamp_square(g)
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (c[2] - o[:, 2]) / d[:, 2]
     q = o + t[:, None] * d
@@ -153,7 +155,7 @@ def reach(ball, g, p, normal, n, rng):
     refracted &= hits & ~tir & ~tir2 & np.isfinite(t2)
     _, reflected = on_lamp(g, q1, refl)
     reflected &= hits & ~np.isfinite(ball.hit(q1, refl))
-    c, half = lamp_corners(g)
+    c, half = lamp_square(g)
     occupied, _, _ = np.histogram2d(lamp_q[refracted, 0], lamp_q[refracted, 1], bins=LAMP_GRID,
                                     range=[[c[0] - half, c[0] + half], [c[1] - half, c[1] + half]])
     # The lamp's points seen straight from p, and those whose straight segment crosses the ball.
