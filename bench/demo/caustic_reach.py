@@ -1,16 +1,15 @@
 # Why the demo's last bright pixels stay at 32 samples: at each Feature speckle pixel that
-# speckles.py lists (bench/results/demo_speckles.json), the surfaces the pixel sees (its
-# camera ray's centre and the branches it takes through the glass sphere, reflection weighted by
-# Fresnel, refraction by the rest), and at each such surface point how the lamp's light through the sphere
+# speckles.py lists (bench/results/demo_speckles.json), the surfaces the pixel sees (its camera
+# ray's centre and the branches it takes through the glass sphere, reflection weighted by Fresnel,
+# refraction by the rest), and at each such surface point how the lamp's light through the sphere
 # can be found: the chance that a cosine-weighted BSDF sample refracts into and out of the sphere
 # and meets the lamp (and, apart, that it reflects off the sphere onto it), the share of the lamp's
 # area such refracted paths reach (where a manifold walk from a light sample can succeed: Shadow
 # Caustics), the share whose straight segment crosses the sphere (the walk's seeds) and the share
-# the point sees directly. A few percent for each technique means a caustic of rare, bright
-# paths: 0-3 per half of 16 samples. The scene is traced analytically from the geometry
-# demo_geometry.py reads from the demo's .blend: a true sphere for the glass ball's 64 x 32 UV
-# sphere, the lamp and the room's five sides (the metal sphere, which none of these pixels sees,
-# is left out).
+# the point sees directly. A few percent for each technique means a caustic of rare, bright paths:
+# 0-3 per half of 16 samples. The scene is traced analytically from the geometry demo_geometry.py
+# reads from the demo's .blend: a true sphere for the glass ball's 64 x 32 UV sphere, the lamp and
+# the room's five sides (the metal sphere, which none of these pixels sees, is left out).
 #   /usr/bin/python3 bench/demo/caustic_reach.py [--build build] [--directions 2000000]
 # Needs speckles.py's scene (out/bench/demo/demo.blend) and its results. Writes
 # bench/results/demo_caustic_reach.json.
