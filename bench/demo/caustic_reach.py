@@ -174,7 +174,8 @@ def reach(ball, g, p, normal, n, rng):
 def describe(row):
     if "point" not in row:
         return "the lamp itself" if row["end"] == "lamp" else row["end"]
-    return (f"{row['end']} {np.round(row['point'], 2).tolist()}, {row['from_contact_m']:.2f} m from the ball's contact: BSDF refracted "
+    return (f"{row['end']} {np.round(row['point'], 2).tolist()}, {row['from_contact_m']:.2f} m "
+            "from the ball's contact: BSDF refracted "
             f"{row['bsdf_refracted_to_lamp']:.3f}, reflected {row['bsdf_reflected_to_lamp']:.3f}; "
             f"lamp reached refracted {row['lamp_share_reached_refracted']:.3f}, straight through "
             f"the ball {row['lamp_share_straight_through_ball']:.2f}")
