@@ -19,11 +19,15 @@
 # 8-bit display levels and how many pixels of the same render are farther; and per render the
 # 99.9th percentile of every pixel's display distance.
 #   /usr/bin/python3 bench/demo/speckles.py [--build build] [--ref-samples 2048] [--seeds 4]
-#       [--samples N] [--reuse]
+#       [--samples N] [--filter-glossy F] [--reuse]
 # --reuse takes the renders already in the folder (after a change that leaves the renders and the
 # in-render reconstruction alone).
-# Writes bench/results/demo_speckles.json (demo_speckles_<N>spp.json with --samples; its renders
-# in out/bench/demo_<N>spp) and prints one line per reconstruction.
+# Every render and the reference are made with Filter Glossy 0 (unbiased), or with --filter-glossy
+# F (the demo's own setting is 1.0, Cycles' default, which blurs the sphere's glass after a
+# diffuse bounce: the floor's caustic then reaches light samples at the roughened glass).
+# Writes bench/results/demo_speckles.json (demo_speckles_<N>spp.json with --samples,
+# demo_speckles[_<N>spp]_filter_glossy_<F>.json with --filter-glossy; their renders in
+# out/bench/demo with the same suffix) and prints one line per reconstruction.
 import argparse
 import json
 import os
@@ -183,15 +187,19 @@ def main():
     p.add_argument("--samples", type=int, help="G-PT samples instead of the demo's own")
     p.add_argument("--out", help="renders' folder (default out/bench/demo[_<N>spp])")
     p.add_argument("--reuse", action="store_true", help="take the renders already in --out")
+    p.add_argument("--filter-glossy", type=float, default=0.0,
+                   help="Filter Glossy of every render, the reference's too (default 0: unbiased; "
+                        "the demo's own is 1.0)")
     args = p.parse_args()
-    suffix = f"_{args.samples}spp" if args.samples else ""
+    suffix = (f"_{args.samples}spp" if args.samples else "") + (
+        f"_filter_glossy_{args.filter_glossy:g}" if args.filter_glossy else "")
     args.out = args.out or os.path.join(ROOT, "out", "bench", "demo" + suffix)
     os.makedirs(args.out, exist_ok=True)
     blender = R.Blender(args.build)
 
     def render(blend, method, path, **kw):
         if not (args.reuse and os.path.exists(path)):
-            R.render(blender, blend, method, path, **kw)
+            R.render(blender, blend, method, path, filter_glossy=args.filter_glossy, **kw)
 
     try:
         blend = os.path.join(args.out, "demo.blend")
@@ -246,7 +254,8 @@ def main():
             rows["feature"][-1]["speckle_pixels"] = details
     finally:
         blender.close()
-    result = {"samples": samples, "reference_samples_per_half": args.ref_samples,
+    result = {"samples": samples, "filter_glossy": args.filter_glossy,
+              "reference_samples_per_half": args.ref_samples,
               "seeds": args.seeds, "speckle_ratio": SPECKLE_RATIO, "commit": R.git(
                   "rev-parse", "--short", "HEAD"),
               "pixels": int(ref.shape[0] * ref.shape[1]), "reference_half_speckles": floor,

@@ -1,7 +1,7 @@
 # One timed render of the benchmark report (runs inside Blender, the add-on staged):
 #   blender -b --factory-startup --addons gdpt --python render_one.py -- \
 #       BLEND METHOD OUT.exr (--seconds T | --samples N) [--seed S] [--adaptive THRESHOLD [--adaptive-min N]]
-#       [--shadow-caustics OBJECT]
+#       [--shadow-caustics OBJECT] [--filter-glossy F]
 # METHOD: cycles_default (Cycles as a new scene has it, but denoising off: Debian's Blender has
 # no OpenImageDenoise), cycles_unbiased (the same with Filter Glossy 0 and no clamping),
 # cycles_bsdf (cycles_unbiased with emissive meshes lit by BSDF rays alone: no light sampling), pt
@@ -10,7 +10,9 @@
 # render, which computes the feature passes it needs). --adaptive: Gradient PT's adaptive sampling
 # at that noise threshold (off by default, as the add-on's), --adaptive-min its Min Samples.
 # --shadow-caustics: Cycles' Shadow Caustics with OBJECT the caster, every other mesh a receiver
-# and every lamp a caustics light (both engines). Prints one line `BENCH {json}` with the render call's wall
+# and every lamp a caustics light (both engines). --filter-glossy: Gradient PT's Filter Glossy
+# (default 0, unbiased as the cycles_unbiased reference; the demo's own is 1.0, Cycles' default).
+# Prints one line `BENCH {json}` with the render call's wall
 # time; the samples reached are parsed by the caller from the engines' console lines.
 import json
 import os
@@ -71,7 +73,7 @@ elif method in ("pt", "gpt", "gpt_feature"):
     g.seed = seed
     g.samples = samples or many
     g.time_limit = seconds
-    g.blur_glossy = 0.0  # unbiased, as the cycles_unbiased reference
+    g.blur_glossy = float(opts.get("--filter-glossy", 0.0))  # 0: unbiased, as cycles_unbiased
     g.use_adaptive_sampling = adaptive > 0
     if adaptive > 0:
         g.adaptive_threshold = adaptive

@@ -113,10 +113,12 @@ def update_scene_results(name, entries, **header):
 
 
 def render(blender, blend, method, out, seconds=0.0, samples=0, seed=1, adaptive=0.0,
-           adaptive_min=0, shadow_caustics=None):
+           adaptive_min=0, shadow_caustics=None, filter_glossy=None):
     args = [blend, method, out] + (["--seconds", seconds] if seconds else ["--samples", samples])
     if shadow_caustics:
         args += ["--shadow-caustics", shadow_caustics]
+    if filter_glossy is not None:
+        args += ["--filter-glossy", filter_glossy]
     if adaptive:
         args += ["--adaptive", adaptive, "--adaptive-min", adaptive_min]
     log = blender.run(os.path.join(HERE, "render_one.py"), *args, "--seed", seed)
