@@ -12,9 +12,9 @@
 //    and refraction by 1 - F, in one lobe) loses its reflected or refracted part, or all of it
 //    when both are off; a Multiscatter GGX glass lobe (Closure::multiscatter: Cycles' single
 //    random-walk closure) is kept whole unless both are off.
-// Smooth glass of a shadow caustics caster is never blurred (`sharp_caster`): manifold NEE
-// connects through it smooth, and BSDF sampling must take the same chain (Cycles leaves Sharp
-// closures unblurred everywhere).
+// Smooth glass (Sharp, or GGX at roughness 0) is blurred like any glossy lobe, as Cycles 3.4
+// does with Filter Glossy on, except on a shadow caustics caster (`sharp_caster`): manifold NEE
+// connects through it smooth, and BSDF sampling must take the same chain.
 #pragma once
 
 #include <cmath>
