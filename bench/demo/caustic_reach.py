@@ -8,8 +8,10 @@
 # Caustics), the share whose straight segment crosses the sphere (the walk's seeds) and the share
 # the point sees directly. A few percent for each technique means a caustic of rare, bright paths:
 # 0-3 per half of 16 samples. The scene is traced analytically from the geometry demo_geometry.py
-# reads from the demo's .blend: a true sphere for the glass ball's 64 x 32 UV sphere, the lamp and
-# the room's five sides (the metal sphere, which none of these pixels sees, is left out).
+# reads from the demo's .blend: true spheres for the glass ball and the metal ball (64 x 32 UV
+# spheres; a branch ends at the metal one), the lamp and the room's five sides. Each pixel is
+# traced at its centre and, for the chance that a camera sample meets the lamp through the glass,
+# over the pixel filter's footprint (Blackman-Harris, 1.5 px).
 #   /usr/bin/python3 bench/demo/caustic_reach.py [--build build] [--directions 2000000]
 # Needs speckles.py's scene (out/bench/demo/demo.blend) and its results. Writes
 # bench/results/demo_caustic_reach.json.
@@ -102,6 +104,9 @@ def branch_ends(ball, g, o, d, weight=1.0, path="", depth=0):
     _, lamp = on_lamp(g, o[None], d[None])
     if lamp[0] and not (t < (g["lamp_center"][2] - o[2]) / d[2]):
         return [(path or "direct", weight, "lamp", None, None)]
+    t_metal = Ball(g["metal_center"], g["metal_radius"], 1.0).hit(o[None], d[None])[0]
+    if t_metal < t and (p is None or t_metal < np.dot(p - o, d)):
+        return [(path or "direct", weight, "metal sphere", None, None)]
     if not np.isfinite(t) or (p is not None and np.dot(p - o, d) < t):
         return [(path or "direct", weight, name, p, normal)]
     if depth == 6:
@@ -181,10 +186,47 @@ def describe(row):
             f"the ball {row['lamp_share_straight_through_ball']:.2f}")
 
 
+# speckles.py's results: its unbiased measurement (Filter Glossy 0) and the demo's own setting.
+MEASUREMENTS = {"filter_glossy_0": "demo_speckles.json",
+                "filter_glossy_1": "demo_speckles_filter_glossy_1.json"}
+
+
 def speckle_pixels():
-    with open(os.path.join(SP.ROOT, "bench", "results", "demo_speckles.json")) as f:
-        rows = json.load(f)["per_seed"]["feature"]
-    return sorted({(s["x"], s["y"]) for r in rows for s in r.get("speckle_pixels", [])})
+    """{(x, y): [the measurements that flagged the pixel]} over speckles.py's results files."""
+    pixels = {}
+    for name, file in MEASUREMENTS.items():
+        path = os.path.join(SP.ROOT, "bench", "results", file)
+        if not os.path.exists(path):
+            continue
+        with open(path) as f:
+            rows = json.load(f)["per_seed"]["feature"]
+        for xy in sorted({(s["x"], s["y"]) for r in rows for s in r.get("speckle_pixels", [])}):
+            pixels.setdefault(xy, []).append(name)
+    return dict(sorted(pixels.items()))
+
+
+def blackman_harris(x, width):
+    """The pixel filter's 1-D profile over [-width, width] (render/pixel_filter.cpp)."""
+    v = np.pi * (x / width + 1.0)
+    return 0.35875 - 0.48829 * np.cos(v) + 0.14128 * np.cos(2 * v) - 0.01168 * np.cos(3 * v)
+
+
+def camera_lamp_chance(ball, g, x, y, n=41):
+    """The chance that a camera sample of pixel (x, y), its position drawn from the pixel filter,
+    follows Fresnel choices through the ball that end on the lamp, and per chain."""
+    kind, width = g["pixel_filter"]
+    assert kind == "BLACKMAN_HARRIS", "the demo's filter, Cycles' default"
+    offsets = np.linspace(-width, width, n)
+    profile = blackman_harris(offsets, width)
+    weights = np.outer(profile, profile) / profile.sum() ** 2
+    chains = {}
+    for i, dy in enumerate(offsets):
+        for j, dx in enumerate(offsets):
+            o, d = camera_ray(g, x + dx, y + dy)
+            for path, w, end, _, _ in branch_ends(ball, g, o, d):
+                if end == "lamp":
+                    chains[path] = chains.get(path, 0.0) + weights[i, j] * w
+    return sum(chains.values()), chains
 
 
 def main():
@@ -204,7 +246,12 @@ def main():
     contact = ball.c - np.array([0.0, 0.0, ball.r])
     result = {"commit": SP.R.git("rev-parse", "--short", "HEAD"), "directions": args.directions,
               "pixels": []}
-    for x, y in speckle_pixels():
+    for (x, y), flagged_by in speckle_pixels().items():
+        chance, chains = camera_lamp_chance(ball, g, x, y)
+        print(f"({x:3d}, {y:3d}) flagged by {', '.join(flagged_by)}: camera samples meeting the "
+              f"lamp through the ball {chance:.4f} "
+              f"{ {k: round(v, 4) for k, v in chains.items()} }; the pixel centre's branches:",
+              flush=True)
         o, d = camera_ray(g, x, y)
         points = []
         for path, w, end, pt, normal in branch_ends(ball, g, o, d):
@@ -214,8 +261,10 @@ def main():
                            from_contact_m=round(float(np.linalg.norm(pt - contact)), 3),
                            **reach(ball, g, pt, normal, args.directions, rng))
             points.append(row)
-            print(f"({x:3d}, {y:3d}) {path:6s} w {w:.2f} {describe(row)}", flush=True)
-        result["pixels"].append({"x": x, "y": y, "branches": points})
+            print(f"    {path:6s} w {w:.2f} {describe(row)}", flush=True)
+        result["pixels"].append({"x": x, "y": y, "flagged_by": flagged_by,
+                                 "camera_samples_meeting_lamp": chance,
+                                 "camera_chains_meeting_lamp": chains, "branches": points})
     with open(os.path.join(SP.ROOT, "bench", "results", "demo_caustic_reach.json"), "w") as f:
         json.dump(result, f, indent=1)
 
