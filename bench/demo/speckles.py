@@ -1,6 +1,7 @@
-# Issue target "no isolated bright speckles left on the demo at its default samples": the demo
-# scene (blender_addon/demo/make_demo_scene.py) rendered by G-PT at the demo's sample count,
-# reconstructed with L1 (the demo's setting) and with Feature, against GDPT PT's converged image.
+# The Feature reconstruction's target "no isolated bright speckles left on the demo at its default
+# samples": the demo scene (blender_addon/demo/make_demo_scene.py) rendered by G-PT at the demo's
+# sample count, reconstructed with L1 and with Feature (the demo's setting), against GDPT PT's
+# converged image.
 # A speckle is a pixel whose luminance is more than 4x the median of the reference's 5x5
 # neighbourhood (that median floored at 1e-3, so black regions count only real light). Also
 # relMSE (epsilon 0.01) against the reference, which decides which default the demo should use.
