@@ -21,16 +21,11 @@ R, exr = SP.R, SP.exr
 
 def main():
     p = argparse.ArgumentParser()
-    p.add_argument("--build", default="build")
-    p.add_argument("--seeds", type=int, default=4)
     p.add_argument("--threshold", type=float, required=True)
     p.add_argument("--max-samples", type=int, required=True)
     p.add_argument("--min-samples", type=int, default=0, help="0: a quarter of the maximum")
-    args = p.parse_args()
-    ref = SP.Reference()
+    args, ref, out, blender = SP.demo_study("demo_adaptive", p)
     blend = ref.blend
-    out = SP.out_dir("demo_adaptive")
-    blender = R.Blender(args.build)
     rows = {"uniform": [], "adaptive": []}
     try:
         samples = SP.demo_samples(blender, blend)

@@ -7,7 +7,6 @@
 #   /usr/bin/python3 bench/demo/shadow_caustics.py [--build build] [--seeds 4]
 # Needs speckles.py's scene and reference (out/bench/demo: run speckles.py first). Writes
 # bench/results/demo_shadow_caustics.json.
-import argparse
 import json
 import os
 import sys
@@ -21,13 +20,7 @@ CASTER = "Glass Ball"  # make_demo_scene.py's glass sphere
 
 
 def main():
-    p = argparse.ArgumentParser()
-    p.add_argument("--build", default="build")
-    p.add_argument("--seeds", type=int, default=4)
-    args = p.parse_args()
-    ref = SP.Reference()
-    out = SP.out_dir("demo_shadow_caustics")
-    blender = R.Blender(args.build)
+    args, ref, out, blender = SP.demo_study("demo_shadow_caustics")
     rows = {"plain": [], "shadow_caustics": []}
     try:
         samples = SP.demo_samples(blender, ref.blend)

@@ -8,7 +8,6 @@
 #   /usr/bin/python3 bench/demo/speckle_paths.py [--build build] [--seeds 4]
 # Needs speckles.py's scene and reference (out/bench/demo). Writes
 # bench/results/demo_speckle_paths.json.
-import argparse
 import json
 import os
 import sys
@@ -40,13 +39,7 @@ bpy.ops.wm.save_as_mainfile(filepath=dst)
 
 
 def main():
-    p = argparse.ArgumentParser()
-    p.add_argument("--build", default="build")
-    p.add_argument("--seeds", type=int, default=4)
-    args = p.parse_args()
-    ref = SP.Reference()
-    out = SP.out_dir("demo_speckle_paths")
-    blender = R.Blender(args.build)
+    args, ref, out, blender = SP.demo_study("demo_speckle_paths")
     paths = {"glass": [], "no_floor_reflection": []}
     try:
         samples = SP.demo_samples(blender, ref.blend)

@@ -58,6 +58,17 @@ def demo_samples(blender, blend):
                            blend).split("DEMO_SAMPLES ")[1].split()[0])
 
 
+def demo_study(name, parser=None):
+    """What the demo studies share (shadow_caustics.py, speckle_paths.py, adaptive.py): their
+    options (--build, --seeds and those `parser` already has), speckles.py's reference, their
+    folder out/bench/<name> and a Blender with the add-on staged (the caller closes it)."""
+    p = parser or argparse.ArgumentParser()
+    p.add_argument("--build", default="build")
+    p.add_argument("--seeds", type=int, default=4)
+    args = p.parse_args()
+    return args, Reference(), out_dir(name), R.Blender(args.build)
+
+
 def out_dir(name):
     """out/bench/<name>, created."""
     path = os.path.join(ROOT, "out", "bench", name)
