@@ -96,7 +96,7 @@ def room_hit(o, d):
     return name, o + t * d, normal
 
 
-def branch_ends(ball, g, o, d, weight=1.0, path="", depth=0):
+def branch_ends(ball, metal, g, o, d, weight=1.0, path="", depth=0):
     """[(path, weight, end, point, normal)] where the branches of the ray o + t d end: on a
     surface of the room or on the lamp (seen through the ball's reflections and refractions)."""
     t = ball.hit(o[None], d[None])[0]
@@ -104,7 +104,7 @@ def branch_ends(ball, g, o, d, weight=1.0, path="", depth=0):
     _, lamp = on_lamp(g, o[None], d[None])
     if lamp[0] and not (t < (g["lamp_center"][2] - o[2]) / d[2]):
         return [(path or "direct", weight, "lamp", None, None)]
-    t_metal = Ball(g["metal_center"], g["metal_radius"], 1.0).hit(o[None], d[None])[0]
+    t_metal = metal.hit(o[None], d[None])[0]
     if t_metal < t and (p is None or t_metal < np.dot(p - o, d)):
         return [(path or "direct", weight, "metal sphere", None, None)]
     if not np.isfinite(t) or (p is not None and np.dot(p - o, d) < t):
@@ -116,7 +116,7 @@ def branch_ends(ball, g, o, d, weight=1.0, path="", depth=0):
     out = []
     for kind, w, nd in (("R", f, refl), ("T", 1 - f, refr)):
         if weight * w >= MIN_BRANCH_WEIGHT and not (kind == "T" and tir):
-            out += branch_ends(ball, g, p, nd, weight * w, path + kind, depth + 1)
+            out += branch_ends(ball, metal, g, p, nd, weight * w, path + kind, depth + 1)
     return out
 
 
@@ -186,16 +186,15 @@ def describe(row):
             f"the ball {row['lamp_share_straight_through_ball']:.2f}")
 
 
-# speckles.py's results: its unbiased measurement (Filter Glossy 0) and the demo's own setting.
-MEASUREMENTS = {"filter_glossy_0": "demo_speckles.json",
-                "filter_glossy_1": "demo_speckles_filter_glossy_1.json"}
+# speckles.py's measurements: unbiased (Filter Glossy 0) and with the demo's own setting.
+MEASUREMENTS = {"filter_glossy_0": 0.0, "filter_glossy_1": 1.0}
 
 
 def speckle_pixels():
     """{(x, y): [the measurements that flagged the pixel]} over speckles.py's results files."""
     pixels = {}
-    for name, file in MEASUREMENTS.items():
-        path = os.path.join(SP.ROOT, "bench", "results", file)
+    for name, filter_glossy in MEASUREMENTS.items():
+        path = SP.results_path(filter_glossy=filter_glossy)
         if not os.path.exists(path):
             continue
         with open(path) as f:
@@ -211,7 +210,7 @@ def blackman_harris(x, width):
     return 0.35875 - 0.48829 * np.cos(v) + 0.14128 * np.cos(2 * v) - 0.01168 * np.cos(3 * v)
 
 
-def camera_lamp_chance(ball, g, x, y, n=41):
+def camera_lamp_chance(ball, metal, g, x, y, n=41):
     """The chance that a camera sample of pixel (x, y), its position drawn from the pixel filter,
     follows Fresnel choices through the ball that end on the lamp, and per chain."""
     kind, width = g["pixel_filter"]
@@ -223,7 +222,7 @@ def camera_lamp_chance(ball, g, x, y, n=41):
     for i, dy in enumerate(offsets):
         for j, dx in enumerate(offsets):
             o, d = camera_ray(g, x + dx, y + dy)
-            for path, w, end, _, _ in branch_ends(ball, g, o, d):
+            for path, w, end, _, _ in branch_ends(ball, metal, g, o, d):
                 if end == "lamp":
                     chains[path] = chains.get(path, 0.0) + weights[i, j] * w
     return sum(chains.values()), chains
@@ -242,19 +241,20 @@ def main():
     finally:
         blender.close()
     ball = Ball(g["ball_center"], g["ball_radius"], g["ior"])
+    metal = Ball(g["metal_center"], g["metal_radius"], 1.0)  # opaque: only its hits count
     rng = np.random.default_rng(1)
     contact = ball.c - np.array([0.0, 0.0, ball.r])
     result = {"commit": SP.R.git("rev-parse", "--short", "HEAD"), "directions": args.directions,
               "pixels": []}
     for (x, y), flagged_by in speckle_pixels().items():
-        chance, chains = camera_lamp_chance(ball, g, x, y)
+        chance, chains = camera_lamp_chance(ball, metal, g, x, y)
         print(f"({x:3d}, {y:3d}) flagged by {', '.join(flagged_by)}: camera samples meeting the "
               f"lamp through the ball {chance:.4f} "
               f"{ {k: round(v, 4) for k, v in chains.items()} }; the pixel centre's branches:",
               flush=True)
         o, d = camera_ray(g, x, y)
         points = []
-        for path, w, end, pt, normal in branch_ends(ball, g, o, d):
+        for path, w, end, pt, normal in branch_ends(ball, metal, g, o, d):
             row = {"camera_path": path, "weight": round(float(w), 3), "end": end}
             if pt is not None:
                 row.update(point=np.round(pt, 3).tolist(),

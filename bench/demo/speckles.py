@@ -58,6 +58,18 @@ def demo_samples(blender, blend):
                            blend).split("DEMO_SAMPLES ")[1].split()[0])
 
 
+def suffix(samples=None, filter_glossy=0.0):
+    """The names' suffix of a measurement other than the default (its results and renders)."""
+    return (f"_{samples}spp" if samples else "") + (
+        f"_filter_glossy_{filter_glossy:g}" if filter_glossy else "")
+
+
+def results_path(samples=None, filter_glossy=0.0):
+    """bench/results/demo_speckles<suffix>.json: what main() writes for that measurement."""
+    return os.path.join(ROOT, "bench", "results",
+                        f"demo_speckles{suffix(samples, filter_glossy)}.json")
+
+
 def demo_study(name, parser=None):
     """What the demo studies share (shadow_caustics.py, speckle_paths.py, adaptive.py): their
     options (--build, --seeds and those `parser` already has), speckles.py's reference, their
@@ -203,9 +215,8 @@ def main():
                    help="Filter Glossy of every render, the reference's too (default 0: unbiased; "
                         "the demo's own is 1.0)")
     args = p.parse_args()
-    suffix = (f"_{args.samples}spp" if args.samples else "") + (
-        f"_filter_glossy_{args.filter_glossy:g}" if args.filter_glossy else "")
-    args.out = args.out or os.path.join(ROOT, "out", "bench", "demo" + suffix)
+    args.out = args.out or os.path.join(ROOT, "out", "bench",
+                                        "demo" + suffix(args.samples, args.filter_glossy))
     os.makedirs(args.out, exist_ok=True)
     blender = R.Blender(args.build)
 
@@ -293,7 +304,7 @@ def main():
     print(f"Feature halves' fireflies in flat regions ({f['flat_pixels']} pixels over the renders): "
           f"{f['one_half']:.1f} per half, in both halves {f['both_halves_same_render']} (one render) "
           f"against {f['both_halves_different_seeds']} (different seeds)", flush=True)
-    with open(os.path.join(ROOT, "bench", "results", f"demo_speckles{suffix}.json"), "w") as f:
+    with open(results_path(args.samples, args.filter_glossy), "w") as f:
         json.dump(result, f, indent=1)
 
 
